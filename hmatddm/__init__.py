@@ -1,0 +1,28 @@
+"""hmatddm: hydraulic fractures with the displacement discontinuity method and H-matrices.
+
+Conventions (DESIGN.md section 1): SI units, tension positive, ``DD = u(+) - u(-)`` with
+``+`` the face the element normal points to, opening ``w = DD . n > 0`` when open, DD and
+tractions in the global frame, element-major.
+
+Quick tour::
+
+    import hmatddm as hd
+    mat = hd.Elastic(shear_modulus=10e9, poisson_ratio=0.25)
+    mesh = hd.mesh.penny([0, 0, 0], [0, 0, 1], radius=1.0, h=0.1)
+    op = hd.ElasticityOperator(mesh, mat, backend="hmatrix", eps=1e-4)
+    dd = hd.solve(op, -1e6 * mesh.normals)      # crack under 1 MPa net pressure
+    w = hd.opening(mesh, dd)
+"""
+from . import analytical, kernels, mesh
+from .errors import ConvergenceError, HmatddmError, InputError
+from .material import Elastic
+from .mesh import Mesh2D, Mesh3D
+from .operators import ElasticityOperator
+from .solve import mean_stress_at, opening, slip, solve, stress_at
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "Elastic", "Mesh2D", "Mesh3D", "ElasticityOperator", "solve", "opening", "slip", "stress_at",
+    "mean_stress_at", "mesh", "analytical", "kernels", "HmatddmError", "InputError", "ConvergenceError",
+]

@@ -1,0 +1,221 @@
+"""Constant displacement discontinuity on a straight segment (2D plane strain), in closed form.
+
+The element lies on its local axis ``y = 0`` from ``x = -a`` to ``x = a``. With
+
+    g(x, y) = 1/(4 pi (1 - nu)) [I(x, y, a) - I(x, y, -a)]       ref. App. A eqs 10-12
+
+the stresses per unit DD are (ref. Eq. 2.59 reduced to 2D; Crouch 1976 with the sign of
+``g`` flipped for DD = u(+) - u(-)):
+
+    shear DD:   s_xx = 2G[2 g_xy - y g_xxx],  s_xy = 2G[g_yy - y g_xxy],  s_yy = 2G[y g_xxx]
+    normal DD:  s_xx = 2G[g_yy - y g_xxy],    s_xy = 2G[y g_xxx],         s_yy = 2G[g_yy + y g_xxy]
+
+using ``g_yy = -g_xx``, ``g_xyy = -g_xxx``, ``g_yyy = -g_xxy`` (harmonicity) and
+ref. App. A eqs 15-19 (eqs 18-19 there print ``r^2`` where ``r^4`` belongs). The only
+singular points are the segment's two end points (dislocations), handled as in
+:mod:`hmatddm.kernels.rectangle3d`; points on the extension of the segment are regular.
+"""
+import math
+
+import numpy as np
+from numba import njit, prange
+
+_INV_4PI = 1.0 / (4.0 * math.pi)
+
+
+@njit(cache=True)
+def on_tip(x, y, a):
+    """True when the local point coincides with an end point of the segment."""
+    tol = 1e-12 * a
+    return abs(y) <= tol and abs(abs(x) - a) <= tol
+
+
+@njit(cache=True)
+def local_stress(x, y, a, shear_modulus, poisson_ratio, out):
+    """``out[k, i, j]`` (2x2x2): local stress for unit local DD k (0 shear, 1 normal)."""
+    gxx = 0.0
+    gxy = 0.0
+    gxxx = 0.0
+    gxxy = 0.0
+    ysq = y * y
+    for end in range(2):
+        xi = a if end == 0 else -a
+        sign = 1.0 if end == 0 else -1.0
+        X = x - xi
+        inv_r2 = 1.0 / (X * X + ysq)
+        inv_r4 = inv_r2 * inv_r2
+        gxx -= sign * X * inv_r2
+        gxy -= sign * y * inv_r2
+        gxxx += sign * (X * X - ysq) * inv_r4
+        gxxy += sign * 2.0 * X * y * inv_r4
+    c = 2.0 * shear_modulus * _INV_4PI / (1.0 - poisson_ratio)  # 2G times the factor of g
+    gxx *= c
+    gxy *= c
+    gxxx *= c
+    gxxy *= c
+    gyy = -gxx
+    out[0, 0, 0] = 2.0 * gxy - y * gxxx
+    out[0, 0, 1] = gyy - y * gxxy
+    out[0, 1, 1] = y * gxxx
+    out[1, 0, 0] = gyy - y * gxxy
+    out[1, 0, 1] = y * gxxx
+    out[1, 1, 1] = gyy + y * gxxy
+    out[0, 1, 0] = out[0, 0, 1]
+    out[1, 1, 0] = out[1, 0, 1]
+
+
+@njit(cache=True)
+def local_stress_corrected(x, y, a, shear_modulus, poisson_ratio, singular_shift, out):
+    """:func:`local_stress`; at an end point either NaN (``singular_shift <= 0``) or the
+    mean of the values ``+-singular_shift * a`` along the segment (ref. Sec. 6.2.3)."""
+    if not on_tip(x, y, a):
+        local_stress(x, y, a, shear_modulus, poisson_ratio, out)
+        return
+    if singular_shift <= 0.0:
+        out[:] = np.nan
+        return
+    delta = singular_shift * a
+    tmp = np.empty((2, 2, 2))
+    local_stress(x + delta, y, a, shear_modulus, poisson_ratio, out)
+    local_stress(x - delta, y, a, shear_modulus, poisson_ratio, tmp)
+    for k in range(2):
+        for i in range(2):
+            for j in range(2):
+                out[k, i, j] = 0.5 * (out[k, i, j] + tmp[k, i, j])
+
+
+@njit(cache=True)
+def traction_pair(point, normal, center, frame, a, shear_modulus, poisson_ratio, singular_shift, out, work):
+    """``out[p, q]``: global traction component p at ``point`` (receiver ``normal``) for a
+    unit global DD component q of the segment (ref. Eqs 2.57-2.58)."""
+    dx = point[0] - center[0]
+    dy = point[1] - center[1]
+    x = frame[0, 0] * dx + frame[0, 1] * dy
+    y = frame[1, 0] * dx + frame[1, 1] * dy
+    local_stress_corrected(x, y, a, shear_modulus, poisson_ratio, singular_shift, work)
+    m0 = frame[0, 0] * normal[0] + frame[0, 1] * normal[1]
+    m1 = frame[1, 0] * normal[0] + frame[1, 1] * normal[1]
+    t00 = work[0, 0, 0] * m0 + work[0, 0, 1] * m1
+    t10 = work[0, 1, 0] * m0 + work[0, 1, 1] * m1
+    t01 = work[1, 0, 0] * m0 + work[1, 0, 1] * m1
+    t11 = work[1, 1, 0] * m0 + work[1, 1, 1] * m1
+    for q in range(2):
+        c0 = t00 * frame[0, q] + t01 * frame[1, q]
+        c1 = t10 * frame[0, q] + t11 * frame[1, q]
+        for p in range(2):
+            out[p, q] = frame[0, p] * c0 + frame[1, p] * c1
+
+
+@njit(cache=True)
+def stress_pair(point, center, frame, a, shear_modulus, poisson_ratio, singular_shift, out, work):
+    """Global stress at ``point`` from unit global DD components: ``out[q, i, j]``."""
+    dx = point[0] - center[0]
+    dy = point[1] - center[1]
+    x = frame[0, 0] * dx + frame[0, 1] * dy
+    y = frame[1, 0] * dx + frame[1, 1] * dy
+    local_stress_corrected(x, y, a, shear_modulus, poisson_ratio, singular_shift, work)
+    for q in range(2):
+        for i in range(2):
+            for j in range(2):
+                acc = 0.0
+                for k in range(2):
+                    for p in range(2):
+                        for s in range(2):
+                            acc += frame[k, q] * frame[p, i] * work[k, p, s] * frame[s, j]
+                out[q, i, j] = acc
+
+
+@njit(cache=True)
+def traction_block(data, rows, cols, out):
+    """Block generator kernel for 2D meshes, as :func:`rectangle3d.traction_block`.
+
+    ``data = (centers, frames, half_length, half_length, params, self_max)`` (the half
+    length is passed twice so that 2D and 3D data tuples have the same layout).
+    """
+    centers, frames, half_length, _unused, params, self_max = data
+    g = params[0]
+    nu = params[1]
+    shift = params[2]
+    alpha = params[3]
+    work = np.empty((2, 2, 2))
+    pair = np.empty((2, 2))
+    for ia in range(rows.shape[0]):
+        i = rows[ia]
+        point = centers[i]
+        normal = frames[i, 1]
+        for jb in range(cols.shape[0]):
+            j = cols[jb]
+            traction_pair(point, normal, centers[j], frames[j], half_length[j], g, nu, shift, pair, work)
+            if alpha > 0.0 and i != j:
+                _scale_to_self(pair, alpha * self_max[j])
+            for p in range(2):
+                for q in range(2):
+                    out[2 * ia + p, 2 * jb + q] = pair[p, q]
+
+
+@njit(cache=True)
+def _scale_to_self(pair, limit):
+    """ref. Eq. 6.11: scale a block whose largest entry exceeds ``limit``."""
+    largest = 0.0
+    for p in range(2):
+        for q in range(2):
+            largest = max(largest, abs(pair[p, q]))
+    if largest > limit:
+        factor = limit / largest
+        for p in range(2):
+            for q in range(2):
+                pair[p, q] *= factor
+
+
+@njit(cache=True, parallel=True)
+def traction_matrix(data, out):
+    """Dense assembly of the whole traction matrix, parallel over row elements."""
+    centers = data[0]
+    n = centers.shape[0]
+    cols = np.arange(n)
+    for i in prange(n):
+        rows = np.array([i])
+        traction_block(data, rows, cols, out[2 * i:2 * i + 2, :])
+
+
+@njit(cache=True, parallel=True)
+def stress_at_points(points, centers, frames, half_length, params, dd, out):
+    """Induced global stress at ``points`` (M, 2) by DDs ``dd`` (N, 2): ``out`` (M, 2, 2)."""
+    g = params[0]
+    nu = params[1]
+    shift = params[2]
+    for m in prange(points.shape[0]):
+        work = np.empty((2, 2, 2))
+        pair = np.empty((2, 2, 2))
+        acc = np.zeros((2, 2))
+        for j in range(centers.shape[0]):
+            stress_pair(points[m], centers[j], frames[j], half_length[j], g, nu, shift, pair, work)
+            for q in range(2):
+                dq = dd[j, q]
+                for i in range(2):
+                    for k in range(2):
+                        acc[i, k] += pair[q, i, k] * dq
+        out[m] = acc
+
+
+@njit(cache=True)
+def mean_stress_pair(point, center, frame, a, shear_modulus, poisson_ratio, out):
+    """In-plane mean-stress influence ``out[q]`` (2,) of unit global DD components
+    (ref. Eqs 5.25, 5.27: ``(s_xx + s_yy)/2 = 2G [g_xy, g_yy]`` in the local frame)."""
+    dx = point[0] - center[0]
+    dy = point[1] - center[1]
+    x = frame[0, 0] * dx + frame[0, 1] * dy
+    y = frame[1, 0] * dx + frame[1, 1] * dy
+    gxx = 0.0
+    gxy = 0.0
+    for end in range(2):
+        X = x - (a if end == 0 else -a)
+        sign = 1.0 if end == 0 else -1.0
+        inv_r2 = 1.0 / (X * X + y * y)
+        gxx -= sign * X * inv_r2
+        gxy -= sign * y * inv_r2
+    c = 2.0 * shear_modulus * _INV_4PI / (1.0 - poisson_ratio)
+    m0 = c * gxy
+    m1 = -c * gxx
+    for q in range(2):
+        out[q] = frame[0, q] * m0 + frame[1, q] * m1

@@ -1,0 +1,211 @@
+"""The elasticity operator: DD (global frame) -> traction sigma.n at the collocation points.
+
+One interface, two backends (DESIGN.md sections 1-3):
+
+* ``"dense"``: the full influence matrix (ref. Eq. 2.47 with the coefficients of
+  ref. Eqs 2.57-2.59), assembled in parallel by the numba kernels. The reference path.
+* ``"hmatrix"``: the same matrix compressed by :mod:`hmatddm.hmatrix` (cluster tree,
+  tensor ACA, recompression); every entry it approximates is checked against the
+  kernels in the tests.
+
+Unknowns are element-major: ``[e0_x, e0_y, (e0_z,) e1_x, ...]``. A pressurised crack
+with net pressure ``p`` satisfies ``op @ dd = -p n``.
+"""
+import time
+
+import numpy as np
+from scipy.sparse.linalg import LinearOperator
+
+from ._validation import finite_scalar, positive_int
+from .errors import InputError
+from .kernels import element_data, kernel_module
+from .material import Elastic
+from .mesh import Mesh2D, Mesh3D
+
+BACKENDS = ("dense", "hmatrix")
+SINGULAR_CORRECTIONS = ("none", "average")
+DEFAULT_EPS = 1e-4
+DEFAULT_ETA = 3.0
+DEFAULT_LEAF_SIZE = 64
+_AVERAGE_SHIFT = 1e-3  # fraction of the element half size used by the NaN averaging
+
+
+class ElasticityOperator(LinearOperator):
+    """DDM influence operator of a mesh in a homogeneous elastic medium.
+
+    Parameters
+    ----------
+    mesh : Mesh2D or Mesh3D
+    material : Elastic
+    backend : {"dense", "hmatrix"}
+    eps : float
+        ACA / recompression tolerance of the ``hmatrix`` backend, in (0, 1).
+        The default 1e-4 keeps the smooth-field error of a pressurised crack below
+        about 1e-4 (see benchmarks/RESULTS.md).
+    eta : float
+        Admissibility parameter, ``min(diam) <= eta * dist``, > 0.
+    leaf_size : int
+        Largest number of elements in a leaf cluster, >= 1.
+    singular_correction : {"none", "average"}
+        Collocation points lying exactly on an element edge (2D: on a segment end)
+        are singular. ``"none"`` refuses such meshes with an error naming the elements;
+        ``"average"`` takes the mean of two neighbouring points (ref. Sec. 6.2.3).
+    alpha : float or None
+        If given (>= 1), blocks whose largest entry exceeds ``alpha`` times the largest
+        entry of the source element's self block are scaled down (ref. Eq. 6.11).
+        Applied entry-wise in the kernel, so both backends see the same matrix.
+    """
+
+    def __init__(self, mesh, material, backend="dense", eps=DEFAULT_EPS, eta=DEFAULT_ETA,
+                 leaf_size=DEFAULT_LEAF_SIZE, singular_correction="none", alpha=None):
+        if not isinstance(mesh, (Mesh2D, Mesh3D)):
+            raise InputError(f"mesh must be a Mesh2D or Mesh3D, got {type(mesh).__name__}")
+        if not isinstance(material, Elastic):
+            raise InputError(f"material must be an hmatddm.Elastic, got {type(material).__name__}")
+        if backend not in BACKENDS:
+            raise InputError(f"backend must be one of {BACKENDS}, got {backend!r}")
+        if singular_correction not in SINGULAR_CORRECTIONS:
+            raise InputError(f"singular_correction must be one of {SINGULAR_CORRECTIONS}, got {singular_correction!r}")
+        eps = finite_scalar("eps", eps)
+        if not 0.0 < eps < 1.0:
+            raise InputError(f"eps must be in (0, 1), got {eps}")
+        eta = finite_scalar("eta", eta)
+        if eta <= 0.0:
+            raise InputError(f"eta must be > 0, got {eta}")
+        leaf_size = positive_int("leaf_size", leaf_size)
+        if alpha is not None:
+            alpha = finite_scalar("alpha", alpha)
+            if alpha < 1.0:
+                raise InputError(f"alpha must be >= 1 (or None for no scaling), got {alpha}")
+
+        self.mesh = mesh
+        self.material = material
+        self.backend = backend
+        self.dof = mesh.dim
+        self.singular_correction = singular_correction
+        self.alpha = alpha
+        n = mesh.n_elements * self.dof
+        super().__init__(dtype=np.float64, shape=(n, n))
+
+        self._kernels = kernel_module(mesh)
+        shift = _AVERAGE_SHIFT if singular_correction == "average" else 0.0
+        self_max = None
+        if alpha is not None:
+            self_max = self._self_block_max(shift)
+        self.data = element_data(mesh, material, singular_shift=shift, alpha=alpha or 0.0, self_max=self_max)
+
+        t0 = time.perf_counter()
+        if backend == "dense":
+            self._matrix = np.empty(self.shape)
+            self._kernels.traction_matrix(self.data, self._matrix)
+            self._hmatrix = None
+            self._check_finite(self._matrix)
+            build = time.perf_counter() - t0
+            nbytes = self._matrix.nbytes
+            self._stats = dict(backend="dense", memory_bytes=nbytes, dense_bytes=nbytes, compression=1.0,
+                               build_seconds=build, n_admissible=0, n_dense_blocks=1, max_rank=0,
+                               eps=0.0, eta=eta, leaf_size=leaf_size, n_elements=mesh.n_elements, dof=self.dof)
+        else:
+            from .hmatrix import BlockGenerator, HMatrix
+
+            self._matrix = None
+            generator = BlockGenerator(kernel=self._kernels.traction_block, data=self.data,
+                                       points=mesh.centers, radii=mesh.radii, dof=self.dof)
+            self._hmatrix = HMatrix.build(generator, eps=eps, eta=eta, leaf_size=leaf_size)
+            self._check_finite(self._hmatrix.near_field_csr().data)
+            self._stats = dict(self._hmatrix.stats)
+            self._stats["backend"] = "hmatrix"
+        self._lu = None
+        self._preconditioner = None
+
+    # -- LinearOperator interface -------------------------------------------------
+    def _matvec(self, x):
+        x = np.asarray(x, dtype=np.float64).ravel()
+        if self._matrix is not None:
+            return self._matrix @ x
+        return self._hmatrix.matvec(x)
+
+    def _matmat(self, X):
+        X = np.asarray(X, dtype=np.float64)
+        if self._matrix is not None:
+            return self._matrix @ X
+        return np.column_stack([self._hmatrix.matvec(X[:, k]) for k in range(X.shape[1])])
+
+    def _adjoint(self):
+        if self._matrix is None:
+            raise NotImplementedError("the hmatrix backend has no adjoint; use backend='dense'")
+        return LinearOperator(self.shape, matvec=lambda y: self._matrix.T @ y, dtype=self.dtype)
+
+    # -- public extras --------------------------------------------------------------
+    @property
+    def stats(self):
+        """Build statistics (memory_bytes, dense_bytes, compression, build_seconds, ...)."""
+        return dict(self._stats)
+
+    @property
+    def hmatrix(self):
+        """The underlying :class:`hmatddm.hmatrix.HMatrix` (``None`` for ``dense``)."""
+        return self._hmatrix
+
+    def to_dense(self):
+        """The full matrix (a copy for ``dense``, expanded from blocks for ``hmatrix``)."""
+        if self._matrix is not None:
+            return self._matrix.copy()
+        return self._hmatrix.to_dense()
+
+    def exact_block(self, rows, cols):
+        """Exact entries for element index arrays ``rows`` x ``cols`` from the kernels."""
+        rows = np.ascontiguousarray(rows, dtype=np.int64)
+        cols = np.ascontiguousarray(cols, dtype=np.int64)
+        out = np.empty((len(rows) * self.dof, len(cols) * self.dof))
+        self._kernels.traction_block(self.data, rows, cols, out)
+        return out
+
+    def check_against_dense(self, n_samples=64):
+        """Worst relative error of any admissible block, on sampled exact entries.
+
+        Dense backend: 0.0 (it is the exact matrix).
+        """
+        if self._hmatrix is None:
+            return 0.0
+        return self._hmatrix.check_against_dense(n_samples=n_samples)
+
+    def preconditioner(self):
+        """Near-field preconditioner of the ``hmatrix`` backend (cached)."""
+        if self._hmatrix is None:
+            return None
+        if self._preconditioner is None:
+            from .hmatrix import default_preconditioner
+
+            self._preconditioner = default_preconditioner(self._hmatrix)
+        return self._preconditioner
+
+    def lu(self):
+        """LU factors of the dense matrix (cached; ``dense`` backend only)."""
+        if self._matrix is None:
+            raise InputError("lu() needs backend='dense'")
+        if self._lu is None:
+            import scipy.linalg
+
+            self._lu = scipy.linalg.lu_factor(self._matrix, check_finite=False)
+        return self._lu
+
+    # -- helpers ------------------------------------------------------------------------
+    def _self_block_max(self, shift):
+        data = element_data(self.mesh, self.material, singular_shift=shift)
+        out = np.empty(self.mesh.n_elements)
+        block = np.empty((self.dof, self.dof))
+        for i in range(self.mesh.n_elements):
+            index = np.array([i], dtype=np.int64)
+            self._kernels.traction_block(data, index, index, block)
+            out[i] = np.max(np.abs(block))
+        return out
+
+    def _check_finite(self, values):
+        if np.all(np.isfinite(values)):
+            return
+        raise InputError(
+            "the mesh has collocation points on element edges (e.g. a T-intersection where an "
+            "element ends on another element's centre), where the DDM kernel is singular; "
+            "use singular_correction='average' (and alpha=1.0, ref. Sec. 6.2.3) or mesh the "
+            "intersection end to end")
