@@ -1,0 +1,77 @@
+"""Closed-form checks of the whole chain (mesh -> kernels -> operator -> solve), as a table.
+
+Each check returns its error against a closed form and the tolerance it must meet;
+``hmatddm validate`` prints them (``--json`` for scripts).
+"""
+import time
+
+import numpy as np
+
+from . import analytical
+from .material import Elastic
+from .mesh import line, penny
+from .operators import ElasticityOperator
+from .solve import opening, solve, stress_at
+
+SHEAR_MODULUS, POISSON_RATIO, PRESSURE = 10e9, 0.25, 1e6
+
+
+def _griffith(material, backend, load):
+    mesh = line([-1.0, 0.0], [1.0, 0.0], 200)
+    op = ElasticityOperator(mesh, material, backend=backend)
+    traction = -PRESSURE * (mesh.normals if load == "pressure" else mesh.tangents)
+    dd = solve(op, traction, rtol=1e-12)
+    value = opening(mesh, dd) if load == "pressure" else dd[:, 0]
+    s = mesh.centers[:, 0]
+    exact = analytical.griffith_opening(s, 1.0, PRESSURE, material)
+    inner = np.abs(s) < 0.8
+    return float(np.max(np.abs(value[inner] - exact[inner])) / exact.max())
+
+
+def _penny_volume(material, backend):
+    mesh = penny([0, 0, 0], [0, 0, 1], 1.0, 0.05)
+    dd = solve(ElasticityOperator(mesh, material, backend=backend), -PRESSURE * mesh.normals, rtol=1e-10)
+    exact = analytical.sneddon_volume(1.0, PRESSURE, material)
+    return float(abs(np.sum(opening(mesh, dd) * mesh.areas) - exact) / exact)
+
+
+def _penny_axis(material):
+    mesh = penny([0, 0, 0], [0, 0, 1], 1.0, 0.05)
+    dd = solve(ElasticityOperator(mesh, material), -PRESSURE * mesh.normals)
+    z = np.array([0.2, 0.5, 1.0, 2.0])
+    stress = stress_at(mesh, material, dd, np.column_stack([0 * z, 0 * z, z]))
+    _, sigma_z, sigma_mean = analytical.sneddon_axis_stress(z, 1.0, PRESSURE, POISSON_RATIO)
+    mean = np.trace(stress, axis1=1, axis2=2) / 3
+    return float(max(np.max(np.abs(stress[:, 2, 2] - sigma_z)), np.max(np.abs(mean - sigma_mean))) / PRESSURE)
+
+
+def checks():
+    """(name, function, tolerance) of every check, cheapest first."""
+    material = Elastic(shear_modulus=SHEAR_MODULUS, poisson_ratio=POISSON_RATIO)
+    return [
+        ("Griffith opening, 200 segments, |x|<0.8a (dense)", lambda: _griffith(material, "dense", "pressure"), 0.01),
+        ("Griffith slip, remote shear (dense)", lambda: _griffith(material, "dense", "shear"), 0.01),
+        ("Sneddon volume, staircase h=c/20 (dense)", lambda: _penny_volume(material, "dense"), 0.05),
+        ("Sneddon on-axis stress, z/c>=0.2, /p (dense)", lambda: _penny_axis(material), 0.01),
+    ]
+
+
+def run_checks():
+    """Run every check; a list of dicts with name, error, tolerance, passed, seconds."""
+    rows = []
+    for name, function, tolerance in checks():
+        t0 = time.perf_counter()
+        error = function()
+        rows.append(dict(name=name, error=error, tolerance=tolerance, passed=bool(error <= tolerance),
+                         seconds=time.perf_counter() - t0))
+    return rows
+
+
+def format_table(rows):
+    width = max(len(r["name"]) for r in rows)
+    lines = [f"{'check':<{width}}  {'error':>9}  {'tolerance':>9}  {'time (s)':>8}  result",
+             "-" * (width + 42)]
+    for r in rows:
+        lines.append(f"{r['name']:<{width}}  {r['error']:9.2e}  {r['tolerance']:9.1e}  {r['seconds']:8.2f}  "
+                     f"{'PASS' if r['passed'] else 'FAIL'}")
+    return "\n".join(lines)
