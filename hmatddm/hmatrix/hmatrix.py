@@ -1,0 +1,336 @@
+"""The HMatrix: a compressed matrix of d x d element blocks, usable as a LinearOperator."""
+
+import math
+import time
+
+import numba
+import numpy as np
+import scipy.sparse as sp
+from numba import njit
+from scipy.sparse.linalg import LinearOperator
+
+from hmatddm.errors import InputError
+
+from .block_tree import block_tree
+from .cluster_tree import cluster_tree
+from .generator import BlockGenerator
+from .storage import KIND_DENSE, KIND_LOWRANK, assemble
+
+
+def _check_parameters(eps, eta, leaf_size):
+    if isinstance(eps, bool) or not isinstance(eps, (int, float, np.floating, np.integer)) or not (0.0 < eps < 1.0):
+        raise InputError(f"eps must be in (0, 1), got {eps!r}")
+    if isinstance(eta, bool) or not isinstance(eta, (int, float, np.floating, np.integer)) or not (
+        math.isfinite(eta) and eta > 0.0
+    ):
+        raise InputError(f"eta must be a finite number > 0, got {eta!r}")
+    if isinstance(leaf_size, bool) or not isinstance(leaf_size, (int, np.integer)) or leaf_size < 1:
+        raise InputError(f"leaf_size must be an integer >= 1, got {leaf_size!r}")
+
+
+class HMatrix(LinearOperator):
+    """Hierarchical matrix approximation of a BlockGenerator's matrix.
+
+    Build with :meth:`HMatrix.build`. Vectors are in the ORIGINAL element-major
+    ordering (unknown ``d*i + p`` = component p of element i); the permutation to the
+    cluster-tree ordering is applied inside :meth:`matvec` / :meth:`matmat`.
+    """
+
+    def __init__(self, generator, tree, blocks, storage, eps, eta, leaf_size, build_seconds):
+        n = generator.n_elements * generator.dof
+        super().__init__(dtype=np.dtype(np.float64), shape=(n, n))
+        self.generator = generator
+        self.tree = tree
+        self.blocks = blocks
+        self.storage = storage
+        self.eps = float(eps)
+        self.eta = float(eta)
+        self.leaf_size = int(leaf_size)
+        self.dof = generator.dof
+        self.n_elements = generator.n_elements
+        self.build_seconds = float(build_seconds)
+        # unknown permutation: permuted unknown d*k + p <-> original d*permutation[k] + p
+        self._unknown_permutation = (
+            self.dof * tree.permutation[:, None] + np.arange(self.dof)[None, :]
+        ).ravel()
+
+    # ------------------------------------------------------------------ construction
+    @classmethod
+    def build(cls, generator, eps=1e-4, eta=3.0, leaf_size=64):
+        """Cluster, partition and compress the matrix of ``generator``.
+
+        Parameters
+        ----------
+        generator : BlockGenerator
+        eps : float in (0, 1)
+            Relative Frobenius accuracy asked of every admissible block (ACA
+            stopping tolerance and recompression truncation).
+        eta : float > 0
+            Admissibility ``min(diam) <= eta * dist`` of bounding boxes.
+        leaf_size : int >= 1
+            Largest number of elements in a leaf cluster.
+
+        Cost: O(N log N) for the trees, kernel evaluations of the near field plus
+        O((m + n) k) per far block, run on numba's thread count.
+        """
+        if not isinstance(generator, BlockGenerator):
+            raise InputError(f"generator must be a BlockGenerator, got {type(generator).__name__}")
+        _check_parameters(eps, eta, leaf_size)
+        started = time.perf_counter()
+        tree = cluster_tree(generator.points, generator.radii, int(leaf_size))
+        blocks = block_tree(tree, float(eta))
+        storage = assemble(generator, tree, blocks, float(eps))
+        seconds = time.perf_counter() - started
+        return cls(generator, tree, blocks, storage, eps, eta, leaf_size, seconds)
+
+    # ------------------------------------------------------------------ products
+    def _matmat(self, X):
+        X = np.asarray(X, dtype=np.float64)
+        if X.ndim == 1:
+            X = X[:, None]
+        permuted = X[self._unknown_permutation]
+        result = self.storage.matmat_permuted(permuted)
+        out = np.empty_like(result)
+        out[self._unknown_permutation] = result
+        return out
+
+    def _matvec(self, x):
+        return self._matmat(np.asarray(x).reshape(-1, 1))[:, 0]
+
+    def _adjoint(self):
+        raise NotImplementedError("HMatrix does not implement the transpose product")
+
+    # ------------------------------------------------------------------ inspection
+    def to_dense(self):
+        """Dense (N d x N d) array of the approximation, original ordering. O((N d)^2)."""
+        s = self.storage
+        d = self.dof
+        dense = np.zeros(self.shape)
+        index = self._unknown_permutation
+        for b in range(s.dense_offset.size - 1):
+            rows = index[d * s.dense_row_start[b]:d * s.dense_row_stop[b]]
+            cols = index[d * s.dense_col_start[b]:d * s.dense_col_stop[b]]
+            block = s.dense_values[s.dense_offset[b]:s.dense_offset[b + 1]].reshape(rows.size, cols.size)
+            dense[np.ix_(rows, cols)] = block
+        for b in range(s.lowrank_rank.size):
+            u, v = self._factors(b)
+            rows = index[d * s.lowrank_row_start[b]:d * s.lowrank_row_stop[b]]
+            cols = index[d * s.lowrank_col_start[b]:d * s.lowrank_col_stop[b]]
+            dense[np.ix_(rows, cols)] = u @ v.T
+        return dense
+
+    def _factors(self, b):
+        """(U, V) of low-rank block b (views into the flat storage)."""
+        s = self.storage
+        k = s.lowrank_rank[b]
+        u = s.u_values[s.u_offset[b]:s.u_offset[b + 1]].reshape(-1, k)
+        v = s.v_values[s.v_offset[b]:s.v_offset[b + 1]].reshape(-1, k)
+        return u, v
+
+    @property
+    def stats(self):
+        """Dictionary of sizes, ranks and timings (bytes, seconds)."""
+        s = self.storage
+        memory = s.memory_bytes
+        dense_bytes = 8 * self.shape[0] * self.shape[1]
+        n_far_dense = int(np.count_nonzero(s.admissible_kind == KIND_DENSE))
+        lowrank = s.lowrank_rank
+        return {
+            "memory_bytes": memory,
+            "dense_bytes": dense_bytes,
+            "compression": dense_bytes / memory if memory else math.inf,
+            "build_seconds": self.build_seconds,
+            "n_admissible": int(s.admissible_kind.size),
+            "n_lowrank_blocks": int(lowrank.size),
+            "n_zero_blocks": int(s.admissible_kind.size - lowrank.size - n_far_dense),
+            "n_near_blocks": int(np.count_nonzero(s.dense_is_near)),
+            "n_dense_blocks": int(s.dense_is_near.size),
+            "max_rank": int(lowrank.max()) if lowrank.size else 0,
+            "mean_rank": float(lowrank.mean()) if lowrank.size else 0.0,
+            "near_field_bytes": int(8 * (s.dense_offset[-1] - s.dense_offset[n_far_dense])),
+            "index_bytes": s.index_bytes,
+            "n_clusters": int(self.tree.n_clusters),
+            "eps": self.eps,
+            "eta": self.eta,
+            "leaf_size": self.leaf_size,
+            "n_elements": int(self.n_elements),
+            "dof": int(self.dof),
+            "n_threads": int(numba.get_num_threads()),
+        }
+
+    # ------------------------------------------------------------------ checks
+    def admissible_block_errors(self, n_samples=1024, seed=0):
+        """Relative error of every admissible block on exactly evaluated samples.
+
+        A block with at most ``n_samples`` element pairs is evaluated whole. Otherwise
+        random whole row elements (d full rows of the block) and whole column
+        elements are evaluated, about ``n_samples`` element pairs in total, at least
+        one row and one column element: full rows and columns always contain the
+        block's dominant entries, which random entries would mostly miss. The error
+        is ``||approx - exact||_F / ||exact||_F`` over the sampled entries (0 when
+        both vanish, inf when only the exact samples do). Returns an array aligned
+        with ``self.blocks.admissible_rows``. Cost O(n_admissible * n_samples * d^2).
+        """
+        if isinstance(n_samples, bool) or not isinstance(n_samples, (int, np.integer)) or n_samples < 1:
+            raise InputError(f"n_samples must be an integer >= 1, got {n_samples!r}")
+        rng = np.random.default_rng(seed)
+        s = self.storage
+        tree = self.tree
+        d = self.dof
+        errors = np.zeros(s.admissible_kind.size)
+        for b in range(errors.size):
+            rs, re = tree.start[self.blocks.admissible_rows[b]], tree.stop[self.blocks.admissible_rows[b]]
+            cs, ce = tree.start[self.blocks.admissible_cols[b]], tree.stop[self.blocks.admissible_cols[b]]
+            me, ne = int(re - rs), int(ce - cs)
+            if me * ne <= n_samples:
+                samples = [(np.arange(me), np.arange(ne))]
+            else:
+                n_rows = min(me, max(1, n_samples // (2 * ne)))
+                n_cols = min(ne, max(1, n_samples // (2 * me)))
+                samples = [(np.sort(rng.choice(me, size=n_rows, replace=False)), np.arange(ne)),
+                           (np.arange(me), np.sort(rng.choice(ne, size=n_cols, replace=False)))]
+            difference2 = 0.0
+            reference2 = 0.0
+            for row_pick, col_pick in samples:
+                exact = self.generator.fill(tree.permutation[rs + row_pick], tree.permutation[cs + col_pick])
+                approx = self._admissible_entries(b, me, ne, row_pick, col_pick)
+                difference2 += float(np.sum((approx - exact) ** 2))
+                reference2 += float(np.sum(exact**2))
+            if reference2 > 0:
+                errors[b] = math.sqrt(difference2 / reference2)
+            else:
+                errors[b] = 0.0 if difference2 == 0 else math.inf
+        return errors
+
+    def _admissible_entries(self, b, me, ne, row_pick, col_pick):
+        """Stored approximation of admissible block b at local row/column elements."""
+        s = self.storage
+        d = self.dof
+        local = np.arange(d)
+        row_unknowns = (d * row_pick[:, None] + local).ravel()
+        col_unknowns = (d * col_pick[:, None] + local).ravel()
+        kind = s.admissible_kind[b]
+        index = s.admissible_index[b]
+        if kind == KIND_LOWRANK:
+            u, v = self._factors(index)
+            return u[row_unknowns] @ v[col_unknowns].T
+        if kind == KIND_DENSE:
+            block = s.dense_values[s.dense_offset[index]:s.dense_offset[index + 1]].reshape(d * me, d * ne)
+            return block[np.ix_(row_unknowns, col_unknowns)]
+        return np.zeros((row_unknowns.size, col_unknowns.size))
+
+    def check_against_dense(self, n_samples=1024, seed=0):
+        """Worst sampled relative error over the admissible blocks (see admissible_block_errors)."""
+        errors = self.admissible_block_errors(n_samples=n_samples, seed=seed)
+        return float(errors.max()) if errors.size else 0.0
+
+    # ------------------------------------------------------------------ near field
+    def near_field_csr(self, part="near", threshold=0.0):
+        """Sparse CSR matrix (original ordering) of part of the stored exact blocks.
+
+        part: ``"near"`` (all near-field leaf blocks; they include the diagonal
+        blocks), ``"leaf_diagonal"`` (the leaf x leaf diagonal blocks only) or
+        ``"element_diagonal"`` (the d x d block of each element). ``threshold`` >= 0
+        drops entries with ``|a_ij| < threshold * max|diagonal block of row i|``.
+        Cost O(selected entries).
+        """
+        if part not in ("near", "leaf_diagonal", "element_diagonal"):
+            raise InputError(f"part must be 'near', 'leaf_diagonal' or 'element_diagonal', got {part!r}")
+        if not (isinstance(threshold, (int, float, np.floating, np.integer)) and threshold >= 0):
+            raise InputError(f"threshold must be a number >= 0, got {threshold!r}")
+        s = self.storage
+        selected = np.flatnonzero(s.dense_is_near)
+        diagonal = s.dense_row_start[selected] == s.dense_col_start[selected]
+        if part != "near":
+            selected = selected[diagonal]
+        row_scale = _row_scale(self.dof, s.dense_row_start, s.dense_row_stop, s.dense_col_start, s.dense_offset,
+                               s.dense_values, np.flatnonzero(s.dense_is_near & (s.dense_row_start == s.dense_col_start)),
+                               self.n_elements)
+        rows, cols, values = _coo_entries(
+            self.dof, s.dense_row_start, s.dense_row_stop, s.dense_col_start, s.dense_col_stop, s.dense_offset,
+            s.dense_values, selected.astype(np.int64), self._unknown_permutation, row_scale, float(threshold),
+            part == "element_diagonal",
+        )
+        matrix = sp.csr_matrix((values, (rows, cols)), shape=self.shape)
+        matrix.sum_duplicates()
+        return matrix
+
+    def element_diagonal_blocks(self):
+        """(N, d, d) array: the exact d x d diagonal block of each element (original order)."""
+        s = self.storage
+        d = self.dof
+        blocks = np.empty((self.n_elements, d, d))
+        diagonal = np.flatnonzero(s.dense_is_near & (s.dense_row_start == s.dense_col_start))
+        for b in diagonal:
+            me = s.dense_row_stop[b] - s.dense_row_start[b]
+            dense = s.dense_values[s.dense_offset[b]:s.dense_offset[b + 1]].reshape(me, d, me, d)
+            local = np.arange(me)
+            blocks[self.tree.permutation[s.dense_row_start[b] + local]] = dense[local, :, local, :]
+        return blocks
+
+    def __repr__(self):
+        st = self.stats
+        return (
+            f"<HMatrix {self.shape[0]}x{self.shape[1]} (N={self.n_elements}, d={self.dof}) eps={self.eps:g} "
+            f"eta={self.eta:g} leaf_size={self.leaf_size} compression={st['compression']:.2f} "
+            f"max_rank={st['max_rank']}>"
+        )
+
+
+@njit(cache=True)
+def _row_scale(dof, row_start, row_stop, col_start, offset, values, diagonal_blocks, n_elements):
+    """Largest |entry| of each unknown's row within its element's d x d diagonal block (permuted)."""
+    d = dof
+    scale = np.zeros(n_elements * d)
+    for b in diagonal_blocks:
+        me = row_stop[b] - row_start[b]
+        n = d * me
+        for a in range(me):
+            for p in range(d):
+                row = d * a + p
+                largest = 0.0
+                for q in range(d):
+                    largest = max(largest, abs(values[offset[b] + row * n + d * a + q]))
+                scale[d * row_start[b] + row] = largest
+    return scale
+
+
+@njit(cache=True)
+def _coo_pass(dof, row_start, row_stop, col_start, col_stop, offset, values, selected, unknown_permutation,
+              row_scale, threshold, element_diagonal, rows, cols, data, fill):
+    """Count (fill=False) or write (fill=True) the kept COO triplets of the selected blocks."""
+    d = dof
+    count = 0
+    for b in selected:
+        r0 = d * row_start[b]
+        c0 = d * col_start[b]
+        m = d * (row_stop[b] - row_start[b])
+        n = d * (col_stop[b] - col_start[b])
+        for i in range(m):
+            limit = threshold * row_scale[r0 + i]
+            for j in range(n):
+                if element_diagonal and (i // d) != (j // d):
+                    continue
+                a = values[offset[b] + i * n + j]
+                if a == 0.0 or abs(a) < limit:
+                    continue
+                if fill:
+                    rows[count] = unknown_permutation[r0 + i]
+                    cols[count] = unknown_permutation[c0 + j]
+                    data[count] = a
+                count += 1
+    return count
+
+
+def _coo_entries(dof, row_start, row_stop, col_start, col_stop, offset, values, selected, unknown_permutation,
+                 row_scale, threshold, element_diagonal):
+    """COO triplets (original ordering) of the selected dense blocks, thresholded."""
+    arguments = (dof, row_start, row_stop, col_start, col_stop, offset, values, selected, unknown_permutation,
+                 row_scale, threshold, element_diagonal)
+    empty_index = np.empty(0, dtype=np.int64)
+    count = _coo_pass(*arguments, empty_index, empty_index, np.empty(0), False)
+    rows = np.empty(count, dtype=np.int64)
+    cols = np.empty(count, dtype=np.int64)
+    data = np.empty(count)
+    _coo_pass(*arguments, rows, cols, data, True)
+    return rows, cols, data

@@ -1,0 +1,461 @@
+"""Flat storage of an H-matrix, its parallel assembly and its parallel matvec.
+
+Everything lives in a few flat arrays, in the PERMUTED ordering of the cluster tree
+(tree position k holds original element ``permutation[k]``; unknown ``d*k + p``):
+
+* dense blocks (near field, plus far blocks whose low rank would not pay): element
+  ranges ``dense_row_start/stop``, ``dense_col_start/stop`` (tree positions), values
+  row-major in ``dense_values[dense_offset[b]:dense_offset[b+1]]``;
+* low-rank blocks U V^T: element ranges as above, ``lowrank_rank``, U (m x k) and
+  V (n x k) row-major in ``u_values[u_offset[b]:...]``, ``v_values[v_offset[b]:...]``;
+* for the matvec, the row space is split into the leaf clusters ("segments"); each
+  segment lists (CSR) the dense and low-rank blocks whose rows cover it, so threads
+  own whole segments of y and never race.
+"""
+
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+from numba import njit, prange
+
+from .aca import (ACA_TOLERANCE_FACTOR, REQUEST_DONE, REQUEST_ROW, aca_advance, aca_start,
+                  recompress_result)
+
+# Block kinds recorded for every admissible block.
+KIND_LOWRANK = 0
+KIND_DENSE = 1
+KIND_ZERO = 2
+
+
+@dataclass
+class BlockStorage:
+    """Flat arrays of all blocks; see the module docstring for the layout."""
+
+    dof: int
+    n_elements: int
+    dense_row_start: np.ndarray
+    dense_row_stop: np.ndarray
+    dense_col_start: np.ndarray
+    dense_col_stop: np.ndarray
+    dense_offset: np.ndarray
+    dense_values: np.ndarray
+    dense_is_near: np.ndarray
+    lowrank_row_start: np.ndarray
+    lowrank_row_stop: np.ndarray
+    lowrank_col_start: np.ndarray
+    lowrank_col_stop: np.ndarray
+    lowrank_rank: np.ndarray
+    u_offset: np.ndarray
+    v_offset: np.ndarray
+    rank_offset: np.ndarray
+    u_values: np.ndarray
+    v_values: np.ndarray
+    segment_start: np.ndarray
+    segment_dense_ptr: np.ndarray
+    segment_dense_ids: np.ndarray
+    segment_lowrank_ptr: np.ndarray
+    segment_lowrank_ids: np.ndarray
+    admissible_kind: np.ndarray
+    admissible_index: np.ndarray
+    admissible_rank: np.ndarray
+
+    @property
+    def memory_bytes(self):
+        """Bytes of stored matrix entries (dense blocks + U + V)."""
+        return int(self.dense_values.nbytes + self.u_values.nbytes + self.v_values.nbytes)
+
+    @property
+    def index_bytes(self):
+        """Bytes of the bookkeeping arrays (offsets, ranges, segment lists)."""
+        total = 0
+        for name, value in vars(self).items():
+            if isinstance(value, np.ndarray) and name not in ("dense_values", "u_values", "v_values"):
+                total += value.nbytes
+        return int(total)
+
+    def matmat_permuted(self, x):
+        """y = A x for x (N*d, nrhs) in the permuted ordering (parallel, race-free)."""
+        return _matmat_permuted(
+            self.dof,
+            self.dense_col_start,
+            self.dense_row_start,
+            self.dense_col_stop,
+            self.dense_offset,
+            self.dense_values,
+            self.lowrank_row_start,
+            self.lowrank_col_start,
+            self.lowrank_col_stop,
+            self.lowrank_rank,
+            self.u_offset,
+            self.v_offset,
+            self.rank_offset,
+            self.u_values,
+            self.v_values,
+            self.segment_start,
+            self.segment_dense_ptr,
+            self.segment_dense_ids,
+            self.segment_lowrank_ptr,
+            self.segment_lowrank_ids,
+            np.ascontiguousarray(x, dtype=np.float64),
+        )
+
+
+# ----------------------------------------------------------------------------- build
+
+
+@njit(nogil=True)
+def _build_blocks(kernel, data, permutation, dof, eps, row_start, row_stop, col_start, col_stop,
+                  admissible, dense_offset, dense_values):
+    """Assemble a batch of blocks (tree-position element ranges) sequentially.
+
+    Inadmissible blocks are filled by the kernel straight into
+    ``dense_values[dense_offset[b]:]`` (the final array). Admissible blocks get ACA
+    plus recompression; their factors (or, when the rank does not pay, their exact
+    dense values) are appended to batch-local buffers returned at the end.
+    Returns (rank per block, stored-dense flag per block, U values, V values, dense
+    values of the far blocks stored dense), factors in batch order.
+    """
+    d = dof
+    count = row_start.shape[0]
+    ranks = np.zeros(count, dtype=np.int64)
+    stored_dense = np.zeros(count, dtype=np.bool_)
+    u_buffer = np.empty(1024)
+    v_buffer = np.empty(1024)
+    far_dense = np.empty(0)
+    u_used = 0
+    v_used = 0
+    far_used = 0
+    for b in range(count):
+        rows = permutation[row_start[b]:row_stop[b]]
+        cols = permutation[col_start[b]:col_stop[b]]
+        m = d * rows.shape[0]
+        n = d * cols.shape[0]
+        if not admissible[b]:
+            target = dense_values[dense_offset[b]:dense_offset[b] + m * n].reshape((m, n))
+            kernel(data, rows, cols, target)
+            continue
+        # whole-element ACA (same loop as aca.aca_tensor, inlined: one kernel-specific compile)
+        ut, vt, row_buffer, col_buffer, row_visited, col_visited, ints, floats, request, index = aca_start(
+            rows.shape[0], cols.shape[0], d, ACA_TOLERANCE_FACTOR * eps)
+        while request != REQUEST_DONE:
+            if request == REQUEST_ROW:
+                kernel(data, rows[index:index + 1], cols, row_buffer)
+            else:
+                kernel(data, rows, cols[index:index + 1], col_buffer)
+            ut, vt, request, index = aca_advance(ut, vt, row_buffer, col_buffer, row_visited, col_visited, ints, floats)
+        u, v, rank = recompress_result(ut, vt, ints, eps)
+        ranks[b] = rank
+        if rank * (m + n) >= m * n:
+            stored_dense[b] = True
+            far_dense = _reserve(far_dense, far_used, m * n)
+            target = far_dense[far_used:far_used + m * n].reshape((m, n))
+            kernel(data, rows, cols, target)
+            far_used += m * n
+        elif rank > 0:
+            u_buffer = _reserve(u_buffer, u_used, m * rank)
+            v_buffer = _reserve(v_buffer, v_used, n * rank)
+            _append(u_buffer, u_used, u)
+            _append(v_buffer, v_used, v)
+            u_used += m * rank
+            v_used += n * rank
+    return ranks, stored_dense, _head(u_buffer, u_used), _head(v_buffer, v_used), _head(far_dense, far_used)
+
+
+# Element-wise copies below avoid numba's slice assignment, whose shape-mismatch error
+# message pulls string formatting into (and slows down) every kernel-specific compile.
+@njit(cache=True, nogil=True)
+def _reserve(buffer, used, extra):
+    """``buffer`` or a larger copy with room for ``used + extra`` values."""
+    if used + extra <= buffer.shape[0]:
+        return buffer
+    grown = np.empty(max(2 * buffer.shape[0], used + extra))
+    for i in range(used):
+        grown[i] = buffer[i]
+    return grown
+
+
+@njit(cache=True, nogil=True)
+def _append(buffer, used, factor):
+    """buffer[used:used + factor.size] = factor (row-major)."""
+    flat = factor.ravel()
+    for i in range(flat.shape[0]):
+        buffer[used + i] = flat[i]
+
+
+@njit(cache=True, nogil=True)
+def _head(buffer, used):
+    out = np.empty(used)
+    for i in range(used):
+        out[i] = buffer[i]
+    return out
+
+
+def _batches(cost, n_threads, per_thread=16):
+    """Split blocks into batches of similar total cost, most expensive first.
+
+    Returns a list of index arrays; with a dynamic thread pool this is longest-
+    processing-time-first scheduling.
+    """
+    order = np.argsort(-cost, kind="stable")
+    if order.size == 0:
+        return []
+    cumulative = np.cumsum(cost[order].astype(np.float64))
+    target = max(cumulative[-1] / max(1, n_threads * per_thread), 1.0)
+    label = np.minimum((cumulative - cost[order]) // target, order.size).astype(np.int64)
+    cuts = np.flatnonzero(np.diff(label)) + 1
+    return np.split(order, cuts)
+
+
+def _run_parallel(function, batches, n_threads):
+    """Yield ``function(batch)`` for each batch, in order, computed on a pool of threads
+    (the numba drivers release the GIL).
+
+    BLAS/LAPACK threading is limited to one thread meanwhile (the factorisations are
+    small; nested threading would only oversubscribe the cores).
+    """
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=1):
+        if n_threads <= 1 or len(batches) <= 1:
+            for batch in batches:
+                yield function(batch)
+            return
+        with ThreadPoolExecutor(max_workers=n_threads) as pool:
+            yield from pool.map(function, batches)
+
+
+class _GrowingArray:
+    """A 1-D float64 array appended to in place.
+
+    Grows by reallocation (``ndarray.resize``), which for large arrays remaps pages
+    instead of copying, so the peak memory stays close to the final size.
+    """
+
+    def __init__(self):
+        self.values = np.empty(1 << 16)
+        self.size = 0
+
+    def append(self, part):
+        needed = self.size + part.size
+        if needed > self.values.size:
+            self.values.resize(max(needed, int(1.25 * self.values.size)), refcheck=False)
+        self.values[self.size:needed] = part
+        self.size = needed
+
+    def finish(self):
+        self.values.resize(self.size, refcheck=False)
+        return self.values
+
+
+def assemble(generator, tree, blocks, eps, n_threads=None):
+    """Compress and store all blocks of ``blocks`` (a BlockTree over ``tree``).
+
+    Far blocks: whole-element ACA + recompression, in batches on ``n_threads``
+    threads (default: numba's thread count). Near blocks: exact kernel fill
+    straight into the final dense array. Cost O(kernel entries evaluated) = near
+    field + O(sum over far blocks of (m + n) * rank).
+    """
+    d = generator.dof
+    n_threads = numba.get_num_threads() if n_threads is None else int(n_threads)
+    permutation = tree.permutation
+    kernel, data = generator.kernel, generator.data
+
+    far_rows_start = tree.start[blocks.admissible_rows]
+    far_rows_stop = tree.stop[blocks.admissible_rows]
+    far_cols_start = tree.start[blocks.admissible_cols]
+    far_cols_stop = tree.stop[blocks.admissible_cols]
+    n_far = far_rows_start.size
+    empty = np.empty(0)
+    no_offsets = np.zeros(n_far, dtype=np.int64)
+
+    def far_batch(ids):
+        return _build_blocks(kernel, data, permutation, d, float(eps), far_rows_start[ids], far_rows_stop[ids],
+                             far_cols_start[ids], far_cols_stop[ids], np.ones(ids.size, dtype=np.bool_),
+                             no_offsets[ids], empty)
+
+    far_cost = (far_rows_stop - far_rows_start + far_cols_stop - far_cols_start).astype(np.float64)
+    batches = _batches(far_cost, n_threads)
+    u_values, v_values, far_dense_values = _GrowingArray(), _GrowingArray(), _GrowingArray()
+    rank_parts, flag_parts = [np.zeros(0, dtype=np.int64)], [np.zeros(0, dtype=bool)]
+    for batch_ranks, batch_flags, batch_u, batch_v, batch_dense in _run_parallel(far_batch, batches, n_threads):
+        rank_parts.append(batch_ranks)
+        flag_parts.append(batch_flags)
+        u_values.append(batch_u)
+        v_values.append(batch_v)
+        far_dense_values.append(batch_dense)
+        del batch_u, batch_v, batch_dense
+    u_values, v_values = u_values.finish(), v_values.finish()
+    order = np.concatenate([np.zeros(0, dtype=np.int64)] + batches)
+    ranks = np.concatenate(rank_parts)
+    dense_flag = np.concatenate(flag_parts)
+
+    admissible_kind = np.full(n_far, KIND_ZERO, dtype=np.int64)
+    admissible_index = np.full(n_far, -1, dtype=np.int64)
+    admissible_rank = np.zeros(n_far, dtype=np.int64)
+    admissible_rank[order] = ranks
+
+    lowrank = order[(~dense_flag) & (ranks > 0)]
+    lowrank_rank = admissible_rank[lowrank]
+    admissible_kind[lowrank] = KIND_LOWRANK
+    admissible_index[lowrank] = np.arange(lowrank.size)
+    far_dense = order[dense_flag]
+    admissible_kind[far_dense] = KIND_DENSE
+    admissible_index[far_dense] = np.arange(far_dense.size)
+
+    # Dense storage: far blocks stored dense first, then the near field.
+    near_rows_start = tree.start[blocks.near_rows]
+    near_rows_stop = tree.stop[blocks.near_rows]
+    near_cols_start = tree.start[blocks.near_cols]
+    near_cols_stop = tree.stop[blocks.near_cols]
+    dense_row_start = np.concatenate((far_rows_start[far_dense], near_rows_start))
+    dense_row_stop = np.concatenate((far_rows_stop[far_dense], near_rows_stop))
+    dense_col_start = np.concatenate((far_cols_start[far_dense], near_cols_start))
+    dense_col_stop = np.concatenate((far_cols_stop[far_dense], near_cols_stop))
+    dense_size = d * d * (dense_row_stop - dense_row_start) * (dense_col_stop - dense_col_start)
+    dense_offset = np.concatenate(([0], np.cumsum(dense_size))).astype(np.int64)
+    dense_values = np.empty(dense_offset[-1])
+    far_dense_values = far_dense_values.finish()
+    assert far_dense_values.size == int(dense_size[: far_dense.size].sum())
+    dense_values[: far_dense_values.size] = far_dense_values
+    del far_dense_values
+
+    n_near = near_rows_start.size
+    near_offset = dense_offset[far_dense.size:-1]
+
+    def near_batch(ids):
+        return _build_blocks(kernel, data, permutation, d, float(eps), near_rows_start[ids], near_rows_stop[ids],
+                             near_cols_start[ids], near_cols_stop[ids], np.zeros(ids.size, dtype=np.bool_),
+                             near_offset[ids], dense_values)
+
+    near_cost = dense_size[far_dense.size:].astype(np.float64)
+    for _ in _run_parallel(near_batch, _batches(near_cost, n_threads), n_threads):
+        pass
+
+    rows_lr = far_rows_stop[lowrank] - far_rows_start[lowrank]
+    cols_lr = far_cols_stop[lowrank] - far_cols_start[lowrank]
+    u_offset = np.concatenate(([0], np.cumsum(d * rows_lr * lowrank_rank))).astype(np.int64)
+    v_offset = np.concatenate(([0], np.cumsum(d * cols_lr * lowrank_rank))).astype(np.int64)
+    rank_offset = np.concatenate(([0], np.cumsum(lowrank_rank))).astype(np.int64)
+    assert u_offset[-1] == u_values.size and v_offset[-1] == v_values.size
+
+    leaves = tree.leaves()
+    segment_start = np.concatenate((tree.start[leaves], [tree.n_elements])).astype(np.int64)
+    dense_ptr, dense_ids = _segment_lists(segment_start, dense_row_start, dense_row_stop)
+    lowrank_row_start = far_rows_start[lowrank]
+    lowrank_row_stop = far_rows_stop[lowrank]
+    lowrank_ptr, lowrank_ids = _segment_lists(segment_start, lowrank_row_start, lowrank_row_stop)
+
+    dense_is_near = np.zeros(dense_row_start.size, dtype=bool)
+    dense_is_near[far_dense.size:] = True
+    return BlockStorage(
+        dof=d,
+        n_elements=tree.n_elements,
+        dense_row_start=dense_row_start,
+        dense_row_stop=dense_row_stop,
+        dense_col_start=dense_col_start,
+        dense_col_stop=dense_col_stop,
+        dense_offset=dense_offset,
+        dense_values=dense_values,
+        dense_is_near=dense_is_near,
+        lowrank_row_start=lowrank_row_start,
+        lowrank_row_stop=lowrank_row_stop,
+        lowrank_col_start=far_cols_start[lowrank],
+        lowrank_col_stop=far_cols_stop[lowrank],
+        lowrank_rank=lowrank_rank,
+        u_offset=u_offset,
+        v_offset=v_offset,
+        rank_offset=rank_offset,
+        u_values=u_values,
+        v_values=v_values,
+        segment_start=segment_start,
+        segment_dense_ptr=dense_ptr,
+        segment_dense_ids=dense_ids,
+        segment_lowrank_ptr=lowrank_ptr,
+        segment_lowrank_ids=lowrank_ids,
+        admissible_kind=admissible_kind,
+        admissible_index=admissible_index,
+        admissible_rank=admissible_rank,
+    )
+
+
+def _segment_lists(segment_start, block_row_start, block_row_stop):
+    """CSR lists: for each segment (leaf row range), the blocks whose rows cover it.
+
+    Block rows are cluster ranges, hence unions of consecutive leaves.
+    """
+    n_segments = segment_start.size - 1
+    first = np.searchsorted(segment_start, block_row_start, side="left")
+    last = np.searchsorted(segment_start, block_row_stop, side="left")
+    counts = last - first
+    block_ids = np.repeat(np.arange(block_row_start.size, dtype=np.int64), counts)
+    # segment of each (block, segment) pair: first[b] + 0, 1, ..., counts[b]-1
+    within = np.arange(block_ids.size, dtype=np.int64) - np.repeat(np.cumsum(counts) - counts, counts)
+    segments = np.repeat(first, counts) + within
+    order = np.argsort(segments, kind="stable")
+    ptr = np.concatenate(([0], np.cumsum(np.bincount(segments, minlength=n_segments)))).astype(np.int64)
+    return ptr, block_ids[order]
+
+
+# ----------------------------------------------------------------------------- matvec
+
+
+@njit(parallel=True, cache=True, fastmath=True)
+def _matmat_permuted(dof, dense_col_start, dense_row_start, dense_col_stop, dense_offset, dense_values,
+                     lowrank_row_start, lowrank_col_start, lowrank_col_stop, lowrank_rank, u_offset, v_offset,
+                     rank_offset, u_values, v_values, segment_start, segment_dense_ptr, segment_dense_ids,
+                     segment_lowrank_ptr, segment_lowrank_ids, x):
+    """y = A x, x of shape (N*d, nrhs), permuted ordering.
+
+    Phase 1 (parallel over low-rank blocks): t_b = V_b^T x_cols (each block owns t_b).
+    Phase 2 (parallel over segments): y_seg = sum of dense rows and U_b rows times t_b
+    over the blocks covering the segment. O(stored entries * nrhs) flops.
+    """
+    d = dof
+    nrhs = x.shape[1]
+    n_lowrank = lowrank_rank.shape[0]
+    t = np.zeros((rank_offset[n_lowrank], nrhs))
+    for b in prange(n_lowrank):
+        k = lowrank_rank[b]
+        c0 = d * lowrank_col_start[b]
+        nc = d * (lowrank_col_stop[b] - lowrank_col_start[b])
+        base = v_offset[b]
+        t0 = rank_offset[b]
+        for j in range(nc):
+            row = base + j * k
+            for r in range(nrhs):
+                xj = x[c0 + j, r]
+                for q in range(k):
+                    t[t0 + q, r] += v_values[row + q] * xj
+    n_segments = segment_start.shape[0] - 1
+    y = np.zeros((x.shape[0], nrhs))
+    for s in prange(n_segments):
+        r0 = d * segment_start[s]
+        r1 = d * segment_start[s + 1]
+        for e in range(segment_dense_ptr[s], segment_dense_ptr[s + 1]):
+            b = segment_dense_ids[e]
+            c0 = d * dense_col_start[b]
+            nc = d * (dense_col_stop[b] - dense_col_start[b])
+            base = dense_offset[b] + (r0 - d * dense_row_start[b]) * nc
+            for i in range(r1 - r0):
+                row = base + i * nc
+                for r in range(nrhs):
+                    total = 0.0
+                    for j in range(nc):
+                        total += dense_values[row + j] * x[c0 + j, r]
+                    y[r0 + i, r] += total
+        for e in range(segment_lowrank_ptr[s], segment_lowrank_ptr[s + 1]):
+            b = segment_lowrank_ids[e]
+            k = lowrank_rank[b]
+            t0 = rank_offset[b]
+            base = u_offset[b] + (r0 - d * lowrank_row_start[b]) * k
+            for i in range(r1 - r0):
+                row = base + i * k
+                for r in range(nrhs):
+                    total = 0.0
+                    for q in range(k):
+                        total += u_values[row + q] * t[t0 + q, r]
+                    y[r0 + i, r] += total
+    return y
+
