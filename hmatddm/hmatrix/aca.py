@@ -142,13 +142,16 @@ def _max_abs(array):
 
 
 @njit(cache=True, nogil=True)
-def _add_cross(ut, vt, rank, residual_rows, residual_cols, first_col):
+def _add_cross(ut, vt, rank, residual_rows, residual_cols, first_col, threshold):
     """Append the cross C P^+ R of a whole-element pivot to the factors (vectors rank..).
 
     residual_rows R (d x n), residual_cols C (m x d), pivot P = R[:, first_col:+d].
-    With P = W diag(s) Z^T the update is (C Z s^-1)(R^T W)^T, restricted to the
-    numerical rank of P. Returns (added rank, squared Frobenius norm of the update,
-    2 * inner product of the update with the previous approximation). O((m+n) k d).
+    With P = W diag(s) Z^T the update is sum_k (C z_k / s_k)(R^T w_k)^T over the
+    numerical rank of P. The direction of the largest s_k is always kept; the others
+    only when ||C z_k / s_k|| ||R^T w_k|| > threshold (a weak direction stays in the
+    residual and is picked up by a later pivot if it matters). Returns (added rank,
+    squared Frobenius norm of the update, 2 * inner product of the update with the
+    previous approximation). O((m+n) k d).
     """
     d = residual_rows.shape[0]
     pivot = np.empty((d, d))
@@ -162,20 +165,29 @@ def _add_cross(ut, vt, rank, residual_rows, residual_cols, first_col):
             added += 1
     m = residual_cols.shape[0]
     n = residual_rows.shape[1]
-    for k in range(added):
-        vector = rank + k
+    candidates = added
+    added = 0
+    for k in range(candidates):
+        vector = rank + added
         inverse = 1.0 / s[k]
+        u_norm2 = 0.0
         for r in range(m):
             total = 0.0
             for q in range(d):
                 total += residual_cols[r, q] * zh[k, q]
             ut[vector, r] = total * inverse
+            u_norm2 += ut[vector, r] ** 2
         for c in range(n):
             vt[vector, c] = 0.0
         for p in range(d):
             coefficient = w[p, k]
             for c in range(n):
                 vt[vector, c] += residual_rows[p, c] * coefficient
+        v_norm2 = 0.0
+        for c in range(n):
+            v_norm2 += vt[vector, c] ** 2
+        if k == 0 or u_norm2 * v_norm2 > threshold * threshold:
+            added += 1
     # ||U_new V_new^T||_F^2 = sum_ab (U_new^T U_new)_ab (V_new^T V_new)_ab, and the
     # cross term with the old part uses (U_old^T U_new) and (V_old^T V_new).
     update_norm2 = 0.0
@@ -296,7 +308,8 @@ def aca_advance(ut, vt, rows, cols, row_visited, col_visited, ints, floats):
         capacity = min(max_rank + d, 2 * ut.shape[0])
         ut = _grow(ut, capacity)
         vt = _grow(vt, capacity)
-    added, update_norm2, cross = _add_cross(ut, vt, rank, rows, cols, col * d)
+    threshold = floats[_EPS] * np.sqrt(floats[_NORM2])
+    added, update_norm2, cross = _add_cross(ut, vt, rank, rows, cols, col * d, threshold)
     rank += added
     ints[_RANK] = rank
     floats[_NORM2] = max(floats[_NORM2] + update_norm2 + cross, 0.0)

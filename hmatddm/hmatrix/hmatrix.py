@@ -17,6 +17,23 @@ from .generator import BlockGenerator
 from .storage import KIND_DENSE, KIND_LOWRANK, assemble
 
 
+# Low-rank factors are stored in single precision when eps >= this (the float32
+# rounding, ~1e-7 relative, is then at most 1% of eps); double precision below.
+SINGLE_PRECISION_EPS = 1e-5
+
+
+def _factor_dtype(factor_dtype, eps):
+    if factor_dtype is None:
+        return np.dtype(np.float32) if eps >= SINGLE_PRECISION_EPS else np.dtype(np.float64)
+    try:
+        dtype = np.dtype(factor_dtype)
+    except TypeError:
+        dtype = None
+    if dtype not in (np.dtype(np.float32), np.dtype(np.float64)):
+        raise InputError(f"factor_dtype must be None, float32 or float64, got {factor_dtype!r}")
+    return dtype
+
+
 def _check_parameters(eps, eta, leaf_size):
     if isinstance(eps, bool) or not isinstance(eps, (int, float, np.floating, np.integer)) or not (0.0 < eps < 1.0):
         raise InputError(f"eps must be in (0, 1), got {eps!r}")
@@ -56,7 +73,7 @@ class HMatrix(LinearOperator):
 
     # ------------------------------------------------------------------ construction
     @classmethod
-    def build(cls, generator, eps=1e-4, eta=3.0, leaf_size=64):
+    def build(cls, generator, eps=1e-4, eta=3.0, leaf_size=64, factor_dtype=None):
         """Cluster, partition and compress the matrix of ``generator``.
 
         Parameters
@@ -69,6 +86,10 @@ class HMatrix(LinearOperator):
             Admissibility ``min(diam) <= eta * dist`` of bounding boxes.
         leaf_size : int >= 1
             Largest number of elements in a leaf cluster.
+        factor_dtype : None, numpy.float32 or numpy.float64
+            Storage of the low-rank factors; None: float32 when eps >= 1e-5 (the
+            rounding is then <= 1% of eps; halves the far-field memory and matvec
+            traffic), float64 otherwise. Dense blocks are always float64.
 
         Cost: O(N log N) for the trees, kernel evaluations of the near field plus
         O((m + n) k) per far block, run on numba's thread count.
@@ -76,10 +97,11 @@ class HMatrix(LinearOperator):
         if not isinstance(generator, BlockGenerator):
             raise InputError(f"generator must be a BlockGenerator, got {type(generator).__name__}")
         _check_parameters(eps, eta, leaf_size)
+        dtype = _factor_dtype(factor_dtype, eps)
         started = time.perf_counter()
         tree = cluster_tree(generator.points, generator.radii, int(leaf_size))
         blocks = block_tree(tree, float(eta))
-        storage = assemble(generator, tree, blocks, float(eps))
+        storage = assemble(generator, tree, blocks, float(eps), factor_dtype=dtype)
         seconds = time.perf_counter() - started
         return cls(generator, tree, blocks, storage, eps, eta, leaf_size, seconds)
 
@@ -88,14 +110,18 @@ class HMatrix(LinearOperator):
         X = np.asarray(X, dtype=np.float64)
         if X.ndim == 1:
             X = X[:, None]
-        permuted = X[self._unknown_permutation]
+        permuted = np.ascontiguousarray(X[self._unknown_permutation].T)
         result = self.storage.matmat_permuted(permuted)
-        out = np.empty_like(result)
-        out[self._unknown_permutation] = result
+        out = np.empty((X.shape[0], X.shape[1]))
+        out[self._unknown_permutation] = result.T
         return out
 
     def _matvec(self, x):
-        return self._matmat(np.asarray(x).reshape(-1, 1))[:, 0]
+        x = np.asarray(x, dtype=np.float64).reshape(-1)
+        result = self.storage.matmat_permuted(x[self._unknown_permutation].reshape(1, -1))
+        out = np.empty(x.shape[0])
+        out[self._unknown_permutation] = result[0]
+        return out
 
     def _adjoint(self):
         raise NotImplementedError("HMatrix does not implement the transpose product")
@@ -120,11 +146,11 @@ class HMatrix(LinearOperator):
         return dense
 
     def _factors(self, b):
-        """(U, V) of low-rank block b (views into the flat storage)."""
+        """(U, V) of low-rank block b as float64 (views when stored in float64)."""
         s = self.storage
         k = s.lowrank_rank[b]
-        u = s.u_values[s.u_offset[b]:s.u_offset[b + 1]].reshape(-1, k)
-        v = s.v_values[s.v_offset[b]:s.v_offset[b + 1]].reshape(-1, k)
+        u = s.u_values[s.u_offset[b]:s.u_offset[b + 1]].reshape(k, -1).T.astype(np.float64, copy=False)
+        v = s.v_values[s.v_offset[b]:s.v_offset[b + 1]].reshape(k, -1).T.astype(np.float64, copy=False)
         return u, v
 
     @property
@@ -155,6 +181,7 @@ class HMatrix(LinearOperator):
             "leaf_size": self.leaf_size,
             "n_elements": int(self.n_elements),
             "dof": int(self.dof),
+            "factor_dtype": str(s.u_values.dtype),
             "n_threads": int(numba.get_num_threads()),
         }
 
@@ -246,14 +273,18 @@ class HMatrix(LinearOperator):
         row_scale = _row_scale(self.dof, s.dense_row_start, s.dense_row_stop, s.dense_col_start, s.dense_offset,
                                s.dense_values, np.flatnonzero(s.dense_is_near & (s.dense_row_start == s.dense_col_start)),
                                self.n_elements)
-        rows, cols, values = _coo_entries(
-            self.dof, s.dense_row_start, s.dense_row_stop, s.dense_col_start, s.dense_col_stop, s.dense_offset,
-            s.dense_values, selected.astype(np.int64), self._unknown_permutation, row_scale, float(threshold),
-            part == "element_diagonal",
-        )
-        matrix = sp.csr_matrix((values, (rows, cols)), shape=self.shape)
-        matrix.sum_duplicates()
-        return matrix
+        arguments = (self.dof, s.dense_row_start, s.dense_row_stop, s.dense_col_start, s.dense_col_stop,
+                     s.dense_offset, s.dense_values, selected.astype(np.int64), self._unknown_permutation, row_scale,
+                     float(threshold), part == "element_diagonal")
+        n = self.shape[0]
+        indptr = np.zeros(n + 1, dtype=np.int64)
+        _csr_pass(*arguments, indptr, indptr[:0], np.zeros(0, dtype=np.int32), np.zeros(0), False)
+        np.cumsum(indptr, out=indptr)
+        index_dtype = np.int32 if max(indptr[-1], n) < np.iinfo(np.int32).max else np.int64
+        indices = np.empty(indptr[-1], dtype=index_dtype)
+        data = np.empty(indptr[-1])
+        _csr_pass(*arguments, indptr, indptr[:-1].copy(), indices, data, True)
+        return sp.csr_matrix((data, indices, indptr.astype(index_dtype)), shape=self.shape)
 
     def element_diagonal_blocks(self):
         """(N, d, d) array: the exact d x d diagonal block of each element (original order)."""
@@ -267,6 +298,12 @@ class HMatrix(LinearOperator):
             local = np.arange(me)
             blocks[self.tree.permutation[s.dense_row_start[b] + local]] = dense[local, :, local, :]
         return blocks
+
+    def is_finite(self):
+        """True when every stored entry (dense blocks, U, V) is finite. O(memory)."""
+        s = self.storage
+        return bool(np.isfinite(s.dense_values).all() and np.isfinite(s.u_values).all()
+                    and np.isfinite(s.v_values).all())
 
     def __repr__(self):
         st = self.stats
@@ -296,11 +333,14 @@ def _row_scale(dof, row_start, row_stop, col_start, offset, values, diagonal_blo
 
 
 @njit(cache=True)
-def _coo_pass(dof, row_start, row_stop, col_start, col_stop, offset, values, selected, unknown_permutation,
-              row_scale, threshold, element_diagonal, rows, cols, data, fill):
-    """Count (fill=False) or write (fill=True) the kept COO triplets of the selected blocks."""
+def _csr_pass(dof, row_start, row_stop, col_start, col_stop, offset, values, selected, unknown_permutation,
+              row_scale, threshold, element_diagonal, indptr, cursor, indices, data, fill):
+    """CSR of the selected dense blocks (original ordering), in two passes.
+
+    fill=False: count the kept entries of each row into indptr[row + 1].
+    fill=True: write them at cursor[row] (initialised to indptr[:-1]).
+    """
     d = dof
-    count = 0
     for b in selected:
         r0 = d * row_start[b]
         c0 = d * col_start[b]
@@ -308,29 +348,18 @@ def _coo_pass(dof, row_start, row_stop, col_start, col_stop, offset, values, sel
         n = d * (col_stop[b] - col_start[b])
         for i in range(m):
             limit = threshold * row_scale[r0 + i]
+            row = unknown_permutation[r0 + i]
+            base = offset[b] + i * n
             for j in range(n):
                 if element_diagonal and (i // d) != (j // d):
                     continue
-                a = values[offset[b] + i * n + j]
+                a = values[base + j]
                 if a == 0.0 or abs(a) < limit:
                     continue
                 if fill:
-                    rows[count] = unknown_permutation[r0 + i]
-                    cols[count] = unknown_permutation[c0 + j]
-                    data[count] = a
-                count += 1
-    return count
-
-
-def _coo_entries(dof, row_start, row_stop, col_start, col_stop, offset, values, selected, unknown_permutation,
-                 row_scale, threshold, element_diagonal):
-    """COO triplets (original ordering) of the selected dense blocks, thresholded."""
-    arguments = (dof, row_start, row_stop, col_start, col_stop, offset, values, selected, unknown_permutation,
-                 row_scale, threshold, element_diagonal)
-    empty_index = np.empty(0, dtype=np.int64)
-    count = _coo_pass(*arguments, empty_index, empty_index, np.empty(0), False)
-    rows = np.empty(count, dtype=np.int64)
-    cols = np.empty(count, dtype=np.int64)
-    data = np.empty(count)
-    _coo_pass(*arguments, rows, cols, data, True)
-    return rows, cols, data
+                    position = cursor[row]
+                    indices[position] = unknown_permutation[c0 + j]
+                    data[position] = a
+                    cursor[row] = position + 1
+                else:
+                    indptr[row + 1] += 1

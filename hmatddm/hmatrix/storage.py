@@ -7,7 +7,9 @@ Everything lives in a few flat arrays, in the PERMUTED ordering of the cluster t
   ranges ``dense_row_start/stop``, ``dense_col_start/stop`` (tree positions), values
   row-major in ``dense_values[dense_offset[b]:dense_offset[b+1]]``;
 * low-rank blocks U V^T: element ranges as above, ``lowrank_rank``, U (m x k) and
-  V (n x k) row-major in ``u_values[u_offset[b]:...]``, ``v_values[v_offset[b]:...]``;
+  V (n x k) stored column by column (i.e. U^T and V^T row-major, so every matvec
+  loop is a long contiguous dot product or axpy) in ``u_values[u_offset[b]:...]``,
+  ``v_values[v_offset[b]:...]``;
 * for the matvec, the row space is split into the leaf clusters ("segments"); each
   segment lists (CSR) the dense and low-rank blocks whose rows cover it, so threads
   own whole segments of y and never race.
@@ -76,7 +78,8 @@ class BlockStorage:
         return int(total)
 
     def matmat_permuted(self, x):
-        """y = A x for x (N*d, nrhs) in the permuted ordering (parallel, race-free)."""
+        """y = A x for x of shape (nrhs, N*d) (transposed!) in the permuted ordering;
+        returns y of shape (nrhs, N*d). Parallel and race-free."""
         return _matmat_permuted(
             self.dof,
             self.dense_col_start,
@@ -85,6 +88,7 @@ class BlockStorage:
             self.dense_offset,
             self.dense_values,
             self.lowrank_row_start,
+            self.lowrank_row_stop,
             self.lowrank_col_start,
             self.lowrank_col_stop,
             self.lowrank_rank,
@@ -156,8 +160,8 @@ def _build_blocks(kernel, data, permutation, dof, eps, row_start, row_stop, col_
         elif rank > 0:
             u_buffer = _reserve(u_buffer, u_used, m * rank)
             v_buffer = _reserve(v_buffer, v_used, n * rank)
-            _append(u_buffer, u_used, u)
-            _append(v_buffer, v_used, v)
+            _append_transposed(u_buffer, u_used, u)
+            _append_transposed(v_buffer, v_used, v)
             u_used += m * rank
             v_used += n * rank
     return ranks, stored_dense, _head(u_buffer, u_used), _head(v_buffer, v_used), _head(far_dense, far_used)
@@ -177,11 +181,12 @@ def _reserve(buffer, used, extra):
 
 
 @njit(cache=True, nogil=True)
-def _append(buffer, used, factor):
-    """buffer[used:used + factor.size] = factor (row-major)."""
-    flat = factor.ravel()
-    for i in range(flat.shape[0]):
-        buffer[used + i] = flat[i]
+def _append_transposed(buffer, used, factor):
+    """buffer[used:used + factor.size] = factor column by column (factor^T row-major)."""
+    rows, columns = factor.shape
+    for k in range(columns):
+        for i in range(rows):
+            buffer[used + k * rows + i] = factor[i, k]
 
 
 @njit(cache=True, nogil=True)
@@ -227,14 +232,14 @@ def _run_parallel(function, batches, n_threads):
 
 
 class _GrowingArray:
-    """A 1-D float64 array appended to in place.
+    """A 1-D array appended to in place (values cast to its dtype).
 
     Grows by reallocation (``ndarray.resize``), which for large arrays remaps pages
     instead of copying, so the peak memory stays close to the final size.
     """
 
-    def __init__(self):
-        self.values = np.empty(1 << 16)
+    def __init__(self, dtype=np.float64):
+        self.values = np.empty(1 << 16, dtype=dtype)
         self.size = 0
 
     def append(self, part):
@@ -249,13 +254,14 @@ class _GrowingArray:
         return self.values
 
 
-def assemble(generator, tree, blocks, eps, n_threads=None):
+def assemble(generator, tree, blocks, eps, n_threads=None, factor_dtype=np.float64):
     """Compress and store all blocks of ``blocks`` (a BlockTree over ``tree``).
 
     Far blocks: whole-element ACA + recompression, in batches on ``n_threads``
-    threads (default: numba's thread count). Near blocks: exact kernel fill
-    straight into the final dense array. Cost O(kernel entries evaluated) = near
-    field + O(sum over far blocks of (m + n) * rank).
+    threads (default: numba's thread count); factors stored as ``factor_dtype``
+    (float64 or float32). Near blocks: exact kernel fill straight into the final
+    (float64) dense array. Cost: the near-field kernel entries plus, per far block,
+    O((m + n) k) kernel entries and O((m + n) k^2) flops.
     """
     d = generator.dof
     n_threads = numba.get_num_threads() if n_threads is None else int(n_threads)
@@ -277,7 +283,8 @@ def assemble(generator, tree, blocks, eps, n_threads=None):
 
     far_cost = (far_rows_stop - far_rows_start + far_cols_stop - far_cols_start).astype(np.float64)
     batches = _batches(far_cost, n_threads)
-    u_values, v_values, far_dense_values = _GrowingArray(), _GrowingArray(), _GrowingArray()
+    u_values, v_values = _GrowingArray(factor_dtype), _GrowingArray(factor_dtype)
+    far_dense_values = _GrowingArray()
     rank_parts, flag_parts = [np.zeros(0, dtype=np.int64)], [np.zeros(0, dtype=bool)]
     for batch_ranks, batch_flags, batch_u, batch_v, batch_dense in _run_parallel(far_batch, batches, n_threads):
         rank_parts.append(batch_ranks)
@@ -403,59 +410,66 @@ def _segment_lists(segment_start, block_row_start, block_row_stop):
 
 @njit(parallel=True, cache=True, fastmath=True)
 def _matmat_permuted(dof, dense_col_start, dense_row_start, dense_col_stop, dense_offset, dense_values,
-                     lowrank_row_start, lowrank_col_start, lowrank_col_stop, lowrank_rank, u_offset, v_offset,
-                     rank_offset, u_values, v_values, segment_start, segment_dense_ptr, segment_dense_ids,
-                     segment_lowrank_ptr, segment_lowrank_ids, x):
-    """y = A x, x of shape (N*d, nrhs), permuted ordering.
+                     lowrank_row_start, lowrank_row_stop, lowrank_col_start, lowrank_col_stop, lowrank_rank,
+                     u_offset, v_offset, rank_offset, u_values, v_values, segment_start, segment_dense_ptr,
+                     segment_dense_ids, segment_lowrank_ptr, segment_lowrank_ids, x):
+    """Y = A X for X given TRANSPOSED, x of shape (nrhs, N*d), permuted ordering.
 
     Phase 1 (parallel over low-rank blocks): t_b = V_b^T x_cols (each block owns t_b).
     Phase 2 (parallel over segments): y_seg = sum of dense rows and U_b rows times t_b
-    over the blocks covering the segment. O(stored entries * nrhs) flops.
+    over the blocks covering the segment. O(stored entries * nrhs) flops; all inner
+    loops run over contiguous memory. Returns y of shape (nrhs, N*d).
     """
+    # Inner loops index slices (views) from 0: with computed offsets numba cannot
+    # prove indices non-negative and its wrap-around checks block SIMD (3x slower).
     d = dof
-    nrhs = x.shape[1]
+    nrhs = x.shape[0]
     n_lowrank = lowrank_rank.shape[0]
-    t = np.zeros((rank_offset[n_lowrank], nrhs))
+    t = np.zeros((nrhs, rank_offset[n_lowrank]))
     for b in prange(n_lowrank):
         k = lowrank_rank[b]
         c0 = d * lowrank_col_start[b]
         nc = d * (lowrank_col_stop[b] - lowrank_col_start[b])
-        base = v_offset[b]
         t0 = rank_offset[b]
-        for j in range(nc):
-            row = base + j * k
-            for r in range(nrhs):
-                xj = x[c0 + j, r]
-                for q in range(k):
-                    t[t0 + q, r] += v_values[row + q] * xj
+        for r in range(nrhs):
+            x_cols = x[r, c0:c0 + nc]
+            for q in range(k):
+                v_column = v_values[v_offset[b] + q * nc:v_offset[b] + (q + 1) * nc]
+                total = 0.0
+                for j in range(nc):
+                    total += v_column[j] * x_cols[j]
+                t[r, t0 + q] = total
     n_segments = segment_start.shape[0] - 1
-    y = np.zeros((x.shape[0], nrhs))
+    y = np.zeros((nrhs, x.shape[1]))
     for s in prange(n_segments):
         r0 = d * segment_start[s]
         r1 = d * segment_start[s + 1]
+        rows = r1 - r0
         for e in range(segment_dense_ptr[s], segment_dense_ptr[s + 1]):
             b = segment_dense_ids[e]
             c0 = d * dense_col_start[b]
             nc = d * (dense_col_stop[b] - dense_col_start[b])
             base = dense_offset[b] + (r0 - d * dense_row_start[b]) * nc
-            for i in range(r1 - r0):
-                row = base + i * nc
-                for r in range(nrhs):
+            for r in range(nrhs):
+                x_cols = x[r, c0:c0 + nc]
+                y_rows = y[r, r0:r1]
+                for i in range(rows):
+                    dense_row = dense_values[base + i * nc:base + (i + 1) * nc]
                     total = 0.0
                     for j in range(nc):
-                        total += dense_values[row + j] * x[c0 + j, r]
-                    y[r0 + i, r] += total
+                        total += dense_row[j] * x_cols[j]
+                    y_rows[i] += total
         for e in range(segment_lowrank_ptr[s], segment_lowrank_ptr[s + 1]):
             b = segment_lowrank_ids[e]
             k = lowrank_rank[b]
             t0 = rank_offset[b]
-            base = u_offset[b] + (r0 - d * lowrank_row_start[b]) * k
-            for i in range(r1 - r0):
-                row = base + i * k
-                for r in range(nrhs):
-                    total = 0.0
-                    for q in range(k):
-                        total += u_values[row + q] * t[t0 + q, r]
-                    y[r0 + i, r] += total
+            m = d * (lowrank_row_stop[b] - lowrank_row_start[b])
+            shift = u_offset[b] + (r0 - d * lowrank_row_start[b])
+            for r in range(nrhs):
+                y_rows = y[r, r0:r1]
+                for q in range(k):
+                    coefficient = t[r, t0 + q]
+                    u_column = u_values[shift + q * m:shift + q * m + rows]
+                    for i in range(rows):
+                        y_rows[i] += coefficient * u_column[i]
     return y
-
