@@ -51,9 +51,10 @@ class BlockGenerator:
             raise InputError(f"points must have shape (N, 2) or (N, 3) with N >= 1, got {points.shape}")
         if not np.all(np.isfinite(points)):
             raise InputError("points must be finite")
-        radii = np.ascontiguousarray(self.radii, dtype=np.float64)
+        radii = np.asarray(self.radii, dtype=np.float64)
         if radii.ndim == 0:
             radii = np.full(points.shape[0], float(radii))
+        radii = np.ascontiguousarray(radii)
         if radii.shape != (points.shape[0],):
             raise InputError(f"radii must have shape ({points.shape[0]},), got {radii.shape}")
         if not np.all(np.isfinite(radii)) or np.any(radii < 0):

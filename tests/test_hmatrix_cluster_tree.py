@@ -1,0 +1,151 @@
+"""Cluster tree and block cluster tree of hmatddm.hmatrix (DESIGN.md section 4)."""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from hmatddm.errors import InputError
+from hmatddm.hmatrix.block_tree import block_tree, box_distance
+from hmatddm.hmatrix.cluster_tree import cluster_tree
+
+
+def tilted_plane(n, rng):
+    """Points on the plane spanned by two tilted unit vectors (a planar fracture)."""
+    e1 = np.array([1.0, 0.2, 0.4])
+    e1 /= np.linalg.norm(e1)
+    e2 = np.array([-0.3, 1.0, 0.5])
+    e2 -= (e2 @ e1) * e1
+    e2 /= np.linalg.norm(e2)
+    uv = rng.random((n, 2))
+    return uv[:, :1] * e1 + uv[:, 1:] * e2
+
+
+def geometries():
+    rng = np.random.default_rng(1)
+    return {
+        "cube": rng.random((700, 3)),
+        "tilted_plane": tilted_plane(600, rng),
+        "line2d": np.c_[np.linspace(0, 1, 333), np.zeros(333)],
+        "disc2d": rng.standard_normal((500, 2)),
+        "coincident": np.zeros((150, 3)),
+        "single": np.array([[0.5, 0.5, 0.5]]),
+    }
+
+
+def check_tree_invariants(tree, points, radii):
+    n = points.shape[0]
+    assert np.array_equal(np.sort(tree.permutation), np.arange(n))
+    assert tree.start[0] == 0 and tree.stop[0] == n
+    leaves = tree.is_leaf
+    assert np.all(tree.size[leaves] <= tree.leaf_size)
+    assert np.all(tree.size >= 1)
+    for c in np.flatnonzero(~leaves):
+        left, right = tree.left[c], tree.right[c]
+        # children partition the parent's range, in order
+        assert tree.start[left] == tree.start[c] and tree.stop[left] == tree.start[right]
+        assert tree.stop[right] == tree.stop[c]
+        assert tree.parent[left] == c and tree.parent[right] == c
+        assert tree.level[left] == tree.level[c] + 1
+        # median split: sizes differ by at most one
+        assert abs(tree.size[left] - tree.size[right]) <= 1
+    # leaves partition [0, N) once sorted by start
+    ordered = tree.leaves()
+    assert tree.start[ordered[0]] == 0 and tree.stop[ordered[-1]] == n
+    assert np.array_equal(tree.stop[ordered[:-1]], tree.start[ordered[1:]])
+    # bounding boxes contain their elements' balls
+    for c in range(tree.n_clusters):
+        members = tree.permutation[tree.start[c]:tree.stop[c]]
+        lower = points[members] - radii[members, None]
+        upper = points[members] + radii[members, None]
+        assert np.all(tree.bbox_min[c] <= lower.min(axis=0) + 1e-15)
+        assert np.all(tree.bbox_max[c] >= upper.max(axis=0) - 1e-15)
+
+
+@pytest.mark.parametrize("name", list(geometries()))
+@pytest.mark.parametrize("leaf_size", [1, 16, 64])
+def test_cluster_tree_invariants(name, leaf_size):
+    points = geometries()[name]
+    radii = np.full(points.shape[0], 0.01)
+    tree = cluster_tree(points, radii, leaf_size)
+    check_tree_invariants(tree, points, radii)
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    n=st.integers(min_value=1, max_value=300),
+    dim=st.sampled_from([2, 3]),
+    leaf_size=st.integers(min_value=1, max_value=40),
+    seed=st.integers(min_value=0, max_value=2**31),
+)
+def test_cluster_tree_invariants_random(n, dim, leaf_size, seed):
+    rng = np.random.default_rng(seed)
+    points = rng.standard_normal((n, dim)) * rng.random(dim) * 10
+    radii = rng.random(n) * 0.1
+    check_tree_invariants(cluster_tree(points, radii, leaf_size), points, radii)
+
+
+def test_principal_axis_split_follows_a_tilted_strip():
+    """The first bisection of a long tilted strip cuts across its long direction."""
+    rng = np.random.default_rng(3)
+    axis = np.array([1.0, 1.0, 1.0]) / np.sqrt(3)
+    across = np.array([1.0, -1.0, 0.0]) / np.sqrt(2)
+    points = rng.random((400, 1)) * 10 * axis + rng.random((400, 1)) * across
+    tree = cluster_tree(points, np.zeros(400), 50)
+    left = points[tree.permutation[tree.start[1]:tree.stop[1]]]
+    right = points[tree.permutation[tree.start[2]:tree.stop[2]]]
+    assert (left @ axis).max() <= (right @ axis).min() + 1e-12 or (right @ axis).max() <= (left @ axis).min() + 1e-12
+
+
+def test_cluster_tree_refuses_bad_leaf_size():
+    points = np.random.default_rng(0).random((10, 3))
+    for bad in (0, -3, 2.5, True):
+        with pytest.raises(InputError, match="leaf_size"):
+            cluster_tree(points, np.zeros(10), bad)
+
+
+def coverage(tree, blocks):
+    n = tree.n_elements
+    count = np.zeros((n, n), dtype=np.int64)
+    for rows, cols in ((blocks.admissible_rows, blocks.admissible_cols), (blocks.near_rows, blocks.near_cols)):
+        for r, c in zip(rows, cols):
+            count[tree.start[r]:tree.stop[r], tree.start[c]:tree.stop[c]] += 1
+    return count
+
+
+@pytest.mark.parametrize("name", ["cube", "tilted_plane", "disc2d", "coincident", "single"])
+@pytest.mark.parametrize("eta", [0.5, 3.0])
+def test_block_tree_covers_matrix_exactly_once(name, eta):
+    points = geometries()[name][:300]
+    tree = cluster_tree(points, np.full(points.shape[0], 0.001), 8)
+    blocks = block_tree(tree, eta)
+    count = coverage(tree, blocks)
+    assert np.all(count == 1)
+    area = np.sum(tree.size[blocks.admissible_rows] * tree.size[blocks.admissible_cols]) + np.sum(
+        tree.size[blocks.near_rows] * tree.size[blocks.near_cols])
+    assert area == points.shape[0] ** 2
+
+
+def test_block_tree_admissibility_and_near_leaves():
+    points = geometries()["cube"]
+    tree = cluster_tree(points, np.zeros(points.shape[0]), 16)
+    eta = 2.0
+    blocks = block_tree(tree, eta)
+    assert blocks.admissible_rows.size > 0
+    diameter = tree.diameter
+    rows, cols = blocks.admissible_rows, blocks.admissible_cols
+    distance = box_distance(tree, rows, cols)
+    assert np.all(distance > 0)
+    assert np.all(np.minimum(diameter[rows], diameter[cols]) <= eta * distance)
+    # near blocks are leaf x leaf, and diagonal leaf blocks are all near
+    assert np.all(tree.is_leaf[blocks.near_rows]) and np.all(tree.is_leaf[blocks.near_cols])
+    diagonal = set(zip(blocks.near_rows[blocks.near_rows == blocks.near_cols].tolist(),
+                       blocks.near_cols[blocks.near_rows == blocks.near_cols].tolist()))
+    assert diagonal == {(c, c) for c in np.flatnonzero(tree.is_leaf).tolist()}
+
+
+def test_block_tree_refuses_bad_eta():
+    tree = cluster_tree(np.random.default_rng(0).random((50, 3)), np.zeros(50), 8)
+    for bad in (0.0, -1.0, np.inf, np.nan):
+        with pytest.raises(InputError, match="eta"):
+            block_tree(tree, bad)
