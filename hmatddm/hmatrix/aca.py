@@ -17,6 +17,10 @@ transposed (``ut`` k x m, ``vt`` k x n) so that every inner loop is contiguous.
 import numpy as np
 from numba import njit
 
+# Floating-point flags that let LLVM vectorise dot products (reassociation) while
+# keeping NaN/inf semantics, so finiteness checks stay meaningful.
+FAST = {"reassoc", "contract", "nsz", "arcp"}
+
 # Pivot singular values below PIVOT_RTOL * largest are dropped (numerical rank).
 PIVOT_RTOL = 1e-12
 # A residual row/column whose largest entry is below NEGLIGIBLE * (largest entry seen
@@ -40,7 +44,7 @@ def _grow(factor, capacity):
     return grown
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, fastmath=FAST)
 def _subtract_rows(residual, ut, vt, rank, first_row):
     """residual (d x n) -= U[first_row:first_row+d, :rank] @ V[:, :rank]^T."""
     d, n = residual.shape
@@ -52,7 +56,7 @@ def _subtract_rows(residual, ut, vt, rank, first_row):
                     residual[p, c] -= coefficient * vt[l, c]
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, fastmath=FAST)
 def _subtract_cols(residual, ut, vt, rank, first_col):
     """residual (m x d) -= U[:, :rank] @ V[first_col:first_col+d, :rank]^T."""
     m, d = residual.shape
@@ -131,7 +135,7 @@ def _coprime_hop(count):
         hop += 1
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, fastmath=FAST)
 def _max_abs(array):
     value = 0.0
     for x in array.ravel():
@@ -141,7 +145,7 @@ def _max_abs(array):
     return value
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, fastmath=FAST)
 def _add_cross(ut, vt, rank, residual_rows, residual_cols, first_col, threshold):
     """Append the cross C P^+ R of a whole-element pivot to the factors (vectors rank..).
 
@@ -365,27 +369,76 @@ def aca_tensor(kernel, data, row_elements, col_elements, dof, eps):
     return aca_result(ut, vt, ints)
 
 
-@njit(cache=True, nogil=True)
-def recompress(u, v, eps):
-    """Truncate U V^T to the smallest rank with relative Frobenius error <= eps.
+@njit(cache=True, nogil=True, fastmath=FAST)
+def _orthonormalize(vectors, count):
+    """Thin QR of the first ``count`` rows of ``vectors`` (k x m, one vector per row).
+
+    Classical Gram-Schmidt applied twice ("twice is enough"), on contiguous rows:
+    O(4 m k^2) flops, faster than LAPACK's Householder QR on these skinny blocks.
+    Returns (q, r) with q (k x m) orthonormal rows (a zero row where a vector lies in
+    the span of the previous ones) and r (k x k) upper triangular, vectors = r^T q.
+    """
+    m = vectors.shape[1]
+    q = np.zeros((count, m))
+    r = np.zeros((count, count))
+    coefficients = np.empty(count)
+    for k in range(count):
+        w = q[k]
+        original = 0.0
+        for i in range(m):
+            w[i] = vectors[k, i]
+            original += w[i] * w[i]
+        for _ in range(2):
+            for j in range(k):
+                total = 0.0
+                qj = q[j]
+                for i in range(m):
+                    total += qj[i] * w[i]
+                coefficients[j] = total
+            for j in range(k):
+                c = coefficients[j]
+                r[j, k] += c
+                qj = q[j]
+                for i in range(m):
+                    w[i] -= c * qj[i]
+        norm2 = 0.0
+        for i in range(m):
+            norm2 += w[i] * w[i]
+        if norm2 > 1e-28 * original and norm2 > 0.0:
+            norm = np.sqrt(norm2)
+            r[k, k] = norm
+            inverse = 1.0 / norm
+            for i in range(m):
+                w[i] *= inverse
+        else:
+            for i in range(m):
+                w[i] = 0.0
+    return q, r
+
+
+@njit(cache=True, nogil=True, fastmath=FAST)
+def recompress_transposed(ut, vt, rank, eps):
+    """Truncate U V^T (given as the first ``rank`` rows of U^T and V^T) to the smallest
+    rank with relative Frobenius error <= eps.
 
     QR of both factors, SVD of the small core R_u R_v^T, truncation of the singular
-    value tail: O((m + n) k^2 + k^3). Returns (U', V', rank') with U' = Q_u W S and
-    V' = Q_v Z (singular values folded into U'). Rank 0 for a zero product.
+    value tail: O((m + n) k^2 + k^3). Returns (U'^T, V'^T, rank') with U' = Q_u W S
+    and V' = Q_v Z (singular values folded into U'). Rank 0 for a zero product.
     """
-    m, k = u.shape
-    n = v.shape[0]
-    if k == 0:
-        return np.zeros((m, 0)), np.zeros((n, 0)), 0
-    qu, ru = np.linalg.qr(u)
-    qv, rv = np.linalg.qr(v)
-    core = np.ascontiguousarray(ru) @ np.ascontiguousarray(rv.T)
+    m = ut.shape[1]
+    n = vt.shape[1]
+    if rank == 0:
+        return np.zeros((0, m)), np.zeros((0, n)), 0
+    qu, ru = _orthonormalize(ut, rank)
+    qv, rv = _orthonormalize(vt, rank)
+    # U = qu^T ru and V = qv^T rv (rows of qu, qv orthonormal): U V^T = qu^T (ru rv^T) qv
+    core = ru @ np.ascontiguousarray(rv.T)
     w, s, zh = np.linalg.svd(core, False)
     total = 0.0
     for x in s:
         total += x * x
     if total == 0.0 or not np.isfinite(total):
-        return np.zeros((m, 0)), np.zeros((n, 0)), 0
+        return np.zeros((0, m)), np.zeros((0, n)), 0
     # smallest rank whose discarded tail satisfies tail^2 <= eps^2 * total
     tail = 0.0
     new_rank = s.shape[0]
@@ -395,13 +448,34 @@ def recompress(u, v, eps):
             break
         tail = candidate
         new_rank -= 1
-    left = np.ascontiguousarray(w[:, :new_rank]) * s[:new_rank]
-    right = np.ascontiguousarray(zh[:new_rank, :].T)
-    return (np.ascontiguousarray(qu) @ left, np.ascontiguousarray(qv) @ right, new_rank)
+    u_out = np.zeros((new_rank, m))
+    v_out = np.zeros((new_rank, n))
+    for k in range(new_rank):
+        target = u_out[k]
+        for j in range(rank):
+            c = w[j, k] * s[k]
+            if c != 0.0:
+                row = qu[j]
+                for i in range(m):
+                    target[i] += c * row[i]
+        target = v_out[k]
+        for j in range(rank):
+            c = zh[k, j]
+            if c != 0.0:
+                row = qv[j]
+                for i in range(n):
+                    target[i] += c * row[i]
+    return u_out, v_out, new_rank
 
 
 @njit(cache=True, nogil=True)
-def recompress_result(ut, vt, ints, eps):
-    """recompress(aca_result(ut, vt, ints)) for a finished ACA state."""
-    u, v, _ = aca_result(ut, vt, ints)
-    return recompress(u, v, eps)
+def recompress(u, v, eps):
+    """recompress_transposed for factors U (m x k), V (n x k); returns (U', V', rank')."""
+    ut, vt, rank = recompress_transposed(np.ascontiguousarray(u.T), np.ascontiguousarray(v.T), u.shape[1], eps)
+    return np.ascontiguousarray(ut.T), np.ascontiguousarray(vt.T), rank
+
+
+@njit(cache=True, nogil=True)
+def recompress_state(ut, vt, ints, eps):
+    """recompress_transposed of a finished ACA state: (U'^T, V'^T, rank')."""
+    return recompress_transposed(ut, vt, ints[_RANK], eps)

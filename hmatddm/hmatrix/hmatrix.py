@@ -166,6 +166,8 @@ class HMatrix(LinearOperator):
             "dense_bytes": dense_bytes,
             "compression": dense_bytes / memory if memory else math.inf,
             "build_seconds": self.build_seconds,
+            "far_field_seconds": float(s.far_seconds),
+            "near_field_seconds": float(s.near_seconds),
             "n_admissible": int(s.admissible_kind.size),
             "n_lowrank_blocks": int(lowrank.size),
             "n_zero_blocks": int(s.admissible_kind.size - lowrank.size - n_far_dense),

@@ -15,6 +15,7 @@ Everything lives in a few flat arrays, in the PERMUTED ordering of the cluster t
   own whole segments of y and never race.
 """
 
+import time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
@@ -22,8 +23,8 @@ import numba
 import numpy as np
 from numba import njit, prange
 
-from .aca import (ACA_TOLERANCE_FACTOR, REQUEST_DONE, REQUEST_ROW, aca_advance, aca_start,
-                  recompress_result)
+from .aca import (ACA_TOLERANCE_FACTOR, FAST, REQUEST_DONE, REQUEST_ROW, aca_advance, aca_start,
+                  recompress_state)
 
 # Block kinds recorded for every admissible block.
 KIND_LOWRANK = 0
@@ -62,6 +63,8 @@ class BlockStorage:
     admissible_kind: np.ndarray
     admissible_index: np.ndarray
     admissible_rank: np.ndarray
+    far_seconds: float = 0.0
+    near_seconds: float = 0.0
 
     @property
     def memory_bytes(self):
@@ -149,7 +152,7 @@ def _build_blocks(kernel, data, permutation, dof, eps, row_start, row_stop, col_
             else:
                 kernel(data, rows, cols[index:index + 1], col_buffer)
             ut, vt, request, index = aca_advance(ut, vt, row_buffer, col_buffer, row_visited, col_visited, ints, floats)
-        u, v, rank = recompress_result(ut, vt, ints, eps)
+        ut, vt, rank = recompress_state(ut, vt, ints, eps)
         ranks[b] = rank
         if rank * (m + n) >= m * n:
             stored_dense[b] = True
@@ -160,8 +163,8 @@ def _build_blocks(kernel, data, permutation, dof, eps, row_start, row_stop, col_
         elif rank > 0:
             u_buffer = _reserve(u_buffer, u_used, m * rank)
             v_buffer = _reserve(v_buffer, v_used, n * rank)
-            _append_transposed(u_buffer, u_used, u)
-            _append_transposed(v_buffer, v_used, v)
+            _append(u_buffer, u_used, ut)
+            _append(v_buffer, v_used, vt)
             u_used += m * rank
             v_used += n * rank
     return ranks, stored_dense, _head(u_buffer, u_used), _head(v_buffer, v_used), _head(far_dense, far_used)
@@ -181,12 +184,12 @@ def _reserve(buffer, used, extra):
 
 
 @njit(cache=True, nogil=True)
-def _append_transposed(buffer, used, factor):
-    """buffer[used:used + factor.size] = factor column by column (factor^T row-major)."""
+def _append(buffer, used, factor):
+    """buffer[used:used + factor.size] = factor (row-major)."""
     rows, columns = factor.shape
-    for k in range(columns):
-        for i in range(rows):
-            buffer[used + k * rows + i] = factor[i, k]
+    for k in range(rows):
+        for i in range(columns):
+            buffer[used + k * columns + i] = factor[k, i]
 
 
 @njit(cache=True, nogil=True)
@@ -281,6 +284,7 @@ def assemble(generator, tree, blocks, eps, n_threads=None, factor_dtype=np.float
                              far_cols_start[ids], far_cols_stop[ids], np.ones(ids.size, dtype=np.bool_),
                              no_offsets[ids], empty)
 
+    started = time.perf_counter()
     far_cost = (far_rows_stop - far_rows_start + far_cols_stop - far_cols_start).astype(np.float64)
     batches = _batches(far_cost, n_threads)
     u_values, v_values = _GrowingArray(factor_dtype), _GrowingArray(factor_dtype)
@@ -297,6 +301,7 @@ def assemble(generator, tree, blocks, eps, n_threads=None, factor_dtype=np.float
     order = np.concatenate([np.zeros(0, dtype=np.int64)] + batches)
     ranks = np.concatenate(rank_parts)
     dense_flag = np.concatenate(flag_parts)
+    far_seconds = time.perf_counter() - started
 
     admissible_kind = np.full(n_far, KIND_ZERO, dtype=np.int64)
     admissible_index = np.full(n_far, -1, dtype=np.int64)
@@ -336,9 +341,11 @@ def assemble(generator, tree, blocks, eps, n_threads=None, factor_dtype=np.float
                              near_cols_start[ids], near_cols_stop[ids], np.zeros(ids.size, dtype=np.bool_),
                              near_offset[ids], dense_values)
 
+    started = time.perf_counter()
     near_cost = dense_size[far_dense.size:].astype(np.float64)
     for _ in _run_parallel(near_batch, _batches(near_cost, n_threads), n_threads):
         pass
+    near_seconds = time.perf_counter() - started
 
     rows_lr = far_rows_stop[lowrank] - far_rows_start[lowrank]
     cols_lr = far_cols_stop[lowrank] - far_cols_start[lowrank]
@@ -384,6 +391,8 @@ def assemble(generator, tree, blocks, eps, n_threads=None, factor_dtype=np.float
         admissible_kind=admissible_kind,
         admissible_index=admissible_index,
         admissible_rank=admissible_rank,
+        far_seconds=far_seconds,
+        near_seconds=near_seconds,
     )
 
 
@@ -408,7 +417,7 @@ def _segment_lists(segment_start, block_row_start, block_row_stop):
 # ----------------------------------------------------------------------------- matvec
 
 
-@njit(parallel=True, cache=True, fastmath=True)
+@njit(parallel=True, cache=True, fastmath=FAST)
 def _matmat_permuted(dof, dense_col_start, dense_row_start, dense_col_stop, dense_offset, dense_values,
                      lowrank_row_start, lowrank_row_stop, lowrank_col_start, lowrank_col_stop, lowrank_rank,
                      u_offset, v_offset, rank_offset, u_values, v_values, segment_start, segment_dense_ptr,
