@@ -4,6 +4,7 @@ import math
 
 import numpy as np
 import scipy.sparse.linalg as spla
+from threadpoolctl import threadpool_limits
 
 from hmatddm.errors import ConvergenceError, InputError
 
@@ -70,8 +71,12 @@ def gmres(A, b, M=None, rtol=1e-8, restart=50, maxiter=20, x0=None):
     def count(_):
         iterations[0] += 1
 
-    x, _ = spla.gmres(A, b, x0=x0, rtol=float(rtol), atol=0.0, restart=restart, maxiter=maxiter, M=M,
-                      callback=count, callback_type="pr_norm")
+    # One BLAS thread: the Krylov vector operations are memory-bound, and idle
+    # spinning BLAS threads would steal the cores from the parallel H-matrix matvec
+    # (measured: matvec twice slower inside GMRES otherwise).
+    with threadpool_limits(limits=1, user_api="blas"):
+        x, _ = spla.gmres(A, b, x0=x0, rtol=float(rtol), atol=0.0, restart=restart, maxiter=maxiter, M=M,
+                          callback=count, callback_type="pr_norm")
     if not np.all(np.isfinite(x)):
         raise ConvergenceError(f"GMRES produced a non-finite iterate after {iterations[0]} iterations",
                                residual=math.nan, iterations=iterations[0])

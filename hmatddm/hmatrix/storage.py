@@ -263,7 +263,7 @@ def _run_parallel(function, batches, n_threads):
     """
     from threadpoolctl import threadpool_limits
 
-    with threadpool_limits(limits=1):
+    with threadpool_limits(limits=1, user_api="blas"):
         if n_threads <= 1 or len(batches) <= 1:
             for batch in batches:
                 yield function(batch)
