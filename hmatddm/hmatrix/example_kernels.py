@@ -84,14 +84,9 @@ def matrix_kernel(data, rows, cols, out):
                     out[d * a + p, d * b + q] = matrix[d * rows[a] + p, d * cols[b] + q]
 
 
-def inverse_distance_generator(points, diagonal=None):
-    """BlockGenerator of the 1/r kernel; default diagonal: 2 / (mean spacing)."""
+def inverse_distance_generator(points, diagonal=1.0):
+    """BlockGenerator of the 1/r kernel with ``diagonal`` on the diagonal (d = 1)."""
     points = np.ascontiguousarray(points, dtype=np.float64)
-    if diagonal is None:
-        extent = np.ptp(points, axis=0)
-        extent = extent[extent > 0]
-        spacing = np.prod(extent) ** (1.0 / max(extent.size, 1)) / max(points.shape[0], 1) ** (1.0 / max(extent.size, 1))
-        diagonal = 2.0 / spacing if spacing > 0 else 1.0
     return BlockGenerator(inverse_distance_kernel, (points, np.array([float(diagonal)])), points,
                           np.zeros(points.shape[0]), 1)
 

@@ -373,7 +373,6 @@ def assemble(generator, tree, blocks, eps, n_threads=None, factor_dtype=np.float
     dense_values[: far_dense_values.size] = far_dense_values
     del far_dense_values
 
-    n_near = near_rows_start.size
     near_offset = dense_offset[far_dense.size:-1]
 
     def near_batch(ids):
