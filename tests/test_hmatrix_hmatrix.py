@@ -249,6 +249,22 @@ def test_build_refuses_bad_arguments(scalar_problems):
         HMatrix.build(np.eye(3))
 
 
+@pytest.mark.parametrize("where", ["near", "far"])
+def test_build_refuses_a_kernel_returning_nan(where):
+    rng = np.random.default_rng(10)
+    points = rng.random((400, 3))
+    matrix = np.exp(-np.linalg.norm(points[:, None] - points[None], axis=2)) + np.eye(400)
+    h = HMatrix.build(matrix_generator(matrix, points), eps=1e-6, leaf_size=16)
+    tree, blocks = h.tree, h.blocks
+    rows, cols = (blocks.near_rows, blocks.near_cols) if where == "near" else (blocks.admissible_rows,
+                                                                                 blocks.admissible_cols)
+    i = tree.permutation[tree.start[rows[0]]]
+    j = tree.permutation[tree.start[cols[0]]]
+    matrix[i, j] = np.nan
+    with pytest.raises(InputError, match="NaN"):
+        HMatrix.build(matrix_generator(matrix, points), eps=1e-6, leaf_size=16)
+
+
 def test_block_generator_refuses_bad_input():
     points = cube(10)
     data = (points, np.array([1.0]))

@@ -92,7 +92,8 @@ class HMatrix(LinearOperator):
             traffic), float64 otherwise. Dense blocks are always float64.
 
         Cost: O(N log N) for the trees, kernel evaluations of the near field plus
-        O((m + n) k) per far block, run on numba's thread count.
+        O((m + n) k) per far block, run on numba's thread count. Raises InputError
+        when the kernel returns NaN or inf (every stored entry is checked).
         """
         if not isinstance(generator, BlockGenerator):
             raise InputError(f"generator must be a BlockGenerator, got {type(generator).__name__}")
@@ -101,9 +102,15 @@ class HMatrix(LinearOperator):
         started = time.perf_counter()
         tree = cluster_tree(generator.points, generator.radii, int(leaf_size))
         blocks = block_tree(tree, float(eta))
-        storage = assemble(generator, tree, blocks, float(eps), factor_dtype=dtype)
+        try:
+            storage = assemble(generator, tree, blocks, float(eps), factor_dtype=dtype)
+        except np.linalg.LinAlgError as error:  # the SVD of a pivot refuses NaN/inf
+            raise InputError(f"the kernel returned NaN or inf entries (in a far-field block): {error}") from None
         seconds = time.perf_counter() - started
-        return cls(generator, tree, blocks, storage, eps, eta, leaf_size, seconds)
+        hmatrix = cls(generator, tree, blocks, storage, eps, eta, leaf_size, seconds)
+        if not hmatrix.is_finite():
+            raise InputError("the kernel returned NaN or inf entries; no H-matrix was built")
+        return hmatrix
 
     # ------------------------------------------------------------------ products
     def _matmat(self, X):
