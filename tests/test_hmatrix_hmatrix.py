@@ -6,6 +6,8 @@ admissible block, matvecs on random vectors, and the full matrix for small N.
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from hmatddm.errors import InputError
 from hmatddm.hmatrix import BlockGenerator, HMatrix
@@ -103,6 +105,25 @@ def test_to_dense_and_original_ordering():
     e = np.zeros(600)
     e[123] = 1.0
     assert relative(h @ e, dense[:, 123]) <= 1e-8
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    n=st.integers(min_value=1, max_value=400),
+    dim=st.sampled_from([2, 3]),
+    leaf_size=st.integers(min_value=1, max_value=48),
+    eta=st.sampled_from([0.5, 1.0, 3.0, 10.0]),
+    eps=st.sampled_from([1e-2, 1e-4, 1e-8]),
+    seed=st.integers(min_value=0, max_value=2**31),
+)
+def test_random_clouds_match_the_dense_matrix(n, dim, leaf_size, eta, eps, seed):
+    points = np.random.default_rng(seed).random((n, dim)) * np.array([1.0, 0.3, 2.0][:dim])
+    generator = inverse_distance_generator(points, diagonal=100.0)
+    h = HMatrix.build(generator, eps=eps, eta=eta, leaf_size=leaf_size)
+    dense = generator.to_dense()
+    assert np.linalg.norm(h.to_dense() - dense) <= 10 * eps * np.linalg.norm(dense)
+    x = np.random.default_rng(seed + 1).standard_normal(n)
+    assert np.allclose(h @ x, h.to_dense() @ x, rtol=1e-10, atol=1e-10 * np.abs(h.to_dense()).sum(axis=1).max())
 
 
 def test_stats_are_complete_and_consistent(scalar_problems):
