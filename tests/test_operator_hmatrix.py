@@ -106,7 +106,7 @@ def test_hmatrix_compresses_and_reports_stats(material):
                 "n_dense_blocks", "max_rank", "eps", "eta", "leaf_size"):
         assert key in s
     assert s["compression"] > 1.5 and s["dense_bytes"] == 8 * (3 * 800) ** 2
-    assert s["eps"] == 1e-6 and s["leaf_size"] == 64
+    assert s["eps"] == 1e-6 and s["leaf_size"] == 32
 
 
 def test_griffith_through_hmatrix(material):

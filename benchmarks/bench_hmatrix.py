@@ -1,0 +1,309 @@
+"""H-matrix against dense: memory, time and error, on 3D rectangular DDM meshes.
+
+    python benchmarks/bench_hmatrix.py                 # full study (about an hour on 2 cores)
+    python benchmarks/bench_hmatrix.py --quick         # N = 1k, 4k only, short eps sweep
+    python benchmarks/bench_hmatrix.py --case planar --n 10000 --eps 1e-4   # one case, JSON
+
+Three studies, each printed as a markdown table and saved (JSON + PNG) in benchmarks/out/:
+
+1. scaling: N = 1k, 4k, 10k (dense where it fits) and 40k, 100k (H only) on a planar
+   square crack and on a cloud of vertical natural-fracture-like rectangles; build time,
+   memory, compression, matvec time, GMRES iterations and time to rtol 1e-8 (crack under
+   uniform pressure), error against dense (smooth-field and random-vector matvec error;
+   solution error where the dense solve is affordable). Without dense, the smooth-field
+   error is measured on 300 exact rows computed by the kernel.
+2. speed against error: eps from 1e-2 to 1e-10 at N = 10k (planar): build time, memory,
+   worst sampled admissible-block error, smooth-field matvec error, solution error.
+3. growth exponents: log-log slopes of build time and memory against N.
+
+Each case runs in its own process, so the peak memory reported is that case's.
+"""
+import argparse
+import json
+import os
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+OUT = os.path.join(HERE, "out")
+P = 1e6
+
+
+def planar(n):
+    import hmatddm as hd
+
+    side = int(round(np.sqrt(n)))
+    return hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], float(side), float(side), side, side)
+
+
+def cloud(n, seed=0):
+    """Vertical fractures (10 m high, 8-40 m long, random strike), 1 m elements, in a
+    square domain sized for an areal fracture density of about 0.05 per m^2."""
+    import hmatddm as hd
+
+    rng = np.random.default_rng(seed)
+    parts, total, k = [], 0, 0
+    domain = np.sqrt(n / 10 / 20 / 0.05) * 3
+    while total < n:
+        length = int(rng.integers(8, 41))
+        length = min(length, max(1, (n - total) // 10))
+        strike = rng.uniform(0, np.pi)
+        e1 = np.array([np.cos(strike), np.sin(strike), 0.0])
+        center = np.array([*rng.uniform(-domain / 2, domain / 2, 2), 0.0])
+        parts.append(hd.mesh.rectangle(center, e1, [0, 0, 1], float(length), 10.0, length, 10, fracture_id=k))
+        total += length * 10
+        k += 1
+    return hd.mesh.concatenate(parts)
+
+
+def smooth_field(mesh):
+    """Elliptical opening over each fracture (DESIGN.md sec. 4: the field that matters)."""
+    dd = np.zeros((mesh.n_elements, 3))
+    for k in np.unique(mesh.fracture_id):
+        idx = np.flatnonzero(mesh.fracture_id == k)
+        local = (mesh.centers[idx] - mesh.centers[idx].mean(axis=0)) @ mesh.frames[idx[0], :2].T
+        half = np.abs(local).max(axis=0) + np.array([mesh.half_a[idx[0]], mesh.half_b[idx[0]]])
+        w = np.sqrt(np.clip(1 - np.sum((local / half) ** 2, axis=1), 0, None))
+        dd[idx] = 1e-3 * w[:, None] * mesh.normals[idx]
+    return dd.ravel()
+
+
+def run_case(geometry, n, eps, dense_limit, solve_limit, check_blocks, rtol=1e-8):
+    """One measurement; returns a dict (run in a fresh process by the driver)."""
+    import hmatddm as hd
+    from _common import peak_rss_bytes
+
+    mesh = (planar if geometry == "planar" else cloud)(n)
+    material = hd.Elastic(shear_modulus=10e9, poisson_ratio=0.25)
+    row = dict(geometry=geometry, n=mesh.n_elements, eps=eps, rtol=rtol)
+    op = hd.ElasticityOperator(mesh, material, backend="hmatrix", eps=eps)
+    stats = op.stats
+    row.update(build_s=stats["build_seconds"], memory_mb=stats["memory_bytes"] / 2**20,
+               dense_mb=stats["dense_bytes"] / 2**20, compression=stats["compression"],
+               max_rank=stats["max_rank"], n_admissible=stats["n_admissible"])
+    x_smooth = smooth_field(mesh)
+    x_random = np.random.default_rng(1).normal(size=op.shape[1])
+    op.matvec(x_smooth)
+    times = []
+    for _ in range(5):
+        t0 = time.perf_counter()
+        y_smooth = op.matvec(x_smooth)
+        times.append(time.perf_counter() - t0)
+    row["matvec_s"] = float(np.median(times))
+    y_random = op.matvec(x_random)
+
+    traction = -P * mesh.normals
+    t0 = time.perf_counter()
+    dd, info = hd.solve(op, traction, rtol=rtol, return_info=True)
+    row.update(gmres_s=time.perf_counter() - t0 + 0.0, gmres_iterations=info["iterations"])
+    if check_blocks:
+        row["worst_block_error"] = float(op.check_against_dense(n_samples=200))
+    row["peak_rss_mb"] = peak_rss_bytes() / 2**20  # the H-matrix run only, before any dense work
+
+    if mesh.n_elements <= dense_limit:
+        ref = dense_reference(mesh, material, x_smooth, x_random, traction, op, solve_limit)
+        row.update({k: ref[k] for k in ("dense_build_s", "dense_matvec_s", "dense_solve_s")})
+        row["smooth_error"] = float(np.linalg.norm(y_smooth - ref["smooth"]) / np.linalg.norm(ref["smooth"]))
+        row["random_error"] = float(np.linalg.norm(y_random - ref["random"]) / np.linalg.norm(ref["random"]))
+        row["solution_error"] = float(np.linalg.norm(dd.ravel() - ref["dd"]) / np.linalg.norm(ref["dd"]))
+    else:
+        rows = np.sort(np.random.default_rng(2).choice(mesh.n_elements, 300, replace=False))
+        exact = op.exact_block(rows, np.arange(mesh.n_elements)) @ x_smooth
+        index = (3 * rows[:, None] + np.arange(3)).ravel()
+        row["smooth_error"] = float(np.linalg.norm(y_smooth[index] - exact) / np.linalg.norm(exact))
+        row["smooth_error_sampled"] = True
+    return row
+
+
+def dense_reference(mesh, material, x_smooth, x_random, traction, op, solve_limit):
+    """Dense products and solution, cached in benchmarks/out/ (the eps sweep reuses them)."""
+    import hmatddm as hd
+
+    import hashlib
+
+    digest = hashlib.sha1(mesh.centers.tobytes() + mesh.frames.tobytes()).hexdigest()[:12]
+    path = os.path.join(OUT, f"dense_{mesh.n_elements}_{digest}.npz")
+    if os.path.exists(path):
+        with np.load(path) as f:
+            return {k: (float(f[k]) if f[k].ndim == 0 else f[k]) for k in f.files}
+    t0 = time.perf_counter()
+    dense = hd.ElasticityOperator(mesh, material, backend="dense")
+    ref = dict(dense_build_s=time.perf_counter() - t0)
+    t0 = time.perf_counter()
+    ref["smooth"] = dense.matvec(x_smooth)
+    ref["dense_matvec_s"] = time.perf_counter() - t0
+    ref["random"] = dense.matvec(x_random)
+    t0 = time.perf_counter()
+    if mesh.n_elements <= solve_limit:
+        ref["dd"] = hd.solve(dense, traction).ravel()
+    else:  # dense matvecs inside GMRES, preconditioned by the H near field, to a tight tolerance
+        from hmatddm.hmatrix import gmres
+
+        ref["dd"], _ = gmres(dense, traction.ravel(), M=op.preconditioner(), rtol=1e-12, restart=200, maxiter=5)
+    ref["dense_solve_s"] = time.perf_counter() - t0
+    os.makedirs(OUT, exist_ok=True)
+    np.savez(path, **ref)
+    return ref
+
+
+def spawn(geometry, n, eps, dense_limit=10_000, solve_limit=4_000, check_blocks=False, rtol=1e-8):
+    cmd = [sys.executable, os.path.abspath(__file__), "--case", geometry, "--n", str(n), "--eps", str(eps),
+           "--rtol", str(rtol),
+           "--dense-limit", str(dense_limit), "--solve-limit", str(solve_limit)]
+    if check_blocks:
+        cmd.append("--check-blocks")
+    print("  running", " ".join(cmd[2:]), flush=True)
+    result = subprocess.run(cmd, capture_output=True, text=True, cwd=HERE)
+    if result.returncode != 0:
+        print(result.stdout, result.stderr, file=sys.stderr)
+        return dict(geometry=geometry, n=n, eps=eps, failed=result.stderr.strip().splitlines()[-1:])
+    return json.loads(result.stdout.strip().splitlines()[-1])
+
+
+def fmt(value, spec):
+    return "-" if value is None else format(value, spec)
+
+
+def scaling_table(rows):
+    from _common import markdown_table
+
+    header = ["geometry", "N", "build (s)", "H memory (MB)", "dense (MB)", "compression", "max rank",
+              "matvec (ms)", "GMRES its", "GMRES (s)", "peak RSS (MB)", "dense build (s)", "dense matvec (ms)",
+              "smooth-field error", "random-vector error", "solution error"]
+    body = []
+    for r in rows:
+        if "failed" in r:
+            body.append([r["geometry"], r["n"], "failed: " + " ".join(r["failed"])] + [""] * (len(header) - 3))
+            continue
+        smooth = fmt(r.get("smooth_error"), ".1e") + (" (sampled)" if r.get("smooth_error_sampled") else "")
+        body.append([r["geometry"], r["n"], fmt(r["build_s"], ".1f"), fmt(r["memory_mb"], ".0f"),
+                     fmt(r["dense_mb"], ".0f"), fmt(r["compression"], ".1f"), r["max_rank"],
+                     fmt(r["matvec_s"] * 1e3, ".0f"), r["gmres_iterations"], fmt(r["gmres_s"], ".1f"),
+                     fmt(r["peak_rss_mb"], ".0f"), fmt(r.get("dense_build_s"), ".1f"),
+                     fmt(None if r.get("dense_matvec_s") is None else r["dense_matvec_s"] * 1e3, ".0f"),
+                     smooth, fmt(r.get("random_error"), ".1e"), fmt(r.get("solution_error"), ".1e")])
+    return markdown_table(header, body)
+
+
+def eps_table(rows):
+    from _common import markdown_table
+
+    header = ["eps", "build (s)", "memory (MB)", "compression", "max rank", "matvec (ms)", "GMRES its",
+              "worst block error", "smooth-field error", "solution error"]
+    body = [[f"{r['eps']:.0e}", fmt(r["build_s"], ".1f"), fmt(r["memory_mb"], ".0f"), fmt(r["compression"], ".1f"),
+             r["max_rank"], fmt(r["matvec_s"] * 1e3, ".0f"), r["gmres_iterations"],
+             fmt(r.get("worst_block_error"), ".1e"), fmt(r.get("smooth_error"), ".1e"),
+             fmt(r.get("solution_error"), ".1e")] for r in rows if "failed" not in r]
+    return markdown_table(header, body)
+
+
+def slopes(rows):
+    out = {}
+    for geometry in ("planar", "cloud"):
+        sel = [r for r in rows if r.get("geometry") == geometry and "failed" not in r and r["n"] >= 4000]
+        if len(sel) >= 2:
+            n = np.log([r["n"] for r in sel])
+            out[geometry] = dict(build=float(np.polyfit(n, np.log([r["build_s"] for r in sel]), 1)[0]),
+                                 memory=float(np.polyfit(n, np.log([r["memory_mb"] for r in sel]), 1)[0]),
+                                 matvec=float(np.polyfit(n, np.log([r["matvec_s"] for r in sel]), 1)[0]))
+    return out
+
+
+def plots(scaling, sweep):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+    for geometry, marker in (("planar", "o"), ("cloud", "s")):
+        sel = [r for r in scaling if r.get("geometry") == geometry and "failed" not in r]
+        if not sel:
+            continue
+        n = [r["n"] for r in sel]
+        axes[0].loglog(n, [r["memory_mb"] for r in sel], marker + "-", label=f"H, {geometry}")
+        axes[1].loglog(n, [r["build_s"] for r in sel], marker + "-", label=f"H build, {geometry}")
+        dn = [r["n"] for r in sel if "dense_build_s" in r]
+        axes[1].loglog(dn, [r["dense_build_s"] for r in sel if "dense_build_s" in r], marker + "--",
+                       label=f"dense assembly, {geometry}")
+    nn = np.array([1e3, 1e5])
+    axes[0].loglog(nn, 8 * (3 * nn) ** 2 / 2**20, "k:", label="dense (8 (3N)^2 bytes)")
+    axes[0].set(xlabel="elements N", ylabel="memory (MB)", title="memory, eps = 1e-4")
+    axes[1].set(xlabel="elements N", ylabel="seconds", title="build time, 2 threads")
+    for ax in axes:
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(os.path.join(HERE, "hmatrix_scaling.png"), dpi=110)
+
+    if sweep:
+        fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+        eps = [r["eps"] for r in sweep if "failed" not in r]
+        ok = [r for r in sweep if "failed" not in r]
+        for key, label in (("worst_block_error", "worst block error"), ("smooth_error", "smooth-field matvec error"),
+                           ("solution_error", "solution error")):
+            axes[0].loglog(eps, [r.get(key, np.nan) for r in ok], "o-", label=label)
+        axes[0].loglog(eps, eps, "k:", label="eps")
+        axes[0].set(xlabel="eps", ylabel="relative error", title="accuracy, planar N = 10k")
+        axes[1].semilogx([r["smooth_error"] for r in ok], [r["build_s"] for r in ok], "o-", label="build (s)")
+        axes[1].semilogx([r["smooth_error"] for r in ok], [r["memory_mb"] / 100 for r in ok], "s-",
+                         label="memory (100 MB)")
+        axes[1].set(xlabel="smooth-field error", ylabel="cost", title="cost against error")
+        for ax in axes:
+            ax.grid(True, which="both", alpha=0.3)
+            ax.legend(fontsize=8)
+        fig.tight_layout()
+        fig.savefig(os.path.join(HERE, "hmatrix_eps.png"), dpi=110)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true")
+    parser.add_argument("--case", choices=["planar", "cloud"])
+    parser.add_argument("--n", type=int)
+    parser.add_argument("--eps", type=float, default=1e-4)
+    parser.add_argument("--dense-limit", type=int, default=10_000)
+    parser.add_argument("--solve-limit", type=int, default=4_000)
+    parser.add_argument("--check-blocks", action="store_true")
+    parser.add_argument("--rtol", type=float, default=1e-8)
+    parser.add_argument("--sizes", default=None, help="comma-separated N (default 1000,4000,10000,40000,100000)")
+    parser.add_argument("--skip-sweep", action="store_true")
+    args = parser.parse_args()
+    sys.path.insert(0, HERE)
+    if args.case:
+        print(json.dumps(run_case(args.case, args.n, args.eps, args.dense_limit, args.solve_limit,
+                                  args.check_blocks, args.rtol)))
+        return
+    from _common import machine
+
+    os.makedirs(OUT, exist_ok=True)
+    sizes = [1000, 4000] if args.quick else [1000, 4000, 10000, 40000, 100000]
+    if args.sizes:
+        sizes = [int(s) for s in args.sizes.split(",")]
+    print(f"Machine: {machine()}")
+    scaling = [spawn(g, n, 1e-4) for g in ("planar", "cloud") for n in sizes]
+    with open(os.path.join(OUT, "hmatrix_scaling.json"), "w") as f:
+        json.dump(scaling, f, indent=1)
+    sweep = []
+    if not args.skip_sweep:
+        n_sweep = 4000 if args.quick else 10000
+        eps_list = [1e-2, 1e-4, 1e-6] if args.quick else [1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-8, 1e-10]
+        sweep = [spawn("planar", n_sweep, e, solve_limit=4000, check_blocks=True, rtol=1e-11) for e in eps_list]
+        with open(os.path.join(OUT, "hmatrix_eps.json"), "w") as f:
+            json.dump(sweep, f, indent=1)
+    print("\n## Scaling (eps = 1e-4, eta = 3, leaf 64)\n")
+    print(scaling_table(scaling))
+    if sweep:
+        print(f"\n## Speed against error (planar, N = {sweep[0].get('n')}, GMRES rtol 1e-11)\n")
+        print(eps_table(sweep))
+    print("\n## Growth exponents (log-log slope against N, N >= 4000)\n")
+    for geometry, s in slopes(scaling).items():
+        print(f"- {geometry}: build {s['build']:.2f}, memory {s['memory']:.2f}, matvec {s['matvec']:.2f}")
+    plots(scaling, sweep)
+
+
+if __name__ == "__main__":
+    main()
