@@ -20,6 +20,8 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from .correction import scale_to_self
+
 _INV_4PI = 1.0 / (4.0 * math.pi)
 
 
@@ -147,24 +149,10 @@ def traction_block(data, rows, cols, out):
             j = cols[jb]
             traction_pair(point, normal, centers[j], frames[j], half_length[j], g, nu, shift, pair, work)
             if alpha > 0.0 and i != j:
-                _scale_to_self(pair, alpha * self_max[j])
+                scale_to_self(pair, alpha * self_max[j])
             for p in range(2):
                 for q in range(2):
                     out[2 * ia + p, 2 * jb + q] = pair[p, q]
-
-
-@njit(cache=True)
-def _scale_to_self(pair, limit):
-    """ref. Eq. 6.11: scale a block whose largest entry exceeds ``limit``."""
-    largest = 0.0
-    for p in range(2):
-        for q in range(2):
-            largest = max(largest, abs(pair[p, q]))
-    if largest > limit:
-        factor = limit / largest
-        for p in range(2):
-            for q in range(2):
-                pair[p, q] *= factor
 
 
 @njit(cache=True, parallel=True)
