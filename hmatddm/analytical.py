@@ -46,3 +46,57 @@ def sneddon_axis_stress(z, radius, pressure, poisson_ratio):
     sigma_r = p / np.pi * ((1 + 2 * nu) * (zeta / (1 + zeta**2) - np.arctan(1 / zeta)) + 2 * zeta / (1 + zeta**2) ** 2)
     sigma_z = 2 * p / np.pi * (zeta * (zeta**2 - 1) / (1 + zeta**2) ** 2 - np.arctan(1 / zeta))
     return sigma_r, sigma_z, (2 * sigma_r + sigma_z) / 3.0
+
+
+# --- propagating hydraulic fractures (ref. Sec. 4.5) --------------------------------------
+# Notation: E' plane-strain modulus, K' = 4 sqrt(2/pi) K_Ic (ref. Eq. 4.68),
+# mu' = 12 mu, Q injection rate (m^3/s; per unit height for KGD).
+
+
+def toughness_scale(fracture_toughness):
+    """K' = 4 (2/pi)^(1/2) K_Ic (ref. Eq. 4.68)."""
+    return 4.0 * np.sqrt(2.0 / np.pi) * finite_scalar("fracture_toughness", fracture_toughness)
+
+
+def radial_k_vertex(t, injection_rate, fracture_toughness, material):
+    """Toughness-dominated radial fracture, no leak-off (ref. Eqs 4.65-4.67).
+
+    Exact for zero viscosity: uniform net pressure p, Sneddon's opening, K_I = 2 p (R/pi)^(1/2)
+    equal to K_Ic and the volume 16 p R^3 / (3 E') equal to Q t. Returns
+    ``(radius, max_width, net_pressure)`` (arrays like ``t``); the constants reproduce
+    0.8546, 0.6537 and 0.3004 of the reference.
+    """
+    t = np.asarray(t, dtype=float)
+    e_prime = material.plane_strain_modulus
+    k_ic = finite_scalar("fracture_toughness", fracture_toughness)
+    radius = (3.0 * e_prime * injection_rate * t / (8.0 * np.sqrt(np.pi) * k_ic)) ** 0.4
+    pressure = k_ic * np.sqrt(np.pi) / (2.0 * np.sqrt(radius))
+    return radius, 8.0 * pressure * radius / (np.pi * e_prime), pressure
+
+
+def radial_m_vertex(t, injection_rate, viscosity, material):
+    """Viscosity-dominated radial fracture, no leak-off (ref. Eqs 4.62-4.63, Savitski and
+    Detournay 2002). Returns ``(radius, max_width)``; the net pressure is log-singular at
+    the injection point and is not a single number."""
+    t = np.asarray(t, dtype=float)
+    e_prime = material.plane_strain_modulus
+    mu_prime = 12.0 * finite_scalar("viscosity", viscosity)
+    q = injection_rate
+    radius = 0.6944 * (q**3 * e_prime * t**4 / mu_prime) ** (1.0 / 9.0)
+    max_width = 1.1901 * (mu_prime**2 * q**3 * t / e_prime**2) ** (1.0 / 9.0)
+    return radius, max_width
+
+
+def kgd_k_vertex(t, injection_rate, fracture_toughness, material):
+    """Toughness-dominated plane-strain (KGD) fracture, no leak-off, exact for zero viscosity.
+
+    ``injection_rate`` is per unit height into both wings. Uniform net pressure p with
+    K_I = p (pi l)^(1/2) = K_Ic and volume 2 pi p l^2 / E' = Q t. Returns
+    ``(half_length, max_width, net_pressure)``: l = 0.9324 (E' Q t / K')^(2/3).
+    """
+    t = np.asarray(t, dtype=float)
+    e_prime = material.plane_strain_modulus
+    k_ic = finite_scalar("fracture_toughness", fracture_toughness)
+    half_length = (e_prime * injection_rate * t / (2.0 * np.sqrt(np.pi) * k_ic)) ** (2.0 / 3.0)
+    pressure = k_ic / np.sqrt(np.pi * half_length)
+    return half_length, 4.0 * pressure * half_length / e_prime, pressure
