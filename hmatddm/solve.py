@@ -105,6 +105,8 @@ def stress_at(mesh, material, dd, points, singular_correction="none"):
         raise InputError(f"mesh must be a Mesh2D or Mesh3D, got {type(mesh).__name__}")
     if not isinstance(material, Elastic):
         raise InputError(f"material must be an hmatddm.Elastic, got {type(material).__name__}")
+    if singular_correction not in ("none", "average"):
+        raise InputError(f"singular_correction must be one of ('none', 'average'), got {singular_correction!r}")
     dd = np.ascontiguousarray(_dd_array(mesh, dd))
     points = _check_points(mesh, points)
     shift = 1e-3 if singular_correction == "average" else 0.0

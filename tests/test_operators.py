@@ -91,5 +91,8 @@ def test_stress_at_refuses_points_on_edges(material):
     dd = np.tile([0.0, 1e-4], (2, 1))
     with pytest.raises(hd.InputError, match=r"points\[1\] lies on an element edge"):
         hd.stress_at(mesh, material, dd, [[0.0, 1.0], [1.0, 0.0]])
+    with pytest.raises(hd.InputError, match="singular_correction must be one of"):
+        hd.stress_at(mesh, material, dd, [[0.0, 1.0]], singular_correction="ignore")
+    assert np.all(np.isfinite(hd.stress_at(mesh, material, dd, [[1.0, 0.0]], singular_correction="average")))
     with pytest.raises(hd.InputError, match=r"points must have shape \(N, 2\)"):
         hd.stress_at(mesh, material, dd, [[0.0, 1.0, 2.0]])
