@@ -1,0 +1,255 @@
+"""Nonlinear solution of one time step of the coupled system (ref. Sec. 4.4, Eq. 4.41)::
+
+    [ A  B ] [DD]   [f]        A: elasticity (dense or H-matrix), B p = p_i n_i,
+    [ C  D ] [p ] = [g]        C, D, g: lubrication (hmatddm.flow.lubrication)
+
+``D`` and ``g`` depend on the widths, so the system is iterated (Picard, widths lagged)
+until the changes of ``p`` and ``DD`` fall below the tolerances of ref. Eqs 4.43-4.44.
+Four schemes:
+
+* ``"fixed-width"`` (ref. Eq. 4.46): ``p = D^-1 (g - C DD^k)``, then ``DD = A^-1 (f - B p)``.
+* ``"fracture-compliance"`` (ref. Eqs 4.48-4.51): the flow solve carries ``omega C'``,
+  ``C' = diag(S_i c_i)/dt`` with the self compliance ``c_i`` of ref. Eq. 4.49.
+* ``"fully-coupled"`` (ref. Eqs 4.52-4.61): the whole system at once, scaled by
+  ``M_1`` (element diagonal blocks of A and the diagonal of D times ``s_u``, ``s_p``)
+  and ``M_2`` (``s_u``, ``s_p``), solved by GMRES (the reference used BiCGSTAB).
+* ``"krylov"`` (beyond the reference): the same scaled system, GMRES preconditioned by
+  the fracture-compliance split ``P = [[A~, B], [0, D + C']]`` with ``A~^-1`` the
+  LU solve (dense) or the near-field ILU (H-matrix). One application costs one
+  sparse flow solve and one near-field solve; no inner iteration.
+
+Segregated schemes relax (ref. Eq. 4.47) with ``alpha``; when an iteration diverges
+or does not converge, ``alpha`` is halved and the step restarted (ref. Fig. 4.10).
+"""
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from .._validation import finite_scalar, positive_int
+from ..errors import ConvergenceError, InputError
+from ..hmatrix import gmres
+
+SCHEMES = ("fixed-width", "fracture-compliance", "fully-coupled", "krylov")
+
+
+@dataclass(frozen=True)
+class SchemeSettings:
+    """Nonlinear and linear solver settings of a time step.
+
+    Parameters
+    ----------
+    scheme : one of ``SCHEMES``
+    omega : float in [0, 1], weight of the compliance term (ref. Eq. 4.50)
+    relaxation : float in (0, 1], initial relaxation factor alpha (ref. Eq. 4.47)
+    min_relaxation : float, the smallest alpha tried before giving up
+    tolerance_pressure, tolerance_opening : eps_p, eps_u of ref. Eqs 4.43-4.44
+    max_iterations : nonlinear iterations per attempt
+    linear_rtol : relative residual asked of every GMRES solve
+    linear_maxiter : GMRES restart cycles (of ``linear_restart`` iterations)
+    """
+
+    scheme: str = "krylov"
+    omega: float = 1.0
+    relaxation: float = 1.0
+    min_relaxation: float = 1.0 / 256.0
+    tolerance_pressure: float = 1e-6
+    tolerance_opening: float = 1e-6
+    max_iterations: int = 400
+    linear_rtol: float = 1e-9
+    linear_restart: int = 100
+    linear_maxiter: int = 20
+
+    def __post_init__(self):
+        if self.scheme not in SCHEMES:
+            raise InputError(f"scheme must be one of {SCHEMES}, got {self.scheme!r}")
+        for name, low, high in (("omega", 0.0, 1.0), ("relaxation", 1e-12, 1.0), ("min_relaxation", 1e-12, 1.0)):
+            value = finite_scalar(name, getattr(self, name))
+            if not low <= value <= high:
+                raise InputError(f"{name} must be in [{low:g}, {high:g}], got {value}")
+            object.__setattr__(self, name, value)
+        for name in ("tolerance_pressure", "tolerance_opening", "linear_rtol"):
+            value = finite_scalar(name, getattr(self, name))
+            if not 0.0 < value < 1.0:
+                raise InputError(f"{name} must be in (0, 1), got {value}")
+            object.__setattr__(self, name, value)
+        for name in ("max_iterations", "linear_restart", "linear_maxiter"):
+            object.__setattr__(self, name, positive_int(name, getattr(self, name)))
+
+
+@dataclass
+class StepProblem:
+    """Everything one time step needs: ``A`` (an ElasticSolver), the flow model and
+    the old state (widths lag inside :meth:`flow_matrices`)."""
+
+    elastic: object          # ElasticSolver
+    normals: np.ndarray      # (N, d)
+    far_field: np.ndarray    # (dN,) f = -sigma_0 . n (ref. Eq. 4.4)
+    flow: object             # LubricationModel
+    compliance: np.ndarray   # (N,) c_i (ref. Eq. 4.49)
+    dt: float
+    width_old: np.ndarray    # (N,) w^n
+    pressure_old: np.ndarray  # (N,) p^n
+    leak_off_rate: np.ndarray  # (N,) Lambda_i
+
+    def __post_init__(self):
+        self.n, self.d = self.normals.shape
+        self.coupling = self.flow.coupling_matrix(self.dt)
+        self.compliance_term = self.flow.areas * self.compliance / self.dt  # diagonal of C'
+
+    def width(self, dd):
+        return np.sum(dd.reshape(self.n, self.d) * self.normals, axis=1)
+
+    def b_times(self, p):
+        return (self.normals * p[:, None]).ravel()
+
+    def flow_matrices(self, dd):
+        return self.flow.assemble(self.width(dd), self.width_old, self.pressure_old, self.dt, self.leak_off_rate)
+
+
+def _relative_change(new, old):
+    scale = np.max(np.abs(old))
+    change = np.max(np.abs(new - old))
+    if scale == 0.0:
+        return 0.0 if change == 0.0 else math.inf
+    return change / scale
+
+
+class _Diverged(Exception):
+    pass
+
+
+def _segregated_iteration(problem, settings, dd, p, alpha, counters):
+    matrix, rhs = problem.flow_matrices(dd)
+    rhs = rhs - problem.coupling @ dd
+    if settings.scheme == "fracture-compliance" and settings.omega > 0.0:
+        correction = settings.omega * problem.compliance_term
+        matrix = matrix + sp.diags(correction)
+        rhs = rhs + correction * p
+    p_new = spla.spsolve(matrix.tocsc(), rhs)
+    dd_new, iterations = problem.elastic.solve(problem.far_field - problem.b_times(p_new), x0=dd)
+    counters["linear"] += iterations
+    return alpha * dd_new + (1.0 - alpha) * dd, alpha * p_new + (1.0 - alpha) * p
+
+
+class _CoupledLinearSystem:
+    """The scaled coupled matrix ``M_1^-1 A M_2`` of ref. Eqs 4.53-4.61 for fixed D."""
+
+    def __init__(self, problem, matrix, dd, p):
+        self.problem = problem
+        self.flow_matrix = matrix.tocsr()
+        n, d = problem.n, problem.d
+        self.s_u = max(float(np.max(np.abs(dd))), 1e-12)
+        self.s_p = max(float(np.max(np.abs(p))), 1.0)
+        blocks = problem.elastic.diagonal_blocks()
+        self.block_inverse = np.linalg.inv(blocks)  # (N, d, d), M_u^-1 without s_u
+        self.flow_diagonal = self.flow_matrix.diagonal()
+        size = n * d + n
+        self.operator = spla.LinearOperator((size, size), matvec=self._matvec, dtype=np.float64)
+
+    def left_scale(self, residual_u, residual_p):
+        n, d = self.problem.n, self.problem.d
+        u = np.einsum("eij,ej->ei", self.block_inverse, residual_u.reshape(n, d)).ravel() / self.s_u
+        return np.concatenate([u, residual_p / (self.s_p * self.flow_diagonal)])
+
+    def unscale_left(self, z):
+        """Inverse of :meth:`left_scale`."""
+        n, d = self.problem.n, self.problem.d
+        blocks = self.problem.elastic.diagonal_blocks()
+        u = np.einsum("eij,ej->ei", blocks, z[:n * d].reshape(n, d)).ravel() * self.s_u
+        return u, z[n * d:] * self.s_p * self.flow_diagonal
+
+    def split(self, y):
+        nd = self.problem.n * self.problem.d
+        return y[:nd] * self.s_u, y[nd:] * self.s_p
+
+    def _matvec(self, y):
+        dd, p = self.split(np.asarray(y).ravel())
+        problem = self.problem
+        u = problem.elastic.matvec(dd) + problem.b_times(p)
+        q = problem.coupling @ dd + self.flow_matrix @ p
+        return self.left_scale(u, q)
+
+    def rhs(self, flow_rhs):
+        return self.left_scale(self.problem.far_field, flow_rhs)
+
+    def compliance_preconditioner(self, omega):
+        """Inverse of the scaled fracture-compliance split, as a LinearOperator."""
+        problem = self.problem
+        schur = (self.flow_matrix + sp.diags(omega * problem.compliance_term)).tocsc()
+        flow_lu = spla.splu(schur)
+        nd = problem.n * problem.d
+
+        def apply(z):
+            r_u, r_p = self.unscale_left(np.asarray(z).ravel())
+            p = flow_lu.solve(r_p)
+            dd = problem.elastic.approximate_inverse(r_u - problem.b_times(p))
+            return np.concatenate([dd / self.s_u, p / self.s_p])
+
+        return spla.LinearOperator((nd + problem.n,) * 2, matvec=apply, dtype=np.float64)
+
+
+def _coupled_iteration(problem, settings, dd, p, alpha, counters):
+    matrix, flow_rhs = problem.flow_matrices(dd)
+    system = _CoupledLinearSystem(problem, matrix, dd, p)
+    preconditioner = None
+    if settings.scheme == "krylov":
+        preconditioner = system.compliance_preconditioner(settings.omega)
+    guess = np.concatenate([dd / system.s_u, p / system.s_p])
+    try:
+        y, info = gmres(system.operator, system.rhs(flow_rhs), M=preconditioner, rtol=settings.linear_rtol,
+                        restart=settings.linear_restart, maxiter=settings.linear_maxiter, x0=guess)
+    except ConvergenceError as error:
+        counters["linear"] += error.iterations or 0
+        raise _Diverged(str(error)) from None
+    counters["linear"] += info["iterations"]
+    dd_new, p_new = system.split(y)
+    return alpha * dd_new + (1.0 - alpha) * dd, alpha * p_new + (1.0 - alpha) * p
+
+
+def solve_step(problem, settings, dd_guess, p_guess, relaxation):
+    """Iterate one time step to convergence (ref. Eqs 4.43-4.44).
+
+    Returns ``(dd, p, info)``; ``info`` has ``nonlinear_iterations`` (all attempts),
+    ``linear_iterations`` (GMRES iterations), ``relaxation`` (the alpha that
+    converged), ``restarts`` and ``solve_seconds``. Raises ConvergenceError when even
+    ``min_relaxation`` fails.
+    """
+    start = time.perf_counter()
+    iterate = _coupled_iteration if settings.scheme in ("fully-coupled", "krylov") else _segregated_iteration
+    counters = {"nonlinear": 0, "linear": 0}
+    alpha = relaxation
+    restarts = 0
+    while True:
+        dd, p = dd_guess.copy(), p_guess.copy()
+        history = []
+        try:
+            for _ in range(settings.max_iterations):
+                counters["nonlinear"] += 1
+                dd_new, p_new = iterate(problem, settings, dd, p, alpha, counters)
+                if not (np.all(np.isfinite(dd_new)) and np.all(np.isfinite(p_new))):
+                    raise _Diverged("non-finite iterate")
+                change_p = _relative_change(p_new, p)
+                change_u = _relative_change(dd_new, dd)
+                dd, p = dd_new, p_new
+                if change_p < settings.tolerance_pressure and change_u < settings.tolerance_opening:
+                    info = dict(nonlinear_iterations=counters["nonlinear"], linear_iterations=counters["linear"],
+                                relaxation=alpha, restarts=restarts, solve_seconds=time.perf_counter() - start)
+                    return dd, p, info
+                history.append(max(change_p, change_u))
+                if len(history) > 6 and all(history[-i] > history[-i - 1] for i in range(1, 6)):
+                    raise _Diverged("changes grew for 5 iterations")
+                if history[-1] > 1e6:
+                    raise _Diverged(f"relative change {history[-1]:.2e}")
+            raise _Diverged(f"no convergence in {settings.max_iterations} iterations "
+                            f"(last relative change {history[-1]:.2e})")
+        except _Diverged as reason:
+            if alpha / 2.0 < settings.min_relaxation:
+                raise ConvergenceError(
+                    f"time step did not converge with scheme {settings.scheme!r} down to relaxation "
+                    f"{alpha:g}: {reason}", iterations=counters["nonlinear"]) from None
+            alpha /= 2.0
+            restarts += 1

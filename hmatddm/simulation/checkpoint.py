@@ -1,0 +1,134 @@
+"""Atomic, checksummed checkpoints that never execute code when read.
+
+A checkpoint is two files in the checkpoint folder:
+
+* ``step-NNNNNN.npz``: the arrays (``numpy.savez``; read with ``allow_pickle=False``),
+* ``step-NNNNNN.json``: metadata (time, step, records, settings fingerprint) and the
+  SHA-256 of the ``.npz`` bytes.
+
+Each file is written to a temporary name in the same folder, flushed to disk and
+renamed (``os.replace`` is atomic on POSIX and Windows), the ``.json`` last, so a
+checkpoint whose ``.json`` exists is complete. :func:`load_latest` verifies the
+checksum and falls back to the previous checkpoint when the newest is truncated or
+corrupted, saying so in a logged warning.
+"""
+import hashlib
+import json
+import logging
+import os
+import re
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import HmatddmError
+
+logger = logging.getLogger(__name__)
+_NAME = re.compile(r"^step-(\d{6,})\.json$")
+FORMAT_VERSION = 1
+
+
+class CheckpointError(HmatddmError):
+    """No usable checkpoint, or a checkpoint folder that cannot be written."""
+
+
+def _atomic_write(path, write):
+    path = Path(path)
+    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    try:
+        with os.fdopen(handle, "wb") as stream:
+            write(stream)
+            stream.flush()
+            os.fsync(stream.fileno())
+        os.replace(temporary, path)
+    except BaseException:
+        if os.path.exists(temporary):
+            os.unlink(temporary)
+        raise
+
+
+def check_writable(folder):
+    """Create ``folder`` if needed and prove a file can be written there."""
+    folder = Path(folder)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        _atomic_write(folder / ".write-test", lambda stream: stream.write(b"ok"))
+        (folder / ".write-test").unlink()
+    except OSError as error:
+        raise CheckpointError(f"checkpoint folder {str(folder)!r} is not writable: {error.strerror or error}") from None
+    return folder
+
+
+def save(folder, step, arrays, metadata, keep=3):
+    """Write checkpoint ``step`` (arrays: dict of numpy arrays; metadata: JSON-able dict).
+
+    Keeps the newest ``keep`` checkpoints and deletes older ones.
+    """
+    folder = Path(folder)
+    stem = f"step-{step:06d}"
+    import io
+
+    buffer = io.BytesIO()
+    np.savez(buffer, **{key: np.asarray(value) for key, value in arrays.items()})
+    payload = buffer.getvalue()
+    digest = hashlib.sha256(payload).hexdigest()
+    try:
+        _atomic_write(folder / f"{stem}.npz", lambda stream: stream.write(payload))
+        document = dict(metadata, format_version=FORMAT_VERSION, step=step, arrays_sha256=digest)
+        text = json.dumps(document, indent=1, sort_keys=True, allow_nan=False).encode()
+        _atomic_write(folder / f"{stem}.json", lambda stream: stream.write(text))
+    except OSError as error:
+        raise CheckpointError(f"could not write checkpoint {stem} in {str(folder)!r}: "
+                              f"{error.strerror or error}") from None
+    for old in list_checkpoints(folder)[:-keep]:
+        for suffix in (".json", ".npz"):
+            try:
+                (folder / f"step-{old:06d}{suffix}").unlink()
+            except FileNotFoundError:
+                pass
+
+
+def list_checkpoints(folder):
+    """Steps with a metadata file, ascending."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        return []
+    return sorted(int(m.group(1)) for name in os.listdir(folder) if (m := _NAME.match(name)))
+
+
+def load(folder, step):
+    """``(arrays, metadata)`` of one checkpoint; CheckpointError if damaged."""
+    folder = Path(folder)
+    stem = f"step-{step:06d}"
+    try:
+        metadata = json.loads((folder / f"{stem}.json").read_text())
+        payload = (folder / f"{stem}.npz").read_bytes()
+    except (OSError, ValueError) as error:
+        raise CheckpointError(f"checkpoint {stem} is unreadable: {error}") from None
+    if metadata.get("format_version") != FORMAT_VERSION:
+        raise CheckpointError(f"checkpoint {stem} has format {metadata.get('format_version')!r}, "
+                              f"expected {FORMAT_VERSION}")
+    if hashlib.sha256(payload).hexdigest() != metadata.get("arrays_sha256"):
+        raise CheckpointError(f"checkpoint {stem} is corrupted or truncated (SHA-256 mismatch)")
+    import io
+
+    with np.load(io.BytesIO(payload), allow_pickle=False) as data:
+        arrays = {key: data[key] for key in data.files}
+    return arrays, metadata
+
+
+def load_latest(folder):
+    """The newest checkpoint that verifies, falling back over damaged ones.
+
+    Raises CheckpointError when there is none.
+    """
+    steps = list_checkpoints(folder)
+    if not steps:
+        raise CheckpointError(f"no checkpoint found in {str(folder)!r}")
+    for step in reversed(steps):
+        try:
+            return load(folder, step)
+        except CheckpointError as error:
+            logger.warning("%s; trying the previous checkpoint", error)
+    raise CheckpointError(f"every checkpoint in {str(folder)!r} is damaged")

@@ -1,0 +1,329 @@
+"""The time loop of a hydraulic-fracturing simulation (ref. Ch. 4, Fig. 4.1).
+
+Each time step: solve the coupled system (:mod:`hmatddm.coupled`); check the
+propagation criterion along the tip edges (:mod:`hmatddm.fracture`); if any edge
+grows, add elements ahead of it and solve the same step again, until no edge grows
+(or ``max_growth_passes``). The elasticity operator is rebuilt only when the mesh
+has grown, never inside the nonlinear iterations.
+
+After every accepted step a record is appended to :attr:`Simulation.records` and,
+with a ``checkpoint_dir``, an atomic checkpoint is written; :meth:`Simulation.run`
+with ``resume=True`` continues from the newest good checkpoint and gives the same
+numbers as an uninterrupted run (everything the loop carries from one step to the
+next is in the checkpoint).
+"""
+import hashlib
+import json
+import logging
+import time
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from .. import topology
+from .._validation import finite_array, finite_scalar, positive_scalar
+from ..coupled import ElasticSolver, SchemeSettings, StepProblem, solve_step
+from ..errors import InputError
+from ..flow import Cluster, Fluid, LeakOff, LubricationModel, fracture_compliance
+from ..fracture import Propagation, evaluate_tips, new_elements
+from ..material import Elastic
+from ..mesh import Mesh2D, Mesh3D, concatenate
+from ..operators import BACKENDS, DEFAULT_EPS, DEFAULT_ETA, DEFAULT_LEAF_SIZE, ElasticityOperator
+from . import checkpoint
+
+logger = logging.getLogger(__name__)
+
+RECORD_KEYS = ("time", "n_elements", "injected_volume", "fracture_volume", "fracture_area", "max_opening",
+               "wellbore_pressure", "nonlinear_iterations", "linear_iterations", "solve_seconds")
+
+
+@dataclass
+class State:
+    """What the loop carries between steps (all of it goes into a checkpoint)."""
+
+    mesh: object
+    dd: np.ndarray             # (N, d)
+    pressure: np.ndarray       # (N,)
+    creation_time: np.ndarray  # (N,) tau_i of Carter's leak-off
+    time: float
+    step: int
+    relaxation: float
+    injected_volume: float
+    leaked_volume: float
+
+
+def _mesh_arrays(mesh):
+    if isinstance(mesh, Mesh3D):
+        return dict(centers=mesh.centers, frames=mesh.frames, half_a=mesh.half_a, half_b=mesh.half_b,
+                    fracture_id=mesh.fracture_id)
+    return dict(centers=mesh.centers, frames=mesh.frames, half_length=mesh.half_length,
+                fracture_id=mesh.fracture_id)
+
+
+def _mesh_from_arrays(arrays):
+    if "half_a" in arrays:
+        return Mesh3D(arrays["centers"], arrays["frames"], arrays["half_a"], arrays["half_b"],
+                      arrays["fracture_id"].astype(np.int64))
+    return Mesh2D(arrays["centers"], arrays["frames"], arrays["half_length"], arrays["fracture_id"].astype(np.int64))
+
+
+class Simulation:
+    """A hydraulic fracture (or several) driven by injection (ref. Ch. 4).
+
+    Parameters
+    ----------
+    mesh : Mesh2D or Mesh3D
+        The initial fracture(s).
+    material : Elastic
+    fluid : Fluid
+    clusters : list of Cluster
+        Injection points; each feeds the element nearest its position.
+    far_field_stress : (d, d) array
+        In-situ stress tensor, tension positive (a 8 MPa minimum horizontal stress
+        along x is ``-8e6`` in entry ``[0, 0]``), Pa.
+    time_step : float
+        dt, s.
+    propagation : Propagation or None
+        None: the mesh is fixed.
+    leak_off : LeakOff
+    initial_pressure : float
+        Fluid pressure in the fractures and wellbores at t = 0, Pa.
+    initial_opening : float
+        Opening of the initial elements at t = 0, m (ref. Table 4.1).
+    minimum_width : float or None
+        Width floor of the flow model (default: ``initial_opening``), m.
+    height : float
+        2D only: the flow height of the plane-strain fracture, m (ref. Table 4.2).
+    backend, eps, eta, leaf_size, singular_correction, alpha
+        Passed to :class:`~hmatddm.ElasticityOperator`.
+    scheme : str or SchemeSettings
+        Coupling scheme (``"krylov"`` default; see :mod:`hmatddm.coupled.schemes`).
+    growing_fractures : iterable of int or None
+        Fracture ids allowed to grow (default: all).
+    checkpoint_dir : path or None
+        Where to write a checkpoint after every step.
+    keep_checkpoints : int
+    """
+
+    def __init__(self, mesh, material, fluid, clusters, far_field_stress, time_step, propagation=None,
+                 leak_off=None, initial_pressure=0.0, initial_opening=1e-5, minimum_width=None, height=1.0,
+                 backend="hmatrix", eps=DEFAULT_EPS, eta=DEFAULT_ETA, leaf_size=DEFAULT_LEAF_SIZE,
+                 singular_correction="none", alpha=None, scheme="krylov", growing_fractures=None,
+                 checkpoint_dir=None, keep_checkpoints=3):
+        if not isinstance(mesh, (Mesh2D, Mesh3D)):
+            raise InputError(f"mesh must be a Mesh2D or Mesh3D, got {type(mesh).__name__}")
+        if not isinstance(material, Elastic):
+            raise InputError(f"material must be an hmatddm.Elastic, got {type(material).__name__}")
+        if not isinstance(fluid, Fluid):
+            raise InputError(f"fluid must be an hmatddm.Fluid, got {type(fluid).__name__}")
+        clusters = list(clusters)
+        if not clusters or not all(isinstance(c, Cluster) for c in clusters):
+            raise InputError("clusters must be a non-empty list of hmatddm.Cluster")
+        if propagation is not None and not isinstance(propagation, Propagation):
+            raise InputError(f"propagation must be an hmatddm.Propagation or None, got {type(propagation).__name__}")
+        leak_off = LeakOff() if leak_off is None else leak_off
+        if not isinstance(leak_off, LeakOff):
+            raise InputError(f"leak_off must be an hmatddm.LeakOff, got {type(leak_off).__name__}")
+        if backend not in BACKENDS:
+            raise InputError(f"backend must be one of {BACKENDS}, got {backend!r}")
+        d = mesh.dim
+        self.far_field_stress = finite_array("far_field_stress", far_field_stress, (d, d))
+        if not np.allclose(self.far_field_stress, self.far_field_stress.T, rtol=0, atol=1e-9 * (1 + np.abs(self.far_field_stress).max())):
+            raise InputError("far_field_stress must be a symmetric tensor")
+        self.mesh0 = mesh
+        self.material, self.fluid, self.clusters, self.leak_off = material, fluid, clusters, leak_off
+        self.propagation = propagation
+        self.time_step = positive_scalar("time_step", time_step)
+        self.initial_pressure = finite_scalar("initial_pressure", initial_pressure)
+        self.initial_opening = finite_scalar("initial_opening", initial_opening)
+        if self.initial_opening < 0.0:
+            raise InputError(f"initial_opening must be >= 0 m, got {self.initial_opening}")
+        minimum_width = self.initial_opening if minimum_width is None else minimum_width
+        self.minimum_width = positive_scalar("minimum_width", minimum_width)
+        self.height = positive_scalar("height", height)
+        self.operator_options = dict(backend=backend, eps=eps, eta=eta, leaf_size=leaf_size,
+                                     singular_correction=singular_correction, alpha=alpha)
+        self.settings = scheme if isinstance(scheme, SchemeSettings) else SchemeSettings(scheme=scheme)
+        self.growing_fractures = None if growing_fractures is None else np.asarray(sorted(growing_fractures), np.int64)
+        self.injection_elements = np.array([c.nearest_element(mesh) for c in clusters], dtype=np.int64)
+        self.checkpoint_dir = checkpoint_dir
+        self.keep_checkpoints = keep_checkpoints
+        self.records = []
+        self.state = self._initial_state()
+        self._operator_mesh = None
+        self._operator = None
+        self.operator_builds = 0
+
+    # -- setup ------------------------------------------------------------------------
+    def _initial_state(self):
+        mesh = self.mesh0
+        dd = self.initial_opening * mesh.normals
+        pressure = np.full(mesh.n_elements, self.initial_pressure)
+        return State(mesh, dd, pressure, np.zeros(mesh.n_elements), 0.0, 0, self.settings.relaxation, 0.0, 0.0)
+
+    def fingerprint(self):
+        """SHA-256 of everything that defines the run (a resume must match it)."""
+        parts = dict(material=asdict(self.material), fluid=asdict(self.fluid),
+                     clusters=[asdict(c) for c in self.clusters], leak_off=asdict(self.leak_off),
+                     propagation=None if self.propagation is None else repr(self.propagation),
+                     far_field_stress=self.far_field_stress.tolist(), time_step=self.time_step,
+                     initial_pressure=self.initial_pressure, initial_opening=self.initial_opening,
+                     minimum_width=self.minimum_width, height=self.height, operator=self.operator_options,
+                     settings=repr(self.settings),
+                     growing=None if self.growing_fractures is None else self.growing_fractures.tolist())
+        digest = hashlib.sha256(json.dumps(parts, sort_keys=True, default=str).encode())
+        for value in _mesh_arrays(self.mesh0).values():
+            digest.update(np.ascontiguousarray(value).tobytes())
+        return digest.hexdigest()
+
+    def operator(self, mesh):
+        """The elasticity operator of ``mesh`` (rebuilt only when the mesh changed)."""
+        if self._operator_mesh is not mesh:
+            self._operator = ElasticityOperator(mesh, self.material, **self.operator_options)
+            self._operator_mesh = mesh
+            self.operator_builds += 1
+        return self._operator
+
+    def far_field_traction(self, mesh):
+        """f = -sigma_0 . n at every element (ref. Eq. 4.4, our sign), flat."""
+        return -(mesh.normals @ self.far_field_stress.T).ravel()
+
+    def flow_model(self, mesh, faces):
+        areas = mesh.areas * (self.height if mesh.dim == 2 else 1.0)
+        return LubricationModel(areas=areas, normals=mesh.normals, faces=faces, fluid=self.fluid,
+                                leak_off=self.leak_off, injection_elements=self.injection_elements,
+                                injection_rates=np.array([c.rate for c in self.clusters]),
+                                wellbore_volumes=np.array([c.wellbore_volume for c in self.clusters]),
+                                minimum_width=self.minimum_width)
+
+    # -- one step -------------------------------------------------------------------------
+    def _solve(self, mesh, dd_old_width, p_old, creation_time, dd_guess, p_guess, t_old, t_new, relaxation):
+        edges = topology.element_edges(mesh, self.height)
+        faces = topology.element_faces(mesh, edges)
+        flow = self.flow_model(mesh, faces)
+        op = self.operator(mesh)
+        problem = StepProblem(elastic=ElasticSolver(op, rtol=self.settings.linear_rtol), normals=mesh.normals,
+                              far_field=self.far_field_traction(mesh), flow=flow,
+                              compliance=fracture_compliance(mesh, self.material), dt=t_new - t_old,
+                              width_old=dd_old_width, pressure_old=p_old,
+                              leak_off_rate=flow.leak_off_rate(creation_time, t_old, t_new))
+        dd, p, info = solve_step(problem, self.settings, dd_guess.ravel(), p_guess, relaxation)
+        return dd.reshape(mesh.n_elements, mesh.dim), p, info, edges, faces, flow
+
+    def step(self):
+        """Advance one time step (with growth passes); returns the record."""
+        start = time.perf_counter()
+        s = self.state
+        t_old, t_new = s.time, s.time + self.time_step
+        mesh = s.mesh
+        width_old = np.sum(s.dd * mesh.normals, axis=1)
+        p_old = s.pressure.copy()
+        creation = s.creation_time.copy()
+        dd, p = s.dd.copy(), s.pressure.copy()
+        totals = dict(nonlinear_iterations=0, linear_iterations=0, restarts=0)
+        added = 0
+        passes = 0
+        relaxation = s.relaxation
+        builds = self.operator_builds
+        while True:
+            dd, p, info, edges, faces, flow = self._solve(mesh, width_old, p_old, creation, dd, p,
+                                                          t_old, t_new, relaxation)
+            relaxation = info["relaxation"]
+            for key in totals:
+                totals[key] += info[key]
+            if self.propagation is None or passes >= self.propagation.max_growth_passes:
+                break
+            grown = self._grow(mesh, edges, faces, dd)
+            if grown is None:
+                break
+            new_mesh, parent = grown
+            passes += 1
+            added += new_mesh.n_elements
+            mesh = concatenate([mesh, new_mesh])
+            width_old = np.concatenate([width_old, np.zeros(new_mesh.n_elements)])
+            p_old = np.concatenate([p_old, p_old[parent]])
+            creation = np.concatenate([creation, np.full(new_mesh.n_elements, t_old)])
+            dd = np.concatenate([dd, dd[parent]])
+            p = np.concatenate([p, p[parent]])
+
+        width = np.sum(dd * mesh.normals, axis=1)
+        leak = flow.leak_off_rate(creation, t_old, t_new) * flow.areas * (p - self.leak_off.pore_pressure)
+        injected = s.injected_volume + self.time_step * sum(c.rate for c in self.clusters)
+        leaked = s.leaked_volume + float(np.sum(leak)) * self.time_step
+        self.state = State(mesh, dd, p, creation, t_new, s.step + 1, relaxation, injected, leaked)
+        record = self._record(flow, width, totals, added, passes, relaxation, time.perf_counter() - start,
+                              self.operator_builds - builds)
+        self.records.append(record)
+        return record
+
+    def _grow(self, mesh, edges, faces, dd):
+        element, edge = topology.tip_edges(mesh, faces, edges)
+        if self.growing_fractures is not None:
+            keep = np.isin(mesh.fracture_id[element], self.growing_fractures)
+            element, edge = element[keep], edge[keep]
+        if element.size == 0:
+            return None
+        tips = evaluate_tips(mesh, edges, element, edge, dd, self.material, self.propagation)
+        return new_elements(mesh, edges, tips, self.propagation)
+
+    def _record(self, flow, width, totals, added, passes, relaxation, seconds, builds):
+        s = self.state
+        mesh = s.mesh
+        area = float(np.sum(flow.areas))
+        record = dict(
+            step=s.step, time=s.time, n_elements=int(mesh.n_elements), injected_volume=s.injected_volume,
+            fracture_volume=float(np.sum(flow.areas * width)), fracture_area=area,
+            max_opening=float(np.max(width)),
+            wellbore_pressure=[float(s.pressure[i]) for i in self.injection_elements],
+            nonlinear_iterations=int(totals["nonlinear_iterations"]),
+            linear_iterations=int(totals["linear_iterations"]), solve_seconds=float(seconds),
+            leaked_volume=s.leaked_volume, relaxation=float(relaxation), restarts=int(totals["restarts"]),
+            elements_added=int(added), growth_passes=int(passes), operator_builds=int(builds))
+        if mesh.dim == 3:
+            record["radius"] = float(np.sqrt(area / np.pi))
+        else:
+            record["half_length"] = float(np.sum(mesh.areas) / 2.0)
+        return record
+
+    # -- run, checkpoints, resume -------------------------------------------------------
+    def run(self, end_time, resume=False, callback=None):
+        """Step until ``end_time`` (s); returns the list of records.
+
+        ``resume=True`` first loads the newest good checkpoint of ``checkpoint_dir``
+        (CheckpointError when there is none or when it belongs to another run).
+        ``callback(simulation, record)`` is called after every step.
+        """
+        end_time = positive_scalar("end_time", end_time)
+        if self.checkpoint_dir is not None:
+            checkpoint.check_writable(self.checkpoint_dir)
+        if resume:
+            if self.checkpoint_dir is None:
+                raise InputError("resume=True needs a checkpoint_dir")
+            self.load_checkpoint()
+        while self.state.time < end_time - 1e-9 * self.time_step:
+            record = self.step()
+            if self.checkpoint_dir is not None:
+                self.save_checkpoint()
+            if callback is not None:
+                callback(self, record)
+        return self.records
+
+    def save_checkpoint(self):
+        s = self.state
+        arrays = dict(_mesh_arrays(s.mesh), dd=s.dd, pressure=s.pressure, creation_time=s.creation_time)
+        metadata = dict(time=s.time, step=s.step, relaxation=s.relaxation, injected_volume=s.injected_volume,
+                        leaked_volume=s.leaked_volume, records=self.records, fingerprint=self.fingerprint())
+        checkpoint.save(self.checkpoint_dir, s.step, arrays, metadata, keep=self.keep_checkpoints)
+
+    def load_checkpoint(self):
+        arrays, metadata = checkpoint.load_latest(self.checkpoint_dir)
+        if metadata.get("fingerprint") != self.fingerprint():
+            raise checkpoint.CheckpointError(
+                f"the checkpoints in {str(self.checkpoint_dir)!r} belong to a different run "
+                "(settings or initial mesh differ); use another checkpoint folder")
+        mesh = _mesh_from_arrays(arrays)
+        self.state = State(mesh, arrays["dd"], arrays["pressure"], arrays["creation_time"], float(metadata["time"]),
+                           int(metadata["step"]), float(metadata["relaxation"]), float(metadata["injected_volume"]),
+                           float(metadata["leaked_volume"]))
+        self.records = list(metadata["records"])
+        return self.state
