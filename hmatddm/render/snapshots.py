@@ -1,0 +1,401 @@
+"""Offscreen PNG snapshots of fractures with pyvista (no window ever opens).
+
+:func:`snapshot` draws one view of a mesh:
+
+* elements coloured by their ``opening`` (metres in, millimetres on the scalar bar);
+* with a per-element ``state``: hydraulic-fracture elements (0) coloured by opening,
+  intact natural-fracture elements (1) as a light grey wireframe (they are stress
+  targets, not unknowns, so their opening means nothing), failed natural-fracture
+  elements (2) coloured by opening and outlined in red (each failed patch, and
+  every element border on small meshes);
+* with ``slip`` vectors: arrows at the elements that slip (magnitude above
+  ``1e-3`` of the largest), their length proportional to the slip;
+* ``view="plan"`` looks down ``-z`` (map view, parallel projection),
+  ``view="oblique"`` is an isometric perspective. A :class:`~hmatddm.mesh.Mesh2D` is
+  always drawn as lines in the ``xy``-plane seen from ``+z``.
+
+:func:`snapshots` writes both views of one state.
+"""
+from pathlib import Path
+
+import numpy as np
+
+from .._validation import finite_array
+from ..errors import HmatddmError, InputError
+from ..io import atomic_output
+from ..io.vtk import cells_of
+from ..mesh import Mesh2D, Mesh3D
+
+HYDRAULIC, INTACT_NATURAL, FAILED_NATURAL = 0, 1, 2
+VIEWS = ("plan", "oblique")
+
+OPENING_COLORMAP = "viridis"
+PLAIN_SURFACE_COLOR = "tan"
+INTACT_COLOR = "darkgrey"  # light grey, still readable as legend text on white
+FAILED_COLOR = "red"
+SLIP_ARROW_COLOR = "magenta"  # stands out on dark (closed) and bright (open) elements
+SLIP_VISIBLE_FRACTION = 1e-3  # arrows where |slip| > this fraction of the largest slip
+MAX_ELEMENTS_WITH_EDGES = 2000  # element borders drawn on smaller meshes only
+MAX_SLIP_ARROWS = 400  # more slipping elements than this: every k-th gets an arrow
+
+
+# ---------------------------------------------------------------------------------
+# Inputs
+# ---------------------------------------------------------------------------------
+
+def _check_mesh(mesh):
+    if not isinstance(mesh, (Mesh2D, Mesh3D)):
+        raise InputError(f"mesh must be a Mesh2D or Mesh3D, got {type(mesh).__name__}")
+    return mesh
+
+
+def _check_state(state, n_elements):
+    array = np.asarray(state)
+    if array.shape != (n_elements,) or not (np.issubdtype(array.dtype, np.integer) or array.dtype == bool):
+        raise InputError(f"state must be an integer array of shape ({n_elements},), "
+                         f"got {array.dtype} {array.shape}")
+    bad = np.flatnonzero(~np.isin(array, (HYDRAULIC, INTACT_NATURAL, FAILED_NATURAL)))
+    if bad.size:
+        raise InputError(f"state values must be 0 (hydraulic), 1 (intact natural) or 2 (failed natural); "
+                         f"element {int(bad[0])} has {int(array[bad[0]])}")
+    return array.astype(np.int64)
+
+
+def _check_window_size(window_size):
+    try:
+        width, height = window_size
+    except (TypeError, ValueError):
+        raise InputError(f"window_size must be a pair (width, height) of pixels, got {window_size!r}") from None
+    for name, value in (("width", width), ("height", height)):
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not 16 <= value <= 16384:
+            raise InputError(f"window_size {name} must be an integer in [16, 16384], got {value!r}")
+    return int(width), int(height)
+
+
+def _check_fields(mesh, opening, state, slip):
+    n = mesh.n_elements
+    opening = None if opening is None else finite_array("opening", opening, (n,))
+    state = None if state is None else _check_state(state, n)
+    slip = None if slip is None else finite_array("slip", slip, (n, mesh.dim))
+    return opening, state, slip
+
+
+# ---------------------------------------------------------------------------------
+# pyvista
+# ---------------------------------------------------------------------------------
+
+def _pyvista():
+    """pyvista, switched to offscreen rendering."""
+    try:
+        import pyvista
+    except ImportError as error:  # pragma: no cover - pyvista is a dependency
+        raise HmatddmError(f"snapshots need pyvista, which could not be imported: {error}") from error
+    pyvista.OFF_SCREEN = True
+    return pyvista
+
+
+def _no_render_context(cause):
+    return HmatddmError(
+        "pyvista could not create an offscreen render context, so no snapshot was written "
+        f"({type(cause).__name__}: {cause}). On a headless machine use a VTK build with EGL or "
+        "OSMesa (e.g. the 'vtk-osmesa' wheel) or run under a virtual display (xvfb-run)."
+    )
+
+
+def _new_plotter(pyvista, window_size):
+    """An offscreen plotter on a white background.
+
+    VTK's warning while it falls back from X to EGL/OSMesa on a headless machine
+    ("bad X server connection") is silenced while the plotter is made; errors still
+    show.
+    """
+    from vtkmodules.vtkCommonCore import vtkLogger
+
+    verbosity = vtkLogger.GetCurrentVerbosityCutoff()
+    vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_ERROR)
+    try:
+        plotter = pyvista.Plotter(off_screen=True, window_size=list(window_size),
+                                  theme=pyvista.themes.DocumentTheme())
+    except Exception as error:
+        raise _no_render_context(error) from error
+    finally:
+        vtkLogger.SetStderrVerbosity(verbosity)
+    if not _supports_opengl(plotter):
+        plotter.close()
+        raise _no_render_context(RuntimeError("the render window reports no OpenGL support"))
+    return plotter
+
+
+def _supports_opengl(plotter):
+    """Whether VTK can make an OpenGL context for this plotter (True when VTK cannot tell)."""
+    supports = getattr(plotter.render_window, "SupportsOpenGL", None)
+    if supports is None:
+        return True
+    try:
+        return bool(supports())
+    except Exception:
+        return False
+
+
+def element_geometry(mesh):
+    """The elements as pyvista ``PolyData``, one cell per element in mesh order:
+    quads for a Mesh3D, line segments at ``z = 0`` for a Mesh2D (the cells the
+    ``.vtu`` files hold, :func:`hmatddm.io.vtk.cells_of`)."""
+    pyvista = _pyvista()
+    points, connectivity, _ = cells_of(mesh)
+    n_elements, nodes_per_cell = connectivity.shape
+    cells = np.column_stack([np.full(n_elements, nodes_per_cell), connectivity]).reshape(-1)
+    if isinstance(mesh, Mesh3D):
+        return pyvista.PolyData(points, faces=cells)
+    return pyvista.PolyData(points, lines=cells)
+
+
+def _part(mesh, indices):
+    """:func:`element_geometry` of the elements ``indices`` only."""
+    return element_geometry(mesh.subset(indices))
+
+
+def _diagonal(mesh):
+    extent = np.ptp(mesh.centers, axis=0)
+    return float(np.hypot.reduce(extent)) + 2.0 * float(np.max(mesh.radii))
+
+
+# ---------------------------------------------------------------------------------
+# Layers
+# ---------------------------------------------------------------------------------
+
+def _opening_range_mm(opening_mm):
+    low = min(0.0, float(np.min(opening_mm)))
+    high = float(np.max(opening_mm))
+    if high - low <= 1e-12 * max(1.0, abs(high)):
+        high = low + max(1e-9, abs(low) * 1e-3)
+    return [low, high]
+
+
+def _line_width(coloured=True):
+    """Pixels of a 2D segment (coloured) or of a wireframe edge."""
+    return 6 if coloured else 2
+
+
+def _add_coloured(plotter, mesh, indices, opening):
+    """Hydraulic and failed elements: coloured by opening (mm) or a plain colour."""
+    if indices.size == 0:
+        return
+    part = _part(mesh, indices)
+    is_2d = isinstance(mesh, Mesh2D)
+    style = dict(line_width=_line_width(), render_lines_as_tubes=True) if is_2d else dict(
+        show_edges=mesh.n_elements <= MAX_ELEMENTS_WITH_EDGES, edge_color="dimgrey")
+    if opening is None:
+        plotter.add_mesh(part, color=PLAIN_SURFACE_COLOR, **style)
+        return
+    opening_mm = 1e3 * opening
+    part.cell_data["opening (mm)"] = opening_mm[indices]
+    plotter.add_mesh(part, scalars="opening (mm)", cmap=OPENING_COLORMAP, clim=_opening_range_mm(opening_mm[indices]),
+                     scalar_bar_args=dict(title="opening (mm)", vertical=True, fmt="%.3g",
+                                          position_x=0.86, position_y=0.15, height=0.7, width=0.08),
+                     **style)
+
+
+def _add_intact(plotter, mesh, indices):
+    """Intact natural fractures: a light grey wireframe."""
+    if indices.size == 0:
+        return
+    part = _part(mesh, indices)
+    plotter.add_mesh(part, style="wireframe", color=INTACT_COLOR, line_width=_line_width(coloured=False))
+
+
+def _region_boundary(mesh, indices):
+    """Outer edges of the patch made of the cells ``indices`` (corners merged)."""
+    patch = _part(mesh, indices)
+    patch = patch.clean(tolerance=1e-9 * _diagonal(mesh), absolute=True)
+    return patch.extract_feature_edges(boundary_edges=True, non_manifold_edges=True,
+                                       feature_edges=False, manifold_edges=False)
+
+
+def _add_failed_outline(plotter, mesh, indices):
+    """Failed natural-fracture elements: outlined in red.
+
+    3D: a thick red line around each failed patch, plus thin red borders of every
+    failed element on meshes small enough for element borders to stay readable.
+    2D: the red line is put just behind the coloured one (seen from ``+z``) and drawn
+    wider, so it shows as a red border of the coloured segment.
+    """
+    if indices.size == 0:
+        return
+    if isinstance(mesh, Mesh2D):
+        part = _part(mesh, indices)
+        part = part.translate((0.0, 0.0, -1e-3 * _diagonal(mesh)), inplace=False)
+        plotter.add_mesh(part, color=FAILED_COLOR, line_width=2 * _line_width(), render_lines_as_tubes=True)
+        return
+    if mesh.n_elements <= MAX_ELEMENTS_WITH_EDGES:
+        plotter.add_mesh(_part(mesh, indices), style="wireframe", color=FAILED_COLOR, line_width=1)
+    plotter.add_mesh(_region_boundary(mesh, indices), color=FAILED_COLOR, line_width=4)
+
+
+def slip_arrow_length(mesh, slipping, n_arrows):
+    """Length of the arrow of the largest slip: about 1.5 arrow spacings (the
+    ``slipping`` elements' area, or length in 2D, shared among ``n_arrows``), within
+    3-12% of the mesh diagonal."""
+    covered = float(np.sum(mesh.areas[slipping]))
+    spacing = covered / n_arrows if isinstance(mesh, Mesh2D) else np.sqrt(covered / n_arrows)
+    diagonal = _diagonal(mesh)
+    return float(np.clip(1.5 * spacing, 0.03 * diagonal, 0.12 * diagonal))
+
+
+def _add_slip_arrows(plotter, mesh, slip):
+    """Arrows centred on the slipping elements, length proportional to ``|slip|``
+    (on at most ``MAX_SLIP_ARROWS`` of them, evenly thinned in element order)."""
+    pyvista = _pyvista()
+    magnitude = np.linalg.norm(slip, axis=1)
+    largest = float(np.max(magnitude))
+    if largest <= 0.0:
+        return
+    slipping = np.flatnonzero(magnitude > SLIP_VISIBLE_FRACTION * largest)
+    shown = slipping[::max(1, -(-slipping.size // MAX_SLIP_ARROWS))]
+    centers = mesh.centers[shown]
+    vectors = slip[shown]
+    if isinstance(mesh, Mesh2D):
+        centers = np.column_stack([centers, np.zeros(len(shown))])
+        vectors = np.column_stack([vectors, np.zeros(len(shown))])
+    points = pyvista.PolyData(centers)
+    points["slip"] = vectors
+    points["slip magnitude"] = magnitude[shown]
+    arrow = pyvista.Arrow(start=(-0.5, 0.0, 0.0), direction=(1.0, 0.0, 0.0), tip_length=0.35,
+                          tip_radius=0.18, shaft_radius=0.07, scale=1.0)
+    length = slip_arrow_length(mesh, slipping, len(shown))
+    arrows = points.glyph(orient="slip", scale="slip magnitude", factor=length / largest, geom=arrow)
+    plotter.add_mesh(arrows, color=SLIP_ARROW_COLOR)
+
+
+def _add_legend(plotter, state):
+    labels = []
+    if np.any(state == INTACT_NATURAL):
+        labels.append(["natural fracture, intact", INTACT_COLOR])
+    if np.any(state == FAILED_NATURAL):
+        labels.append(["natural fracture, failed", FAILED_COLOR])
+    if labels:
+        plotter.add_legend(labels=labels, bcolor="white", face="rectangle", loc="lower center", size=(0.3, 0.08))
+
+
+def _set_view(plotter, mesh, view):
+    """Plan: look down ``-z`` with a parallel projection. Oblique: isometric. Both
+    frame every actor. A 2D mesh is always seen from ``+z``."""
+    if view == "plan" or isinstance(mesh, Mesh2D):
+        plotter.view_xy()
+        plotter.enable_parallel_projection()
+    else:
+        plotter.view_isometric()
+    plotter.reset_camera()
+
+
+def _draw(plotter, mesh, opening, state, slip):
+    every = np.arange(mesh.n_elements)
+    if state is None:
+        _add_coloured(plotter, mesh, every, opening)
+    else:
+        _add_coloured(plotter, mesh, every[state != INTACT_NATURAL], opening)
+        _add_intact(plotter, mesh, every[state == INTACT_NATURAL])
+        _add_failed_outline(plotter, mesh, every[state == FAILED_NATURAL])
+        _add_legend(plotter, state)
+    if slip is not None:
+        _add_slip_arrows(plotter, mesh, slip)
+
+
+# ---------------------------------------------------------------------------------
+# Output
+# ---------------------------------------------------------------------------------
+
+def _save_png(image, path):
+    """Write an (H, W, 3|4) uint8 image as PNG, atomically."""
+    from PIL import Image
+
+    with atomic_output(path) as temporary:
+        Image.fromarray(np.ascontiguousarray(image)).save(temporary, format="PNG")
+    return path
+
+
+def _screenshot(plotter, window_size):
+    try:
+        image = plotter.screenshot(return_img=True, window_size=list(window_size))
+    except Exception as error:
+        raise _no_render_context(error) from error
+    if image is None or image.size == 0 or int(np.max(image)) == 0:
+        # A white-background scene that renders all black means no working GL context.
+        raise _no_render_context(RuntimeError("the rendered image is empty (all black)"))
+    return image
+
+
+def snapshot(mesh, path, opening=None, state=None, slip=None, view="oblique", title=None,
+             window_size=(1200, 900)):
+    """Render one offscreen PNG of the fractures.
+
+    Parameters
+    ----------
+    mesh : Mesh2D or Mesh3D
+    path : str or Path
+        Output PNG (folder created if missing; written atomically).
+    opening : (N,) array, optional
+        Opening ``w = DD . n`` in metres; shown in millimetres on the scalar bar.
+    state : (N,) int array, optional
+        0 hydraulic fracture (coloured by opening), 1 intact natural fracture (light
+        grey wireframe), 2 failed natural fracture (coloured by opening, red outline).
+    slip : (N, d) array, optional
+        Slip vectors (global frame, m); arrows at elements slipping more than
+        ``1e-3`` of the largest slip, length proportional to the slip (the largest
+        arrow spans a few elements, 3-12% of the mesh diagonal).
+    view : {"plan", "oblique"}
+        ``plan`` looks down ``-z`` (parallel projection), ``oblique`` is isometric.
+        Ignored for a Mesh2D (always seen from ``+z``).
+    title : str, optional
+        Text at the top of the image.
+    window_size : (width, height)
+        Image size in pixels.
+
+    Returns
+    -------
+    Path
+
+    Raises
+    ------
+    InputError
+        Fields of the wrong shape or with NaN/inf, a ``state`` outside {0, 1, 2}, an
+        unknown ``view``.
+    HmatddmError
+        pyvista cannot render offscreen on this machine.
+    """
+    _check_mesh(mesh)
+    if view not in VIEWS:
+        raise InputError(f"view must be one of {VIEWS}, got {view!r}")
+    window_size = _check_window_size(window_size)
+    opening, state, slip = _check_fields(mesh, opening, state, slip)
+    pyvista = _pyvista()
+    plotter = _new_plotter(pyvista, window_size)
+    try:
+        _draw(plotter, mesh, opening, state, slip)
+        if title is not None:
+            plotter.add_text(str(title), position="upper_edge", font_size=12)
+        if isinstance(mesh, Mesh3D):
+            plotter.add_axes()
+        _set_view(plotter, mesh, view)
+        image = _screenshot(plotter, window_size)
+    finally:
+        plotter.close()
+    return _save_png(image, Path(path))
+
+
+def snapshots(mesh, folder, stem, **fields):
+    """Write ``folder/<stem>_plan.png`` and ``folder/<stem>_oblique.png``.
+
+    ``fields`` are passed to :func:`snapshot` (``opening``, ``state``, ``slip``,
+    ``title``, ``window_size``). A Mesh2D has one view only, so only the plan image is
+    written. Returns the list of written paths (plan first).
+    """
+    if "view" in fields:
+        raise InputError("snapshots writes every view; call snapshot(..., view=...) for one view")
+    folder = Path(folder)
+    views = ("plan",) if isinstance(mesh, Mesh2D) else VIEWS
+    return [snapshot(mesh, folder / f"{stem}_{view}.png", view=view, **fields) for view in views]
+
+
+__all__ = ["snapshot", "snapshots", "element_geometry", "slip_arrow_length",
+           "HYDRAULIC", "INTACT_NATURAL", "FAILED_NATURAL", "VIEWS"]

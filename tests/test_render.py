@@ -1,0 +1,166 @@
+"""Offscreen snapshots and history plots: files exist, have the asked size, show something."""
+import matplotlib.image
+import numpy as np
+import pytest
+
+import hmatddm as hd
+from hmatddm.render import plot_history, snapshot, snapshots
+from hmatddm.render.snapshots import FAILED_NATURAL, HYDRAULIC, INTACT_NATURAL
+
+WINDOW = (400, 300)
+
+
+@pytest.fixture(scope="module")
+def scene3d():
+    """A vertical hydraulic fracture (8 x 4) crossed by a natural one (4 x 4), part of
+    which has failed and slips."""
+    hydraulic = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 0, 1], 4, 2, 8, 4)
+    natural = hd.mesh.rectangle([1, 0.5, 0], [0, 1, 0], [0, 0, 1], 2, 2, 4, 4, fracture_id=1)
+    mesh = hd.mesh.concatenate([hydraulic, natural])
+    x = mesh.centers
+    is_natural = mesh.fracture_id == 1
+    opening = np.where(is_natural, 1e-5, 1e-3 * np.sqrt(np.clip(1 - (x[:, 0] / 2) ** 2 - x[:, 2] ** 2, 0.01, None)))
+    state = np.where(is_natural, INTACT_NATURAL, HYDRAULIC)
+    state[is_natural & (np.abs(x[:, 1]) < 0.6)] = FAILED_NATURAL
+    slip = np.zeros((mesh.n_elements, 3))
+    slip[state == FAILED_NATURAL] = [0.0, 1e-4, 3e-5]
+    return mesh, dict(opening=opening, state=state, slip=slip)
+
+
+@pytest.fixture(scope="module")
+def scene2d():
+    crossing = hd.mesh.line([0.5, -0.5], [0.5, 0.5], 5, fracture_id=1)
+    mesh = hd.mesh.concatenate([hd.mesh.line([-1, 0], [1, 0], 10), crossing])
+    n = mesh.n_elements
+    opening = np.r_[1e-3 * np.sqrt(1 - np.linspace(-0.9, 0.9, 10) ** 2), np.zeros(5)]
+    state = np.r_[np.full(10, HYDRAULIC), np.full(5, INTACT_NATURAL)]
+    state[12] = FAILED_NATURAL
+    slip = np.zeros((n, 2))
+    slip[12] = [0.0, 1e-4]
+    return mesh, dict(opening=opening, state=state, slip=slip)
+
+
+def _image(path):
+    return matplotlib.image.imread(path)[..., :3]
+
+
+def _assert_picture(path, window_size):
+    assert path.is_file()
+    image = _image(path)
+    width, height = window_size
+    assert image.shape[:2] == (height, width)
+    assert np.var(image) > 1e-3, "the image is blank"
+
+
+def _red_pixels(image):
+    return int(np.sum((image[..., 0] > 0.8) & (image[..., 1] < 0.25) & (image[..., 2] < 0.25)))
+
+
+def test_snapshots_3d_write_plan_and_oblique_views(tmp_path, scene3d):
+    mesh, fields = scene3d
+    paths = snapshots(mesh, tmp_path / "png", "step_0001", title="t = 1 s", window_size=WINDOW, **fields)
+    assert [p.name for p in paths] == ["step_0001_plan.png", "step_0001_oblique.png"]
+    for path in paths:
+        _assert_picture(path, WINDOW)
+    plan, oblique = (_image(p) for p in paths)
+    assert not np.array_equal(plan, oblique)
+    assert _red_pixels(oblique) > 20, "failed natural-fracture elements are not outlined in red"
+    assert sorted(p.name for p in (tmp_path / "png").iterdir()) == sorted(p.name for p in paths)
+
+
+def test_plan_view_of_a_horizontal_fracture_fills_the_frame(tmp_path):
+    mesh = hd.mesh.penny([5.0, -3.0, 100.0], [0, 0, 1], 1.0, 0.2)
+    opening = 1e-3 * np.sqrt(np.clip(1 - np.sum((mesh.centers[:, :2] - [5, -3]) ** 2, axis=1), 0, None))
+    path = snapshot(mesh, tmp_path / "plan.png", opening=opening, view="plan", window_size=WINDOW)
+    _assert_picture(path, WINDOW)
+    image = _image(path)
+    coloured = np.ptp(image, axis=2) > 0.15  # viridis is far from grey; the white background is not
+    rows, columns = np.nonzero(coloured)
+    assert np.ptp(rows) > 0.5 * WINDOW[1], "the disc should span most of the picture height"
+
+
+def test_snapshot_without_fields_and_with_opening_only(tmp_path, scene3d):
+    mesh, fields = scene3d
+    _assert_picture(snapshot(mesh, tmp_path / "plain.png", window_size=WINDOW), WINDOW)
+    _assert_picture(snapshot(mesh, tmp_path / "opening.png", opening=fields["opening"], window_size=WINDOW), WINDOW)
+
+
+def test_snapshots_2d_draw_one_plan_view(tmp_path, scene2d):
+    mesh, fields = scene2d
+    paths = snapshots(mesh, tmp_path, "crack", window_size=WINDOW, **fields)
+    assert [p.name for p in paths] == ["crack_plan.png"]
+    _assert_picture(paths[0], WINDOW)
+    assert _red_pixels(_image(paths[0])) > 5
+
+
+@pytest.mark.parametrize("change, message", [
+    (dict(view="side"), "view"),
+    (dict(state=np.full(48, 5)), "state values"),
+    (dict(state=np.zeros(48)), "state must be an integer array"),
+    (dict(opening=np.zeros(47)), "opening"),
+    (dict(opening=np.full(48, np.nan)), "opening"),
+    (dict(slip=np.zeros((48, 2))), "slip"),
+    (dict(window_size=(0, 300)), "window_size"),
+])
+def test_snapshot_bad_inputs_raise_input_error(tmp_path, scene3d, change, message):
+    mesh, fields = scene3d
+    assert mesh.n_elements == 48
+    with pytest.raises(hd.InputError, match=message):
+        snapshot(mesh, tmp_path / "bad.png", **{**fields, **change})
+    assert not list(tmp_path.iterdir())
+
+
+def test_missing_render_context_is_a_clear_error(tmp_path, scene2d, monkeypatch):
+    import pyvista
+
+    def no_context(*args, **kwargs):
+        raise RuntimeError("failed to create an OpenGL context")
+
+    monkeypatch.setattr(pyvista, "Plotter", no_context)
+    mesh, fields = scene2d
+    with pytest.raises(hd.HmatddmError, match="offscreen render context"):
+        snapshot(mesh, tmp_path / "none.png", **fields)
+    assert not list(tmp_path.iterdir())
+
+
+def _history(n_clusters=2):
+    records = []
+    for time in np.linspace(0.5, 10.0, 12):
+        radius = 0.7 * time ** 0.4
+        records.append(dict(time=time, fracture_area=np.pi * radius**2, max_opening=1e-3 * time ** 0.2,
+                            wellbore_pressure=[20e6 + 1e6 * time ** -0.2 + 1e4 * k for k in range(n_clusters)]))
+    return records
+
+
+def test_plot_history_with_closed_form_overlay(tmp_path):
+    time = np.linspace(0.5, 10.0, 50)
+    reference = dict(time=time, radius=0.7 * time ** 0.4, max_opening=1e-3 * time ** 0.2,
+                     net_pressure=1e6 * time ** -0.2)
+    path = plot_history(_history(), tmp_path / "plots" / "history.png", reference=reference, confining_stress=20e6)
+    assert path.is_file()
+    image = _image(path)
+    assert image.shape[0] > 300 and image.shape[1] > 300
+    assert np.var(image) > 1e-3
+
+
+def test_plot_history_prefers_radius_or_half_length_keys(tmp_path):
+    records = [dict(record, half_length=2.0 * record["time"] ** 0.5, wellbore_pressure=1e6)
+               for record in _history(n_clusters=1)]
+    path = plot_history(records, tmp_path / "kgd.png", reference=dict(time=[1.0, 5.0], half_length=[2.0, 4.5]))
+    assert np.var(_image(path)) > 1e-3
+
+
+@pytest.mark.parametrize("records, reference, message", [
+    ([], None, "non-empty"),
+    ([dict(time=0.0, fracture_area=1.0, max_opening=1e-3)], None, "wellbore_pressure"),
+    ([dict(time=0.0, fracture_area=1.0, max_opening=np.nan, wellbore_pressure=[1e6])], None, "max_opening"),
+    ([dict(time=0.0, fracture_area=1.0, max_opening=0.0, wellbore_pressure=[1e6]),
+      dict(time=1.0, fracture_area=1.0, max_opening=0.0, wellbore_pressure=[1e6, 2e6])], None, "one per cluster"),
+    (_history(), dict(radius=[1.0, 2.0]), "time"),
+    (_history(), dict(time=[0.0, 1.0], radius=[1.0]), "radius"),
+    (_history(), dict(time=[0.0, 1.0], pressure=[1.0, 2.0]), "keys"),
+])
+def test_plot_history_bad_inputs_raise_input_error(tmp_path, records, reference, message):
+    with pytest.raises(hd.InputError, match=message):
+        plot_history(records, tmp_path / "history.png", reference=reference)
+    assert not list(tmp_path.iterdir())
