@@ -12,17 +12,31 @@ Quick tour::
     op = hd.ElasticityOperator(mesh, mat, backend="hmatrix", eps=1e-4)
     dd = hd.solve(op, -1e6 * mesh.normals)      # crack under 1 MPa net pressure
     w = hd.opening(mesh, dd)
+
+A growing radial fracture (ref. Ch. 4)::
+
+    sim = hd.Simulation(hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 3, 3, 3, 3),
+                        hd.Elastic(24e9, 0.25), hd.Fluid(viscosity=1e-3, compressibility=4.4e-10),
+                        [hd.Cluster((0, 0, 0), rate=0.01, wellbore_volume=0.005)],
+                        far_field_stress=-8e6 * np.diag([0, 0, 1]), time_step=1.0,
+                        propagation=hd.Propagation(toughness=5e6), initial_pressure=10e6)
+    records = sim.run(end_time=50.0)
 """
-from . import analytical, kernels, mesh
+from . import analytical, kernels, mesh, topology
+from .coupled import SchemeSettings
 from .errors import ConvergenceError, HmatddmError, InputError
+from .flow import Cluster, Fluid, LeakOff
+from .fracture import Propagation
 from .material import Elastic
 from .mesh import Mesh2D, Mesh3D
 from .operators import ElasticityOperator
+from .simulation import CheckpointError, Simulation
 from .solve import mean_stress_at, opening, slip, solve, stress_at
 
 __version__ = "0.1.0"
 
 __all__ = [
     "Elastic", "Mesh2D", "Mesh3D", "ElasticityOperator", "solve", "opening", "slip", "stress_at",
-    "mean_stress_at", "mesh", "analytical", "kernels", "HmatddmError", "InputError", "ConvergenceError",
+    "mean_stress_at", "mesh", "analytical", "kernels", "topology", "HmatddmError", "InputError", "ConvergenceError",
+    "Fluid", "LeakOff", "Cluster", "Propagation", "SchemeSettings", "Simulation", "CheckpointError",
 ]

@@ -15,11 +15,13 @@ Eqs 4.37-4.40) with
 * ``D`` the storage, leak-off and transmissibility matrix (sparse, symmetric),
 * ``g`` the injection, old storage and old width.
 
-Transmissibility of a face: the two-point flux of the cubic law (ref. Eqs 4.32-4.33)
-with half-distances ``d_i``, ``d_j`` from each centre to the face and face length
-``l``: ``K_e = l / (mu' (d_i / w_i^3 + d_j / w_j^3))``. For equal neighbours this is
-``l w^3 / (mu' d_e)`` of the reference; for different sizes and widths it is the
-series (harmonic) combination, which conserves mass across size jumps.
+Transmissibility of a face (ref. Eqs 4.32-4.33): face length ``l``, centre-to-face
+distances ``d_i``, ``d_j``, and the width at the face interpolated linearly between
+the two centres, ``w_e = (d_j w_i + d_i w_j) / (d_i + d_j)``:
+``K_e = l w_e^3 / (mu' (d_i + d_j))``, which is ``l w^3 / (mu' d_e)`` of the reference
+for equal neighbours. The flux is antisymmetric, so mass is conserved across size
+jumps. (A harmonic mean of ``w^3`` would throttle the flow into a freshly created tip
+element to its floor width and lock a viscosity-dominated front; measured.)
 
 Carter leak-off over a step is integrated exactly: ``Lambda_i dt = 2 c_l
 (sqrt(t^{n+1} - tau_i) - sqrt(max(t^n - tau_i, 0)))``, finite for elements created
@@ -83,8 +85,9 @@ class LubricationModel:
         """K_e of every face (ref. Eq. 4.36) for element widths ``width``."""
         w = self.effective_width(width)
         f = self.faces
-        resistance = f.first_distance / w[f.first] ** 3 + f.second_distance / w[f.second] ** 3
-        return f.length / (self.fluid.viscosity_prime * resistance)
+        distance = f.first_distance + f.second_distance
+        face_width = (f.second_distance * w[f.first] + f.first_distance * w[f.second]) / distance
+        return f.length * face_width**3 / (self.fluid.viscosity_prime * distance)
 
     def leak_off_rate(self, creation_time, time_old, time_new):
         """Lambda_i, the step-averaged Carter coefficient (1/s per Pa scale: m/(s Pa))."""
