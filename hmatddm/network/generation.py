@@ -1,0 +1,489 @@
+"""Synthetic natural-fracture networks (ref. Sec. 6.2): power-law lengths, von Mises
+orientations of undirected strikes, uniform positions at a given areal density.
+
+Conventions
+-----------
+* Plan view, SI units (m). Every fracture is a straight segment in the x-y plane; in
+  3D it is a vertical rectangle of the network's ``height`` centred at ``z_center``.
+* **Azimuth** ``theta`` is the strike direction measured from the +x axis,
+  counter-clockwise, as in the reference ("45 deg and 135 deg from the x axis",
+  Fig. 6.14). Strikes are undirected lines (axial data), so azimuths live in
+  ``[0, pi)``; a fracture runs from ``p0`` to ``p1 = p0 + l (cos theta, sin theta)``.
+  The sampling functions take and return radians; :class:`NetworkSpec` takes degrees.
+* **Concentration** ``kappa`` is the von Mises concentration of the *doubled* angle
+  ``2 theta`` (the reference's ``kappa'``; ref. Sec. 6.2.2): the reference generates
+  ``theta' ~ VM(mu', kappa')`` and uses ``theta = theta'/2``, so its Table 6.1 pair
+  ``mu = 45 deg, kappa = 5`` means ``mu' = 90 deg, kappa' = 5``.
+* **Density** is the areal density of Eq. 6.12: ``N_NF = rho_NF * A`` fractures
+  (fracture *centres*, not trace length) per square metre of the region; ``N_NF`` is
+  rounded to the nearest integer and is exactly the number of fractures generated.
+"""
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .. import mesh as _mesh
+from .._validation import finite_array, finite_scalar, positive_int, positive_scalar
+from ..errors import InputError
+
+_BOUNDARY_MODES = ("resample", "clip")
+
+
+def _rng(rng):
+    """A numpy Generator from a Generator, an integer seed or None (fresh entropy)."""
+    if isinstance(rng, np.random.Generator):
+        return rng
+    if rng is not None and (isinstance(rng, bool) or not isinstance(rng, (int, np.integer)) or rng < 0):
+        raise InputError(f"rng must be a numpy.random.Generator, an integer seed >= 0 or None, got {rng!r}")
+    return np.random.default_rng(rng)
+
+
+def _check_lengths(exponent, l_min, l_max, exponent_name="exponent"):
+    exponent = finite_scalar(exponent_name, exponent)
+    if exponent < 1.0:
+        raise InputError(f"{exponent_name} must be >= 1 (ref. Eq. 6.1 a > 1; a = 1 is the log-uniform limit), "
+                         f"got {exponent}")
+    l_min = positive_scalar("l_min", l_min)
+    try:
+        l_max = float(l_max)
+    except (TypeError, ValueError):
+        raise InputError(f"l_max must be a number >= l_min = {l_min}, got {l_max!r}") from None
+    if np.isnan(l_max) or l_max < l_min:
+        raise InputError(f"l_max must be >= l_min = {l_min}, got {l_max}")
+    if np.isinf(l_max) and exponent <= 1.0:
+        raise InputError(f"l_max must be finite when {exponent_name} = 1 "
+                         "(1/l is not normalisable on [l_min, inf)), got inf")
+    return exponent, l_min, l_max
+
+
+def power_law_lengths(n, exponent, l_min, l_max, rng=None):
+    """``n`` fracture lengths from the truncated power law of ref. Eqs. 6.1-6.7.
+
+    The density is ``f(l) = b l^-a / (l_min^-b - l_max^-b)`` on ``[l_min, l_max]``
+    with ``a = exponent`` and ``b = a - 1`` (Eq. 6.4), sampled by inverting the
+    cumulative distribution Eq. 6.5 at uniform ``u``::
+
+        l = l_min * (1 - u (1 - (l_max/l_min)^-b))^(-1/b)
+
+    evaluated with ``log1p``/``expm1`` so that it stays accurate as ``a -> 1``.
+    ``a == 1`` is handled exactly as its limit, the log-uniform law
+    ``F(l) = ln(l/l_min) / ln(l_max/l_min)``. ``l_max = inf`` gives Eqs. 6.6-6.7
+    (needs ``a > 1``); ``l_max == l_min`` gives constant lengths.
+
+    Parameters
+    ----------
+    n : int >= 0
+    exponent : float >= 1, the ``a`` of ``n(l) ~ l^-a``
+    l_min, l_max : lower and upper length limits ``l_0``, ``l_1``, m
+    rng : numpy Generator, integer seed or None
+    """
+    n = positive_int("n", n, minimum=0)
+    a, l_min, l_max = _check_lengths(exponent, l_min, l_max)
+    rng = _rng(rng)
+    u = rng.random(n)
+    if l_max == l_min:
+        return np.full(n, l_min)
+    b = a - 1.0
+    if b == 0.0:
+        lengths = l_min * np.exp(u * np.log(l_max / l_min))
+    else:
+        q = 1.0 if np.isinf(l_max) else -np.expm1(-b * np.log(l_max / l_min))  # 1 - (l_max/l_min)^-b
+        lengths = l_min * np.exp(-np.log1p(-u * q) / b)
+    return np.clip(lengths, l_min, l_max)
+
+
+def von_mises_directions(n, mean_azimuth, kappa, rng=None):
+    """``n`` axial directions (undirected strikes) in ``[0, pi)``, radians.
+
+    Angle doubling of ref. Sec. 6.2.2: ``theta' = 2 theta`` follows the von Mises law
+    Eq. 6.8 with mean ``mu' = 2 * mean_azimuth`` and concentration ``kappa``; it is
+    drawn with numpy's ``Generator.vonmises`` (the Best & Fisher 1979 algorithm the
+    reference uses) and halved, ``theta = theta'/2 mod pi``.
+
+    Parameters
+    ----------
+    mean_azimuth : mean strike ``mu`` in radians from the +x axis, counter-clockwise
+        (any value; only ``mu mod pi`` matters)
+    kappa : concentration >= 0 of the doubled angle (the reference's ``kappa'``);
+        0 gives uniformly random strikes
+    """
+    n = positive_int("n", n, minimum=0)
+    mean_azimuth = finite_scalar("mean_azimuth", mean_azimuth)
+    kappa = finite_scalar("kappa", kappa)
+    if kappa < 0.0:
+        raise InputError(f"kappa must be >= 0, got {kappa}")
+    rng = _rng(rng)
+    doubled = rng.vonmises(2.0 * mean_azimuth, kappa, n)
+    return np.mod(0.5 * doubled, np.pi)
+
+
+def _check_modes(means, kappas, weights, names=("means", "kappas", "weights")):
+    means = np.atleast_1d(finite_array(names[0], means))
+    kappas = np.atleast_1d(finite_array(names[1], kappas))
+    if means.ndim != 1 or means.size == 0:
+        raise InputError(f"{names[0]} must be a non-empty 1D sequence, got shape {means.shape}")
+    if weights is None:
+        weights = np.full(means.size, 1.0 / means.size)
+    weights = np.atleast_1d(finite_array(names[2], weights))
+    if kappas.shape != means.shape or weights.shape != means.shape:
+        raise InputError(f"{', '.join(names)} must have the same length, got "
+                         f"{means.size}, {kappas.size}, {weights.size}")
+    if np.any(kappas < 0.0):
+        raise InputError(f"{names[1]} must be >= 0, got {kappas.tolist()}")
+    if np.any(weights < 0.0) or abs(weights.sum() - 1.0) > 1e-9:
+        raise InputError(f"{names[2]} must be >= 0 and sum to 1, got {weights.tolist()}")
+    return means, kappas, weights / weights.sum()
+
+
+def bimodal_directions(n, means, kappas, weights, rng=None, return_modes=False):
+    """``n`` axial directions from a mixture of von Mises modes (ref. Eq. 6.10).
+
+    The reference's procedure, for any number of modes: draw ``x ~ U(0, 1)`` for every
+    fracture; it belongs to mode ``k`` when ``x`` falls in the ``k``-th interval of the
+    cumulative weights (two modes: mode 1 when ``x < w``); then each mode's strikes are
+    drawn with :func:`von_mises_directions`.
+
+    Parameters
+    ----------
+    means : mean strikes (radians, from +x counter-clockwise), one per mode
+    kappas : concentrations >= 0 of the doubled angle, one per mode
+    weights : mixing factors >= 0 summing to 1 (``(w, 1 - w)`` in Eq. 6.10)
+    return_modes : also return the (n,) mode index of each direction
+
+    Returns
+    -------
+    azimuths : (n,) in ``[0, pi)``, and ``modes`` (n,) int when ``return_modes``
+    """
+    n = positive_int("n", n, minimum=0)
+    means, kappas, weights = _check_modes(means, kappas, weights)
+    rng = _rng(rng)
+    x = rng.random(n)
+    cumulative = np.cumsum(weights)
+    modes = np.minimum(np.searchsorted(cumulative, x, side="right"), len(weights) - 1)
+    azimuths = np.empty(n)
+    for k in range(len(weights)):
+        index = np.flatnonzero(modes == k)
+        azimuths[index] = von_mises_directions(index.size, means[k], kappas[k], rng)
+    if return_modes:
+        return azimuths, modes.astype(np.int64)
+    return azimuths
+
+
+def _as_tuple(name, value):
+    array = np.atleast_1d(finite_array(name, value))
+    if array.ndim != 1 or array.size == 0:
+        raise InputError(f"{name} must be a number or a non-empty 1D sequence, got shape {array.shape}")
+    return tuple(float(v) for v in array)
+
+
+@dataclass(frozen=True)
+class NetworkSpec:
+    """Parameters of a synthetic natural-fracture network (ref. Sec. 6.2, Table 6.1).
+
+    Attributes
+    ----------
+    region : (x_min, x_max, y_min, y_max), m; the plan-view rectangle that holds the
+        network. The reference's 100 m x 100 m domain is ``(-50, 50, -50, 50)``.
+    density : areal density ``rho_NF`` of Eq. 6.12, fractures (centres) per m^2;
+        ``round(density * area)`` fractures are generated (at least one).
+    length_exponent : ``a`` of the power law ``f(l) ~ l^-a`` (Eq. 6.1), >= 1.
+    l_min, l_max : length limits ``l_0 <= l <= l_1`` (Eq. 6.4), m.
+    mean_azimuths_deg : mean strike of each orientation set, degrees from the +x axis
+        counter-clockwise (45 deg is the reference's ``mu = pi/4``); a number or a
+        sequence (one entry per set, Eq. 6.10).
+    kappas : von Mises concentration of the doubled angle of each set, >= 0.
+    weights : mixing factor of each set, >= 0, summing to 1; None means equal weights.
+    height : height of every (vertical) fracture in 3D, m.
+    z_center : depth of the fractures' mid-height, m.
+    seed : integer >= 0 for ``numpy.random.default_rng`` (None: fresh entropy).
+    boundary : how fractures are kept inside ``region``:
+
+        * ``"resample"`` (default): every fracture keeps its sampled length and strike;
+          its centre is drawn uniformly among the positions where the whole fracture
+          fits in the region (the same law as redrawing the centre until it fits).
+          Lengths and strikes follow Eqs. 6.4 and 6.10 exactly; centres thin out near
+          the boundary. Needs ``l_max <= min(region width, region height)``.
+        * ``"clip"``: centres are uniform in the region and fractures are cut at its
+          boundary, like a mapping window. Positions are exactly uniform; fractures that
+          reach the boundary are shorter than sampled (possibly below ``l_min``).
+    """
+
+    region: tuple
+    density: float
+    length_exponent: float = 2.0
+    l_min: float = 1.0
+    l_max: float = 30.0
+    mean_azimuths_deg: tuple = (45.0,)
+    kappas: tuple = (5.0,)
+    weights: tuple = None
+    height: float = 1.0
+    z_center: float = 0.0
+    seed: int = 0
+    boundary: str = "resample"
+
+    def __post_init__(self):
+        def put(name, value):
+            object.__setattr__(self, name, value)
+
+        region = finite_array("region", self.region, (4,))
+        x_min, x_max, y_min, y_max = (float(v) for v in region)
+        if not (x_min < x_max and y_min < y_max):
+            raise InputError("region must be (x_min, x_max, y_min, y_max) with x_min < x_max and "
+                             f"y_min < y_max, got {tuple(region.tolist())}")
+        put("region", (x_min, x_max, y_min, y_max))
+        area = (x_max - x_min) * (y_max - y_min)
+        density = positive_scalar("density", self.density)
+        if np.rint(density * area) < 1:
+            raise InputError(f"density must be >= {0.5 / area:.6g} per m^2 so that the region of area "
+                             f"{area:.6g} m^2 holds at least one fracture (Eq. 6.12), got {density}")
+        put("density", density)
+        a, l_min, l_max = _check_lengths(self.length_exponent, self.l_min, self.l_max, "length_exponent")
+        if np.isinf(l_max):
+            raise InputError("l_max must be finite for a network in a bounded region, got inf")
+        put("length_exponent", a)
+        put("l_min", l_min)
+        put("l_max", l_max)
+        means = _as_tuple("mean_azimuths_deg", self.mean_azimuths_deg)
+        kappas = _as_tuple("kappas", self.kappas)
+        weights = None if self.weights is None else _as_tuple("weights", self.weights)
+        _, _, normalised = _check_modes(means, kappas, weights, ("mean_azimuths_deg", "kappas", "weights"))
+        put("mean_azimuths_deg", means)
+        put("kappas", kappas)
+        put("weights", tuple(float(w) for w in normalised))
+        put("height", positive_scalar("height", self.height))
+        put("z_center", finite_scalar("z_center", self.z_center))
+        if self.seed is not None:
+            put("seed", positive_int("seed", self.seed, minimum=0))
+        if self.boundary not in _BOUNDARY_MODES:
+            raise InputError(f"boundary must be one of {', '.join(map(repr, _BOUNDARY_MODES))}, got {self.boundary!r}")
+        if self.boundary == "resample":
+            fit = min(x_max - x_min, y_max - y_min)
+            if l_max > fit:
+                raise InputError(f"l_max must be <= min(region width, region height) = {fit:.6g} with "
+                                 f"boundary='resample' (use boundary='clip' for longer fractures), got {l_max}")
+
+    @property
+    def area(self):
+        x_min, x_max, y_min, y_max = self.region
+        return (x_max - x_min) * (y_max - y_min)
+
+    @property
+    def n_fractures(self):
+        """``N_NF = rho_NF A`` (Eq. 6.12), rounded to the nearest integer."""
+        return int(np.rint(self.density * self.area))
+
+
+@dataclass(frozen=True, eq=False)
+class Network:
+    """A plan-view network of straight vertical fractures, as a struct of arrays.
+
+    Each row is one straight *segment*; a fracture may consist of several collinear
+    segments that meet end to end (e.g. after :func:`~hmatddm.network.split_at_intersections`).
+
+    Attributes
+    ----------
+    p0, p1 : (M, 2) segment end points, m
+    fracture_id : (M,) int, the fracture each segment belongs to
+    set_id : (M,) int, the orientation set (mode of Eq. 6.10) of each segment
+    height : fracture height in 3D, m
+    z_center : depth of the fractures' mid-height, m
+    region : (x_min, x_max, y_min, y_max) or None
+    """
+
+    p0: np.ndarray
+    p1: np.ndarray
+    fracture_id: np.ndarray
+    set_id: np.ndarray
+    height: float = 1.0
+    z_center: float = 0.0
+    region: tuple = field(default=None)
+
+    @classmethod
+    def from_segments(cls, p0, p1, fracture_id=None, set_id=None, height=1.0, z_center=0.0, region=None):
+        """A network from segment end points ``p0``, ``p1`` (M, 2), validated.
+
+        ``fracture_id`` defaults to ``0..M-1`` (one fracture per segment), ``set_id`` to
+        zeros; ``region`` (x_min, x_max, y_min, y_max) defaults to None.
+        """
+        p0 = finite_array("p0", p0, (None, 2))
+        p1 = finite_array("p1", p1, (None, 2))
+        if p0.shape != p1.shape:
+            raise InputError(f"p0 and p1 must have the same shape, got {p0.shape} and {p1.shape}")
+        m = len(p0)
+        lengths = np.hypot(*(p1 - p0).T) if m else np.zeros(0)
+        scale = max(1.0, float(np.max(np.abs(np.concatenate([p0, p1]))))) if m else 1.0
+        bad = np.flatnonzero(lengths <= 1e-12 * scale)
+        if bad.size:
+            raise InputError(f"segment lengths must be > 0; segment {int(bad[0])} has zero length")
+        ids = {}
+        for name, value, default in (("fracture_id", fracture_id, np.arange(m)),
+                                     ("set_id", set_id, np.zeros(m, dtype=np.int64))):
+            value = default if value is None else np.asarray(value)
+            if value.shape != (m,) or not (np.issubdtype(value.dtype, np.integer) or m == 0):
+                raise InputError(f"{name} must be an integer array of shape ({m},), got {value.dtype} {value.shape}")
+            ids[name] = value.astype(np.int64)
+        if np.any(ids["fracture_id"] < 0):
+            raise InputError("fracture_id must be >= 0")
+        if region is not None:
+            region = tuple(float(v) for v in finite_array("region", region, (4,)))
+            if not (region[0] < region[1] and region[2] < region[3]):
+                raise InputError(f"region must be (x_min, x_max, y_min, y_max) with x_min < x_max and "
+                                 f"y_min < y_max, got {region}")
+        return cls(p0, p1, ids["fracture_id"], ids["set_id"], positive_scalar("height", height),
+                   finite_scalar("z_center", z_center), region)
+
+    def __len__(self):
+        return len(self.p0)
+
+    @property
+    def n_segments(self):
+        return len(self.p0)
+
+    @property
+    def n_fractures(self):
+        """Number of distinct fractures."""
+        return int(np.unique(self.fracture_id).size)
+
+    @property
+    def lengths(self):
+        """(M,) segment lengths, m."""
+        d = self.p1 - self.p0
+        return np.hypot(d[:, 0], d[:, 1])
+
+    @property
+    def azimuths(self):
+        """(M,) strikes in ``[0, pi)``, radians from the +x axis counter-clockwise."""
+        d = self.p1 - self.p0
+        return np.mod(np.arctan2(d[:, 1], d[:, 0]), np.pi)
+
+    @property
+    def tangents(self):
+        """(M, 2) unit vectors from ``p0`` to ``p1``."""
+        d = self.p1 - self.p0
+        return d / np.hypot(d[:, 0], d[:, 1])[:, None]
+
+    @property
+    def centers(self):
+        return 0.5 * (self.p0 + self.p1)
+
+    @property
+    def bounds(self):
+        """The region, or the bounding box (x_min, x_max, y_min, y_max) of the segments."""
+        if self.region is not None:
+            return self.region
+        points = np.concatenate([self.p0, self.p1])
+        return (float(points[:, 0].min()), float(points[:, 0].max()),
+                float(points[:, 1].min()), float(points[:, 1].max()))
+
+    def subset(self, index):
+        index = np.asarray(index)
+        return Network(self.p0[index], self.p1[index], self.fracture_id[index], self.set_id[index],
+                       self.height, self.z_center, self.region)
+
+    def _strike_elements(self, element_length):
+        """Cut every segment into ``max(1, round(length / element_length))`` equal parts.
+
+        Returns the segment index of each element and its end points. Nodes are convex
+        combinations ``(1 - s) p0 + s p1``, so the first and last nodes are exactly
+        ``p0`` and ``p1`` (shared intersection points stay shared).
+        """
+        h = positive_scalar("element_length", element_length)
+        if len(self) == 0:
+            raise InputError("the network must hold at least one segment to be meshed")
+        counts = np.maximum(1, np.rint(self.lengths / h)).astype(np.int64)
+        segment = np.repeat(np.arange(len(self)), counts)
+        offsets = np.concatenate([[0], np.cumsum(counts)[:-1]])
+        local = np.arange(segment.size) - offsets[segment]
+        s0 = (local / counts[segment])[:, None]
+        s1 = ((local + 1) / counts[segment])[:, None]
+        p0, p1 = self.p0[segment], self.p1[segment]
+        return segment, (1.0 - s0) * p0 + s0 * p1, (1.0 - s1) * p0 + s1 * p1
+
+    def to_mesh2d(self, element_length):
+        """A :class:`~hmatddm.mesh.Mesh2D` (plane strain): every segment cut into
+        ``max(1, round(length / element_length))`` equal elements, ordered segment by
+        segment from ``p0`` to ``p1``; ``fracture_id`` is the segment's fracture."""
+        segment, a, b = self._strike_elements(element_length)
+        return _mesh.Mesh2D.from_segments(a, b, fracture_id=self.fracture_id[segment])
+
+    def to_mesh3d(self, element_length, n_height):
+        """A :class:`~hmatddm.mesh.Mesh3D` of vertical rectangles spanning the full
+        ``height`` (``z_center +- height/2``).
+
+        Along strike each segment is cut as in :meth:`to_mesh2d`; over the height into
+        ``n_height`` equal rows. Element axes: ``e1`` the strike tangent (p0 -> p1),
+        ``e2 = +z``, normal ``e1 x e2 = (t_y, -t_x, 0)``. Order: segment, then along
+        strike, then bottom to top (as :func:`hmatddm.mesh.rectangle`).
+        """
+        n_height = positive_int("n_height", n_height)
+        segment, a, b = self._strike_elements(element_length)
+        n_strike = len(segment)
+        tangent = b - a
+        half_a = 0.5 * np.hypot(tangent[:, 0], tangent[:, 1])
+        tangent = tangent / (2.0 * half_a[:, None])
+        z = self.z_center + ((np.arange(n_height) + 0.5) / n_height - 0.5) * self.height
+        mid = 0.5 * (a + b)
+        centers = np.column_stack([np.repeat(mid, n_height, axis=0), np.tile(z, n_strike)])
+        e1 = np.column_stack([np.repeat(tangent, n_height, axis=0), np.zeros(n_strike * n_height)])
+        e2 = np.array([0.0, 0.0, 1.0])
+        return _mesh.Mesh3D.from_rectangles(centers, e1, e2, np.repeat(half_a, n_height),
+                                            np.full(n_strike * n_height, 0.5 * self.height / n_height),
+                                            fracture_id=np.repeat(self.fracture_id[segment], n_height))
+
+
+def _clip_to_region(center, half_vector, region):
+    """Liang-Barsky: the part of ``center + s * half_vector``, ``s in [-1, 1]``, inside
+    ``region``, for centres inside the region. Returns (p0, p1)."""
+    x_min, x_max, y_min, y_max = region
+    s_lo = np.full(len(center), -1.0)
+    s_hi = np.full(len(center), 1.0)
+    for axis, (low, high) in enumerate(((x_min, x_max), (y_min, y_max))):
+        d = half_vector[:, axis]
+        moving = d != 0.0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            to_low = (low - center[:, axis]) / d
+            to_high = (high - center[:, axis]) / d
+        enter = np.where(d > 0, to_low, to_high)
+        leave = np.where(d > 0, to_high, to_low)
+        s_lo = np.where(moving, np.maximum(s_lo, enter), s_lo)
+        s_hi = np.where(moving, np.minimum(s_hi, leave), s_hi)
+    return center + s_lo[:, None] * half_vector, center + s_hi[:, None] * half_vector
+
+
+def generate_network(spec):
+    """Draw the network described by ``spec`` (a :class:`NetworkSpec`).
+
+    Random numbers come from ``numpy.random.default_rng(spec.seed)`` in a fixed order
+    (lengths, then set membership and strikes, then centres), so one seed always gives
+    the same arrays. ``N = round(density * area)`` fractures (Eq. 6.12); lengths from
+    :func:`power_law_lengths`, strikes from :func:`bimodal_directions`, centres uniform
+    (see ``spec.boundary`` for how fractures are kept inside the region). Fracture ``k``
+    runs from ``p0[k]`` to ``p1[k]`` along its strike; ``fracture_id`` is ``0..N-1``.
+    """
+    if not isinstance(spec, NetworkSpec):
+        raise InputError(f"spec must be a NetworkSpec, got {type(spec).__name__}")
+    rng = np.random.default_rng(spec.seed)
+    n = spec.n_fractures
+    lengths = power_law_lengths(n, spec.length_exponent, spec.l_min, spec.l_max, rng)
+    azimuths, modes = bimodal_directions(n, np.radians(spec.mean_azimuths_deg), spec.kappas, spec.weights,
+                                         rng, return_modes=True)
+    tangent = np.column_stack([np.cos(azimuths), np.sin(azimuths)])
+    half_vector = 0.5 * lengths[:, None] * tangent
+    x_min, x_max, y_min, y_max = spec.region
+    if spec.boundary == "resample":
+        reach = np.abs(half_vector)
+        cx = rng.uniform(x_min + reach[:, 0], x_max - reach[:, 0])
+        cy = rng.uniform(y_min + reach[:, 1], y_max - reach[:, 1])
+        center = np.column_stack([cx, cy])
+        p0, p1 = center - half_vector, center + half_vector
+    else:
+        center = np.column_stack([rng.uniform(x_min, x_max, n), rng.uniform(y_min, y_max, n)])
+        p0, p1 = _clip_to_region(center, half_vector, spec.region)
+    low, high = np.array([x_min, y_min]), np.array([x_max, y_max])
+    p0, p1 = np.clip(p0, low, high), np.clip(p1, low, high)  # round-off only
+    return Network.from_segments(p0, p1, fracture_id=np.arange(n), set_id=modes, height=spec.height,
+                                 z_center=spec.z_center, region=spec.region)
+
+
+__all__ = ["power_law_lengths", "von_mises_directions", "bimodal_directions", "NetworkSpec", "Network",
+           "generate_network"]
