@@ -23,6 +23,7 @@ or does not converge, ``alpha`` is halved and the step restarted (ref. Fig. 4.10
 """
 import math
 import time
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -129,8 +130,16 @@ def _segregated_iteration(problem, settings, dd, p, alpha, counters):
         correction = settings.omega * problem.compliance_term
         matrix = matrix + sp.diags(correction)
         rhs = rhs + correction * p
-    p_new = spla.spsolve(matrix.tocsc(), rhs)
-    dd_new, iterations = problem.elastic.solve(problem.far_field - problem.b_times(p_new), x0=dd)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", spla.MatrixRankWarning)
+        p_new = spla.spsolve(matrix.tocsc(), rhs)
+    if not np.all(np.isfinite(p_new)):
+        raise _Diverged("the flow solve gave non-finite pressures")
+    try:
+        dd_new, iterations = problem.elastic.solve(problem.far_field - problem.b_times(p_new), x0=dd)
+    except ConvergenceError as error:
+        counters["linear"] += error.iterations or 0
+        raise _Diverged(str(error)) from None
     counters["linear"] += iterations
     return alpha * dd_new + (1.0 - alpha) * dd, alpha * p_new + (1.0 - alpha) * p
 
@@ -194,10 +203,15 @@ class _CoupledLinearSystem:
 
 def _coupled_iteration(problem, settings, dd, p, alpha, counters):
     matrix, flow_rhs = problem.flow_matrices(dd)
-    system = _CoupledLinearSystem(problem, matrix, dd, p)
-    preconditioner = None
-    if settings.scheme == "krylov":
-        preconditioner = system.compliance_preconditioner(settings.omega)
+    if not (np.all(np.isfinite(matrix.data)) and np.all(np.isfinite(flow_rhs))):
+        raise _Diverged("non-finite flow matrix")
+    try:
+        system = _CoupledLinearSystem(problem, matrix, dd, p)
+        preconditioner = None
+        if settings.scheme == "krylov":
+            preconditioner = system.compliance_preconditioner(settings.omega)
+    except (RuntimeError, np.linalg.LinAlgError) as error:  # singular flow or diagonal blocks
+        raise _Diverged(f"singular coupled system: {error}") from None
     guess = np.concatenate([dd / system.s_u, p / system.s_p])
     try:
         y, info = gmres(system.operator, system.rhs(flow_rhs), M=preconditioner, rtol=settings.linear_rtol,

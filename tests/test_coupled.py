@@ -1,0 +1,104 @@
+"""The four coupling schemes on one time step (ref. Sec. 4.4): same answer, dense twin,
+scaling of ref. Eqs 4.53-4.61 (Fig. 4.13)."""
+import numpy as np
+import pytest
+
+import hmatddm as hd
+from hmatddm import topology
+from hmatddm.coupled import ElasticSolver, SchemeSettings, StepProblem, solve_step
+from hmatddm.coupled.schemes import _CoupledLinearSystem
+from hmatddm.flow import LeakOff, LubricationModel, fracture_compliance
+
+
+def _problem(mesh, backend="dense", dt=1.0, height=1.0, rate=5e-4, leak=0.0):
+    mat = hd.Elastic(10e9, 0.25)
+    fluid = hd.Fluid(viscosity=1e-3, compressibility=4.5e-10)
+    faces = topology.element_faces(mesh, height=height)
+    areas = mesh.areas * (height if mesh.dim == 2 else 1.0)
+    flow = LubricationModel(areas=areas, normals=mesh.normals, faces=faces, fluid=fluid,
+                            leak_off=LeakOff(coefficient=leak, pore_pressure=0.5e6),
+                            injection_elements=np.array([mesh.n_elements // 2]), injection_rates=np.array([rate]),
+                            wellbore_volumes=np.array([0.5]), minimum_width=1e-5)
+    op = hd.ElasticityOperator(mesh, mat, backend=backend, eps=1e-8, leaf_size=8)
+    stress = np.zeros((mesh.dim, mesh.dim))
+    stress[-1, -1] = -0.5e6
+    n = mesh.n_elements
+    width_old = 1e-4 * (1 - (mesh.centers[:, 0] / (1.05 * np.abs(mesh.centers[:, 0]).max())) ** 2)
+    problem = StepProblem(elastic=ElasticSolver(op, rtol=1e-11), normals=mesh.normals,
+                          far_field=-(mesh.normals @ stress.T).ravel(), flow=flow,
+                          compliance=fracture_compliance(mesh, mat), dt=dt, width_old=width_old,
+                          pressure_old=np.full(n, 1e6), leak_off_rate=flow.leak_off_rate(np.zeros(n), 0.0, dt))
+    guess = (width_old[:, None] * mesh.normals).ravel()
+    return problem, guess, np.full(n, 1e6)
+
+
+@pytest.fixture(scope="module")
+def reference_step():
+    mesh = hd.mesh.line([-5, 0], [5, 0], 20)
+    problem, dd0, p0 = _problem(mesh, leak=1e-12)
+    settings = SchemeSettings(scheme="krylov", tolerance_pressure=1e-9, tolerance_opening=1e-9, linear_rtol=1e-12)
+    dd, p, info = solve_step(problem, settings, dd0, p0, 1.0)
+    return mesh, dd, p, info
+
+
+@pytest.mark.parametrize("scheme", ["fixed-width", "fracture-compliance", "fully-coupled"])
+def test_schemes_reach_the_same_step_solution(reference_step, scheme):
+    mesh, dd_ref, p_ref, _ = reference_step
+    problem, dd0, p0 = _problem(mesh, leak=1e-12)
+    settings = SchemeSettings(scheme=scheme, tolerance_pressure=1e-9, tolerance_opening=1e-9,
+                              linear_rtol=1e-12, max_iterations=3000)
+    dd, p, info = solve_step(problem, settings, dd0, p0, 1.0)
+    # a converged relaxed iteration stops within about tol/alpha of the fixed point
+    tolerance = 1e-9 / info["relaxation"] * 20
+    np.testing.assert_allclose(p, p_ref, rtol=tolerance)
+    np.testing.assert_allclose(dd, dd_ref, atol=tolerance * np.abs(dd_ref).max())
+
+
+def test_step_conserves_mass(reference_step):
+    mesh, dd, p, _ = reference_step
+    problem, _, _ = _problem(mesh, leak=1e-12)
+    width = problem.width(dd)
+    flow = problem.flow
+    stored = np.sum(flow.areas * (width - problem.width_old))
+    compressed = np.sum(4.5e-10 * (flow.areas * np.maximum(width, 1e-5) + flow.wellbore_storage()) * (p - 1e6))
+    leaked = np.sum(flow.areas * problem.leak_off_rate * (p - 0.5e6)) * problem.dt
+    np.testing.assert_allclose(stored + compressed + leaked, 5e-4 * problem.dt, rtol=1e-6)
+
+
+def test_relaxation_ordering_of_the_segregated_schemes():
+    # ref. Figs 4.11-4.15: the fixed-width split needs more relaxation than the
+    # fracture-compliance split, and the coupled schemes none
+    mesh = hd.mesh.line([-5, 0], [5, 0], 20)
+    alphas = {}
+    for scheme in ("fixed-width", "fracture-compliance", "krylov"):
+        problem, dd0, p0 = _problem(mesh)
+        _, _, info = solve_step(problem, SchemeSettings(scheme=scheme, max_iterations=3000), dd0, p0, 1.0)
+        alphas[scheme] = info["relaxation"]
+    assert alphas["fixed-width"] < alphas["fracture-compliance"] <= alphas["krylov"] == 1.0
+
+
+def test_hmatrix_step_matches_dense():
+    mesh = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 8.0, 8.0, 8, 8)
+    results = {}
+    for backend in ("dense", "hmatrix"):
+        problem, dd0, p0 = _problem(mesh, backend=backend, rate=1e-2)
+        settings = SchemeSettings(scheme="krylov", tolerance_pressure=1e-9, tolerance_opening=1e-9, linear_rtol=1e-11)
+        results[backend] = solve_step(problem, settings, dd0, p0, 1.0)
+    np.testing.assert_allclose(results["hmatrix"][1], results["dense"][1], rtol=1e-6)
+    np.testing.assert_allclose(results["hmatrix"][0], results["dense"][0], atol=1e-6 * np.abs(results["dense"][0]).max())
+
+
+def test_scaling_makes_the_coupled_matrix_well_conditioned():
+    # ref. Fig. 4.13: cond(A) ~ 1e19 falls to O(100) after M_1^-1 A M_2
+    mesh = hd.mesh.line([-1.5, 0], [1.5, 0], 3)
+    problem, dd0, p0 = _problem(mesh)
+    matrix, _ = problem.flow_matrices(dd0)
+    system = _CoupledLinearSystem(problem, matrix, dd0, p0)
+    a = problem.elastic.operator.to_dense()
+    b = np.zeros((a.shape[0], mesh.n_elements))
+    for i in range(mesh.n_elements):
+        b[2 * i:2 * i + 2, i] = mesh.normals[i]
+    full = np.block([[a, b], [problem.coupling.toarray(), matrix.toarray()]])
+    scaled = np.column_stack([system.operator @ e for e in np.eye(full.shape[0])])
+    assert np.linalg.cond(full) > 1e12
+    assert np.linalg.cond(scaled) < 1e3
