@@ -87,12 +87,7 @@ class ElasticityOperator(LinearOperator):
         n = mesh.n_elements * self.dof
         super().__init__(dtype=np.float64, shape=(n, n))
 
-        self._kernels = kernel_module(mesh)
-        shift = _AVERAGE_SHIFT if singular_correction == "average" else 0.0
-        self_max = None
-        if alpha is not None:
-            self_max = self._self_block_max(shift)
-        self.data = element_data(mesh, material, singular_shift=shift, alpha=alpha or 0.0, self_max=self_max)
+        self._kernels, self.data = influence_data(mesh, material, singular_correction, alpha)
 
         t0 = time.perf_counter()
         if backend == "dense":
@@ -193,18 +188,30 @@ class ElasticityOperator(LinearOperator):
         return self._lu
 
     # -- helpers ------------------------------------------------------------------------
-    def _self_block_max(self, shift):
-        data = element_data(self.mesh, self.material, singular_shift=shift)
-        out = np.empty(self.mesh.n_elements)
-        block = np.empty((self.dof, self.dof))
-        for i in range(self.mesh.n_elements):
-            index = np.array([i], dtype=np.int64)
-            self._kernels.traction_block(data, index, index, block)
-            out[i] = np.max(np.abs(block))
-        return out
-
     def _refuse_singular(self):
-        raise InputError(
+        refuse_singular()
+
+
+def influence_data(mesh, material, singular_correction="none", alpha=None):
+    """``(kernel_module, element_data)`` that fill exact influence blocks of ``mesh``
+    with the same options (NaN averaging, Eq. 6.11 scaling) as the operator uses."""
+    kernels = kernel_module(mesh)
+    shift = _AVERAGE_SHIFT if singular_correction == "average" else 0.0
+    self_max = None
+    if alpha is not None:
+        data = element_data(mesh, material, singular_shift=shift)
+        self_max = np.empty(mesh.n_elements)
+        block = np.empty((mesh.dim, mesh.dim))
+        for i in range(mesh.n_elements):
+            index = np.array([i], dtype=np.int64)
+            kernels.traction_block(data, index, index, block)
+            self_max[i] = np.max(np.abs(block))
+    return kernels, element_data(mesh, material, singular_shift=shift, alpha=alpha or 0.0, self_max=self_max)
+
+
+def refuse_singular():
+    """Raise the InputError of a mesh with collocation points on element edges."""
+    raise InputError(
             "the mesh has collocation points on element edges (e.g. a T-intersection where an "
             "element ends on another element's centre), where the DDM kernel is singular; "
             "use singular_correction='average' (and alpha=1.0, ref. Sec. 6.2.3) or mesh the "

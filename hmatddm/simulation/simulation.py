@@ -28,6 +28,7 @@ from ..flow import Cluster, Fluid, LeakOff, LubricationModel, fracture_complianc
 from ..fracture import Propagation, evaluate_tips, new_elements
 from ..material import Elastic
 from ..mesh import Mesh2D, Mesh3D, concatenate
+from ..extended_operator import ExtendedElasticityOperator
 from ..operators import BACKENDS, DEFAULT_EPS, DEFAULT_ETA, DEFAULT_LEAF_SIZE, ElasticityOperator
 from . import checkpoint
 
@@ -103,13 +104,18 @@ class Simulation:
     checkpoint_dir : path or None
         Where to write a checkpoint after every step.
     keep_checkpoints : int
+    rebuild_fraction, max_border_bytes
+        ``hmatrix`` backend: elements added by growth join the operator as exact
+        border blocks (:class:`~hmatddm.extended_operator.ExtendedElasticityOperator`)
+        until they exceed ``rebuild_fraction`` of the compressed elements or the
+        border exceeds ``max_border_bytes``; then the H-matrix is rebuilt.
     """
 
     def __init__(self, mesh, material, fluid, clusters, far_field_stress, time_step, propagation=None,
                  leak_off=None, initial_pressure=0.0, initial_opening=1e-5, minimum_width=None, height=1.0,
                  backend="hmatrix", eps=DEFAULT_EPS, eta=DEFAULT_ETA, leaf_size=DEFAULT_LEAF_SIZE,
                  singular_correction="none", alpha=None, scheme="krylov", growing_fractures=None,
-                 checkpoint_dir=None, keep_checkpoints=3):
+                 checkpoint_dir=None, keep_checkpoints=3, rebuild_fraction=0.25, max_border_bytes=2**28):
         if not isinstance(mesh, (Mesh2D, Mesh3D)):
             raise InputError(f"mesh must be a Mesh2D or Mesh3D, got {type(mesh).__name__}")
         if not isinstance(material, Elastic):
@@ -150,8 +156,13 @@ class Simulation:
         self.keep_checkpoints = keep_checkpoints
         self.records = []
         self.state = self._initial_state()
+        self.rebuild_fraction = finite_scalar("rebuild_fraction", rebuild_fraction)
+        if not 0.0 <= self.rebuild_fraction <= 10.0:
+            raise InputError(f"rebuild_fraction must be in [0, 10], got {self.rebuild_fraction}")
+        self.max_border_bytes = finite_scalar("max_border_bytes", max_border_bytes)
         self._operator_mesh = None
         self._operator = None
+        self._base = None
         self.operator_builds = 0
 
     # -- setup ------------------------------------------------------------------------
@@ -177,12 +188,37 @@ class Simulation:
         return digest.hexdigest()
 
     def operator(self, mesh):
-        """The elasticity operator of ``mesh`` (rebuilt only when the mesh changed)."""
-        if self._operator_mesh is not mesh:
-            self._operator = ElasticityOperator(mesh, self.material, **self.operator_options)
-            self._operator_mesh = mesh
-            self.operator_builds += 1
-        return self._operator
+        """The elasticity operator of ``mesh``: the last one if the mesh is unchanged, the
+        compressed base plus exact borders if the mesh only grew a little, else a new build."""
+        if self._operator_mesh is mesh:
+            return self._operator
+        base = self._base
+        n = mesh.n_elements
+        extends = (base is not None and n >= base.mesh.n_elements
+                   and np.array_equal(mesh.centers[:base.mesh.n_elements], base.mesh.centers))
+        if extends and n == base.mesh.n_elements:
+            operator = base
+        elif extends and self.operator_options["backend"] == "hmatrix" and self._border_fits(base, n):
+            operator = ExtendedElasticityOperator(base, mesh)
+        else:
+            operator = self._build_base(mesh)
+        self._operator, self._operator_mesh = operator, mesh
+        return operator
+
+    def _border_fits(self, base, n):
+        n0, m, d = base.mesh.n_elements, n - base.mesh.n_elements, base.dof
+        border_bytes = 8.0 * d * d * (2 * n0 * m + m * m)
+        return m <= self.rebuild_fraction * n0 and border_bytes <= self.max_border_bytes
+
+    def _build_base(self, mesh):
+        self._base = ElasticityOperator(mesh, self.material, **self.operator_options)
+        self.operator_builds += 1
+        return self._base
+
+    @property
+    def compressed_elements(self):
+        """Elements in the compressed base operator (0 before the first build)."""
+        return 0 if self._base is None else self._base.mesh.n_elements
 
     def far_field_traction(self, mesh):
         """f = -sigma_0 . n at every element (ref. Eq. 4.4, our sign), flat."""
@@ -312,7 +348,8 @@ class Simulation:
         s = self.state
         arrays = dict(_mesh_arrays(s.mesh), dd=s.dd, pressure=s.pressure, creation_time=s.creation_time)
         metadata = dict(time=s.time, step=s.step, relaxation=s.relaxation, injected_volume=s.injected_volume,
-                        leaked_volume=s.leaked_volume, records=self.records, fingerprint=self.fingerprint())
+                        leaked_volume=s.leaked_volume, records=self.records, fingerprint=self.fingerprint(),
+                        compressed_elements=self.compressed_elements)
         checkpoint.save(self.checkpoint_dir, s.step, arrays, metadata, keep=self.keep_checkpoints)
 
     def load_checkpoint(self):
@@ -326,4 +363,10 @@ class Simulation:
                            int(metadata["step"]), float(metadata["relaxation"]), float(metadata["injected_volume"]),
                            float(metadata["leaked_volume"]))
         self.records = list(metadata["records"])
+        # rebuild the compressed base exactly as the interrupted run had it, so the
+        # resumed run applies the same operator (bit for bit)
+        self._operator_mesh = self._operator = self._base = None
+        n_base = int(metadata.get("compressed_elements", 0))
+        if 0 < n_base <= mesh.n_elements:
+            self._build_base(mesh.subset(np.arange(n_base)))
         return self.state

@@ -1,0 +1,96 @@
+"""An elasticity operator grown by a few elements without recompressing it.
+
+When a fracture grows, the mesh gains a ring of elements at its front. Rebuilding the
+H-matrix for every growth pass would dominate the run time, so the new elements are
+added as exact border blocks around the existing operator::
+
+    A = [ A_oo   A_on ]    A_oo: the H-matrix (or dense matrix) already built
+        [ A_no   A_nn ]    A_on, A_no, A_nn: exact kernel blocks (dense)
+
+Matvec cost grows by ``2 N m d^2`` for ``m`` new elements, so the simulation rebuilds
+the base operator once the border is large (see ``Simulation``). The preconditioner
+is block lower-triangular: the base near-field preconditioner for the old unknowns,
+then an exact LU of ``A_nn`` for the new ones.
+"""
+import numpy as np
+import scipy.linalg
+from scipy.sparse.linalg import LinearOperator
+
+from .operators import ElasticityOperator, influence_data, refuse_singular
+
+
+class ExtendedElasticityOperator(LinearOperator):
+    """``base`` (an ElasticityOperator of the first ``n0`` elements of ``mesh``) plus
+    exact border blocks for elements ``n0..N-1``."""
+
+    def __init__(self, base, mesh):
+        if not isinstance(base, ElasticityOperator):
+            raise TypeError("base must be an ElasticityOperator")
+        n0, n = base.mesh.n_elements, mesh.n_elements
+        if n <= n0 or not np.array_equal(mesh.centers[:n0], base.mesh.centers):
+            raise ValueError("mesh must extend the base operator's mesh by appending elements")
+        self.base = base
+        self.mesh = mesh
+        self.material = base.material
+        self.backend = base.backend
+        self.dof = d = base.dof
+        self.n_base = n0
+        super().__init__(dtype=np.float64, shape=(n * d, n * d))
+        kernels, data = influence_data(mesh, base.material, base.singular_correction, base.alpha)
+        old = np.arange(n0, dtype=np.int64)
+        new = np.arange(n0, n, dtype=np.int64)
+        self.on = self._block(kernels, data, old, new)
+        self.no = self._block(kernels, data, new, old)
+        self.nn = self._block(kernels, data, new, new)
+        if not (np.all(np.isfinite(self.on)) and np.all(np.isfinite(self.no)) and np.all(np.isfinite(self.nn))):
+            refuse_singular()
+        self._nn_lu = None
+        self.border_bytes = self.on.nbytes + self.no.nbytes + self.nn.nbytes
+
+    def _block(self, kernels, data, rows, cols):
+        out = np.empty((len(rows) * self.dof, len(cols) * self.dof))
+        kernels.traction_block(data, rows, cols, out)
+        return out
+
+    @property
+    def n_new(self):
+        return self.mesh.n_elements - self.n_base
+
+    def _matvec(self, x):
+        x = np.asarray(x, dtype=np.float64).ravel()
+        k = self.n_base * self.dof
+        x_old, x_new = x[:k], x[k:]
+        return np.concatenate([self.base.matvec(x_old) + self.on @ x_new, self.no @ x_old + self.nn @ x_new])
+
+    def _nn_factor(self):
+        if self._nn_lu is None:
+            self._nn_lu = scipy.linalg.lu_factor(self.nn, check_finite=False)
+        return self._nn_lu
+
+    def approximate_inverse(self, r):
+        """Block lower-triangular solve: base preconditioner (or LU), then LU of ``A_nn``."""
+        k = self.n_base * self.dof
+        r = np.asarray(r, dtype=np.float64).ravel()
+        if self.base.backend == "dense":
+            x_old = scipy.linalg.lu_solve(self.base.lu(), r[:k], check_finite=False)
+        else:
+            x_old = self.base.preconditioner() @ r[:k]
+        x_new = scipy.linalg.lu_solve(self._nn_factor(), r[k:] - self.no @ x_old, check_finite=False)
+        return np.concatenate([x_old, x_new])
+
+    def preconditioner(self):
+        return LinearOperator(self.shape, matvec=self.approximate_inverse, dtype=np.float64)
+
+    def element_diagonal_blocks(self):
+        d, n0 = self.dof, self.n_base
+        if self.base.backend == "dense":
+            matrix = self.base._matrix.reshape(n0, d, n0, d)
+            index = np.arange(n0)
+            old = matrix[index, :, index, :]
+        else:
+            old = self.base.hmatrix.element_diagonal_blocks()
+        m = self.n_new
+        nn = self.nn.reshape(m, d, m, d)
+        index = np.arange(m)
+        return np.concatenate([old, nn[index, :, index, :]])
+
