@@ -22,11 +22,11 @@ A growing radial fracture (ref. Ch. 4)::
                         propagation=hd.Propagation(toughness=5e6), initial_pressure=10e6)
     records = sim.run(end_time=50.0)
 """
-from . import analytical, kernels, mesh, topology
+from . import analytical, kernels, mesh, network, topology
 from .coupled import SchemeSettings
 from .errors import ConvergenceError, HmatddmError, InputError
 from .flow import Cluster, Fluid, LeakOff
-from .fracture import Propagation
+from .fracture import NaturalFractureProperties, Propagation
 from .material import Elastic
 from .mesh import Mesh2D, Mesh3D
 from .operators import ElasticityOperator
@@ -38,5 +38,5 @@ __version__ = "0.1.0"
 __all__ = [
     "Elastic", "Mesh2D", "Mesh3D", "ElasticityOperator", "solve", "opening", "slip", "stress_at",
     "mean_stress_at", "mesh", "analytical", "kernels", "topology", "HmatddmError", "InputError", "ConvergenceError",
-    "Fluid", "LeakOff", "Cluster", "Propagation", "SchemeSettings", "Simulation", "CheckpointError",
+    "Fluid", "LeakOff", "Cluster", "Propagation", "NaturalFractureProperties", "network", "SchemeSettings", "Simulation", "CheckpointError",
 ]

@@ -58,17 +58,25 @@ class Faces:
     def n_faces(self):
         return len(self.first)
 
-    def append(self, first, second, length, first_distance, second_distance):
-        """These faces plus extra connections (e.g. fracture intersections), edges ``-1``."""
+    def append(self, first, second, length, first_distance, second_distance, first_edge=None):
+        """These faces plus extra connections (e.g. fracture intersections).
+
+        ``first_edge`` (optional, -1 for none) is the local edge of ``first`` the
+        connection covers (a tip arrested on a natural fracture is no tip any more);
+        the other side gets edge ``-1``.
+        """
         first = np.asarray(first, dtype=np.int64)
         second = np.asarray(second, dtype=np.int64)
+        first_edge = -np.ones(len(first), np.int64) if first_edge is None else np.asarray(first_edge, np.int64)
         low, high = np.minimum(first, second), np.maximum(first, second)
         swap = first > second
         d_first = np.where(swap, second_distance, first_distance)
         d_second = np.where(swap, first_distance, second_distance)
         minus = -np.ones(len(low), dtype=np.int64)
+        edge_low = np.where(swap, minus, first_edge)
+        edge_high = np.where(swap, first_edge, minus)
         return Faces(np.concatenate([self.first, low]), np.concatenate([self.second, high]),
-                     np.concatenate([self.first_edge, minus]), np.concatenate([self.second_edge, minus]),
+                     np.concatenate([self.first_edge, edge_low]), np.concatenate([self.second_edge, edge_high]),
                      np.concatenate([self.length, np.asarray(length, float)]),
                      np.concatenate([self.first_distance, np.asarray(d_first, float)]),
                      np.concatenate([self.second_distance, np.asarray(d_second, float)]))

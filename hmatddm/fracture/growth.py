@@ -160,10 +160,11 @@ def _turn_angles(mesh, edges, tips, propagation):
     return theta
 
 
-def new_elements(mesh, edges, tips, propagation):
+def new_elements(mesh, edges, tips, propagation, return_tips=False):
     """Elements ahead of the growing tip edges, or ``None``.
 
-    Returns ``(mesh_of_new_elements, parent_element)``. Candidates closer than half an
+    Returns ``(mesh_of_new_elements, parent_element)`` (plus the row of ``tips`` each
+    came from when ``return_tips``). Candidates closer than half an
     element to an existing centre or to an earlier candidate are dropped (two tips of
     a staircase front may reach the same cell); candidates outside ``bounds`` too.
     """
@@ -195,6 +196,7 @@ def new_elements(mesh, edges, tips, propagation):
     if not chosen:
         return None
     chosen = np.asarray(chosen, dtype=np.int64)
+    tip_rows = index[chosen]
     parent, edge, theta, centers = parent[chosen], edge[chosen], theta[chosen], centers[chosen]
     fracture_id = mesh.fracture_id[parent]
 
@@ -213,4 +215,4 @@ def new_elements(mesh, edges, tips, propagation):
         new_normal = c * normal - sense * s * tangent
         grown = Mesh2D(centers, np.ascontiguousarray(np.stack([new_tangent, new_normal], axis=1)),
                        mesh.half_length[parent].copy(), fracture_id.copy())
-    return grown, parent
+    return (grown, parent, tip_rows) if return_tips else (grown, parent)

@@ -26,11 +26,13 @@ from ..coupled import ElasticSolver, SchemeSettings, StepProblem, solve_step
 from ..errors import InputError
 from ..flow import Cluster, Fluid, LeakOff, LubricationModel, fracture_compliance
 from ..fracture import Propagation, evaluate_tips, new_elements
+from ..fracture.crossing import NaturalFractureProperties
 from ..material import Elastic
 from ..mesh import Mesh2D, Mesh3D, concatenate
 from ..extended_operator import ExtendedElasticityOperator
 from ..operators import BACKENDS, DEFAULT_EPS, DEFAULT_ETA, DEFAULT_LEAF_SIZE, ElasticityOperator
 from . import checkpoint
+from .natural import NaturalNetwork
 
 logger = logging.getLogger(__name__)
 
@@ -51,6 +53,11 @@ class State:
     relaxation: float
     injected_volume: float
     leaked_volume: float
+    origin: np.ndarray = None         # (N,) 0 hydraulic element, 1 activated natural element
+    natural_index: np.ndarray = None  # (N,) index in the natural mesh, -1 for hydraulic elements
+    intact: np.ndarray = None         # (M,) natural elements still intact (stress targets)
+    failed: np.ndarray = None         # (M,) intact natural elements failing Coulomb's criterion
+    extra_faces: np.ndarray = None    # (K, 6) flow connections (i, j, length, d_i, d_j, edge of i) at intersections
 
 
 def _mesh_arrays(mesh):
@@ -104,6 +111,13 @@ class Simulation:
     checkpoint_dir : path or None
         Where to write a checkpoint after every step.
     keep_checkpoints : int
+    natural_fractures : Mesh2D or Mesh3D or None
+        Natural-fracture elements (same dimension as ``mesh``). Intact ones are stress
+        targets; they join the system when the fluid reaches them (ref. Ch. 5, see
+        :mod:`hmatddm.simulation.natural`). Use ``singular_correction="average"`` and
+        ``alpha=1.0`` (ref. Sec. 6.2.3) when elements meet at intersections.
+    natural : NaturalFractureProperties or None
+        Their strength and the crossing criterion (default properties if None).
     rebuild_fraction, max_border_bytes
         ``hmatrix`` backend: elements added by growth join the operator as exact
         border blocks (:class:`~hmatddm.extended_operator.ExtendedElasticityOperator`)
@@ -115,7 +129,8 @@ class Simulation:
                  leak_off=None, initial_pressure=0.0, initial_opening=1e-5, minimum_width=None, height=1.0,
                  backend="hmatrix", eps=DEFAULT_EPS, eta=DEFAULT_ETA, leaf_size=DEFAULT_LEAF_SIZE,
                  singular_correction="none", alpha=None, scheme="krylov", growing_fractures=None,
-                 checkpoint_dir=None, keep_checkpoints=3, rebuild_fraction=0.25, max_border_bytes=2**28):
+                 checkpoint_dir=None, keep_checkpoints=3, rebuild_fraction=0.25, max_border_bytes=2**28,
+                 natural_fractures=None, natural=None):
         if not isinstance(mesh, (Mesh2D, Mesh3D)):
             raise InputError(f"mesh must be a Mesh2D or Mesh3D, got {type(mesh).__name__}")
         if not isinstance(material, Elastic):
@@ -152,6 +167,19 @@ class Simulation:
         self.settings = scheme if isinstance(scheme, SchemeSettings) else SchemeSettings(scheme=scheme)
         self.growing_fractures = None if growing_fractures is None else np.asarray(sorted(growing_fractures), np.int64)
         self.injection_elements = np.array([c.nearest_element(mesh) for c in clusters], dtype=np.int64)
+        self.network = None
+        if natural_fractures is not None:
+            if type(natural_fractures) is not type(mesh):
+                raise InputError(f"natural_fractures must be a {type(mesh).__name__} like mesh, "
+                                 f"got {type(natural_fractures).__name__}")
+            natural = NaturalFractureProperties() if natural is None else natural
+            if not isinstance(natural, NaturalFractureProperties):
+                raise InputError("natural must be an hmatddm.NaturalFractureProperties or None")
+            # natural fracture ids follow the hydraulic ones so that they never collide
+            offset = int(mesh.fracture_id.max()) + 1 - int(natural_fractures.fracture_id.min())
+            shifted = natural_fractures.subset(np.arange(natural_fractures.n_elements))
+            object.__setattr__(shifted, "fracture_id", natural_fractures.fracture_id + offset)
+            self.network = NaturalNetwork(shifted, natural)
         self.checkpoint_dir = checkpoint_dir
         self.keep_checkpoints = keep_checkpoints
         self.records = []
@@ -170,7 +198,11 @@ class Simulation:
         mesh = self.mesh0
         dd = self.initial_opening * mesh.normals
         pressure = np.full(mesh.n_elements, self.initial_pressure)
-        return State(mesh, dd, pressure, np.zeros(mesh.n_elements), 0.0, 0, self.settings.relaxation, 0.0, 0.0)
+        n_natural = 0 if self.network is None else self.network.mesh.n_elements
+        return State(mesh, dd, pressure, np.zeros(mesh.n_elements), 0.0, 0, self.settings.relaxation, 0.0, 0.0,
+                     origin=np.zeros(mesh.n_elements, np.int64), natural_index=-np.ones(mesh.n_elements, np.int64),
+                     intact=np.ones(n_natural, bool), failed=np.zeros(n_natural, bool),
+                     extra_faces=np.zeros((0, 6)))
 
     def fingerprint(self):
         """SHA-256 of everything that defines the run (a resume must match it)."""
@@ -183,8 +215,11 @@ class Simulation:
                      settings=repr(self.settings),
                      growing=None if self.growing_fractures is None else self.growing_fractures.tolist())
         digest = hashlib.sha256(json.dumps(parts, sort_keys=True, default=str).encode())
-        for value in _mesh_arrays(self.mesh0).values():
+        meshes = [self.mesh0] + ([] if self.network is None else [self.network.mesh])
+        for value in [v for m in meshes for v in _mesh_arrays(m).values()]:
             digest.update(np.ascontiguousarray(value).tobytes())
+        if self.network is not None:
+            digest.update(repr(self.network.properties).encode())
         return digest.hexdigest()
 
     def operator(self, mesh):
@@ -233,9 +268,13 @@ class Simulation:
                                 minimum_width=self.minimum_width)
 
     # -- one step -------------------------------------------------------------------------
-    def _solve(self, mesh, dd_old_width, p_old, creation_time, dd_guess, p_guess, t_old, t_new, relaxation):
+    def _solve(self, mesh, dd_old_width, p_old, creation_time, dd_guess, p_guess, t_old, t_new, relaxation,
+               extra_faces):
         edges = topology.element_edges(mesh, self.height)
         faces = topology.element_faces(mesh, edges)
+        if len(extra_faces):
+            i, j, length, d_i, d_j, edge_i = extra_faces.T
+            faces = faces.append(i.astype(np.int64), j.astype(np.int64), length, d_i, d_j, edge_i.astype(np.int64))
         flow = self.flow_model(mesh, faces)
         op = self.operator(mesh)
         problem = StepProblem(elastic=ElasticSolver(op, rtol=self.settings.linear_rtol), normals=mesh.normals,
@@ -256,43 +295,67 @@ class Simulation:
         p_old = s.pressure.copy()
         creation = s.creation_time.copy()
         dd, p = s.dd.copy(), s.pressure.copy()
+        origin, natural_index = s.origin.copy(), s.natural_index.copy()
+        intact, extra = s.intact.copy(), s.extra_faces.copy()
         totals = dict(nonlinear_iterations=0, linear_iterations=0, restarts=0)
+        self._events = dict(natural_crossed=0, natural_deflected=0)
         added = 0
         passes = 0
         relaxation = s.relaxation
         builds = self.operator_builds
         while True:
             dd, p, info, edges, faces, flow = self._solve(mesh, width_old, p_old, creation, dd, p,
-                                                          t_old, t_new, relaxation)
+                                                          t_old, t_new, relaxation, extra)
             relaxation = info["relaxation"]
             for key in totals:
                 totals[key] += info[key]
             if self.propagation is None or passes >= self.propagation.max_growth_passes:
                 break
-            grown = self._grow(mesh, edges, faces, dd)
+            grown = self._grow(mesh, edges, faces, dd, origin, natural_index, intact)
             if grown is None:
                 break
-            new_mesh, parent = grown
+            new_mesh, parent, new_natural, connections = grown
             passes += 1
             added += new_mesh.n_elements
+            first_new = mesh.n_elements
             mesh = concatenate([mesh, new_mesh])
             width_old = np.concatenate([width_old, np.zeros(new_mesh.n_elements)])
             p_old = np.concatenate([p_old, p_old[parent]])
             creation = np.concatenate([creation, np.full(new_mesh.n_elements, t_old)])
-            dd = np.concatenate([dd, dd[parent]])
+            guess = dd[parent]
+            activated = new_natural >= 0
+            guess[activated] = self.minimum_width * new_mesh.normals[activated]
+            dd = np.concatenate([dd, guess])
             p = np.concatenate([p, p[parent]])
+            origin = np.concatenate([origin, activated.astype(np.int64)])
+            natural_index = np.concatenate([natural_index, new_natural])
+            intact[new_natural[activated]] = False
+            for k, tip_element, length, d_tip, d_natural, tip_edge in connections:
+                extra = np.vstack([extra, [tip_element, first_new + k, length, d_tip, d_natural, tip_edge]])
 
         width = np.sum(dd * mesh.normals, axis=1)
         leak = flow.leak_off_rate(creation, t_old, t_new) * flow.areas * (p - self.leak_off.pore_pressure)
         injected = s.injected_volume + self.time_step * sum(c.rate for c in self.clusters)
         leaked = s.leaked_volume + float(np.sum(leak)) * self.time_step
-        self.state = State(mesh, dd, p, creation, t_new, s.step + 1, relaxation, injected, leaked)
+        failed = s.failed.copy()
+        if self.network is not None:
+            failed, *_ = self.network.remote_failure(mesh, dd, self.material, self.far_field_stress, intact)
+        self.state = State(mesh, dd, p, creation, t_new, s.step + 1, relaxation, injected, leaked,
+                           origin=origin, natural_index=natural_index, intact=intact, failed=failed,
+                           extra_faces=extra)
         record = self._record(flow, width, totals, added, passes, relaxation, time.perf_counter() - start,
                               self.operator_builds - builds)
         self.records.append(record)
         return record
 
-    def _grow(self, mesh, edges, faces, dd):
+    def _grow(self, mesh, edges, faces, dd, origin, natural_index, intact):
+        """Elements to add: ``(new_mesh, parent, natural_index_of_new, connections)`` or None.
+
+        New elements come from :func:`new_elements`; with natural fractures each
+        candidate is checked against the intact natural elements (see
+        :mod:`hmatddm.simulation.natural`): it may activate one instead, or be kept
+        when the crossing criterion says the tip crosses.
+        """
         element, edge = topology.tip_edges(mesh, faces, edges)
         if self.growing_fractures is not None:
             keep = np.isin(mesh.fracture_id[element], self.growing_fractures)
@@ -300,7 +363,62 @@ class Simulation:
         if element.size == 0:
             return None
         tips = evaluate_tips(mesh, edges, element, edge, dd, self.material, self.propagation)
-        return new_elements(mesh, edges, tips, self.propagation)
+        result = new_elements(mesh, edges, tips, self.propagation, return_tips=True)
+        if result is None:
+            return None
+        grown, parent, rows = result
+        if self.network is None:
+            return grown, parent, -np.ones(grown.n_elements, np.int64), []
+        network = self.network
+        available = intact.copy()
+        kept, activated, activated_parent, connections = [], [], [], []
+        for k in range(grown.n_elements):
+            row, tip = rows[k], parent[k]
+            distance, nearest = network.tree.query(grown.centers[k])
+            size = min(float(grown.radii[k]), float(network.mesh.radii[nearest]))
+            if available[nearest] and distance < 0.5 * size:
+                # the next element is an intact natural element: the fluid runs into it
+                available[nearest] = False
+                activated.append(nearest)
+                activated_parent.append(tip)
+                continue
+            hinge = edges.midpoints[tip, tips.edge[row]]
+            hit = network.encounter(grown, k, hinge, available)
+            if hit is None:
+                kept.append(k)
+                continue
+            target, point = hit
+            if network.decide_crossing(tips.k_1[row], tips.k_2[row], tips.theta[row], edges.ahead[tip, tips.edge[row]],
+                                       mesh.normals[tip], target, self.far_field_stress, self.propagation.toughness):
+                self._events["natural_crossed"] += 1
+                kept.append(k)
+                continue
+            self._events["natural_deflected"] += 1
+            available[target] = False
+            if mesh.dim == 3:
+                length = min(float(edges.length[tip, tips.edge[row]]), 2.0 * float(network.vertical_half[target]))
+                gap = np.linalg.norm(network.mesh.centers[target, :2] - point)
+            else:
+                length = self.height
+                gap = np.linalg.norm(network.mesh.centers[target] - point)
+            connections.append((len(activated), tip, length, float(edges.half_width[tip, tips.edge[row]]),
+                                max(gap, 0.1 * size), int(tips.edge[row])))
+            activated.append(target)
+            activated_parent.append(tip)
+        pieces, parents = [], []
+        if kept:
+            pieces.append(grown.subset(np.asarray(kept)))
+            parents.append(parent[np.asarray(kept)])
+        if activated:
+            pieces.append(network.mesh.subset(np.asarray(activated)))
+            parents.append(np.asarray(activated_parent, dtype=np.int64))
+        if not pieces:
+            return None
+        new_mesh = concatenate(pieces)
+        new_natural = np.concatenate([-np.ones(len(kept), np.int64), np.asarray(activated, dtype=np.int64)])
+        connections = [(len(kept) + k, tip, length, d_tip, d_nat, edge)
+                       for k, tip, length, d_tip, d_nat, edge in connections]
+        return new_mesh, np.concatenate(parents), new_natural, connections
 
     def _record(self, flow, width, totals, added, passes, relaxation, seconds, builds):
         s = self.state
@@ -315,6 +433,10 @@ class Simulation:
             linear_iterations=int(totals["linear_iterations"]), solve_seconds=float(seconds),
             leaked_volume=s.leaked_volume, relaxation=float(relaxation), restarts=int(totals["restarts"]),
             elements_added=int(added), growth_passes=int(passes), operator_builds=int(builds))
+        if self.network is not None:
+            record["natural_active"] = int(np.count_nonzero(s.origin == 1))
+            record["natural_failed"] = int(np.count_nonzero(s.failed))
+            record.update(self._events)
         if mesh.dim == 3:
             record["radius"] = float(np.sqrt(area / np.pi))
         else:
@@ -346,7 +468,9 @@ class Simulation:
 
     def save_checkpoint(self):
         s = self.state
-        arrays = dict(_mesh_arrays(s.mesh), dd=s.dd, pressure=s.pressure, creation_time=s.creation_time)
+        arrays = dict(_mesh_arrays(s.mesh), dd=s.dd, pressure=s.pressure, creation_time=s.creation_time,
+                      origin=s.origin, natural_index=s.natural_index, intact=s.intact, failed=s.failed,
+                      extra_faces=s.extra_faces)
         metadata = dict(time=s.time, step=s.step, relaxation=s.relaxation, injected_volume=s.injected_volume,
                         leaked_volume=s.leaked_volume, records=self.records, fingerprint=self.fingerprint(),
                         compressed_elements=self.compressed_elements)
@@ -361,7 +485,9 @@ class Simulation:
         mesh = _mesh_from_arrays(arrays)
         self.state = State(mesh, arrays["dd"], arrays["pressure"], arrays["creation_time"], float(metadata["time"]),
                            int(metadata["step"]), float(metadata["relaxation"]), float(metadata["injected_volume"]),
-                           float(metadata["leaked_volume"]))
+                           float(metadata["leaked_volume"]), origin=arrays["origin"],
+                           natural_index=arrays["natural_index"], intact=arrays["intact"], failed=arrays["failed"],
+                           extra_faces=arrays["extra_faces"])
         self.records = list(metadata["records"])
         # rebuild the compressed base exactly as the interrupted run had it, so the
         # resumed run applies the same operator (bit for bit)

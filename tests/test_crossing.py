@@ -1,0 +1,117 @@
+"""Crossing criteria (ref. Sec. 5.2) and natural fractures in the time loop (ref. Ch. 5)."""
+import numpy as np
+import pytest
+
+import hmatddm as hd
+from hmatddm.errors import InputError
+from hmatddm.fracture import NaturalFractureProperties, crosses, near_tip_stress, plane_tractions
+from hmatddm.simulation.natural import NaturalNetwork
+
+TABLE_5_1 = dict(friction=0.38, cohesion=3.2e6, tensile_strength=5e6, toughness=0.5e6, critical_radius=0.005)
+
+
+def test_near_tip_field_matches_the_hoop_stress_formula():
+    # sigma_theta_theta at theta: cos(t/2)[K_I cos^2(t/2) - 3/2 K_II sin t] / sqrt(2 pi r)
+    for theta in (0.3, 1.0, -1.2):
+        sxx, syy, sxy = near_tip_stress(1.0, 0.4, 0.01, theta)
+        hoop, _ = plane_tractions(sxx, syy, sxy, theta)  # normal stress on the radial plane
+        expected = np.cos(theta / 2) * (np.cos(theta / 2) ** 2 - 1.5 * 0.4 * np.sin(theta)) / np.sqrt(2 * np.pi * 0.01)
+        np.testing.assert_allclose(hoop, expected, rtol=1e-12)
+
+
+@pytest.mark.parametrize("angle", [60.0, 90.0])
+def test_mohr_coulomb_decision_is_monotone_in_the_stress_contrast(angle):
+    natural = NaturalFractureProperties(**TABLE_5_1, crossing="mohr-coulomb")
+    values = [crosses(2e6, 0.0, 0.0, np.deg2rad(angle), np.diag([-s, -3e6]), 2e6, natural)
+              for s in (6e6, 8e6, 10e6, 13e6, 20e6, 40e6)]
+    assert values == sorted(values)
+
+
+@pytest.mark.parametrize("angle", [90.0])
+def test_mohr_coulomb_crosses_at_high_stress_contrast_and_turns_at_low(angle):
+    # ref. Sec. 5.2.4 (Table 5.1): S_hmin 3 MPa; the HF grows along S_Hmax (tip frame x)
+    natural = NaturalFractureProperties(**TABLE_5_1, crossing="mohr-coulomb")
+    phi = np.deg2rad(angle)
+    decisions = {}
+    for s_hmax in (6e6, 8e6, 10e6, 13e6):
+        far = np.diag([-s_hmax, -3e6])
+        decisions[s_hmax] = crosses(2e6, 0.0, 0.0, phi, far, 2e6, natural)
+    assert decisions[13e6] and not decisions[6e6]
+
+
+@pytest.mark.parametrize("criterion", ["sif", "energy"])
+def test_sif_and_energy_criteria_ignore_the_far_field(criterion):
+    # ref. Sec. 5.2.4: only the Mohr-Coulomb criterion depends on the stress contrast
+    natural = NaturalFractureProperties(**TABLE_5_1, crossing=criterion)
+    for angle in (30.0, 60.0, 90.0):
+        phi = np.deg2rad(angle)
+        low = crosses(2e6, 0.0, 0.0, phi, np.diag([-6e6, -3e6]), 2e6, natural)
+        high = crosses(2e6, 0.0, 0.0, phi, np.diag([-13e6, -3e6]), 2e6, natural)
+        assert low == high
+    # a natural fracture as tough as the rock is crossed head-on; a weak one at 30 deg deflects
+    strong = NaturalFractureProperties(**dict(TABLE_5_1, toughness=2e6), crossing=criterion)
+    assert crosses(2e6, 0.0, 0.0, np.pi / 2, np.diag([-6e6, -3e6]), 2e6, strong)
+    assert not crosses(2e6, 0.0, 0.0, np.deg2rad(30), np.diag([-6e6, -3e6]), 2e6, natural)
+
+
+def _crossing_run(s_hmax, angle=90.0):
+    mat = hd.Elastic(3.415e9, 0.23)
+    hf = hd.mesh.line([-0.075, 0], [0.075, 0], 3)
+    a = np.deg2rad(angle)
+    center, tangent = np.array([0.2, 0.0]), np.array([np.cos(a), np.sin(a)])
+    nf = hd.mesh.line(center - 0.15 * tangent, center + 0.15 * tangent, 6)
+    sim = hd.Simulation(hf, mat, hd.Fluid(0.135, 4.545e-10), [hd.Cluster((0, 0), 4e-6, 1e-5)],
+                        far_field_stress=np.diag([-s_hmax, -3e6]), time_step=1.0,
+                        propagation=hd.Propagation(toughness=2e6), initial_pressure=3.5e6, initial_opening=1e-5,
+                        backend="dense", natural_fractures=nf,
+                        natural=NaturalFractureProperties(**TABLE_5_1, crossing="mohr-coulomb"),
+                        singular_correction="average", alpha=1.0)
+    records = sim.run(20.0)
+    return sim, records
+
+
+def test_hydraulic_fracture_crosses_or_follows_the_natural_fracture():
+    crossed, records = _crossing_run(13e6)
+    assert sum(r["natural_crossed"] for r in records) >= 1 and records[-1]["natural_active"] == 0
+    s = crossed.state
+    assert np.any((s.origin == 0) & (s.mesh.centers[:, 0] > 0.19) & (np.abs(s.mesh.centers[:, 1]) < 0.03))
+
+    deflected, records = _crossing_run(6e6)
+    assert sum(r["natural_deflected"] for r in records) >= 1 and records[-1]["natural_active"] >= 1
+    s = deflected.state
+    # the tip stopped at the natural fracture: nothing beyond it on the crack line
+    assert not np.any((s.origin == 0) & (s.mesh.centers[:, 0] > 0.19) & (np.abs(s.mesh.centers[:, 1]) < 0.03))
+    for record in records:
+        assert np.isfinite(record["max_opening"]) and np.isfinite(record["wellbore_pressure"][0])
+
+
+def test_remote_failure_is_near_the_fracture_and_grows_with_skempton():
+    # a pressurised crack loads natural fractures at 45 degrees; critically stressed
+    # planes fail close to the crack only (ref. Sec. 5.3.3)
+    mat = hd.Elastic(6.62e9, 0.25)
+    hf = hd.mesh.line([-5, 0], [5, 0], 40)
+    dd = hd.solve(hd.ElasticityOperator(hf, mat), -2e6 * hf.normals)
+    far = np.diag([-39.44e6, -35.85e6])
+    centers = np.array([[x, y] for x in (-3.0, 0.0, 3.0, 6.0) for y in (0.5, 1.5, 4.0, 15.0, 30.0)])
+    tangent = np.array([np.cos(np.pi / 4), np.sin(np.pi / 4)])
+    nf = hd.Mesh2D.from_segments(centers - 0.25 * tangent, centers + 0.25 * tangent)
+    counts = {}
+    for name, skempton in (("none", 0.0), ("gas", 0.01456), ("oil", 0.5255)):
+        props = NaturalFractureProperties(friction=0.25, cohesion=0.0, pore_pressure=30.2e6 * 0.98,
+                                          skempton=skempton)
+        failed, normal, shear, dp = NaturalNetwork(nf, props).remote_failure(hf, dd, mat, far, np.ones(len(nf), bool))
+        assert np.all(np.isfinite(normal)) and np.all(np.isfinite(shear))
+        counts[name] = int(failed.sum())
+        far_away = np.abs(centers[:, 1]) >= 15.0
+        assert not np.any(failed[far_away])
+    assert counts["none"] >= 1
+    assert counts["oil"] >= counts["gas"] >= counts["none"]
+
+
+def test_bad_natural_properties():
+    with pytest.raises(InputError, match="natural.crossing"):
+        NaturalFractureProperties(crossing="maybe")
+    with pytest.raises(InputError, match="natural.skempton"):
+        NaturalFractureProperties(skempton=1.5)
+    with pytest.raises(InputError, match="natural.critical_radius"):
+        NaturalFractureProperties(critical_radius=0.0)
