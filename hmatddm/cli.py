@@ -1,13 +1,33 @@
 """The ``hmatddm`` command line.
 
-    hmatddm validate [--json]     closed-form checks as a table of error and time
+    hmatddm run [SCENE] [--out DIR]   run a scene (embedded name or .toml file; default: "default")
+    hmatddm scenes [NAME]             list the embedded scenes, or print one as TOML
+    hmatddm validate [--json]         closed-form checks as a table of error and time
+    hmatddm bench [--quick] [--json]  H-matrix against dense: build time, memory, matvec time, error
+    hmatddm render DIR                snapshots and history plot of a finished or partial run
+
+Exit codes: 0 ok, 1 a check failed (validate), 2 bad input, 3 did not converge,
+130 interrupted (Ctrl-C; a run can be continued with --resume).
 """
 import argparse
 import json
+import shlex
 import sys
+from pathlib import Path
 
-EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT, EXIT_NOT_CONVERGED = 0, 1, 2, 3
+EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT, EXIT_NOT_CONVERGED, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
+DEFAULT_SCENE = "default"
+DEFAULT_OUT_ROOT = "hmatddm-runs"
 
+
+def _say(args, text, stream=None):
+    if not getattr(args, "quiet", False):
+        print(text, file=stream or sys.stdout)
+
+
+# ---------------------------------------------------------------------------------
+# validate
+# ---------------------------------------------------------------------------------
 
 def _validate(args):
     from .validate import format_table, run_checks
@@ -20,27 +40,198 @@ def _validate(args):
     return EXIT_OK if all(r["passed"] for r in rows) else EXIT_FAILED
 
 
+# ---------------------------------------------------------------------------------
+# scenes
+# ---------------------------------------------------------------------------------
+
+def _scenes(args):
+    from .scene import embedded_names, embedded_scenes, embedded_text
+
+    if args.name:
+        sys.stdout.write(embedded_text(args.name))
+        return EXIT_OK
+    scenes = embedded_scenes()
+    if args.json:
+        print(json.dumps(scenes, indent=2))
+        return EXIT_OK
+    width = max(len(name) for name in embedded_names())
+    for name, description in scenes.items():
+        print(f"{name:<{width}}  {description}")
+    return EXIT_OK
+
+
+# ---------------------------------------------------------------------------------
+# run
+# ---------------------------------------------------------------------------------
+
+def _resume_command(args, out):
+    parts = ["hmatddm", "run", "--out", str(out), "--resume"]
+    return " ".join(shlex.quote(p) for p in parts)
+
+
+def _load_run_scene(args):
+    """The scene to run and the output folder."""
+    from .runner import SCENE_FILE
+    from .scene import load_scene
+
+    overrides = list(args.set or [])
+    if args.backend:
+        overrides.append(f'numerics.backend="{args.backend}"')
+    stored = Path(args.out) / SCENE_FILE if args.out else None
+    if args.scene is None and args.resume and stored is not None and stored.is_file():
+        scene = load_scene(str(stored), overrides=overrides)  # the scene the run in DIR was started with
+    else:
+        scene = load_scene(args.scene or DEFAULT_SCENE, overrides=overrides)
+    out = Path(args.out) if args.out else Path(DEFAULT_OUT_ROOT) / scene.name
+    return scene, out
+
+
+def _run(args):
+    from .errors import ConvergenceError
+    from .runner import SceneRun
+    from .scene import NATURAL_FRACTURES_UNSUPPORTED, build_simulation
+
+    scene, out = _load_run_scene(args)
+    if args.check:
+        if scene.has_natural_fractures:
+            _say(args, f"hmatddm: note: the scene is valid, but `hmatddm run` refuses it: "
+                       f"{NATURAL_FRACTURES_UNSUPPORTED}", sys.stderr)
+        else:
+            build_simulation(scene.data)  # geometry checks (clusters on fractures, overlaps)
+        _say(args, json.dumps(scene.to_dict(), indent=1))
+        return EXIT_OK
+    if scene.has_natural_fractures:
+        from .errors import InputError
+
+        raise InputError(NATURAL_FRACTURES_UNSUPPORTED)
+    run = SceneRun(scene, out, resume=args.resume, overwrite=args.overwrite, quiet=args.quiet)
+    if not args.quiet:
+        numerics = scene.numerics
+        print(f"hmatddm: running {scene.name!r} ({scene.source}) to t = {numerics['end_time']:g} s, "
+              f"dt = {numerics['time_step']:g} s, backend {numerics['backend']}, into {out}", file=sys.stderr)
+    try:
+        summary = run.execute()
+    except KeyboardInterrupt:
+        record = run.last_record
+        where = (f"after step {record['step']} (t = {record['time']:g} s)" if record is not None
+                 else "before the first step finished")
+        print(f"\nhmatddm: interrupted {where}; every finished step is checkpointed in {out / 'checkpoints'}. "
+              f"Continue with: {_resume_command(args, out)}", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except ConvergenceError as error:
+        record = run.last_record
+        where = f"after step {record['step']} (t = {record['time']:g} s)" if record is not None else "in the first step"
+        print(f"hmatddm: did not converge {where}: {error}. The outputs of the last converged step are in {out}; "
+              "try a smaller numerics.time_step, a lower numerics.relaxation or another numerics.scheme",
+              file=sys.stderr)
+        return EXIT_NOT_CONVERGED
+    last = summary["steps"][-1] if summary["steps"] else None
+    if not args.quiet:
+        state = (f"t = {last['time']:g} s, {last['n_elements']} elements, {len(summary['steps'])} steps"
+                 if last else "no step")
+        reference = summary["reference"]
+        comparison = ""
+        if reference:
+            errors = reference[-1]["relative_error"]
+            comparison = "; vs closed form: " + ", ".join(
+                f"{key} {100 * value:+.1f}%" for key, value in errors.items() if value is not None)
+        print(f"hmatddm: done in {summary['wall_seconds']:.1f} s ({state}{comparison}); outputs in {out}")
+    return EXIT_OK
+
+
+# ---------------------------------------------------------------------------------
+# bench, render
+# ---------------------------------------------------------------------------------
+
+def _bench(args):
+    from .bench_cli import format_table, run_bench
+
+    rows = run_bench(quick=args.quick, stream=None if (args.quiet or args.json) else sys.stderr)
+    if args.json:
+        print(json.dumps(rows, indent=2))
+    else:
+        print(format_table(rows))
+    return EXIT_OK
+
+
+def _render(args):
+    from .runner import render_folder
+
+    written = render_folder(args.dir)
+    for path in written:
+        _say(args, f"wrote {path}")
+    return EXIT_OK
+
+
+# ---------------------------------------------------------------------------------
+# parser and main
+# ---------------------------------------------------------------------------------
+
 def build_parser():
-    parser = argparse.ArgumentParser(prog="hmatddm", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="hmatddm",
+                                     description="Hydraulic fractures with the displacement discontinuity "
+                                                 "method, made fast by H-matrices (SI units throughout).",
+                                     epilog="Exit codes: 0 ok, 1 check failed, 2 bad input, 3 did not converge, "
+                                            "130 interrupted.")
     sub = parser.add_subparsers(dest="command", required=True)
+
+    run = sub.add_parser("run", help="run a scene and write summary.json, VTU/PVD, checkpoints and PNGs",
+                         description="Run a scene (an embedded name, see `hmatddm scenes`, or a TOML file; "
+                                     "default: the embedded 'default') and write DIR/summary.json, "
+                                     "DIR/fractures.pvd with DIR/vtu/*.vtu, DIR/checkpoints, "
+                                     "DIR/snapshots/*.png and DIR/history.png.")
+    run.add_argument("scene", nargs="?", metavar="SCENE",
+                     help="embedded scene name or .toml file (default: 'default'; with --resume and no SCENE, "
+                          "the scene stored in DIR)")
+    run.add_argument("--out", metavar="DIR", help=f"output folder (default: {DEFAULT_OUT_ROOT}/<scene name>)")
+    run.add_argument("--backend", choices=("dense", "hmatrix"), help="override numerics.backend")
+    run.add_argument("--resume", action="store_true", help="continue from the newest checkpoint in DIR")
+    run.add_argument("--overwrite", action="store_true", help="start over in a DIR that already holds a run")
+    run.add_argument("--set", action="append", metavar="KEY=VALUE",
+                     help="override a scene value, e.g. --set numerics.end_time=10 (repeatable)")
+    run.add_argument("--check", action="store_true",
+                     help="validate the scene, print it as JSON (every default filled in) and stop")
+    run.add_argument("--quiet", action="store_true", help="no progress and no messages (errors still print)")
+    run.set_defaults(handler=_run)
+
+    scenes = sub.add_parser("scenes", help="list the embedded scenes (or print one as TOML)")
+    scenes.add_argument("name", nargs="?", metavar="NAME", help="print this scene's TOML")
+    scenes.add_argument("--json", action="store_true", help="print {name: description} as JSON")
+    scenes.set_defaults(handler=_scenes)
+
     validate = sub.add_parser("validate", help="closed-form checks (Griffith, Sneddon) as a table")
     validate.add_argument("--json", action="store_true", help="print JSON instead of a table")
     validate.set_defaults(handler=_validate)
+
+    bench = sub.add_parser("bench", help="H-matrix against dense: build time, memory, matvec time, error")
+    bench.add_argument("--quick", action="store_true", help="small sizes only (about 20 s)")
+    bench.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    bench.add_argument("--quiet", action="store_true", help="no progress")
+    bench.set_defaults(handler=_bench)
+
+    render = sub.add_parser("render", help="snapshots and history plot of a finished or partial run")
+    render.add_argument("dir", metavar="DIR", help="the --out folder of `hmatddm run`")
+    render.add_argument("--quiet", action="store_true", help="do not list the written files")
+    render.set_defaults(handler=_render)
     return parser
 
 
 def main(argv=None):
     from .errors import ConvergenceError, InputError
+    from .simulation import CheckpointError
 
     args = build_parser().parse_args(argv)
     try:
         return args.handler(args)
-    except InputError as exc:
+    except (InputError, CheckpointError) as exc:
         print(f"hmatddm: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except ConvergenceError as exc:
         print(f"hmatddm: did not converge: {exc}", file=sys.stderr)
         return EXIT_NOT_CONVERGED
+    except KeyboardInterrupt:
+        print("\nhmatddm: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
 
 
 if __name__ == "__main__":

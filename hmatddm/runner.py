@@ -1,0 +1,542 @@
+"""Run a scene into an output folder: what ``hmatddm run`` and ``hmatddm render`` do.
+
+The folder (``--out DIR``) holds::
+
+    summary.json        scene (validated echo, SI), versions, steps (one record per
+                        step), reference (closed form at each step, or null),
+                        wall_seconds; rewritten atomically after every step, so a
+                        partial or interrupted run is always readable
+    scene.toml          the validated scene (every default filled in); `--resume`
+                        without a SCENE reads it
+    fractures.pvd       ParaView time series of the .vtu files
+    vtu/step-NNNNNN.vtu cell data: opening (m), slip (vector, m), pressure (Pa),
+                        net_pressure (Pa, pressure minus the compressive normal far-field
+                        stress), fracture_id, state (0 hydraulic, 1 intact natural,
+                        2 failed natural), dd (vector, m)
+    checkpoints/        the simulation's atomic checkpoints (one per step, newest kept)
+    snapshots/step-NNNNNN_plan.png, _oblique.png   views of the last state
+    history.png         size, opening and wellbore pressure against time, with the
+                        closed form overlaid when the scene has a [reference]
+
+Progress goes to stderr (:class:`Progress`); nothing is printed with ``quiet=True``.
+"""
+import json
+import math
+import platform
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from .errors import HmatddmError, InputError
+from .io import atomic_output, read_vtu, write_pvd, write_vtu
+from .mesh import Mesh2D, Mesh3D
+from .simulation import checkpoint as checkpoints
+from .solve import opening, slip
+
+SUMMARY = "summary.json"
+SCENE_FILE = "scene.toml"
+PVD = "fractures.pvd"
+VTU_DIR = "vtu"
+CHECKPOINT_DIR = "checkpoints"
+SNAPSHOT_DIR = "snapshots"
+HISTORY = "history.png"
+SUMMARY_KEYS = ("scene", "versions", "steps", "reference", "wall_seconds")
+HYDRAULIC = 0
+
+
+# ---------------------------------------------------------------------------------
+# Small helpers
+# ---------------------------------------------------------------------------------
+
+def versions():
+    """Versions of hmatddm, numpy, scipy, numba and python."""
+    import numba
+    import scipy
+
+    from . import __version__
+
+    return {"hmatddm": __version__, "numpy": np.__version__, "scipy": scipy.__version__,
+            "numba": numba.__version__, "python": platform.python_version()}
+
+
+def _json_safe(value):
+    """Plain JSON: numpy scalars and arrays converted, NaN and inf written as null."""
+    if isinstance(value, dict):
+        return {str(k): _json_safe(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_json_safe(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return _json_safe(value.tolist())
+    if isinstance(value, (np.integer,)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        value = float(value)
+        return value if math.isfinite(value) else None
+    return value
+
+
+def write_json(path, document):
+    text = json.dumps(_json_safe(document), indent=1, allow_nan=False)
+    with atomic_output(path) as temporary:
+        temporary.write_text(text + "\n", encoding="utf-8")
+
+
+def read_summary(out):
+    """The summary.json of an output folder, or None when there is none."""
+    path = Path(out) / SUMMARY
+    if not path.is_file():
+        return None
+    try:
+        return json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError) as error:
+        raise InputError(f"{path} is not a readable summary.json: {error}") from None
+
+
+def _vtu_name(step):
+    return f"{VTU_DIR}/step-{step:06d}.vtu"
+
+
+def _vtu_steps(out):
+    folder = Path(out) / VTU_DIR
+    if not folder.is_dir():
+        return []
+    steps = []
+    for path in folder.glob("step-*.vtu"):
+        try:
+            steps.append(int(path.stem.split("-", 1)[1]))
+        except ValueError:
+            continue
+    return sorted(steps)
+
+
+def _format_seconds(seconds):
+    seconds = max(0.0, float(seconds))
+    if seconds < 60:
+        return f"{seconds:.0f}s"
+    minutes, seconds = divmod(int(round(seconds)), 60)
+    if minutes < 60:
+        return f"{minutes}m{seconds:02d}s"
+    hours, minutes = divmod(minutes, 60)
+    return f"{hours}h{minutes:02d}m"
+
+
+# ---------------------------------------------------------------------------------
+# Progress
+# ---------------------------------------------------------------------------------
+
+class Progress:
+    """A one-line progress display on ``stream`` (stderr by default).
+
+    On a terminal the line is redrawn in place after every step: step, simulated time
+    against the end time with a bar, elements, nonlinear (and linear) iterations,
+    seconds of the last step and an estimate of the time left. When the stream is not
+    a terminal (a log file, CI), a plain line is printed every ``ceil(steps / 10)``
+    steps and at the end. ``enabled=False`` prints nothing.
+    """
+
+    BAR = 20
+
+    def __init__(self, end_time, time_step, stream=None, enabled=True, start_time=0.0):
+        self.stream = sys.stderr if stream is None else stream
+        self.enabled = enabled
+        self.end_time, self.time_step = float(end_time), float(time_step)
+        self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
+        steps = max(1, math.ceil(self.end_time / self.time_step - 1e-9))
+        self.every = max(1, math.ceil(steps / 10))
+        self.started = time.perf_counter()
+        self.start_time = float(start_time)
+        self._drawn = False
+        self._width = 0
+
+    def _line(self, record):
+        fraction = min(1.0, max(0.0, record["time"] / self.end_time))
+        filled = int(round(fraction * self.BAR))
+        bar = "#" * filled + "-" * (self.BAR - filled)
+        elapsed = time.perf_counter() - self.started
+        done = (record["time"] - self.start_time) / max(self.end_time - self.start_time, 1e-300)
+        left = elapsed * (1.0 - done) / done if 0.0 < done < 1.0 else 0.0
+        return (f"step {record['step']:>4}  t {record['time']:g}/{self.end_time:g} s [{bar}] {100 * fraction:3.0f}%"
+                f"  elements {record['n_elements']}  iterations {record['nonlinear_iterations']}"
+                f" ({record['linear_iterations']} linear)  {record['solve_seconds']:.1f} s/step"
+                f"  left ~{_format_seconds(left)}")
+
+    def update(self, record):
+        if not self.enabled:
+            return
+        line = self._line(record)
+        if self.tty:
+            self.stream.write("\r" + line.ljust(self._width))
+            self._width = len(line)
+            self._drawn = True
+        elif record["step"] % self.every == 0 or record["time"] >= self.end_time - 1e-9 * self.time_step:
+            self.stream.write(line + "\n")
+        self.stream.flush()
+
+    def note(self, text):
+        """Print a message on its own line (below the progress line)."""
+        if not self.enabled:
+            return
+        self.close()
+        self.stream.write(text + "\n")
+        self.stream.flush()
+
+    def close(self):
+        if self.enabled and self.tty and self._drawn:
+            self.stream.write("\n")
+            self.stream.flush()
+        self._drawn = False
+        self._width = 0
+
+
+# ---------------------------------------------------------------------------------
+# Fields, VTU and pictures
+# ---------------------------------------------------------------------------------
+
+def cell_fields(mesh, dd, pressure, stress):
+    """Per-element fields written to the .vtu files (see the module docstring)."""
+    dd = np.asarray(dd, dtype=float).reshape(mesh.n_elements, mesh.dim)
+    normal_stress = np.einsum("ei,ij,ej->e", mesh.normals, stress, mesh.normals)
+    return {"opening": opening(mesh, dd), "slip": slip(mesh, dd), "pressure": np.asarray(pressure, dtype=float),
+            "net_pressure": np.asarray(pressure, dtype=float) + normal_stress,
+            "fracture_id": mesh.fracture_id, "state": np.full(mesh.n_elements, HYDRAULIC, dtype=np.int64),
+            "dd": dd}
+
+
+def _visible_slip(mesh, slip_vectors, opening_values):
+    """Slip worth drawing as arrows: None when it is round-off next to the opening."""
+    largest = float(np.max(np.linalg.norm(slip_vectors, axis=1))) if len(slip_vectors) else 0.0
+    scale = float(np.max(np.abs(opening_values))) if len(opening_values) else 0.0
+    return slip_vectors if largest > 1e-3 * scale and largest > 0.0 else None
+
+
+def snapshot_views(mesh):
+    """The views worth drawing: the plan view (looking down z) shows nothing of a 3D
+    mesh whose elements are all vertical (seen edge on), so it is left out then."""
+    if mesh.dim == 2:
+        return ("plan",)
+    if np.all(np.abs(mesh.normals[:, 2]) < 1e-6):
+        return ("oblique",)
+    return ("plan", "oblique")
+
+
+def write_snapshots(out, mesh, fields, step, time_value, title_prefix):
+    """``snapshots/step-NNNNNN_{plan,oblique}.png`` of one state; returns the paths."""
+    from .render import snapshot
+
+    title = f"{title_prefix}: t = {time_value:g} s, {mesh.n_elements} elements"
+    slip_vectors = _visible_slip(mesh, fields["slip"], fields["opening"])
+    return [snapshot(mesh, Path(out) / SNAPSHOT_DIR / f"step-{step:06d}_{view}.png", opening=fields["opening"],
+                     state=fields.get("state"), slip=slip_vectors, view=view, title=title)
+            for view in snapshot_views(mesh)]
+
+
+def write_history(out, records, scene):
+    """``history.png`` with the closed form overlaid; None when there is nothing to plot."""
+    from .render import plot_history
+    from .scene import confining_stress, reference_curves
+
+    if not records:
+        return None
+    reference = reference_curves(scene, end_time=max(r["time"] for r in records)) if scene is not None else None
+    confining = confining_stress(scene) if scene is not None and reference is not None else 0.0
+    if reference is not None and "net_pressure" not in reference:
+        confining = 0.0
+    return plot_history(records, Path(out) / HISTORY, reference=reference, confining_stress=confining)
+
+
+# ---------------------------------------------------------------------------------
+# A run
+# ---------------------------------------------------------------------------------
+
+class SceneRun:
+    """One run of a scene into an output folder.
+
+    Parameters
+    ----------
+    scene : hmatddm.scene.Scene
+    out : path
+        Output folder (created).
+    resume : bool
+        Continue from the newest checkpoint in ``out/checkpoints`` (a fresh start when
+        there is none). The scene must be the one that wrote the checkpoints.
+    overwrite : bool
+        Start over in a folder that already holds a run (its files are replaced).
+    quiet : bool
+        No progress and no notes.
+    stream : text stream for progress and notes (default stderr).
+
+    After :meth:`execute` (or an exception in it), ``simulation``, ``records`` and
+    ``last_record`` describe how far the run got.
+    """
+
+    def __init__(self, scene, out, resume=False, overwrite=False, quiet=False, stream=None):
+        self.scene = scene
+        self.out = Path(out)
+        self.resume = resume
+        self.overwrite = overwrite
+        self.quiet = quiet
+        self.stream = stream
+        self.simulation = None
+        self.progress = None
+        self.written = {"vtu": 0, "snapshots": [], "history": None}
+        self._pvd_entries = []
+        self._wall_before = 0.0
+        self._started = None
+        self._last_vtu_step = None
+        self._stress = None
+
+    # -- public -----------------------------------------------------------------------
+    @property
+    def records(self):
+        return [] if self.simulation is None else self.simulation.records
+
+    @property
+    def last_record(self):
+        return self.records[-1] if self.records else None
+
+    def note(self, text):
+        if self.progress is not None:
+            self.progress.note(text)
+        elif not self.quiet:
+            print(text, file=self.stream or sys.stderr)
+
+    def execute(self):
+        """Run to ``numerics.end_time``; returns the summary dict.
+
+        Raises InputError (bad scene, folder already holding a run), CheckpointError
+        (checkpoints of another run), ConvergenceError (after writing the outputs of
+        the last converged step) and lets KeyboardInterrupt through (the checkpoint of
+        the last finished step is on disk).
+        """
+        from .errors import ConvergenceError
+        from .scene import build_simulation
+
+        self._started = time.perf_counter()
+        scene = self.scene.data
+        numerics = scene["numerics"]
+        simulation = build_simulation(scene, checkpoint_dir=self.out / CHECKPOINT_DIR)
+        self._stress = simulation.far_field_stress
+        self._prepare_folder(simulation)
+        self.simulation = simulation
+        start_time = simulation.state.time
+        self.progress = Progress(numerics["end_time"], numerics["time_step"], stream=self.stream,
+                                 enabled=not self.quiet, start_time=start_time)
+        step = simulation.state.step
+        if step == 0 or (step % scene["output"]["every"] == 0 and self._last_vtu_step != step):
+            self._write_vtu(simulation.state)  # t = 0, or a step whose .vtu an interruption cut off
+        self._write_summary()
+        try:
+            simulation.run(numerics["end_time"], callback=self._after_step)
+        except ConvergenceError:
+            self.progress.close()
+            self._finish()
+            raise
+        except BaseException:
+            self.progress.close()
+            raise
+        self.progress.close()
+        return self._finish()
+
+    # -- folder -------------------------------------------------------------------------
+    def _holds_a_run(self):
+        return ((self.out / SUMMARY).exists() or bool(checkpoints.list_checkpoints(self.out / CHECKPOINT_DIR))
+                or bool(_vtu_steps(self.out)))
+
+    def _clear(self):
+        """Remove the files an earlier run wrote (only ours, by name)."""
+        names = [self.out / SUMMARY, self.out / PVD, self.out / HISTORY, self.out / SCENE_FILE]
+        folder = self.out / CHECKPOINT_DIR
+        names += list(folder.glob("step-*.json")) + list(folder.glob("step-*.npz"))
+        names += list((self.out / VTU_DIR).glob("step-*.vtu")) + list((self.out / SNAPSHOT_DIR).glob("step-*.png"))
+        for path in names:
+            path.unlink(missing_ok=True)
+
+    def _prepare_folder(self, simulation):
+        from .scene import to_toml
+
+        out = self.out
+        if out.exists() and not out.is_dir():
+            raise InputError(f"--out {str(out)!r} exists and is not a folder")
+        has_checkpoint = bool(checkpoints.list_checkpoints(out / CHECKPOINT_DIR))
+        if self.resume and has_checkpoint:
+            simulation.load_checkpoint()
+            step = simulation.state.step
+            summary = read_summary(out)
+            if summary is not None:
+                self._wall_before = float(summary.get("wall_seconds") or 0.0)
+            times = {0: 0.0, **{int(r["step"]): float(r["time"]) for r in simulation.records}}
+            for old in _vtu_steps(out):
+                if old > step or old not in times:  # written after the checkpoint we resume from
+                    (out / _vtu_name(old)).unlink(missing_ok=True)
+                else:
+                    self._pvd_entries.append((times[old], _vtu_name(old)))
+                    self._last_vtu_step = old
+            self.note(f"resuming {self.scene.name} from step {step} (t = {simulation.state.time:g} s) in {out}")
+        else:
+            if self._holds_a_run():
+                if self.resume:
+                    self.note(f"no checkpoint in {out / CHECKPOINT_DIR}: starting {self.scene.name} from t = 0")
+                elif not self.overwrite:
+                    raise InputError(f"--out {str(out)!r} already holds a run; add --resume to continue it or "
+                                     "--overwrite to start over (or choose another folder)")
+                self._clear()
+        out.mkdir(parents=True, exist_ok=True)
+        from . import __version__
+
+        header = (f"Scene {self.scene.name!r} as validated by hmatddm {__version__} (SI units, stresses compressive "
+                  f"positive, every default filled in).\nContinue this run with: hmatddm run --out {out} --resume")
+        with atomic_output(out / SCENE_FILE) as temporary:
+            temporary.write_text(to_toml(self.scene.data, header), encoding="utf-8")
+
+    # -- per step ------------------------------------------------------------------------
+    def _write_vtu(self, state):
+        if not self.scene.data["output"]["vtu"]:
+            return
+        mesh = state.mesh
+        fields = cell_fields(mesh, state.dd, state.pressure, self._stress)
+        write_vtu(self.out / _vtu_name(state.step), mesh, fields)
+        self._pvd_entries = [(t, name) for t, name in self._pvd_entries if name != _vtu_name(state.step)]
+        self._pvd_entries.append((state.time, _vtu_name(state.step)))
+        write_pvd(self.out / PVD, self._pvd_entries)
+        self._last_vtu_step = state.step
+        self.written["vtu"] += 1
+
+    def _is_last(self, record):
+        numerics = self.scene.data["numerics"]
+        return record["time"] >= numerics["end_time"] - 1e-9 * numerics["time_step"]
+
+    def _after_step(self, simulation, record):
+        every = self.scene.data["output"]["every"]
+        if record["step"] % every == 0 or self._is_last(record):
+            self._write_vtu(simulation.state)
+        self._write_summary()
+        self.progress.update(record)
+
+    def summary(self):
+        from .scene import reference_values
+
+        wall = self._wall_before + (time.perf_counter() - self._started if self._started else 0.0)
+        return {"scene": self.scene.to_dict(), "versions": versions(), "steps": self.records,
+                "reference": reference_values(self.scene.data, self.records), "wall_seconds": wall}
+
+    def _write_summary(self):
+        document = self.summary()
+        write_json(self.out / SUMMARY, document)
+        return document
+
+    # -- the end -------------------------------------------------------------------------
+    def _finish(self):
+        """Last VTU, snapshots and history of the last converged state; final summary."""
+        state = self.simulation.state
+        output = self.scene.data["output"]
+        if output["vtu"] and self._last_vtu_step != state.step:
+            self._write_vtu(state)
+        if output["snapshots"]:
+            fields = cell_fields(state.mesh, state.dd, state.pressure, self._stress)
+            try:
+                self.written["snapshots"] = write_snapshots(self.out, state.mesh, fields, state.step, state.time,
+                                                            self.scene.name)
+            except HmatddmError as error:  # e.g. no offscreen OpenGL on this machine
+                self.note(f"hmatddm: warning: no snapshots written: {error}")
+        if output["history_plot"]:
+            self.written["history"] = write_history(self.out, self.records, self.scene.data)
+        return self._write_summary()
+
+
+def run_scene(scene, out, resume=False, overwrite=False, quiet=False, stream=None):
+    """Run ``scene`` (a Scene, an embedded name or a .toml path) into ``out``; returns
+    the summary dict. See :class:`SceneRun`."""
+    from .scene import load_scene
+
+    return SceneRun(load_scene(scene), out, resume=resume, overwrite=overwrite, quiet=quiet,
+                    stream=stream).execute()
+
+
+# ---------------------------------------------------------------------------------
+# Render a finished or partial run
+# ---------------------------------------------------------------------------------
+
+def _mesh_from_checkpoint(arrays):
+    if "half_a" in arrays:
+        return Mesh3D(arrays["centers"], arrays["frames"], arrays["half_a"], arrays["half_b"],
+                      arrays["fracture_id"].astype(np.int64))
+    return Mesh2D(arrays["centers"], arrays["frames"], arrays["half_length"], arrays["fracture_id"].astype(np.int64))
+
+
+def mesh_from_vtu(points, cells, cell_data):
+    """Rebuild a mesh from the cells that :func:`hmatddm.io.write_vtu` writes (quads in
+    3D with corners counter-clockwise about the normal, lines at z = 0 in 2D)."""
+    fracture_id = np.asarray(cell_data.get("fracture_id", np.zeros(len(cells))), dtype=np.int64)
+    if cells.shape[1] == 4:
+        corners = points[cells]                       # (N, 4, 3)
+        side_a = corners[:, 1] - corners[:, 0]
+        side_b = corners[:, 3] - corners[:, 0]
+        length_a = np.linalg.norm(side_a, axis=1)
+        length_b = np.linalg.norm(side_b, axis=1)
+        return Mesh3D.from_rectangles(corners.mean(axis=1), side_a / length_a[:, None], side_b / length_b[:, None],
+                                      0.5 * length_a, 0.5 * length_b, fracture_id=fracture_id)
+    if cells.shape[1] == 2:
+        return Mesh2D.from_segments(points[cells[:, 0], :2], points[cells[:, 1], :2], fracture_id=fracture_id)
+    raise InputError(f"cannot rebuild a mesh from cells with {cells.shape[1]} points")
+
+
+def latest_state(out):
+    """``(mesh, fields, step, time)`` of the newest state in an output folder: the newest
+    good checkpoint, else the newest .vtu file."""
+    out = Path(out)
+    stress = None
+    summary = read_summary(out)
+    if summary is not None and "scene" in summary:
+        from .scene import far_field_stress, scene_from_dict
+
+        stress = far_field_stress(scene_from_dict(summary["scene"]).data)
+    if checkpoints.list_checkpoints(out / CHECKPOINT_DIR):
+        arrays, metadata = checkpoints.load_latest(out / CHECKPOINT_DIR)
+        mesh = _mesh_from_checkpoint(arrays)
+        if stress is None:
+            stress = np.zeros((mesh.dim, mesh.dim))
+        fields = cell_fields(mesh, arrays["dd"], arrays["pressure"], stress)
+        return mesh, fields, int(metadata["step"]), float(metadata["time"])
+    steps = _vtu_steps(out)
+    if not steps:
+        raise InputError(f"{str(out)!r} holds no checkpoint and no .vtu file; give the --out folder of an "
+                         "`hmatddm run`")
+    step = steps[-1]
+    points, cells, data = read_vtu(out / _vtu_name(step))
+    mesh = mesh_from_vtu(points, cells, data)
+    fields = {"opening": np.asarray(data["opening"], dtype=float),
+              "slip": np.asarray(data["slip"], dtype=float)[:, :mesh.dim],
+              "state": np.asarray(data.get("state", np.zeros(mesh.n_elements)), dtype=np.int64)}
+    times = dict(read_pvd_entries(out))
+    return mesh, fields, step, float(times.get(_vtu_name(step), float("nan")))
+
+
+def read_pvd_entries(out):
+    from .io import read_pvd
+
+    path = Path(out) / PVD
+    return [(name, time_value) for time_value, name in read_pvd(path)] if path.is_file() else []
+
+
+def render_folder(out):
+    """Snapshots of the newest state and the history plot of an output folder (a
+    finished or partial run); returns the written paths."""
+    from .scene import scene_from_dict
+
+    out = Path(out)
+    if not out.is_dir():
+        raise InputError(f"{str(out)!r} is not a folder; give the --out folder of an `hmatddm run`")
+    mesh, fields, step, time_value = latest_state(out)
+    summary = read_summary(out)
+    scene = scene_from_dict(summary["scene"]).data if summary is not None and "scene" in summary else None
+    name = scene["name"] if scene is not None else out.name
+    written = list(write_snapshots(out, mesh, fields, step, time_value, name))
+    if summary is not None and summary.get("steps"):
+        written.append(write_history(out, summary["steps"], scene))
+    return written
+
+
+__all__ = ["SceneRun", "run_scene", "render_folder", "latest_state", "Progress", "cell_fields", "versions",
+           "read_summary", "SUMMARY_KEYS"]

@@ -1,0 +1,311 @@
+'''Scenes: a hydraulic-fracturing simulation described in a TOML file.
+
+    import hmatddm.scene as hs
+    scene = hs.load_scene("radial-k")            # an embedded scene, or a path to a .toml file
+    sim = hs.build_simulation(scene)             # an hmatddm.Simulation, ready to run
+    records = sim.run(scene.numerics["end_time"])
+    hs.reference_values(scene.data, records)     # closed-form values at each step
+
+``hmatddm run SCENE --out DIR`` does the same and writes the outputs (see
+:mod:`hmatddm.runner`). ``hmatddm scenes`` lists the embedded scenes and
+``hmatddm scenes NAME`` prints one, a good start for a scene of your own.
+
+Conventions
+-----------
+* SI units everywhere: Pa, m, s, Pa s, m^3/s, 1/Pa. Angles are in degrees and their
+  keys end in ``_deg``.
+* Stresses are COMPRESSIVE POSITIVE in the file (``s_hmin = 8e6`` is 8 MPa of
+  compression), as engineers write them. The engine counts tension positive: the
+  tensor it receives is the negative of the file's (:func:`far_field_stress`).
+* Plan view is the x-y plane, z is vertical. A 2D scene is plane strain in the x-y
+  plane. ``azimuth_deg`` is the direction of ``s_hmax`` in degrees from +x,
+  counter-clockwise; ``s_hmin`` acts perpendicular to it in the x-y plane (so with
+  ``azimuth_deg = 0`` hydraulic fractures open along y and grow along x).
+* Validation names the key, the value and the allowed range of every problem, and
+  refuses unknown keys with a "did you mean" suggestion (InputError).
+
+The format, annotated (``=`` values are the defaults unless marked REQUIRED)::
+
+    name = "my-scene"              # optional; default: file name or embedded name
+    description = "one line shown by `hmatddm scenes`"
+    dimension = 3                  # 3: rectangular elements in space; 2: plane strain (x-y)
+    # height = 1.0                 # 2D only: flow height of the plane-strain fracture, m
+
+    [material]
+    shear_modulus = 24e9           # REQUIRED, Pa, > 0
+    poisson_ratio = 0.25           # REQUIRED, [0, 0.5)
+
+    [fluid]
+    viscosity = 1e-3               # REQUIRED, Pa s, > 0 (1 cP = 1e-3 Pa s)
+    compressibility = 4.4e-10      # 1/Pa, >= 0 (default 0)
+
+    [stress]                       # compressive positive, Pa; EITHER principal values:
+    s_hmin = 8e6                   #   minimum horizontal stress
+    s_hmax = 10e6                  #   maximum horizontal stress (>= s_hmin)
+    s_v = 12e6                     #   vertical stress (3D only)
+    azimuth_deg = 0.0              #   direction of s_hmax from +x, counter-clockwise
+    # OR the full tensor (d x d, symmetric, compressive positive):
+    # tensor = [[10e6, 0, 0], [0, 8e6, 0], [0, 0, 12e6]]
+
+    [[cluster]]                    # one table per perforation cluster (at least one)
+    position = [0.0, 0.0, 0.0]     # REQUIRED, m (d coordinates); must lie on an initial fracture
+    rate = 0.01                    # REQUIRED, m^3/s, >= 0 (2D: into the whole flow height)
+    wellbore_volume = 0.005        # m^3, >= 0 (default 0)
+
+    [[initial_fracture]]           # one table per initial fracture; fracture ids 0, 1, ...
+    shape = "rectangle"            # 3D: "rectangle" (default) or "penny"; 2D: "line"
+    center = [0.0, 0.0, 0.0]       # m
+    e1 = [1.0, 0.0, 0.0]           # direction of the length (default +x)
+    e2 = [0.0, 0.0, 1.0]           # direction of the height (default +z); normal = e1 x e2
+    length = 3.0                   # REQUIRED, m, a whole multiple of element_size
+    height = 3.0                   # REQUIRED, m, a whole multiple of element_size
+    element_size = 1.0             # REQUIRED, m (square elements)
+    # penny: center, normal = [0, 1, 0], radius, element_size (staircase disc)
+    # line (2D): p0 = [-1.5, 0.0], p1 = [1.5, 0.0], element_size
+
+    [propagation]                  # leave out for a fixed (non-growing) mesh
+    toughness = 5e6                # REQUIRED, K_Ic, Pa m^0.5, > 0
+    criterion = "mcs"              # "mcs" (K-bar_I >= K_Ic) or "energy" (G >= G_c)
+    # critical_energy_release_rate = 100.0   # G_c, J/m^2 (default K_Ic^2 / E')
+    correction = 0.806             # Olson's C_cor, (0, 2]
+    turning = "plan"               # "none", "plan" (edges along z may turn) or "any"
+    min_turn_angle_deg = 1.0       # [0, 90): smaller turns grow straight
+    max_growth_passes = 50         # re-solves of a step after adding elements, >= 0
+    # bounds = [[-100, 100], [-100, 100], [-10, 10]]   # m, per-axis limits of new elements
+    # growing_fractures = [0]      # fracture ids allowed to grow (default: all)
+
+    [leak_off]                     # Carter leak-off (default: none)
+    coefficient = 0.0              # m/(s^0.5 Pa), >= 0
+    pore_pressure = 0.0            # Pa
+
+    [numerics]
+    time_step = 1.0                # s, > 0
+    end_time = 30.0                # REQUIRED, s, > 0
+    backend = "hmatrix"            # "hmatrix" or "dense"
+    eps = 1e-4                     # H-matrix tolerance, (0, 1)
+    eta = 3.0                      # admissibility, > 0
+    leaf_size = 32                 # elements per leaf cluster, >= 1
+    scheme = "krylov"              # "krylov", "fully-coupled", "fracture-compliance", "fixed-width"
+    tolerance_pressure = 1e-6      # (0, 1), ref. Eq. 4.43
+    tolerance_opening = 1e-6       # (0, 1), ref. Eq. 4.44
+    max_iterations = 400           # nonlinear iterations per attempt, >= 1
+    relaxation = 1.0               # initial alpha, (0, 1]
+    min_relaxation = 0.00390625    # smallest alpha tried, (0, relaxation]
+    omega = 1.0                    # fracture-compliance weight, [0, 1]
+    linear_rtol = 1e-9             # GMRES relative residual, (0, 1)
+    linear_restart = 100           # GMRES Krylov dimension, >= 1
+    linear_maxiter = 20            # GMRES restart cycles, >= 1
+    initial_pressure = 10e6        # Pa, fluid pressure at t = 0 (default 0)
+    initial_opening = 1e-5         # m, >= 0, opening of the initial elements
+    # minimum_width = 1e-5         # m, > 0, width floor of the flow (default initial_opening)
+    singular_correction = "none"   # "none" or "average"
+    # alpha = 10.0                 # >= 1, influence scaling of ref. Eq. 6.11 (default off)
+    keep_checkpoints = 3           # newest checkpoints kept, >= 1
+
+    [output]
+    every = 1                      # write a .vtu every k steps (the last one always), >= 1
+    vtu = true
+    snapshots = true               # PNG views of the last state
+    history_plot = true
+
+    [reference]                    # optional closed form reported at every step
+    kind = "radial-k"              # "radial-k", "radial-m" (3D), "kgd-k", "kgd-m" (2D);
+                                   # needs one cluster, [propagation] and no leak-off
+
+    # Natural fractures: the schema is defined and validated, but the engine has no
+    # natural-fracture physics yet, so `hmatddm run` refuses such scenes (exit code 2).
+    [network]                      # properties of every natural fracture (ref. Table 6.2)
+    friction_coefficient = 0.25    # >= 0
+    cohesion = 0.0                 # Pa, >= 0
+    tensile_strength = 0.0         # Pa, >= 0
+    toughness = 0.5e6              # Pa m^0.5, > 0
+    critical_radius = 0.005        # m, > 0
+    crossing = "mohr-coulomb"      # "mohr-coulomb", "energy-release-rate", "stress-intensity"
+    remote_failure = true
+    element_size = 1.0             # m
+    height = 1.0                   # m (3D: vertical rectangles of this height)
+    z_center = 0.0                 # m
+    # generator (ref. Sec. 6.2, Table 6.1), used when density is given:
+    # region = [-50, 50, -100, 100]      # m, [x_min, x_max, y_min, y_max]
+    # density = 0.05                     # fractures per m^2 (Eq. 6.12)
+    # length_exponent = 2.0              # >= 1
+    # l_min = 1.0                        # m
+    # l_max = 30.0                       # m
+    # mean_azimuths_deg = [45.0]         # one per orientation set
+    # kappas = [5.0]                     # >= 0, one per set
+    # weights = [1.0]                    # >= 0, summing to 1
+    # seed = 0
+    # boundary = "resample"              # or "clip"
+
+    [[natural_fracture]]           # explicit natural fractures: plan-view segments
+    p0 = [5.0, -10.0]              # m
+    p1 = [5.0, 10.0]               # m
+'''
+import difflib
+import tomllib
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+
+from ..errors import InputError
+from .build import (NATURAL_FRACTURES_UNSUPPORTED, build_simulation, confining_stress, initial_mesh,
+                    reference_curves, reference_values)
+from .schema import far_field_stress, has_natural_fractures, to_toml, validate
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A validated scene: ``data`` is the echo (every default filled in, SI units),
+    ``source`` the file it came from (or ``embedded:NAME``), ``text`` its TOML text."""
+
+    data: dict
+    source: str = "<dict>"
+    text: str = ""
+
+    @property
+    def name(self):
+        return self.data["name"]
+
+    @property
+    def description(self):
+        return self.data.get("description", "")
+
+    @property
+    def dimension(self):
+        return self.data["dimension"]
+
+    @property
+    def numerics(self):
+        return self.data["numerics"]
+
+    @property
+    def has_natural_fractures(self):
+        return has_natural_fractures(self.data)
+
+    def to_dict(self):
+        """The validated scene as a plain, JSON-able dict (a deep copy)."""
+        import copy
+
+        return copy.deepcopy(self.data)
+
+    def to_toml(self, header=None):
+        return to_toml(self.data, header)
+
+
+def _scenes_folder():
+    return resources.files(__name__).joinpath("scenes")
+
+
+def embedded_names():
+    """Names of the scenes shipped in the package, sorted ("default" first)."""
+    names = [Path(entry.name).stem for entry in _scenes_folder().iterdir() if entry.name.endswith(".toml")]
+    return sorted(names, key=lambda name: (name != "default", name))
+
+
+def embedded_text(name):
+    """TOML text of an embedded scene; InputError with a suggestion for an unknown name."""
+    names = embedded_names()
+    if name not in names:
+        close = difflib.get_close_matches(name, names, n=1)
+        hint = f"did you mean {close[0]!r}? " if close else ""
+        raise InputError(f"unknown scene {name!r}: {hint}embedded scenes are {', '.join(names)} "
+                         "(or give the path of a .toml file)")
+    return _scenes_folder().joinpath(f"{name}.toml").read_text(encoding="utf-8")
+
+
+def embedded_scenes():
+    """``{name: description}`` of every embedded scene."""
+    return {name: load_scene(name).description for name in embedded_names()}
+
+
+def _parse(text, source):
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as error:
+        raise InputError(f"{source} is not valid TOML: {error}") from None
+
+
+def parse_scene(text, name=None, source="<string>", overrides=()):
+    """Validate scene TOML ``text``; ``name`` is used when the text has no ``name`` key;
+    ``overrides`` are ``"section.key=value"`` strings applied before validation (see
+    :func:`apply_override`)."""
+    raw = _parse(text, source)
+    for override in overrides:
+        apply_override(raw, override)
+    return Scene(validate(raw, name=None if "name" in raw else (name or "scene")), source, text)
+
+
+def load_scene(scene, overrides=()):
+    """A scene from an embedded name (``"radial-k"``) or a TOML file path.
+
+    A string that names an existing file, or ends in ``.toml``, is read as a file;
+    anything else is looked up among the embedded scenes. The scene's ``name`` is the
+    one in the file, else the file's stem (or the embedded name).
+    """
+    if isinstance(scene, Scene):
+        return scene
+    text_name = str(scene)
+    path = Path(text_name)
+    if path.suffix == ".toml" or path.is_file() or "/" in text_name:
+        if not path.is_file():
+            raise InputError(f"scene file {text_name!r} does not exist")
+        try:
+            text = path.read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError) as error:
+            raise InputError(f"scene file {text_name!r} cannot be read: {error}") from None
+        raw = _parse(text, text_name)
+        default_name, source = path.stem, str(path)
+    else:
+        text = embedded_text(text_name)
+        raw = _parse(text, f"embedded scene {text_name!r}")
+        default_name, source = text_name, f"embedded:{text_name}"
+    for override in overrides:
+        apply_override(raw, override)
+    return Scene(validate(raw, name=None if "name" in raw else default_name), source, text)
+
+
+def scene_from_dict(data, source="<dict>"):
+    """Validate a scene given as a dict (e.g. the ``scene`` echo of a summary.json)."""
+    return Scene(validate(data), source)
+
+
+def apply_override(raw, assignment):
+    """Apply ``"section.key=value"`` (or ``"cluster[0].rate=0.02"``, or a top-level
+    ``"dimension=2"``) to a raw scene dict. The value is read as a TOML value (numbers,
+    booleans, arrays, quoted strings); anything unreadable is taken as a string."""
+    if "=" not in assignment:
+        raise InputError(f"--set expects KEY=VALUE (e.g. numerics.end_time=10), got {assignment!r}")
+    key, text = (part.strip() for part in assignment.split("=", 1))
+    try:
+        value = tomllib.loads(f"value = {text}")["value"]
+    except tomllib.TOMLDecodeError:
+        value = text
+    parts = key.split(".")
+    if not all(parts) or len(parts) > 2:
+        raise InputError(f"--set key must be KEY, SECTION.KEY or SECTION[i].KEY, got {key!r}")
+    if len(parts) == 1:
+        raw[key] = value
+        return raw
+    section, leaf = parts
+    index = None
+    if section.endswith("]") and "[" in section:
+        section, _, number = section[:-1].partition("[")
+        if not number.isdigit():
+            raise InputError(f"--set key {key!r}: the index in {section}[...] must be an integer >= 0")
+        index = int(number)
+    table = raw.setdefault(section, {} if index is None else [])
+    if isinstance(table, list):
+        position = 0 if index is None else index
+        if position >= len(table):
+            raise InputError(f"--set key {key!r}: the scene has {len(table)} [[{section}]] table(s)")
+        table = table[position]
+    elif index not in (None, 0):
+        raise InputError(f"--set key {key!r}: [{section}] is a single table, use {section}.{leaf}")
+    table[leaf] = value
+    return raw
+
+
+__all__ = ["Scene", "load_scene", "parse_scene", "scene_from_dict", "embedded_names", "embedded_text",
+           "embedded_scenes", "apply_override", "validate", "build_simulation", "initial_mesh",
+           "reference_values", "reference_curves", "confining_stress", "far_field_stress",
+           "has_natural_fractures", "to_toml", "NATURAL_FRACTURES_UNSUPPORTED"]

@@ -1,0 +1,696 @@
+"""The scene schema: what a scene file may hold, its defaults and its allowed ranges.
+
+A scene is a TOML document (read with the standard library's ``tomllib``). Every
+quantity is in SI units (Pa, m, s, Pa s, m^3/s, 1/Pa); angles are in degrees and the
+keys that hold them end in ``_deg``. Stresses in the file are COMPRESSIVE POSITIVE,
+as engineers write them (``s_hmin = 8e6`` is 8 MPa of compression); the engine counts
+tension positive, so the tensor handed to :class:`hmatddm.Simulation` is the negative
+of the one in the file (:func:`far_field_stress`).
+
+Validation (:func:`validate`) returns a new dict with every default filled in and every
+number converted to float (the "echo" of the scene). Every problem raises
+:class:`~hmatddm.errors.InputError` naming the key (``section.key`` or
+``section[i].key``), the value and the allowed range; unknown keys are errors with a
+"did you mean" suggestion. Validating an echo gives the same echo back.
+
+The full format, annotated, is in ``hmatddm/scene/__init__.py``.
+"""
+import difflib
+import math
+
+import numpy as np
+
+from ..coupled import SCHEMES, SchemeSettings
+from ..errors import InputError
+from ..fracture.criteria import OLSON_CORRECTION
+from ..fracture.growth import CRITERIA, TURNING
+from ..operators import BACKENDS, DEFAULT_EPS, DEFAULT_ETA, DEFAULT_LEAF_SIZE, SINGULAR_CORRECTIONS
+
+REQUIRED = object()  # marker: the key has no default
+ABSENT = object()    # marker: optional key without a default (left out of the echo when not given)
+
+REFERENCE_KINDS = ("radial-k", "radial-m", "kgd-k", "kgd-m")
+SHAPES = {2: ("line",), 3: ("rectangle", "penny")}
+CROSSING_CRITERIA = ("mohr-coulomb", "energy-release-rate", "stress-intensity")
+NETWORK_BOUNDARY = ("resample", "clip")
+
+
+def show(value):
+    """A value as error messages print it (numbers with up to 12 significant digits)."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        return f"{value:.12g}"
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(show(v) for v in value) + "]"
+    if isinstance(value, dict):
+        return "a table"
+    return repr(value)
+
+
+class Key:
+    """One key of a section: its kind, default, range and unit.
+
+    kind: ``number``, ``integer``, ``boolean``, ``string``, ``choice`` (one of ``choices``),
+    ``point`` (``length`` numbers; ``length="dim"`` is the scene dimension),
+    ``numbers`` (a non-empty list of numbers, or one number), ``integers`` (a list of
+    integers >= 0), ``matrix`` (dim x dim numbers), ``pairs`` (a list of [low, high]).
+    ``low``/``high`` bound numbers (and every entry of a list), open when
+    ``low_open``/``high_open``.
+    """
+
+    def __init__(self, kind, default=ABSENT, *, low=None, high=None, low_open=False, high_open=False,
+                 choices=None, length=None, unit="", doc=""):
+        self.kind, self.default = kind, default
+        self.low, self.high, self.low_open, self.high_open = low, high, low_open, high_open
+        self.choices, self.length, self.unit, self.doc = choices, length, unit, doc
+
+    # -- ranges --------------------------------------------------------------------
+    def range_text(self):
+        unit = f" {self.unit}" if self.unit else ""
+        low, high = self.low, self.high
+        if low is not None and high is not None:
+            return (f"in {'(' if self.low_open else '['}{show(float(low))}, {show(float(high))}"
+                    f"{')' if self.high_open else ']'}{unit}")
+        if low is not None:
+            return f"{'>' if self.low_open else '>='} {show(float(low))}{unit}"
+        if high is not None:
+            return f"{'<' if self.high_open else '<='} {show(float(high))}{unit}"
+        return f"a finite number{unit}"
+
+    def in_range(self, value):
+        if self.low is not None and (value <= self.low if self.low_open else value < self.low):
+            return False
+        if self.high is not None and (value >= self.high if self.high_open else value > self.high):
+            return False
+        return True
+
+    # -- checks -----------------------------------------------------------------------
+    def _number(self, path, value, what=None):
+        what = what or path
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise InputError(f"{what} must be a number ({self.range_text()}), got {show(value)}")
+        number = float(value)
+        if not math.isfinite(number):
+            raise InputError(f"{what} must be finite ({self.range_text()}), got {show(number)}")
+        if not self.in_range(number):
+            raise InputError(f"{what} must be {self.range_text()}, got {show(value)}")
+        return number
+
+    def _list(self, path, value, length, item_text):
+        if not isinstance(value, list):
+            raise InputError(f"{path} must be a list of {item_text}, got {show(value)}")
+        if length is not None and len(value) != length:
+            raise InputError(f"{path} must be a list of {length} {item_text}, got {len(value)}: {show(value)}")
+        return value
+
+    def check(self, path, value, dim):
+        kind = self.kind
+        if kind == "number":
+            return self._number(path, value)
+        if kind == "integer":
+            if isinstance(value, bool) or not isinstance(value, int):
+                allowed = f"one of {show(list(self.choices))}" if self.choices else self.range_text()
+                raise InputError(f"{path} must be an integer ({allowed}), got {show(value)}")
+            if self.choices is not None and value not in self.choices:
+                raise InputError(f"{path} must be one of {show(list(self.choices))}, got {show(value)}")
+            if not self.in_range(value):
+                raise InputError(f"{path} must be an integer {self.range_text()}, got {show(value)}")
+            return int(value)
+        if kind == "boolean":
+            if not isinstance(value, bool):
+                raise InputError(f"{path} must be true or false, got {show(value)}")
+            return value
+        if kind == "string":
+            if not isinstance(value, str):
+                raise InputError(f"{path} must be a string, got {show(value)}")
+            return value
+        if kind == "choice":
+            if not isinstance(value, str) or value not in self.choices:
+                hint = ""
+                if isinstance(value, str):
+                    close = difflib.get_close_matches(value, self.choices, n=1)
+                    hint = f"; did you mean {close[0]!r}?" if close else ""
+                raise InputError(f"{path} must be one of {', '.join(map(repr, self.choices))}, "
+                                 f"got {show(value)}{hint}")
+            return value
+        if kind == "point":
+            length = dim if self.length == "dim" else self.length
+            self._list(path, value, length, f"coordinates{f' ({self.unit})' if self.unit else ''}")
+            return [self._number(path, v, f"{path}[{i}]") for i, v in enumerate(value)]
+        if kind == "numbers":
+            if isinstance(value, (int, float)) and not isinstance(value, bool):
+                value = [value]
+            self._list(path, value, None, "numbers")
+            if not value:
+                raise InputError(f"{path} must be a non-empty list of numbers, got []")
+            return [self._number(path, v, f"{path}[{i}]") for i, v in enumerate(value)]
+        if kind == "integers":
+            self._list(path, value, None, "integers")
+            for i, v in enumerate(value):
+                if isinstance(v, bool) or not isinstance(v, int) or v < 0:
+                    raise InputError(f"{path}[{i}] must be an integer >= 0, got {show(v)}")
+            return [int(v) for v in value]
+        if kind == "matrix":
+            self._list(path, value, dim, f"rows (a {dim} x {dim} tensor)")
+            rows = []
+            for i, row in enumerate(value):
+                self._list(f"{path}[{i}]", row, dim, "numbers")
+                rows.append([self._number(path, v, f"{path}[{i}][{j}]") for j, v in enumerate(row)])
+            return rows
+        if kind == "pairs":
+            self._list(path, value, None, "[low, high] pairs")
+            pairs = []
+            for i, pair in enumerate(value):
+                if not isinstance(pair, list) or len(pair) != 2:
+                    raise InputError(f"{path}[{i}] must be a pair [low, high], got {show(pair)}")
+                low, high = (float(v) if isinstance(v, (int, float)) and not isinstance(v, bool) else None
+                             for v in pair)
+                if low is None or high is None or math.isnan(low) or math.isnan(high) or not low < high:
+                    raise InputError(f"{path}[{i}] must be numbers [low, high] with low < high "
+                                     f"(m; +-inf allowed), got {show(pair)}")
+                pairs.append([low, high])
+            return pairs
+        raise AssertionError(kind)  # pragma: no cover
+
+
+def _scheme_default(name):
+    return SchemeSettings.__dataclass_fields__[name].default
+
+
+# ---------------------------------------------------------------------------------
+# The sections
+# ---------------------------------------------------------------------------------
+
+TOP = {
+    "name": Key("string", doc="short name of the scene (default: the file name)"),
+    "description": Key("string", "", doc="one line shown by `hmatddm scenes`"),
+    "dimension": Key("integer", 3, choices=(2, 3), doc="2: plane strain in the x-y plane; 3: rectangles in space"),
+    "height": Key("number", 1.0, low=0.0, low_open=True, unit="m",
+                  doc="2D only: flow height of the plane-strain fractures (ref. Table 4.2)"),
+}
+
+MATERIAL = {
+    "shear_modulus": Key("number", REQUIRED, low=0.0, low_open=True, unit="Pa"),
+    "poisson_ratio": Key("number", REQUIRED, low=0.0, high=0.5, high_open=True),
+}
+
+FLUID = {
+    "viscosity": Key("number", REQUIRED, low=0.0, low_open=True, unit="Pa s"),
+    "compressibility": Key("number", 0.0, low=0.0, unit="1/Pa"),
+}
+
+STRESS = {
+    "tensor": Key("matrix", unit="Pa", doc="full tensor, compressive positive, symmetric"),
+    "s_hmin": Key("number", unit="Pa", doc="minimum horizontal stress, compressive positive"),
+    "s_hmax": Key("number", unit="Pa", doc="maximum horizontal stress, compressive positive"),
+    "s_v": Key("number", unit="Pa", doc="vertical stress (along z), compressive positive; 3D only"),
+    "azimuth_deg": Key("number", low=-360.0, high=360.0, unit="deg",
+                       doc="direction of s_hmax, degrees from +x counter-clockwise (default 0)"),
+}
+
+CLUSTER = {
+    "position": Key("point", REQUIRED, length="dim", unit="m"),
+    "rate": Key("number", REQUIRED, low=0.0, unit="m^3/s"),
+    "wellbore_volume": Key("number", 0.0, low=0.0, unit="m^3"),
+}
+
+_POSITIVE_LENGTH = dict(low=0.0, low_open=True, unit="m")
+INITIAL_FRACTURE = {
+    "shape": Key("choice", choices=("rectangle", "penny", "line"),
+                 doc="rectangle (3D, default), penny (3D) or line (2D, default)"),
+    "center": Key("point", length=3, unit="m"),
+    "e1": Key("point", length=3, doc="rectangle: direction of its length"),
+    "e2": Key("point", length=3, doc="rectangle: direction of its height"),
+    "normal": Key("point", length=3, doc="penny: its unit normal"),
+    "length": Key("number", **_POSITIVE_LENGTH),
+    "height": Key("number", **_POSITIVE_LENGTH),
+    "radius": Key("number", **_POSITIVE_LENGTH),
+    "p0": Key("point", length=2, unit="m"),
+    "p1": Key("point", length=2, unit="m"),
+    "element_size": Key("number", REQUIRED, **_POSITIVE_LENGTH),
+}
+SHAPE_KEYS = {  # key -> default (REQUIRED or a value) for each shape
+    "rectangle": {"center": [0.0, 0.0, 0.0], "e1": [1.0, 0.0, 0.0], "e2": [0.0, 0.0, 1.0],
+                  "length": REQUIRED, "height": REQUIRED, "element_size": REQUIRED},
+    "penny": {"center": [0.0, 0.0, 0.0], "normal": [0.0, 1.0, 0.0], "radius": REQUIRED, "element_size": REQUIRED},
+    "line": {"p0": REQUIRED, "p1": REQUIRED, "element_size": REQUIRED},
+}
+
+PROPAGATION = {
+    "toughness": Key("number", REQUIRED, low=0.0, low_open=True, unit="Pa m^0.5"),
+    "criterion": Key("choice", "mcs", choices=CRITERIA),
+    "critical_energy_release_rate": Key("number", low=0.0, low_open=True, unit="J/m^2"),
+    "correction": Key("number", OLSON_CORRECTION, low=0.0, high=2.0, low_open=True),
+    "turning": Key("choice", "plan", choices=TURNING),
+    "min_turn_angle_deg": Key("number", 1.0, low=0.0, high=90.0, high_open=True, unit="deg"),
+    "max_growth_passes": Key("integer", 50, low=0),
+    "bounds": Key("pairs", unit="m"),
+    "growing_fractures": Key("integers"),
+}
+
+LEAK_OFF = {
+    "coefficient": Key("number", 0.0, low=0.0, unit="m/(s^0.5 Pa)"),
+    "pore_pressure": Key("number", 0.0, unit="Pa"),
+}
+
+_UNIT_INTERVAL = dict(low=0.0, high=1.0, low_open=True, high_open=True)
+NUMERICS = {
+    "time_step": Key("number", 1.0, low=0.0, low_open=True, unit="s"),
+    "end_time": Key("number", REQUIRED, low=0.0, low_open=True, unit="s"),
+    "backend": Key("choice", "hmatrix", choices=BACKENDS),
+    "eps": Key("number", DEFAULT_EPS, **_UNIT_INTERVAL),
+    "eta": Key("number", DEFAULT_ETA, low=0.0, low_open=True),
+    "leaf_size": Key("integer", DEFAULT_LEAF_SIZE, low=1),
+    "scheme": Key("choice", _scheme_default("scheme"), choices=SCHEMES),
+    "tolerance_pressure": Key("number", _scheme_default("tolerance_pressure"), **_UNIT_INTERVAL),
+    "tolerance_opening": Key("number", _scheme_default("tolerance_opening"), **_UNIT_INTERVAL),
+    "max_iterations": Key("integer", _scheme_default("max_iterations"), low=1),
+    "relaxation": Key("number", _scheme_default("relaxation"), low=0.0, high=1.0, low_open=True),
+    "min_relaxation": Key("number", _scheme_default("min_relaxation"), low=0.0, high=1.0, low_open=True),
+    "omega": Key("number", _scheme_default("omega"), low=0.0, high=1.0),
+    "linear_rtol": Key("number", _scheme_default("linear_rtol"), **_UNIT_INTERVAL),
+    "linear_restart": Key("integer", _scheme_default("linear_restart"), low=1),
+    "linear_maxiter": Key("integer", _scheme_default("linear_maxiter"), low=1),
+    "initial_pressure": Key("number", 0.0, unit="Pa"),
+    "initial_opening": Key("number", 1e-5, low=0.0, unit="m"),
+    "minimum_width": Key("number", low=0.0, low_open=True, unit="m"),
+    "singular_correction": Key("choice", "none", choices=SINGULAR_CORRECTIONS),
+    "alpha": Key("number", low=1.0),
+    "keep_checkpoints": Key("integer", 3, low=1),
+}
+
+SCHEME_KEYS = ("scheme", "omega", "relaxation", "min_relaxation", "tolerance_pressure", "tolerance_opening",
+               "max_iterations", "linear_rtol", "linear_restart", "linear_maxiter")  # -> SchemeSettings
+
+OUTPUT = {
+    "every": Key("integer", 1, low=1, doc="write a .vtu every k steps (the last step always)"),
+    "vtu": Key("boolean", True),
+    "snapshots": Key("boolean", True, doc="PNG views of the last state"),
+    "history_plot": Key("boolean", True),
+}
+
+REFERENCE = {
+    "kind": Key("choice", REQUIRED, choices=REFERENCE_KINDS),
+}
+
+NETWORK_MECHANICS = {  # defaults: ref. Table 6.2 (natural-fracture properties)
+    "friction_coefficient": Key("number", 0.25, low=0.0),
+    "cohesion": Key("number", 0.0, low=0.0, unit="Pa"),
+    "tensile_strength": Key("number", 0.0, low=0.0, unit="Pa"),
+    "toughness": Key("number", 0.5e6, low=0.0, low_open=True, unit="Pa m^0.5"),
+    "critical_radius": Key("number", 0.005, **_POSITIVE_LENGTH),
+    "crossing": Key("choice", "mohr-coulomb", choices=CROSSING_CRITERIA),
+    "remote_failure": Key("boolean", True),
+    "element_size": Key("number", 1.0, **_POSITIVE_LENGTH),
+    "height": Key("number", 1.0, **_POSITIVE_LENGTH),
+    "z_center": Key("number", 0.0, unit="m"),
+}
+NETWORK_GENERATOR = {  # defaults: ref. Table 6.1, as hmatddm.network.NetworkSpec
+    "region": Key("point", length=4, unit="m", doc="[x_min, x_max, y_min, y_max]"),
+    "density": Key("number", low=0.0, low_open=True, unit="1/m^2"),
+    "length_exponent": Key("number", 2.0, low=1.0),
+    "l_min": Key("number", 1.0, **_POSITIVE_LENGTH),
+    "l_max": Key("number", 30.0, **_POSITIVE_LENGTH),
+    "mean_azimuths_deg": Key("numbers", [45.0], unit="deg"),
+    "kappas": Key("numbers", [5.0], low=0.0),
+    "weights": Key("numbers", low=0.0),
+    "seed": Key("integer", 0, low=0),
+    "boundary": Key("choice", "resample", choices=NETWORK_BOUNDARY),
+}
+NETWORK = {**NETWORK_MECHANICS, **NETWORK_GENERATOR}
+
+NATURAL_FRACTURE = {
+    "p0": Key("point", REQUIRED, length=2, unit="m"),
+    "p1": Key("point", REQUIRED, length=2, unit="m"),
+}
+
+# name -> (keys, array of tables?, required?)
+SECTIONS = {
+    "material": (MATERIAL, False, True),
+    "fluid": (FLUID, False, True),
+    "stress": (STRESS, False, True),
+    "cluster": (CLUSTER, True, True),
+    "initial_fracture": (INITIAL_FRACTURE, True, True),
+    "propagation": (PROPAGATION, False, False),
+    "leak_off": (LEAK_OFF, False, False),
+    "numerics": (NUMERICS, False, True),
+    "output": (OUTPUT, False, False),
+    "reference": (REFERENCE, False, False),
+    "network": (NETWORK, False, False),
+    "natural_fracture": (NATURAL_FRACTURE, True, False),
+}
+FILLED_WHEN_ABSENT = ("leak_off", "output")  # optional sections echoed with their defaults
+
+
+# ---------------------------------------------------------------------------------
+# Helpers
+# ---------------------------------------------------------------------------------
+
+def _unknown(path, key, allowed, where=""):
+    """InputError for an unknown key, with the closest allowed key as a suggestion."""
+    full = f"{path}.{key}" if path else key
+    close = difflib.get_close_matches(key, list(allowed), n=1, cutoff=0.6)
+    if close:
+        suggestion = f"{path}.{close[0]}" if path else close[0]
+        return InputError(f"unknown key {full!r}{where}; did you mean {suggestion!r}?")
+    if path and key in TOP:
+        return InputError(f"unknown key {full!r}; {key!r} is a top-level key: put it above the first "
+                          "[section] header of the file")
+    return InputError(f"unknown key {full!r}{where}; allowed keys: {', '.join(sorted(allowed))}")
+
+
+def _check_table(path, table, keys, dim, defaults=None, required=()):
+    """Check the keys of one table against ``keys``; returns the echo (defaults filled).
+
+    ``defaults`` overrides the defaults of ``keys`` (and restricts the allowed keys to
+    its own, for shape-dependent tables)."""
+    if not isinstance(table, dict):
+        raise InputError(f"{path} must be a table, got {show(table)}")
+    allowed = keys if defaults is None else {k: keys[k] for k in defaults}
+    for key in table:
+        if key not in allowed:
+            raise _unknown(path, key, allowed)
+    echo = {}
+    for key, spec in allowed.items():
+        default = spec.default if defaults is None else defaults[key]
+        if key in table:
+            echo[key] = spec.check(f"{path}.{key}", table[key], dim)
+        elif default is REQUIRED or key in required:
+            unit = f" ({spec.unit})" if spec.unit else ""
+            raise InputError(f"{path}.{key}{unit} is required")
+        elif default is not ABSENT:
+            echo[key] = list(default) if isinstance(default, list) else default
+    return echo
+
+
+def _as_tables(name, value):
+    """An array-of-tables section as a list (a single ``[name]`` table counts as one)."""
+    if isinstance(value, dict):
+        return [value]
+    if not isinstance(value, list) or not all(isinstance(v, dict) for v in value):
+        raise InputError(f"{name} must be one or more tables [[{name}]], got {show(value)}")
+    if not value:
+        raise InputError(f"{name} must hold at least one [[{name}]] table")
+    return value
+
+
+def _norm(vector):
+    return math.sqrt(sum(v * v for v in vector))
+
+
+def _unit_vector(path, vector):
+    norm = _norm(vector)
+    if norm == 0.0:
+        raise InputError(f"{path} must be a non-zero vector, got {show(vector)}")
+    return [v / norm for v in vector]
+
+
+def _whole_multiple(path, size_path, extent, size):
+    count = extent / size
+    if abs(count - round(count)) > 1e-6 * max(1.0, count) or round(count) < 1:
+        raise InputError(f"{path} = {show(extent)} m must be a whole multiple (>= 1) of {size_path} = "
+                         f"{show(size)} m, got {count:.6g} elements")
+    return int(round(count))
+
+
+# ---------------------------------------------------------------------------------
+# Cross-key checks
+# ---------------------------------------------------------------------------------
+
+def _check_initial_fracture(path, table, dim):
+    if not isinstance(table, dict):
+        raise InputError(f"{path} must be a table, got {show(table)}")
+    shape = table.get("shape", SHAPES[dim][0])
+    shape = INITIAL_FRACTURE["shape"].check(f"{path}.shape", shape, dim)
+    if shape not in SHAPES[dim]:
+        raise InputError(f"{path}.shape = {shape!r} needs dimension = {2 if dim == 3 else 3}; with "
+                         f"dimension = {dim} use {' or '.join(map(repr, SHAPES[dim]))}")
+    rest = {k: v for k, v in table.items() if k != "shape"}
+    for key in rest:
+        if key not in SHAPE_KEYS[shape]:
+            if key in INITIAL_FRACTURE:
+                raise InputError(f"{path}.{key} is not used by shape {shape!r}; its keys are "
+                                 f"{', '.join(['shape', *SHAPE_KEYS[shape]])}")
+            raise _unknown(path, key, INITIAL_FRACTURE)
+    echo = {"shape": shape, **_check_table(path, rest, INITIAL_FRACTURE, dim, defaults=SHAPE_KEYS[shape])}
+    size = echo["element_size"]
+    if shape == "rectangle":
+        e1 = _unit_vector(f"{path}.e1", echo["e1"])
+        e2 = _unit_vector(f"{path}.e2", echo["e2"])
+        dot = sum(a * b for a, b in zip(e1, e2))
+        if abs(dot) > 1e-6:
+            raise InputError(f"{path}.e1 and {path}.e2 must be orthogonal, got e1.e2 = {dot:.3g} "
+                             f"(unit vectors of {show(echo['e1'])} and {show(echo['e2'])})")
+        _whole_multiple(f"{path}.length", f"{path}.element_size", echo["length"], size)
+        _whole_multiple(f"{path}.height", f"{path}.element_size", echo["height"], size)
+    elif shape == "penny":
+        _unit_vector(f"{path}.normal", echo["normal"])
+        if size > 2.0 * echo["radius"]:
+            raise InputError(f"{path}.element_size must be <= 2 * radius = {show(2 * echo['radius'])} m, "
+                             f"got {show(size)}")
+    else:
+        length = _norm([b - a for a, b in zip(echo["p0"], echo["p1"])])
+        if length == 0.0:
+            raise InputError(f"{path}.p0 and {path}.p1 must differ (a crack of zero length), got {show(echo['p0'])}")
+        _whole_multiple(f"{path} length |p1 - p0|", f"{path}.element_size", length, size)
+    return echo
+
+
+def _check_stress(echo, dim):
+    has_tensor = "tensor" in echo
+    principal = [k for k in ("s_hmin", "s_hmax", "s_v", "azimuth_deg") if k in echo]
+    if has_tensor and principal:
+        raise InputError(f"stress: give either stress.tensor or the principal values (s_hmin, s_hmax"
+                         f"{', s_v' if dim == 3 else ''}, azimuth_deg), not both; got tensor and "
+                         f"{', '.join('stress.' + k for k in principal)}")
+    if has_tensor:
+        tensor = np.array(echo["tensor"])
+        scale = 1.0 + float(np.max(np.abs(tensor)))
+        if not np.allclose(tensor, tensor.T, rtol=0.0, atol=1e-9 * scale):
+            i, j = np.unravel_index(np.argmax(np.abs(tensor - tensor.T)), tensor.shape)
+            raise InputError(f"stress.tensor must be symmetric, got [{i}][{j}] = {show(tensor[i, j])} but "
+                             f"[{j}][{i}] = {show(tensor[j, i])}")
+        return echo
+    needed = ["s_hmin", "s_hmax"] + (["s_v"] if dim == 3 else [])
+    missing = [k for k in needed if k not in echo]
+    if missing:
+        raise InputError(f"stress needs either stress.tensor or the principal values "
+                         f"{', '.join('stress.' + k for k in needed)} (Pa, compressive positive); "
+                         f"missing {', '.join('stress.' + k for k in missing)}")
+    if dim == 2 and "s_v" in echo:
+        raise InputError("stress.s_v is not used in a 2D scene (dimension = 2: plane strain in the x-y "
+                         "plane, only s_hmin, s_hmax and azimuth_deg act); remove it")
+    if echo["s_hmin"] > echo["s_hmax"]:
+        raise InputError(f"stress.s_hmin must be <= stress.s_hmax = {show(echo['s_hmax'])} Pa, "
+                         f"got {show(echo['s_hmin'])}")
+    echo.setdefault("azimuth_deg", 0.0)
+    return echo
+
+
+def _check_network(echo, given):
+    generator = [k for k in NETWORK_GENERATOR if k in given]
+    if generator and "density" not in given:
+        raise InputError(f"network.density (1/m^2) is required to generate a network (given: "
+                         f"{', '.join('network.' + k for k in generator)})")
+    if "density" not in given:
+        for key in NETWORK_GENERATOR:
+            echo.pop(key, None)
+        return echo
+    if "region" not in given:
+        raise InputError("network.region = [x_min, x_max, y_min, y_max] (m) is required with network.density")
+    x_min, x_max, y_min, y_max = echo["region"]
+    if not (x_min < x_max and y_min < y_max):
+        raise InputError(f"network.region must be [x_min, x_max, y_min, y_max] with x_min < x_max and "
+                         f"y_min < y_max, got {show(echo['region'])}")
+    area = (x_max - x_min) * (y_max - y_min)
+    if round(echo["density"] * area) < 1:
+        raise InputError(f"network.density must be >= {0.5 / area:.6g} 1/m^2 so that network.region "
+                         f"(area {area:.6g} m^2) holds at least one fracture, got {show(echo['density'])}")
+    if echo["l_max"] < echo["l_min"]:
+        raise InputError(f"network.l_max must be >= network.l_min = {show(echo['l_min'])} m, "
+                         f"got {show(echo['l_max'])}")
+    modes = len(echo["mean_azimuths_deg"])
+    weights = echo.get("weights", [1.0 / modes] * modes)
+    if len(echo["kappas"]) != modes or len(weights) != modes:
+        raise InputError(f"network.mean_azimuths_deg, network.kappas and network.weights must have the same "
+                         f"length (one entry per orientation set), got {modes}, {len(echo['kappas'])}, "
+                         f"{len(weights)}")
+    if abs(sum(weights) - 1.0) > 1e-9:
+        raise InputError(f"network.weights must sum to 1, got {show(weights)} (sum {sum(weights):.6g})")
+    echo["weights"] = weights
+    fit = min(x_max - x_min, y_max - y_min)
+    if echo["boundary"] == "resample" and echo["l_max"] > fit:
+        raise InputError(f"network.l_max must be <= min(region width, region height) = {fit:.6g} m with "
+                         f"network.boundary = 'resample' (use 'clip' for longer fractures), got {show(echo['l_max'])}")
+    return echo
+
+
+def _check_reference(scene):
+    kind = scene["reference"]["kind"]
+    dim = scene["dimension"]
+    want = 3 if kind.startswith("radial") else 2
+    where = f"reference.kind = {kind!r}"
+    if dim != want:
+        raise InputError(f"{where} is a {want}D closed form; the scene has dimension = {dim}")
+    if len(scene["cluster"]) != 1 or scene["cluster"][0]["rate"] <= 0.0:
+        raise InputError(f"{where} needs exactly one [[cluster]] with rate > 0, got {len(scene['cluster'])} "
+                         "cluster(s)")
+    if "propagation" not in scene:
+        raise InputError(f"{where} compares a growing fracture: the scene needs a [propagation] section")
+    if scene["leak_off"]["coefficient"] != 0.0:
+        raise InputError(f"{where} assumes no leak-off: leak_off.coefficient must be 0, got "
+                         f"{show(scene['leak_off']['coefficient'])}")
+
+
+# ---------------------------------------------------------------------------------
+# Entry point
+# ---------------------------------------------------------------------------------
+
+def validate(raw, name=None):
+    """Validate a scene given as a dict (e.g. from ``tomllib``); returns its echo.
+
+    The echo has every section and key in a fixed order, defaults filled in, numbers as
+    floats, and ``name`` set (``name`` argument, else the scene's own, else "scene").
+    Raises InputError on the first problem found.
+    """
+    if not isinstance(raw, dict):
+        raise InputError(f"a scene must be a table of sections, got {show(raw)}")
+    for key, value in raw.items():
+        if key not in TOP and key not in SECTIONS:
+            if isinstance(value, dict) or (isinstance(value, list) and value
+                                           and all(isinstance(v, dict) for v in value)):
+                close = difflib.get_close_matches(key, list(SECTIONS), n=1, cutoff=0.6)
+                hint = f"; did you mean {close[0]!r}?" if close else f"; sections: {', '.join(SECTIONS)}"
+                raise InputError(f"unknown section {key!r}{hint}")
+            raise _unknown("", key, {**TOP, **SECTIONS})
+    scene = {}
+    for key, spec in TOP.items():
+        if key in raw:
+            scene[key] = spec.check(key, raw[key], None)
+        elif spec.default is not ABSENT:
+            scene[key] = spec.default
+    if name is not None:
+        scene["name"] = name
+    scene.setdefault("name", "scene")
+    dim = scene["dimension"]
+    if dim == 3 and "height" in raw:
+        raise InputError("height is the flow height of a 2D (plane-strain) scene; a 3D scene "
+                         "(dimension = 3) takes its heights from the fractures: remove it")
+    if dim == 3:
+        scene.pop("height")
+
+    for section, (keys, is_array, required) in SECTIONS.items():
+        if section not in raw:
+            if required:
+                header = f"[[{section}]]" if is_array else f"[{section}]"
+                raise InputError(f"the scene needs a {header} section")
+            if section in FILLED_WHEN_ABSENT:
+                scene[section] = _check_table(section, {}, keys, dim)
+            continue
+        value = raw[section]
+        if is_array:
+            tables = _as_tables(section, value)
+            if section == "initial_fracture":
+                scene[section] = [_check_initial_fracture(f"{section}[{i}]", t, dim) for i, t in enumerate(tables)]
+            else:
+                scene[section] = [_check_table(f"{section}[{i}]", t, keys, dim) for i, t in enumerate(tables)]
+            continue
+        if isinstance(value, list):
+            raise InputError(f"{section} must be one table [{section}], not an array of tables [[{section}]]")
+        if not isinstance(value, dict):
+            raise InputError(f"{section} must be a table [{section}], got {show(value)}")
+        echo = _check_table(section, value, keys, dim)
+        if section == "stress":
+            echo = _check_stress(echo, dim)
+        elif section == "network":
+            echo = _check_network(echo, set(value))
+        scene[section] = echo
+
+    numerics = scene["numerics"]
+    if numerics["min_relaxation"] > numerics["relaxation"]:
+        raise InputError(f"numerics.min_relaxation must be <= numerics.relaxation = {show(numerics['relaxation'])}, "
+                         f"got {show(numerics['min_relaxation'])}")
+    propagation = scene.get("propagation")
+    if propagation is not None:
+        if "bounds" in propagation and len(propagation["bounds"]) > dim:
+            raise InputError(f"propagation.bounds must hold at most {dim} [low, high] pairs (one per axis), "
+                             f"got {len(propagation['bounds'])}")
+        count = len(scene["initial_fracture"])
+        for index in propagation.get("growing_fractures", []):
+            if index >= count:
+                raise InputError(f"propagation.growing_fractures holds {index}, but the scene has {count} "
+                                 f"initial fracture(s), numbered 0 to {count - 1}")
+    for i, fracture in enumerate(scene.get("natural_fracture", [])):
+        if fracture["p0"] == fracture["p1"]:
+            raise InputError(f"natural_fracture[{i}].p0 and natural_fracture[{i}].p1 must differ, "
+                             f"got {show(fracture['p0'])}")
+    if "reference" in scene:
+        _check_reference(scene)
+    return scene
+
+
+def has_natural_fractures(scene):
+    """Whether a validated scene declares natural fractures (a network or explicit ones)."""
+    return "network" in scene or bool(scene.get("natural_fracture"))
+
+
+def far_field_stress(scene):
+    """The (d, d) far-field stress tensor the engine wants (tension positive, Pa).
+
+    The file's stresses are compressive positive: ``tensor`` is negated; the principal
+    form puts ``s_hmax`` along the azimuth (degrees from +x, counter-clockwise),
+    ``s_hmin`` perpendicular to it in the x-y plane and ``s_v`` along z.
+    """
+    stress = scene["stress"]
+    dim = scene["dimension"]
+    if "tensor" in stress:
+        return -np.array(stress["tensor"], dtype=float) + 0.0
+    angle = math.radians(stress["azimuth_deg"])
+    along = np.array([math.cos(angle), math.sin(angle)])
+    across = np.array([-math.sin(angle), math.cos(angle)])
+    horizontal = stress["s_hmax"] * np.outer(along, along) + stress["s_hmin"] * np.outer(across, across)
+    if dim == 2:
+        return -horizontal + 0.0
+    tensor = np.zeros((3, 3))
+    tensor[:2, :2] = horizontal
+    tensor[2, 2] = stress["s_v"]
+    return -tensor + 0.0
+
+
+# ---------------------------------------------------------------------------------
+# TOML output (the echo written next to a run, readable by tomllib)
+# ---------------------------------------------------------------------------------
+
+def _toml_value(value):
+    import json
+
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        if math.isinf(value):
+            return "inf" if value > 0 else "-inf"
+        return repr(value)
+    if isinstance(value, str):
+        return json.dumps(value, ensure_ascii=False)
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+    raise TypeError(f"cannot write {type(value).__name__} as TOML")  # pragma: no cover
+
+
+def to_toml(scene, header=None):
+    """A validated scene as TOML text (``tomllib`` reads it back to the same echo)."""
+    lines = [f"# {line}" for line in (header or "").splitlines()]
+    for key in TOP:
+        if key in scene:
+            lines.append(f"{key} = {_toml_value(scene[key])}")
+    for section, (_, is_array, _) in SECTIONS.items():
+        if section not in scene:
+            continue
+        tables = scene[section] if is_array else [scene[section]]
+        for table in tables:
+            lines += ["", f"[[{section}]]" if is_array else f"[{section}]"]
+            lines += [f"{key} = {_toml_value(value)}" for key, value in table.items()]
+    return "\n".join(lines) + "\n"

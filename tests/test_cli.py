@@ -1,0 +1,191 @@
+"""The command line: run, scenes, validate, bench, render; exit codes 0/1/2/3/130."""
+import json
+import py_compile
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
+
+import pytest
+
+from hmatddm import bench_cli, cli, runner
+
+ROOT = Path(__file__).resolve().parents[1]
+
+TINY_2D = """
+dimension = 2
+[material]
+shear_modulus = 10e9
+poisson_ratio = 0.25
+[fluid]
+viscosity = 1e-4
+compressibility = 4.5e-10
+[stress]
+s_hmin = 0.5e6
+s_hmax = 1e6
+[[cluster]]
+position = [0.0, 0.0]
+rate = 5e-4
+wellbore_volume = 0.01
+[[initial_fracture]]
+shape = "line"
+p0 = [-0.375, 0.0]
+p1 = [0.375, 0.0]
+element_size = 0.25
+[propagation]
+toughness = 5e6
+[numerics]
+end_time = 2.0
+backend = "dense"
+initial_pressure = 0.6e6
+[reference]
+kind = "kgd-k"
+"""
+
+
+@pytest.fixture
+def tiny(tmp_path):
+    path = tmp_path / "tiny.toml"
+    path.write_text(TINY_2D)
+    return path
+
+
+def test_scenes_lists_names_with_descriptions(capsys):
+    assert cli.main(["scenes"]) == cli.EXIT_OK
+    lines = capsys.readouterr().out.splitlines()
+    names = [line.split()[0] for line in lines]
+    assert names[0] == "default" and {"radial-k", "radial-m", "kgd"} <= set(names)
+    assert all(len(line.split(maxsplit=1)) == 2 for line in lines)  # a description on every line
+    assert cli.main(["scenes", "kgd"]) == cli.EXIT_OK
+    assert tomllib.loads(capsys.readouterr().out)["dimension"] == 2
+    assert cli.main(["scenes", "--json"]) == cli.EXIT_OK
+    assert "radial-m" in json.loads(capsys.readouterr().out)
+    assert cli.main(["scenes", "nope"]) == cli.EXIT_BAD_INPUT
+    assert "unknown scene 'nope'" in capsys.readouterr().err
+
+
+def test_run_writes_the_outputs_and_exits_0(tiny, tmp_path, capsys):
+    out = tmp_path / "out"
+    assert cli.main(["run", str(tiny), "--out", str(out)]) == cli.EXIT_OK
+    captured = capsys.readouterr()
+    assert "hmatddm: done in" in captured.out and "vs closed form: half_length" in captured.out
+    assert "running 'tiny'" in captured.err and "step    2  t 2/2 s" in captured.err
+    summary = json.loads((out / "summary.json").read_text())
+    assert tuple(summary) == ("scene", "versions", "steps", "reference", "wall_seconds")
+    assert len(summary["steps"]) == 2 and len(summary["reference"]) == 2
+    assert len(list((out / "vtu").glob("*.vtu"))) == 3 and (out / "fractures.pvd").is_file()
+    assert (out / "snapshots/step-000002_plan.png").is_file() and (out / "history.png").is_file()
+
+    # --resume with no SCENE continues the scene stored in DIR, here to a later end time
+    assert cli.main(["run", "--out", str(out), "--resume", "--set", "numerics.end_time=3", "--quiet"]) == 0
+    assert capsys.readouterr().out == ""
+    summary = json.loads((out / "summary.json").read_text())
+    assert [s["step"] for s in summary["steps"]] == [1, 2, 3]
+    # the run was a different scene: its checkpoints are refused
+    assert cli.main(["run", str(tiny), "--out", str(out), "--resume", "--set", "fluid.viscosity=1e-3"]) == 2
+    assert "belong to a different run" in capsys.readouterr().err
+
+    # render a finished run
+    assert cli.main(["render", str(out)]) == cli.EXIT_OK
+    assert "history.png" in capsys.readouterr().out
+
+
+def test_bad_input_exits_2_with_a_one_line_message(tiny, tmp_path, capsys):
+    bad = tmp_path / "bad.toml"
+    bad.write_text(TINY_2D.replace("[numerics]", "[numerics]\ntme_step = 1.0"))
+    assert cli.main(["run", str(bad), "--out", str(tmp_path / "o")]) == cli.EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert err.strip() == ("hmatddm: error: unknown key 'numerics.tme_step'; did you mean 'numerics.time_step'?")
+    assert not (tmp_path / "o").exists()
+
+    natural = tmp_path / "natural.toml"
+    natural.write_text(TINY_2D + "\n[[natural_fracture]]\np0 = [2.0, -1.0]\np1 = [2.0, 1.0]\n")
+    assert cli.main(["run", str(natural), "--out", str(tmp_path / "o")]) == cli.EXIT_BAD_INPUT
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("hmatddm: error: natural fractures are not supported yet") and "\n" not in err
+
+    assert cli.main(["run", str(tiny), "--backend", "dense", "--set", "material.poisson_ratio=0.6"]) == 2
+    assert "material.poisson_ratio must be in [0, 0.5), got 0.6" in capsys.readouterr().err
+    assert cli.main(["run", "no-such-scene"]) == cli.EXIT_BAD_INPUT
+    assert cli.main(["render", str(tmp_path / "missing")]) == cli.EXIT_BAD_INPUT
+    with pytest.raises(SystemExit) as error:  # argparse: unknown option
+        cli.main(["run", "--backend", "fast"])
+    assert error.value.code == 2
+
+
+def test_run_check_prints_the_validated_scene(capsys):
+    assert cli.main(["run", "kgd", "--check"]) == cli.EXIT_OK
+    scene = json.loads(capsys.readouterr().out)
+    assert scene["name"] == "kgd" and scene["numerics"]["scheme"] == "krylov"
+
+
+def test_a_run_that_does_not_converge_exits_3(tiny, tmp_path, capsys):
+    out = tmp_path / "out"
+    code = cli.main(["run", str(tiny), "--out", str(out), "--quiet", "--set", "numerics.max_iterations=1",
+                     "--set", "numerics.min_relaxation=1.0", "--set", "numerics.tolerance_pressure=1e-15"])
+    assert code == cli.EXIT_NOT_CONVERGED
+    err = capsys.readouterr().err
+    assert "did not converge in the first step" in err
+    summary = json.loads((out / "summary.json").read_text())  # readable, with the steps that converged
+    assert summary["steps"] == []
+
+
+def test_interrupt_exits_130_and_says_how_to_resume(tiny, tmp_path, capsys, monkeypatch):
+    def interrupt(progress, record):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(runner.Progress, "update", interrupt)
+    out = tmp_path / "out"
+    assert cli.main(["run", str(tiny), "--out", str(out)]) == cli.EXIT_INTERRUPTED
+    err = capsys.readouterr().err
+    assert "interrupted after step 1 (t = 1 s)" in err and f"hmatddm run --out {out} --resume" in err
+    monkeypatch.undo()
+    assert cli.main(["run", "--out", str(out), "--resume", "--quiet"]) == cli.EXIT_OK
+    assert len(json.loads((out / "summary.json").read_text())["steps"]) == 2
+    assert cli.main(["run", str(tiny), "--out", str(out)]) == cli.EXIT_BAD_INPUT  # no silent overwrite
+    assert "already holds a run" in capsys.readouterr().err
+    assert cli.main(["run", str(tiny), "--out", str(out), "--overwrite", "--quiet"]) == cli.EXIT_OK
+
+
+def test_bench_prints_a_table_or_json(capsys, monkeypatch):
+    monkeypatch.setattr(bench_cli, "QUICK_SIDES", (4, 6))
+    assert cli.main(["bench", "--quick", "--json"]) == cli.EXIT_OK
+    rows = json.loads(capsys.readouterr().out)
+    assert [(r["elements"], r["backend"]) for r in rows] == [(16, "dense"), (16, "hmatrix"), (36, "dense"),
+                                                             (36, "hmatrix")]
+    assert all(r["relative_error"] < 1e-3 for r in rows if r["backend"] == "hmatrix")
+    assert all(r["build_seconds"] >= 0 and r["memory_mb"] > 0 and r["matvec_ms"] > 0 for r in rows)
+    assert cli.main(["bench", "--quick", "--quiet"]) == cli.EXIT_OK
+    assert "error (smooth)" in capsys.readouterr().out
+
+
+def test_validate_keeps_its_exit_codes(capsys, monkeypatch):
+    import hmatddm.validate as validate
+
+    rows = [dict(name="check", error=1e-3, tolerance=1e-2, passed=True, seconds=0.1)]
+    monkeypatch.setattr(validate, "run_checks", lambda: rows)
+    assert cli.main(["validate", "--json"]) == cli.EXIT_OK
+    assert json.loads(capsys.readouterr().out) == rows
+    monkeypatch.setattr(validate, "run_checks", lambda: [dict(rows[0], passed=False)])
+    assert cli.main(["validate"]) == cli.EXIT_FAILED
+    assert "FAIL" in capsys.readouterr().out
+
+
+def test_console_script_and_examples_compile():
+    result = subprocess.run([sys.executable, "-m", "hmatddm.cli", "scenes"], capture_output=True, text=True,
+                            cwd=ROOT, timeout=120)
+    assert result.returncode == 0 and "radial-k" in result.stdout
+    examples = sorted((ROOT / "examples").glob("*.py"))
+    assert len(examples) >= 3
+    for path in examples:
+        py_compile.compile(str(path), doraise=True)
+
+
+def test_run_check_validates_natural_fracture_scenes_but_run_refuses_them(tiny, capsys):
+    text = tiny.read_text() + "\n[network]\nfriction_coefficient = 0.3\n"
+    tiny.write_text(text)
+    assert cli.main(["run", str(tiny), "--check"]) == cli.EXIT_OK
+    captured = capsys.readouterr()
+    assert json.loads(captured.out)["network"]["friction_coefficient"] == 0.3
+    assert "natural fractures are not supported yet" in captured.err
+    assert cli.main(["run", str(tiny), "--out", str(tiny.parent / "o")]) == cli.EXIT_BAD_INPUT
