@@ -5,6 +5,7 @@
     hmatddm validate [--json]         closed-form checks as a table of error and time
     hmatddm bench [--quick] [--json]  H-matrix against dense: build time, memory, matvec time, error
     hmatddm render DIR                snapshots and history plot of a finished or partial run
+    hmatddm sweep [--realizations N]  natural-fracture network ensembles on Dask (ref. Fig. 6.9)
 
 Exit codes: 0 ok, 1 a check failed (validate), 2 bad input, 3 did not converge,
 130 interrupted (Ctrl-C; a run can be continued with --resume).
@@ -89,21 +90,13 @@ def _load_run_scene(args):
 def _run(args):
     from .errors import ConvergenceError
     from .runner import SceneRun
-    from .scene import NATURAL_FRACTURES_UNSUPPORTED, build_simulation
+    from .scene import build_simulation
 
     scene, out = _load_run_scene(args)
     if args.check:
-        if scene.has_natural_fractures:
-            _say(args, f"hmatddm: note: the scene is valid, but `hmatddm run` refuses it: "
-                       f"{NATURAL_FRACTURES_UNSUPPORTED}", sys.stderr)
-        else:
-            build_simulation(scene.data)  # geometry checks (clusters on fractures, overlaps)
+        build_simulation(scene.data)  # geometry checks (clusters on fractures, overlaps)
         _say(args, json.dumps(scene.to_dict(), indent=1))
         return EXIT_OK
-    if scene.has_natural_fractures:
-        from .errors import InputError
-
-        raise InputError(NATURAL_FRACTURES_UNSUPPORTED)
     run = SceneRun(scene, out, resume=args.resume, overwrite=args.overwrite, quiet=args.quiet)
     if not args.quiet:
         numerics = scene.numerics
@@ -167,6 +160,18 @@ def _render(args):
 # parser and main
 # ---------------------------------------------------------------------------------
 
+def _sweep(args):
+    from . import ensemble
+
+    grid = ensemble.parameter_grid(length_exponent=args.length_exponent, density=args.density)
+    rows = ensemble.sweep(grid, realizations=args.realizations, scheduler=args.scheduler, n_workers=args.workers)
+    if args.json:
+        print(json.dumps(rows, indent=1))
+    else:
+        print(ensemble.format_table(ensemble.summarize(rows)))
+    return EXIT_OK
+
+
 def build_parser():
     parser = argparse.ArgumentParser(prog="hmatddm",
                                      description="Hydraulic fractures with the displacement discontinuity "
@@ -213,6 +218,15 @@ def build_parser():
     render.add_argument("dir", metavar="DIR", help="the --out folder of `hmatddm run`")
     render.add_argument("--quiet", action="store_true", help="do not list the written files")
     render.set_defaults(handler=_render)
+    sweep = sub.add_parser("sweep", help="natural-fracture network ensembles on Dask: intersection frequency "
+                                         "(ref. Fig. 6.9) over a grid of densities and length exponents")
+    sweep.add_argument("--density", type=float, nargs="+", default=[0.05, 0.1], help="areal densities, 1/m^2")
+    sweep.add_argument("--length-exponent", type=float, nargs="+", default=[2.0, 3.0], help="power-law exponents a")
+    sweep.add_argument("--realizations", type=int, default=10, help="seeds per grid point")
+    sweep.add_argument("--scheduler", default=None, help="Dask scheduler address (default: a local cluster)")
+    sweep.add_argument("--workers", type=int, default=None, help="local cluster workers (default: CPU count)")
+    sweep.add_argument("--json", action="store_true", help="print JSON rows instead of a table")
+    sweep.set_defaults(handler=_sweep)
     return parser
 
 

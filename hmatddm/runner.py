@@ -194,13 +194,14 @@ class Progress:
 # Fields, VTU and pictures
 # ---------------------------------------------------------------------------------
 
-def cell_fields(mesh, dd, pressure, stress):
+def cell_fields(mesh, dd, pressure, stress, state=None):
     """Per-element fields written to the .vtu files (see the module docstring)."""
     dd = np.asarray(dd, dtype=float).reshape(mesh.n_elements, mesh.dim)
     normal_stress = np.einsum("ei,ij,ej->e", mesh.normals, stress, mesh.normals)
     return {"opening": opening(mesh, dd), "slip": slip(mesh, dd), "pressure": np.asarray(pressure, dtype=float),
             "net_pressure": np.asarray(pressure, dtype=float) + normal_stress,
-            "fracture_id": mesh.fracture_id, "state": np.full(mesh.n_elements, HYDRAULIC, dtype=np.int64),
+            "fracture_id": mesh.fracture_id,
+            "state": np.full(mesh.n_elements, HYDRAULIC, dtype=np.int64) if state is None else state,
             "dd": dd}
 
 
@@ -394,8 +395,8 @@ class SceneRun:
     def _write_vtu(self, state):
         if not self.scene.data["output"]["vtu"]:
             return
-        mesh = state.mesh
-        fields = cell_fields(mesh, state.dd, state.pressure, self._stress)
+        mesh, dd, pressure, codes = self.simulation.view()
+        fields = cell_fields(mesh, dd, pressure, self._stress, codes)
         write_vtu(self.out / _vtu_name(state.step), mesh, fields)
         self._pvd_entries = [(t, name) for t, name in self._pvd_entries if name != _vtu_name(state.step)]
         self._pvd_entries.append((state.time, _vtu_name(state.step)))
@@ -434,9 +435,10 @@ class SceneRun:
         if output["vtu"] and self._last_vtu_step != state.step:
             self._write_vtu(state)
         if output["snapshots"]:
-            fields = cell_fields(state.mesh, state.dd, state.pressure, self._stress)
+            mesh, dd, pressure, codes = self.simulation.view()
+            fields = cell_fields(mesh, dd, pressure, self._stress, codes)
             try:
-                self.written["snapshots"] = write_snapshots(self.out, state.mesh, fields, state.step, state.time,
+                self.written["snapshots"] = write_snapshots(self.out, mesh, fields, state.step, state.time,
                                                             self.scene.name)
             except HmatddmError as error:  # e.g. no offscreen OpenGL on this machine
                 self.note(f"hmatddm: warning: no snapshots written: {error}")

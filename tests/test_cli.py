@@ -1,5 +1,7 @@
 """The command line: run, scenes, validate, bench, render; exit codes 0/1/2/3/130."""
 import json
+
+import numpy as np
 import py_compile
 import subprocess
 import sys
@@ -100,9 +102,8 @@ def test_bad_input_exits_2_with_a_one_line_message(tiny, tmp_path, capsys):
 
     natural = tmp_path / "natural.toml"
     natural.write_text(TINY_2D + "\n[[natural_fracture]]\np0 = [2.0, -1.0]\np1 = [2.0, 1.0]\n")
-    assert cli.main(["run", str(natural), "--out", str(tmp_path / "o")]) == cli.EXIT_BAD_INPUT
-    err = capsys.readouterr().err.strip()
-    assert err.startswith("hmatddm: error: natural fractures are not supported yet") and "\n" not in err
+    assert cli.main(["run", str(natural), "--check", "--quiet"]) == cli.EXIT_OK
+    capsys.readouterr()
 
     assert cli.main(["run", str(tiny), "--backend", "dense", "--set", "material.poisson_ratio=0.6"]) == 2
     assert "material.poisson_ratio must be in [0, 0.5), got 0.6" in capsys.readouterr().err
@@ -181,11 +182,21 @@ def test_console_script_and_examples_compile():
         py_compile.compile(str(path), doraise=True)
 
 
-def test_run_check_validates_natural_fracture_scenes_but_run_refuses_them(tiny, capsys):
-    text = tiny.read_text() + "\n[network]\nfriction_coefficient = 0.3\n"
+def test_run_check_validates_natural_fracture_scenes(tiny, capsys):
+    text = tiny.read_text() + "\n[network]\nfriction_coefficient = 0.3\n[[natural_fracture]]\np0 = [2.0, -1.0]\np1 = [2.0, 1.0]\n"
     tiny.write_text(text)
     assert cli.main(["run", str(tiny), "--check"]) == cli.EXIT_OK
     captured = capsys.readouterr()
     assert json.loads(captured.out)["network"]["friction_coefficient"] == 0.3
-    assert "natural fractures are not supported yet" in captured.err
-    assert cli.main(["run", str(tiny), "--out", str(tiny.parent / "o")]) == cli.EXIT_BAD_INPUT
+
+
+def test_crossing_scene_runs_and_reports_the_crossing(tmp_path, capsys):
+    out = tmp_path / "x"
+    assert cli.main(["run", "crossing", "--out", str(out), "--quiet", "--set", "numerics.end_time=25"]) == cli.EXIT_OK
+    summary = json.loads((out / "summary.json").read_text())
+    assert sum(step["natural_crossed"] for step in summary["steps"]) >= 1
+    from hmatddm.io import read_vtu
+
+    vtus = sorted((out / "vtu").glob("*.vtu"))
+    _, _, data = read_vtu(vtus[-1])
+    assert set(np.unique(data["state"]).tolist()) >= {0, 1}  # hydraulic and intact natural elements

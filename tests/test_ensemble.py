@@ -26,3 +26,11 @@ def test_bad_grid_is_refused():
         ensemble.parameter_grid(density=[])
     with pytest.raises(InputError, match="realizations"):
         ensemble.sweep([{"density": 0.05}], realizations=0)
+
+
+def test_sweep_command_prints_a_table(capsys):
+    from hmatddm import cli
+
+    assert cli.main(["sweep", "--realizations", "1", "--density", "0.05", "--length-exponent", "3",
+                     "--workers", "1"]) == cli.EXIT_OK
+    assert "| 3.0 | 0.05 |" in capsys.readouterr().out

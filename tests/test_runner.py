@@ -137,10 +137,6 @@ def test_a_folder_holding_a_run_is_not_overwritten_by_accident(finished_3d, tmp_
     out, _ = finished_3d
     with pytest.raises(InputError, match="already holds a run; add --resume to continue it or --overwrite"):
         runner.run_scene(hs.parse_scene(TINY_3D), out, quiet=True)
-    with pytest.raises(InputError, match="natural fractures are not supported yet"):
-        text = TINY_3D + '[[natural_fracture]]\np0 = [5.0, -1.0]\np1 = [5.0, 1.0]\n'
-        runner.run_scene(hs.parse_scene(text), tmp_path / "nf", quiet=True)
-    assert not (tmp_path / "nf").exists()  # bad input writes nothing
 
 
 def test_interrupted_run_is_readable_and_resumes_to_the_same_result(tmp_path, monkeypatch):

@@ -197,12 +197,11 @@ def test_invalid_toml_and_unknown_scene_names():
 def test_embedded_scenes_validate_build_and_round_trip():
     names = hs.embedded_names()
     assert names[0] == "default"
-    assert {"default", "radial-k", "radial-m", "kgd"} <= set(names)
-    assert not {"crossing", "dfn-3cluster"} & set(names)  # natural-fracture physics is not built yet
+    assert {"default", "radial-k", "radial-m", "kgd", "crossing"} <= set(names)
     for name in names:
         scene = hs.load_scene(name)
         assert scene.name == name and scene.description
-        assert not scene.has_natural_fractures
+        assert scene.has_natural_fractures == (name == "crossing")
         sim = hs.build_simulation(scene.data)
         assert isinstance(sim, hd.Simulation) and sim.mesh0.dim == scene.dimension
         again = hs.parse_scene(scene.to_toml())  # the echo reads back to itself
@@ -272,7 +271,7 @@ def test_penny_and_multiple_fractures_build():
     assert sim.growing_fractures.tolist() == [0]
 
 
-def test_natural_fractures_validate_but_are_refused_by_build():
+def test_natural_fractures_validate_and_build():
     scene = raw()
     scene["network"] = {"friction_coefficient": 0.3, "region": [-50.0, 50.0, -100.0, 100.0], "density": 0.05,
                         "mean_azimuths_deg": [45.0, 135.0], "kappas": [5.0, 5.0], "weights": [0.5, 0.5]}
@@ -281,8 +280,8 @@ def test_natural_fractures_validate_but_are_refused_by_build():
     assert checked["network"]["l_max"] == 30.0 and checked["network"]["crossing"] == "mohr-coulomb"
     assert hs.has_natural_fractures(checked)
     assert validate(copy.deepcopy(checked)) == checked
-    with pytest.raises(InputError, match="natural fractures are not supported yet"):
-        hs.build_simulation(checked)
+    simulation = hs.build_simulation(checked)
+    assert simulation.network.mesh.n_elements > 20 and simulation.network.properties.friction == 0.3
     bad = copy.deepcopy(scene)
     bad["network"]["weights"] = [0.5, 0.6]
     with pytest.raises(InputError, match=r"network.weights must sum to 1"):

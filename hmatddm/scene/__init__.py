@@ -148,7 +148,7 @@ from importlib import resources
 from pathlib import Path
 
 from ..errors import InputError
-from .build import (NATURAL_FRACTURES_UNSUPPORTED, build_simulation, confining_stress, initial_mesh,
+from .build import (build_simulation, natural_mesh, natural_network, natural_properties, confining_stress, initial_mesh,
                     reference_curves, reference_values)
 from .schema import far_field_stress, has_natural_fractures, to_toml, validate
 
@@ -308,4 +308,4 @@ def apply_override(raw, assignment):
 __all__ = ["Scene", "load_scene", "parse_scene", "scene_from_dict", "embedded_names", "embedded_text",
            "embedded_scenes", "apply_override", "validate", "build_simulation", "initial_mesh",
            "reference_values", "reference_curves", "confining_stress", "far_field_stress",
-           "has_natural_fractures", "to_toml", "NATURAL_FRACTURES_UNSUPPORTED"]
+           "has_natural_fractures", "to_toml", "natural_mesh", "natural_network", "natural_properties"]

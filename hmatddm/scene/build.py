@@ -16,10 +16,7 @@ from ..material import Elastic
 from ..simulation import Simulation
 from .schema import SCHEME_KEYS, far_field_stress, has_natural_fractures, show
 
-NATURAL_FRACTURES_UNSUPPORTED = (
-    "natural fractures are not supported yet: the engine has no crossing, remote-failure or "
-    "intersection physics, so a scene with [network] or [[natural_fracture]] cannot run; "
-    "remove those sections to run the hydraulic fractures alone")
+_CROSSING_NAMES = {"mohr-coulomb": "mohr-coulomb", "energy-release-rate": "energy", "stress-intensity": "sif"}
 
 
 def material(scene):
@@ -117,11 +114,9 @@ def scheme_settings(scene):
 def build_simulation(scene, checkpoint_dir=None):
     """A :class:`~hmatddm.Simulation` of a validated scene (nothing is solved yet).
 
-    Raises InputError for a scene with natural fractures (not supported by the engine
-    yet), a cluster off the initial fractures, or overlapping initial fractures.
+    Raises InputError for a cluster off the initial fractures or overlapping initial
+    fractures.
     """
-    if has_natural_fractures(scene):
-        raise InputError(NATURAL_FRACTURES_UNSUPPORTED)
     mesh = initial_mesh(scene)
     _check_clusters(scene, mesh)
     numerics = scene["numerics"]
@@ -133,7 +128,58 @@ def build_simulation(scene, checkpoint_dir=None):
         height=scene.get("height", 1.0), backend=numerics["backend"], eps=numerics["eps"], eta=numerics["eta"],
         leaf_size=numerics["leaf_size"], singular_correction=numerics["singular_correction"],
         alpha=numerics.get("alpha"), scheme=scheme_settings(scene), growing_fractures=growing,
-        checkpoint_dir=checkpoint_dir, keep_checkpoints=numerics["keep_checkpoints"])
+        checkpoint_dir=checkpoint_dir, keep_checkpoints=numerics["keep_checkpoints"],
+        natural_fractures=natural_mesh(scene), natural=natural_properties(scene),
+        remote_failure=scene.get("network", {}).get("remote_failure", True))
+
+
+def natural_network(scene):
+    """The scene's natural fractures as an :class:`hmatddm.network.Network` (generated
+    when ``network.density`` is given, plus the explicit ``[[natural_fracture]]``), or None."""
+    from ..network import Network, NetworkSpec, generate_network
+
+    if not has_natural_fractures(scene):
+        return None
+    settings = scene.get("network", {})
+    height, z_center = settings.get("height", 1.0), settings.get("z_center", 0.0)
+    p0 = [np.asarray(f["p0"], float) for f in scene.get("natural_fracture", [])]
+    p1 = [np.asarray(f["p1"], float) for f in scene.get("natural_fracture", [])]
+    if "density" in settings:
+        keys = ("region", "density", "length_exponent", "l_min", "l_max", "mean_azimuths_deg", "kappas",
+                "weights", "seed", "boundary")
+        spec = NetworkSpec(height=height, z_center=z_center,
+                           **{k: (tuple(settings[k]) if isinstance(settings[k], list) else settings[k])
+                              for k in keys if k in settings and settings[k] is not None})
+        generated = generate_network(spec)
+        p0.extend(generated.p0)
+        p1.extend(generated.p1)
+    return Network.from_segments(np.array(p0), np.array(p1), height=height, z_center=z_center)
+
+
+def natural_mesh(scene):
+    """Elements of the natural fractures (2D segments or 3D vertical rectangles), or None."""
+    network = natural_network(scene)
+    if network is None:
+        return None
+    size = scene.get("network", {}).get("element_size", 1.0)
+    if scene["dimension"] == 2:
+        return network.to_mesh2d(size)
+    return network.to_mesh3d(size, max(1, int(round(network.height / size))))
+
+
+def natural_properties(scene):
+    """:class:`hmatddm.NaturalFractureProperties` of the scene, or None."""
+    from ..fracture import NaturalFractureProperties
+
+    if not has_natural_fractures(scene):
+        return None
+    settings = scene.get("network", {})
+    return NaturalFractureProperties(
+        friction=settings.get("friction_coefficient", 0.25), cohesion=settings.get("cohesion", 0.0),
+        tensile_strength=settings.get("tensile_strength", 0.0), toughness=settings.get("toughness", 0.5e6),
+        critical_radius=settings.get("critical_radius", 0.005),
+        crossing=_CROSSING_NAMES[settings.get("crossing", "mohr-coulomb")],
+        pore_pressure=scene["leak_off"]["pore_pressure"])
 
 
 def confining_stress(scene, normal=None):

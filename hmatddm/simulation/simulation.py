@@ -118,6 +118,9 @@ class Simulation:
         ``alpha=1.0`` (ref. Sec. 6.2.3) when elements meet at intersections.
     natural : NaturalFractureProperties or None
         Their strength and the crossing criterion (default properties if None).
+    remote_failure : bool
+        Check intact natural elements against Coulomb's criterion after every step
+        (ref. Sec. 5.3); the failed ones are reported (``natural_failed``).
     rebuild_fraction, max_border_bytes
         ``hmatrix`` backend: elements added by growth join the operator as exact
         border blocks (:class:`~hmatddm.extended_operator.ExtendedElasticityOperator`)
@@ -130,7 +133,7 @@ class Simulation:
                  backend="hmatrix", eps=DEFAULT_EPS, eta=DEFAULT_ETA, leaf_size=DEFAULT_LEAF_SIZE,
                  singular_correction="none", alpha=None, scheme="krylov", growing_fractures=None,
                  checkpoint_dir=None, keep_checkpoints=3, rebuild_fraction=0.25, max_border_bytes=2**28,
-                 natural_fractures=None, natural=None):
+                 natural_fractures=None, natural=None, remote_failure=True):
         if not isinstance(mesh, (Mesh2D, Mesh3D)):
             raise InputError(f"mesh must be a Mesh2D or Mesh3D, got {type(mesh).__name__}")
         if not isinstance(material, Elastic):
@@ -168,6 +171,7 @@ class Simulation:
         self.growing_fractures = None if growing_fractures is None else np.asarray(sorted(growing_fractures), np.int64)
         self.injection_elements = np.array([c.nearest_element(mesh) for c in clusters], dtype=np.int64)
         self.network = None
+        self.remote_failure = bool(remote_failure)
         if natural_fractures is not None:
             if type(natural_fractures) is not type(mesh):
                 raise InputError(f"natural_fractures must be a {type(mesh).__name__} like mesh, "
@@ -338,7 +342,7 @@ class Simulation:
         injected = s.injected_volume + self.time_step * sum(c.rate for c in self.clusters)
         leaked = s.leaked_volume + float(np.sum(leak)) * self.time_step
         failed = s.failed.copy()
-        if self.network is not None:
+        if self.network is not None and self.remote_failure:
             failed, *_ = self.network.remote_failure(mesh, dd, self.material, self.far_field_stress, intact)
         self.state = State(mesh, dd, p, creation, t_new, s.step + 1, relaxation, injected, leaked,
                            origin=origin, natural_index=natural_index, intact=intact, failed=failed,
@@ -442,6 +446,22 @@ class Simulation:
         else:
             record["half_length"] = float(np.sum(mesh.areas) / 2.0)
         return record
+
+    def view(self):
+        """Every element of the run for output: ``(mesh, dd, pressure, state)`` with the
+        active elements first, then the intact natural elements (zero DD, the pore
+        pressure). ``state``: 0 hydraulic, 1 intact natural, 2 activated or failed natural."""
+        s = self.state
+        state = np.where(s.origin == 1, 2, 0).astype(np.int64)
+        if self.network is None or not np.any(s.intact):
+            return s.mesh, s.dd, s.pressure, state
+        intact = np.flatnonzero(s.intact)
+        natural = self.network.mesh.subset(intact)
+        mesh = concatenate([s.mesh, natural])
+        dd = np.concatenate([s.dd, np.zeros((len(intact), s.mesh.dim))])
+        pressure = np.concatenate([s.pressure, np.full(len(intact), self.network.properties.pore_pressure)])
+        state = np.concatenate([state, np.where(s.failed[intact], 2, 1).astype(np.int64)])
+        return mesh, dd, pressure, state
 
     # -- run, checkpoints, resume -------------------------------------------------------
     def run(self, end_time, resume=False, callback=None):
