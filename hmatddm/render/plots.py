@@ -5,11 +5,11 @@ half-length, or the equivalent radius ``sqrt(area / pi)``), the maximum opening 
 and the wellbore pressure of each cluster (MPa), with closed-form solutions overlaid
 as dashed lines.
 """
-import math
 from pathlib import Path
 
 import numpy as np
 
+from .._validation import finite_scalar
 from ..errors import InputError
 from ..io import atomic_output
 
@@ -23,13 +23,7 @@ CLOSED_FORM_STYLE = dict(color="black", linestyle="--", linewidth=1.2, label="cl
 # ---------------------------------------------------------------------------------
 
 def _finite_number(value, where):
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise InputError(f"{where} must be a number, got {value!r}") from None
-    if not math.isfinite(number):
-        raise InputError(f"{where} must be finite, got {number}")
-    return number
+    return finite_scalar(where, value)
 
 
 def _column(records, key):
