@@ -1,6 +1,5 @@
 """Closed-form validation of the dense DDM path: Griffith (2D) and Sneddon (3D)."""
 import numpy as np
-import pytest
 
 import hmatddm as hd
 from conftest import NU, random_rotation, rotation_2d

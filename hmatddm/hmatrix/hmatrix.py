@@ -216,7 +216,6 @@ class HMatrix(LinearOperator):
         rng = np.random.default_rng(seed)
         s = self.storage
         tree = self.tree
-        d = self.dof
         errors = np.zeros(s.admissible_kind.size)
         for b in range(errors.size):
             rs, re = tree.start[self.blocks.admissible_rows[b]], tree.stop[self.blocks.admissible_rows[b]]
