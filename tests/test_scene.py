@@ -167,11 +167,11 @@ def test_invalid_toml_and_unknown_scene_names():
 def test_embedded_scenes_validate_build_and_round_trip():
     names = hs.embedded_names()
     assert names[0] == "default"
-    assert {"default", "radial-k", "radial-m", "kgd", "crossing"} <= set(names)
+    assert {"default", "radial-k", "radial-m", "kgd", "crossing", "dfn-3cluster"} <= set(names)
     for name in names:
         scene = hs.load_scene(name)
         assert scene.name == name and scene.description
-        assert scene.has_natural_fractures == (name == "crossing")
+        assert scene.has_natural_fractures == (name in ("crossing", "dfn-3cluster"))
         sim = hs.build_simulation(scene.data)
         assert isinstance(sim, hd.Simulation) and sim.mesh0.dim == scene.dimension
         again = hs.parse_scene(scene.to_toml())  # the echo reads back to itself
