@@ -78,6 +78,7 @@ class ElasticityOperator(LinearOperator):
             if alpha < 1.0:
                 raise InputError(f"alpha must be >= 1 (or None for no scaling), got {alpha}")
 
+        _refuse_coincident(mesh)
         self.mesh = mesh
         self.material = material
         self.backend = backend
@@ -190,6 +191,17 @@ class ElasticityOperator(LinearOperator):
     # -- helpers ------------------------------------------------------------------------
     def _refuse_singular(self):
         refuse_singular()
+
+
+def _refuse_coincident(mesh):
+    """Two elements with the same centre and plane make the matrix singular: refuse them."""
+    from scipy.spatial import cKDTree
+
+    tolerance = 1e-9 * float(np.min(mesh.radii))
+    for i, j in sorted(cKDTree(mesh.centers).query_pairs(tolerance)):
+        if abs(float(mesh.normals[i] @ mesh.normals[j])) > 1.0 - 1e-9:
+            raise InputError(f"elements {i} and {j} coincide (same centre and plane), which makes the DDM "
+                             "system singular; remove one of them")
 
 
 def influence_data(mesh, material, singular_correction="none", alpha=None):

@@ -1,0 +1,102 @@
+"""Property-based bad input (issue: hard cases and reliability): any mutation of a valid
+scene either validates or raises InputError naming a field; nothing else escapes."""
+import copy
+import math
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import hmatddm as hd
+import hmatddm.scene as hs
+from hmatddm.errors import InputError
+from hmatddm.scene.schema import validate
+
+BASE = hs.load_scene("kgd").data
+BAD_VALUES = st.one_of(st.none(), st.booleans(), st.text(max_size=5), st.just(math.nan), st.just(math.inf),
+                       st.just(-math.inf), st.floats(allow_nan=True, allow_infinity=True),
+                       st.integers(min_value=-10**12, max_value=10**12), st.lists(st.floats(), max_size=4),
+                       st.dictionaries(st.text(max_size=3), st.integers(), max_size=2))
+
+
+def _paths(node, prefix=()):
+    if isinstance(node, dict):
+        for key, value in node.items():
+            yield from _paths(value, prefix + (key,))
+    elif isinstance(node, list) and node and isinstance(node[0], dict):
+        for i, value in enumerate(node):
+            yield from _paths(value, prefix + (i,))
+    else:
+        yield prefix
+
+
+PATHS = sorted(_paths(BASE), key=str)
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.lists(st.tuples(st.sampled_from(PATHS), BAD_VALUES, st.booleans()), min_size=1, max_size=3))
+def test_scene_mutations_end_in_input_error_or_a_valid_scene(mutations):
+    scene = copy.deepcopy(BASE)
+    for path, value, delete in mutations:
+        node = scene
+        for key in path[:-1]:
+            node = node[key]
+        if delete:
+            node.pop(path[-1], None)
+        else:
+            node[path[-1]] = value
+    try:
+        checked = validate(scene)
+    except InputError as error:
+        message = str(error)
+        assert message and "\n" not in message.strip()
+        return
+    # a scene that validates must build without any other exception type
+    try:
+        hs.build_simulation(checked)
+    except InputError:
+        pass
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.floats(allow_nan=True, allow_infinity=True, width=32), min_size=1, max_size=12),
+       st.sampled_from(["centers", "half_a", "e1", "load"]))
+def test_api_arrays_with_bad_numbers_raise_input_error(values, field):
+    mat = hd.Elastic(10e9, 0.25)
+    centers = np.zeros((2, 3))
+    centers[1, 0] = 3.0
+    e1, e2 = np.tile([1.0, 0, 0], (2, 1)), np.tile([0.0, 1, 0], (2, 1))
+    half = np.ones(2)
+    arrays = dict(centers=centers, half_a=half, e1=e1)
+    if field != "load":
+        padded = np.resize(np.asarray(values, float), arrays[field].size).reshape(arrays[field].shape)
+        arrays[field] = padded
+    try:
+        mesh = hd.Mesh3D.from_rectangles(arrays["centers"], arrays["e1"], e2, arrays["half_a"], half)
+        load = np.resize(np.asarray(values, float), 6) if field == "load" else -np.ones(6)
+        op = hd.ElasticityOperator(mesh, mat)
+        dd = hd.solve(op, load)
+        assert np.all(np.isfinite(dd))
+    except InputError as error:
+        assert str(error)
+
+
+def test_checkpoints_and_scenes_are_read_without_executing_code(tmp_path):
+    # checkpoints are numpy .npz read with allow_pickle=False plus JSON; scenes are TOML
+    from hmatddm.simulation import checkpoint
+
+    checkpoint.save(tmp_path, 1, {"x": np.arange(3)}, {"time": 1.0})
+    npz = tmp_path / "step-000001.npz"
+    np.savez(npz, x=np.array([object()], dtype=object))  # a pickled payload
+    import hashlib
+    import json
+
+    meta = json.loads((tmp_path / "step-000001.json").read_text())
+    meta["arrays_sha256"] = hashlib.sha256(npz.read_bytes()).hexdigest()
+    (tmp_path / "step-000001.json").write_text(json.dumps(meta))
+    try:
+        checkpoint.load(tmp_path, 1)
+    except (ValueError, checkpoint.CheckpointError):
+        pass  # refused: object arrays need pickle
+    else:
+        raise AssertionError("a pickled checkpoint array was loaded")
