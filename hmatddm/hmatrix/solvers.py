@@ -4,9 +4,10 @@ import math
 
 import numpy as np
 import scipy.sparse.linalg as spla
-from threadpoolctl import threadpool_limits
 
 from hmatddm.errors import ConvergenceError, InputError
+
+from ._threads import single_threaded_blas
 
 
 def _positive_integer(name, value):
@@ -74,7 +75,7 @@ def gmres(A, b, M=None, rtol=1e-8, restart=50, maxiter=20, x0=None):
     # One BLAS thread: the Krylov vector operations are memory-bound, and idle
     # spinning BLAS threads would steal the cores from the parallel H-matrix matvec
     # (measured: matvec twice slower inside GMRES otherwise).
-    with threadpool_limits(limits=1, user_api="blas"):
+    with single_threaded_blas():
         x, _ = spla.gmres(A, b, x0=x0, rtol=float(rtol), atol=0.0, restart=restart, maxiter=maxiter, M=M,
                           callback=count, callback_type="pr_norm")
     if not np.all(np.isfinite(x)):

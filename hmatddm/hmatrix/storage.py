@@ -261,9 +261,9 @@ def _run_parallel(function, batches, n_threads):
     BLAS/LAPACK threading is limited to one thread meanwhile (the factorisations are
     small; nested threading would only oversubscribe the cores).
     """
-    from threadpoolctl import threadpool_limits
+    from ._threads import single_threaded_blas
 
-    with threadpool_limits(limits=1, user_api="blas"):
+    with single_threaded_blas():
         if n_threads <= 1 or len(batches) <= 1:
             for batch in batches:
                 yield function(batch)
