@@ -32,3 +32,30 @@ initial_pressure = 10e6
 [reference]
 kind = "radial-k"
 """
+
+# a 0.75 m plane-strain crack on 0.25 m elements, toughness dominated; ends inside
+# [numerics], so the caller appends end_time and what follows
+KGD_2D_HEAD = """
+dimension = 2
+[material]
+shear_modulus = 10e9
+poisson_ratio = 0.25
+[fluid]
+viscosity = 1e-4
+compressibility = 4.5e-10
+[stress]
+s_hmin = 0.5e6
+s_hmax = 1e6
+[[cluster]]
+position = [0.0, 0.0]
+rate = 5e-4
+wellbore_volume = 0.01
+[[initial_fracture]]
+shape = "line"
+p0 = [-0.375, 0.0]
+p1 = [0.375, 0.0]
+element_size = 0.25
+[propagation]
+toughness = 5e6
+[numerics]
+"""

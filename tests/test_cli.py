@@ -11,33 +11,11 @@ from pathlib import Path
 import pytest
 
 from hmatddm import bench_cli, cli, runner
+from scene_texts import KGD_2D_HEAD
 
 ROOT = Path(__file__).resolve().parents[1]
 
-TINY_2D = """
-dimension = 2
-[material]
-shear_modulus = 10e9
-poisson_ratio = 0.25
-[fluid]
-viscosity = 1e-4
-compressibility = 4.5e-10
-[stress]
-s_hmin = 0.5e6
-s_hmax = 1e6
-[[cluster]]
-position = [0.0, 0.0]
-rate = 5e-4
-wellbore_volume = 0.01
-[[initial_fracture]]
-shape = "line"
-p0 = [-0.375, 0.0]
-p1 = [0.375, 0.0]
-element_size = 0.25
-[propagation]
-toughness = 5e6
-[numerics]
-end_time = 2.0
+TINY_2D = KGD_2D_HEAD + """end_time = 2.0
 backend = "dense"
 initial_pressure = 0.6e6
 [reference]

@@ -11,35 +11,11 @@ import hmatddm.scene as hs
 from hmatddm import runner
 from hmatddm.errors import InputError
 from hmatddm.io import read_pvd, read_vtu
-from scene_texts import RADIAL_3D_BODY
+from scene_texts import KGD_2D_HEAD, RADIAL_3D_BODY
 
 TINY_3D = 'name = "tiny"\n' + RADIAL_3D_BODY
 
-TINY_2D = """
-name = "tiny-kgd"
-dimension = 2
-[material]
-shear_modulus = 10e9
-poisson_ratio = 0.25
-[fluid]
-viscosity = 1e-4
-compressibility = 4.5e-10
-[stress]
-s_hmin = 0.5e6
-s_hmax = 1e6
-[[cluster]]
-position = [0.0, 0.0]
-rate = 5e-4
-wellbore_volume = 0.01
-[[initial_fracture]]
-shape = "line"
-p0 = [-0.375, 0.0]
-p1 = [0.375, 0.0]
-element_size = 0.25
-[propagation]
-toughness = 5e6
-[numerics]
-end_time = 6.0
+TINY_2D = 'name = "tiny-kgd"\n' + KGD_2D_HEAD + """end_time = 6.0
 backend = "dense"
 initial_pressure = 0.6e6
 [output]
