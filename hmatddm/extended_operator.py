@@ -82,15 +82,8 @@ class ExtendedElasticityOperator(LinearOperator):
         return LinearOperator(self.shape, matvec=self.approximate_inverse, dtype=np.float64)
 
     def element_diagonal_blocks(self):
-        d, n0 = self.dof, self.n_base
-        if self.base.backend == "dense":
-            matrix = self.base._matrix.reshape(n0, d, n0, d)
-            index = np.arange(n0)
-            old = matrix[index, :, index, :]
-        else:
-            old = self.base.hmatrix.element_diagonal_blocks()
-        m = self.n_new
-        nn = self.nn.reshape(m, d, m, d)
+        """(N, d, d): the base operator's self blocks, then those of ``A_nn``."""
+        d, m = self.dof, self.n_new
         index = np.arange(m)
-        return np.concatenate([old, nn[index, :, index, :]])
-
+        new = self.nn.reshape(m, d, m, d)[index, :, index, :]
+        return np.concatenate([self.base.element_diagonal_blocks(), new])

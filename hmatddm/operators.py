@@ -178,6 +178,14 @@ class ElasticityOperator(LinearOperator):
             self._preconditioner = default_preconditioner(self._hmatrix)
         return self._preconditioner
 
+    def element_diagonal_blocks(self):
+        """(N, d, d): the exact self-influence block of each element."""
+        if self._matrix is None:
+            return self._hmatrix.element_diagonal_blocks()
+        n, d = self.mesh.n_elements, self.dof
+        index = np.arange(n)
+        return np.ascontiguousarray(self._matrix.reshape(n, d, n, d)[index, :, index, :])
+
     def lu(self):
         """LU factors of the dense matrix (cached; ``dense`` backend only)."""
         if self._matrix is None:

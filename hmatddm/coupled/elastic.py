@@ -58,13 +58,5 @@ class ElasticSolver:
     def diagonal_blocks(self):
         """(N, d, d) self-influence block of each element."""
         if self._diagonal_blocks is None:
-            d, n = self.dof, self.n_elements
-            if self.extended:
-                self._diagonal_blocks = self.operator.element_diagonal_blocks()
-            elif self.operator.backend == "dense":
-                matrix = self.operator._matrix.reshape(n, d, n, d)
-                index = np.arange(n)
-                self._diagonal_blocks = np.ascontiguousarray(matrix[index, :, index, :])
-            else:
-                self._diagonal_blocks = self.operator.hmatrix.element_diagonal_blocks()
+            self._diagonal_blocks = self.operator.element_diagonal_blocks()
         return self._diagonal_blocks

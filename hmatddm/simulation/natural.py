@@ -90,14 +90,10 @@ class NaturalNetwork:
         """True to cross natural element ``element`` (tip frame: ``ahead``, ``normal``)."""
         tangent = self.p1[element] - self.p0[element]
         tangent = tangent / np.linalg.norm(tangent)
-        x, y = ahead, normal
-        if len(x) > 2:  # plan view of the tip frame
-            t3 = np.array([tangent[0], tangent[1], 0.0])
-            phi = np.arctan2(t3 @ y, t3 @ x)
-            frame = np.stack([x, y])
-        else:
-            phi = np.arctan2(tangent @ y, tangent @ x)
-            frame = np.stack([x, y])
+        if len(ahead) > 2:  # the natural fracture's plan-view direction, in 3D
+            tangent = np.array([tangent[0], tangent[1], 0.0])
+        phi = np.arctan2(tangent @ normal, tangent @ ahead)
+        frame = np.stack([ahead, normal])
         stress_tip = frame @ far_field @ frame.T
         return crosses(tips_k1, tips_k2, tips_theta, phi, stress_tip, rock_toughness, self.properties)
 
