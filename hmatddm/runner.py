@@ -14,7 +14,9 @@ The folder (``--out DIR``) holds::
                         stress), fracture_id, state (0 hydraulic, 1 intact natural,
                         2 failed natural), dd (vector, m)
     checkpoints/        the simulation's atomic checkpoints (one per step, newest kept)
-    snapshots/step-NNNNNN_plan.png, _oblique.png   views of the last state
+    snapshots/step-NNNNNN_plan.png, _oblique.png   views of the last state (plan
+                        only in 2D; the plan view of vertical 3D fractures shows their
+                        traces, coloured by the largest opening over the height)
     history.png         size, opening and wellbore pressure against time, with the
                         closed form overlaid when the scene has a [reference]
 
@@ -213,12 +215,12 @@ def _visible_slip(mesh, slip_vectors, opening_values):
 
 
 def snapshot_views(mesh):
-    """The views worth drawing: the plan view (looking down z) shows nothing of a 3D
-    mesh whose elements are all vertical (seen edge on), so it is left out then."""
+    """The views worth drawing: the plan view only in 2D, plan and oblique in 3D. A
+    plan view of (mostly) vertical 3D fractures, which looking down z would see edge
+    on, draws their horizontal traces coloured by the largest opening over the height
+    (:func:`hmatddm.render.snapshots.plan_traces`)."""
     if mesh.dim == 2:
         return ("plan",)
-    if np.all(np.abs(mesh.normals[:, 2]) < 1e-6):
-        return ("oblique",)
     return ("plan", "oblique")
 
 

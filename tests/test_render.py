@@ -93,8 +93,65 @@ def test_snapshots_2d_draw_one_plan_view(tmp_path, scene2d):
     assert _red_pixels(_image(paths[0])) > 5
 
 
+def _coloured_pixels(image):
+    return np.ptp(image, axis=2) > 0.15  # viridis and red are far from grey; white and grey are not
+
+
+def test_plan_view_of_vertical_fractures_draws_their_traces(tmp_path, scene3d):
+    """Seen from above, vertical fractures are edge on: the plan view draws each column
+    of elements as its horizontal trace, coloured by its largest opening."""
+    mesh, fields = scene3d
+    assert np.all(np.abs(mesh.normals[:, 2]) < 1e-12)
+    traces = snapshot(mesh, tmp_path / "traces.png", view="plan", window_size=WINDOW, **fields)
+    edge_on = snapshot(mesh, tmp_path / "edge_on.png", view="plan", plan_style="surfaces", window_size=WINDOW,
+                       **fields)
+    _assert_picture(traces, WINDOW)
+    image = _image(traces)
+    rows, columns = np.nonzero(_coloured_pixels(image[:, :int(0.8 * WINDOW[0])]))  # left of the scalar bar
+    assert np.ptp(columns) > 0.4 * WINDOW[0], "the 4 m hydraulic trace should span much of the width"
+    assert np.ptp(rows) > 0.15 * WINDOW[1], "the natural trace (along y) should show"
+    assert _red_pixels(image) > 10, "the failed natural trace has no red border"
+    grey = (np.ptp(image, axis=2) < 0.05) & (image[..., 0] > 0.5) & (image[..., 0] < 0.8)
+    assert np.sum(grey) > 10, "the intact natural trace is not grey"
+    assert np.sum(_coloured_pixels(image)) > 3 * np.sum(_coloured_pixels(_image(edge_on))[:, :int(0.8 * WINDOW[0])])
+
+
+def test_plan_traces_merge_each_column_with_its_largest_opening(scene3d):
+    from hmatddm.render.snapshots import plan_traces
+
+    mesh, fields = scene3d
+    traces, opening, state, slip, column = plan_traces(mesh, **fields)
+    assert isinstance(traces, hd.Mesh2D) and traces.n_elements == 8 + 4  # 8 + 4 columns of 4 elements
+    assert column.shape == (mesh.n_elements,)
+    for line in range(traces.n_elements):
+        members = np.flatnonzero(column == line)
+        assert members.size == 4 and np.unique(mesh.fracture_id[members]).size == 1
+        assert opening[line] == np.max(fields["opening"][members])
+        assert np.allclose(mesh.centers[members, :2], traces.centers[line])
+        expected = FAILED_NATURAL if np.any(fields["state"][members] == FAILED_NATURAL) else fields["state"][members[0]]
+        assert state[line] == expected
+    assert np.allclose(slip[state == FAILED_NATURAL], [0.0, 1e-4])  # the horizontal part of the slip
+    assert np.all(slip[state != FAILED_NATURAL] == 0.0)
+
+
+def test_plan_view_of_a_mostly_vertical_mesh_keeps_its_other_elements(tmp_path, scene3d):
+    from hmatddm.render.snapshots import is_mostly_vertical
+
+    mesh, fields = scene3d
+    horizontal = hd.mesh.rectangle([3.0, -1.5, 0.5], [1, 0, 0], [0, 1, 0], 1.0, 1.0, 2, 2, fracture_id=3)
+    mixed = hd.mesh.concatenate([mesh, horizontal])
+    assert is_mostly_vertical(mixed) and not is_mostly_vertical(horizontal)
+    opening = np.r_[fields["opening"], np.full(4, 5e-4)]
+    state = np.r_[fields["state"], np.zeros(4, dtype=int)]
+    with_patch = _image(snapshot(mixed, tmp_path / "mixed.png", view="plan", opening=opening, state=state,
+                                 window_size=WINDOW))
+    without = _image(snapshot(mesh, tmp_path / "vertical.png", view="plan", window_size=WINDOW, **fields))
+    assert np.sum(_coloured_pixels(with_patch)) > np.sum(_coloured_pixels(without)) + 500  # the 1 m x 1 m patch
+
+
 @pytest.mark.parametrize("change, message", [
     (dict(view="side"), "view"),
+    (dict(view="plan", plan_style="map"), "plan_style"),
     (dict(state=np.full(48, 5)), "state values"),
     (dict(state=np.zeros(48)), "state must be an integer array"),
     (dict(opening=np.zeros(47)), "opening"),
@@ -107,6 +164,13 @@ def test_snapshot_bad_inputs_raise_input_error(tmp_path, scene3d, change, messag
     assert mesh.n_elements == 48
     with pytest.raises(hd.InputError, match=message):
         snapshot(mesh, tmp_path / "bad.png", **{**fields, **change})
+    assert not list(tmp_path.iterdir())
+
+
+def test_traces_of_a_mesh_without_vertical_elements_are_refused(tmp_path):
+    disc = hd.mesh.penny([0.0, 0.0, 0.0], [0, 0, 1], 1.0, 0.5)
+    with pytest.raises(hd.InputError, match="plan_style='traces' needs vertical elements"):
+        snapshot(disc, tmp_path / "bad.png", view="plan", plan_style="traces")
     assert not list(tmp_path.iterdir())
 
 

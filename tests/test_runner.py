@@ -80,6 +80,25 @@ def test_a_run_writes_every_output(finished_3d):
     assert hs.load_scene(str(out / "scene.toml")).data == document["scene"]
 
 
+def test_a_vertical_3d_run_writes_the_plan_view_of_its_traces(tmp_path):
+    """A vertical fracture is edge on from above: the plan view draws its trace."""
+    from PIL import Image
+
+    text = TINY_3D.replace('name = "tiny"', 'name = "tiny-vertical"').replace(
+        "e2 = [0.0, 1.0, 0.0]", "e2 = [0.0, 0.0, 1.0]").replace("s_hmin = 10e6", "s_hmin = 8e6").replace(
+        "s_v = 8e6", "s_v = 10e6").replace("end_time = 2.0", "end_time = 1.0")
+    assert runner.snapshot_views(hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 0, 1], 3, 3, 3, 3)) == (
+        "plan", "oblique")
+    summary = runner.run_scene(hs.parse_scene(text), tmp_path, quiet=True)
+    assert [s["step"] for s in summary["steps"]] == [1]
+    plan = tmp_path / "snapshots" / "step-000001_plan.png"
+    assert png_is_not_blank(plan) and png_is_not_blank(tmp_path / "snapshots" / "step-000001_oblique.png")
+    image = np.asarray(Image.open(plan).convert("RGB"), dtype=float) / 255.0
+    coloured = np.ptp(image[:, :int(0.8 * image.shape[1])], axis=2) > 0.15  # left of the scalar bar
+    rows, columns = np.nonzero(coloured)
+    assert np.ptp(columns) > 0.3 * image.shape[1], "the trace along x should span the picture"
+
+
 def test_a_folder_holding_a_run_is_not_overwritten_by_accident(finished_3d, tmp_path):
     out, _ = finished_3d
     with pytest.raises(InputError, match="already holds a run; add --resume to continue it or --overwrite"):

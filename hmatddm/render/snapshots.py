@@ -13,6 +13,14 @@
 * ``view="plan"`` looks down ``-z`` (map view, parallel projection),
   ``view="oblique"`` is an isometric perspective. A :class:`~hmatddm.mesh.Mesh2D` is
   always drawn as lines in the ``xy``-plane seen from ``+z``.
+* the plan view of a 3D mesh of (mostly) vertical fractures, which looking down ``-z``
+  would see edge on, draws each vertical element as its horizontal trace (a line, as
+  in the DFN maps of ref. Figs 6.10-6.14): the elements of one column (same fracture,
+  same trace, stacked over the height) merge into one line coloured by the LARGEST
+  opening over the height; intact natural fractures are thin grey lines, failed or
+  activated natural ones are coloured by opening with a red border (as in 2D); slip
+  arrows show the horizontal (strike-slip) part of the slip. The few non-vertical
+  elements of such a mesh are drawn as surfaces underneath (:func:`plan_traces`).
 
 :func:`snapshots` writes both views of one state.
 """
@@ -37,6 +45,12 @@ SLIP_ARROW_COLOR = "magenta"  # stands out on dark (closed) and bright (open) el
 SLIP_VISIBLE_FRACTION = 1e-3  # arrows where |slip| > this fraction of the largest slip
 MAX_ELEMENTS_WITH_EDGES = 2000  # element borders drawn on smaller meshes only
 MAX_SLIP_ARROWS = 400  # more slipping elements than this: every k-th gets an arrow
+VERTICAL_NORMAL_Z = 0.05  # an element is vertical when |n_z| <= this (within ~2.9 degrees)
+MOSTLY_VERTICAL_AREA = 0.5  # plan view as traces when vertical elements hold this share of the area
+PLAN_STYLES = ("auto", "traces", "surfaces")
+# a column of elements shows its highest-ranked state: failed > hydraulic > intact
+_RANK_OF_STATE = np.array([1, 0, 2])                     # indexed by state code 0, 1, 2
+_STATE_OF_RANK = np.array([INTACT_NATURAL, HYDRAULIC, FAILED_NATURAL])
 
 
 # ---------------------------------------------------------------------------------
@@ -150,9 +164,11 @@ def element_geometry(mesh):
     return pyvista.PolyData(points, lines=cells)
 
 
-def _part(mesh, indices):
-    """:func:`element_geometry` of the elements ``indices`` only."""
-    return element_geometry(mesh.subset(indices))
+def _part(mesh, indices, lift=0.0):
+    """:func:`element_geometry` of the elements ``indices`` only, moved up by ``lift``
+    (m, along ``z``)."""
+    part = element_geometry(mesh.subset(indices))
+    return part.translate((0.0, 0.0, lift), inplace=False) if lift else part
 
 
 def _diagonal(mesh):
@@ -177,11 +193,12 @@ def _line_width(coloured=True):
     return 6 if coloured else 2
 
 
-def _add_coloured(plotter, mesh, indices, opening):
-    """Hydraulic and failed elements: coloured by opening (mm) or a plain colour."""
+def _add_coloured(plotter, mesh, indices, opening, lift=0.0, clim=None):
+    """Hydraulic and failed elements: coloured by opening (mm; colour range ``clim``,
+    default that of these elements) or a plain colour."""
     if indices.size == 0:
         return
-    part = _part(mesh, indices)
+    part = _part(mesh, indices, lift)
     is_2d = isinstance(mesh, Mesh2D)
     style = dict(line_width=_line_width(), render_lines_as_tubes=True) if is_2d else dict(
         show_edges=mesh.n_elements <= MAX_ELEMENTS_WITH_EDGES, edge_color="dimgrey")
@@ -190,17 +207,18 @@ def _add_coloured(plotter, mesh, indices, opening):
         return
     opening_mm = 1e3 * opening
     part.cell_data["opening (mm)"] = opening_mm[indices]
-    plotter.add_mesh(part, scalars="opening (mm)", cmap=OPENING_COLORMAP, clim=_opening_range_mm(opening_mm[indices]),
+    clim = _opening_range_mm(opening_mm[indices]) if clim is None else clim
+    plotter.add_mesh(part, scalars="opening (mm)", cmap=OPENING_COLORMAP, clim=clim,
                      scalar_bar_args=dict(title="opening (mm)", vertical=True, fmt="%.3g",
                                           position_x=0.86, position_y=0.15, height=0.7, width=0.08),
                      **style)
 
 
-def _add_intact(plotter, mesh, indices):
+def _add_intact(plotter, mesh, indices, lift=0.0):
     """Intact natural fractures: a light grey wireframe."""
     if indices.size == 0:
         return
-    part = _part(mesh, indices)
+    part = _part(mesh, indices, lift)
     plotter.add_mesh(part, style="wireframe", color=INTACT_COLOR, line_width=_line_width(coloured=False))
 
 
@@ -212,19 +230,21 @@ def _region_boundary(mesh, indices):
                                        feature_edges=False, manifold_edges=False)
 
 
-def _add_failed_outline(plotter, mesh, indices):
+def _add_failed_outline(plotter, mesh, indices, lift=0.0):
     """Failed natural-fracture elements: outlined in red.
 
     3D: a thick red line around each failed patch, plus thin red borders of every
     failed element on meshes small enough for element borders to stay readable.
-    2D: the red line is put just behind the coloured one (seen from ``+z``) and drawn
-    wider, so it shows as a red border of the coloured segment.
+    2D: the red line is put behind the coloured one (seen from ``+z``) and drawn
+    wider, so it shows as a red border of the coloured segment. It sits a tenth of the
+    mesh diagonal lower: lines drawn as tubes have a depth of about their width, and a
+    closer red tube would cover the coloured one (the parallel projection of a plan
+    view does not move it on screen).
     """
     if indices.size == 0:
         return
     if isinstance(mesh, Mesh2D):
-        part = _part(mesh, indices)
-        part = part.translate((0.0, 0.0, -1e-3 * _diagonal(mesh)), inplace=False)
+        part = _part(mesh, indices, lift - 0.1 * _diagonal(mesh))
         plotter.add_mesh(part, color=FAILED_COLOR, line_width=2 * _line_width(), render_lines_as_tubes=True)
         return
     if mesh.n_elements <= MAX_ELEMENTS_WITH_EDGES:
@@ -242,9 +262,10 @@ def slip_arrow_length(mesh, slipping, n_arrows):
     return float(np.clip(1.5 * spacing, 0.03 * diagonal, 0.12 * diagonal))
 
 
-def _add_slip_arrows(plotter, mesh, slip):
-    """Arrows centred on the slipping elements, length proportional to ``|slip|``
-    (on at most ``MAX_SLIP_ARROWS`` of them, evenly thinned in element order)."""
+def _add_slip_arrows(plotter, mesh, slip, lift=0.0):
+    """Arrows centred on the slipping elements (moved up by ``lift``), length
+    proportional to ``|slip|`` (on at most ``MAX_SLIP_ARROWS`` of them, evenly thinned
+    in element order)."""
     pyvista = _pyvista()
     magnitude = np.linalg.norm(slip, axis=1)
     largest = float(np.max(magnitude))
@@ -255,7 +276,7 @@ def _add_slip_arrows(plotter, mesh, slip):
     centers = mesh.centers[shown]
     vectors = slip[shown]
     if isinstance(mesh, Mesh2D):
-        centers = np.column_stack([centers, np.zeros(len(shown))])
+        centers = np.column_stack([centers, np.full(len(shown), float(lift))])
         vectors = np.column_stack([vectors, np.zeros(len(shown))])
     points = pyvista.PolyData(centers)
     points["slip"] = vectors
@@ -302,6 +323,120 @@ def _draw(plotter, mesh, opening, state, slip):
 
 
 # ---------------------------------------------------------------------------------
+# Plan view of vertical fractures: traces
+# ---------------------------------------------------------------------------------
+
+def vertical_elements(mesh):
+    """Boolean mask of the elements of a Mesh3D that stand vertical (``|n_z| <=
+    VERTICAL_NORMAL_Z``, within ~2.9 degrees), which a plan view sees edge on."""
+    return np.abs(mesh.normals[:, 2]) <= VERTICAL_NORMAL_Z
+
+
+def is_mostly_vertical(mesh):
+    """Whether a plan view of ``mesh`` should draw traces: a Mesh3D whose vertical
+    elements hold at least ``MOSTLY_VERTICAL_AREA`` of its area."""
+    if not isinstance(mesh, Mesh3D):
+        return False
+    areas = mesh.areas
+    return float(np.sum(areas[vertical_elements(mesh)])) >= MOSTLY_VERTICAL_AREA * float(np.sum(areas))
+
+
+def plan_traces(mesh, opening=None, state=None, slip=None):
+    """The vertical elements of a Mesh3D as plan-view line elements, one per column.
+
+    Each vertical element's horizontal mid-line (:func:`hmatddm.simulation.natural.plan_segments`)
+    is its trace; the elements of one fracture with the same trace (a column stacked
+    over the height) become one line. Per line:
+
+    * ``opening``: the LARGEST opening of the column (max over the height: the plan
+      view shows where the fracture is open at all, as the DFN maps of ref. Figs
+      6.10-6.14 do);
+    * ``state``: failed natural (2) when any element of the column failed or was
+      activated, else hydraulic (0) when any is hydraulic, else intact natural (1);
+    * ``slip``: the horizontal (x, y) part of the slip of the column's element that
+      slips most (dip-slip is invisible in plan).
+
+    Returns ``(traces, opening, state, slip, column)``: ``traces`` a Mesh2D (same
+    ``fracture_id``), the per-line fields (None where not given) and ``column`` (for
+    each vertical element in mesh order, the index of its line). Non-vertical
+    elements are left out (see :func:`vertical_elements`).
+    """
+    from ..simulation.natural import plan_segments
+
+    _check_mesh(mesh)
+    if not isinstance(mesh, Mesh3D):
+        raise InputError("plan_traces needs a Mesh3D (a Mesh2D already is a plan view)")
+    opening, state, slip = _check_fields(mesh, opening, state, slip)
+    vertical = np.flatnonzero(vertical_elements(mesh))
+    if vertical.size == 0:
+        raise InputError("plan_traces: the mesh has no vertical element (|n_z| <= "
+                         f"{VERTICAL_NORMAL_Z})")
+    part = mesh.subset(vertical)
+    p0, p1, _ = plan_segments(part)
+    # one key per column: fracture id and the trace's end points (ordered, rounded)
+    ends = np.stack([p0, p1], axis=1)                                   # (n, 2, 2)
+    swap = (ends[:, 0, 0] > ends[:, 1, 0]) | ((ends[:, 0, 0] == ends[:, 1, 0]) & (ends[:, 0, 1] > ends[:, 1, 1]))
+    ends[swap] = ends[swap][:, ::-1]
+    tolerance = 1e-6 * _diagonal(mesh)
+    key = np.column_stack([part.fracture_id, np.round(ends.reshape(-1, 4) / tolerance).astype(np.int64)])
+    _, first, column = np.unique(key, axis=0, return_index=True, return_inverse=True)
+    column = column.reshape(-1)
+    n_lines = first.size
+    traces = Mesh2D.from_segments(p0[first], p1[first], fracture_id=part.fracture_id[first])
+    line_opening = line_state = line_slip = None
+    if opening is not None:
+        line_opening = np.full(n_lines, -np.inf)
+        np.maximum.at(line_opening, column, opening[vertical])
+    if state is not None:
+        top = np.zeros(n_lines, dtype=np.int64)
+        np.maximum.at(top, column, _RANK_OF_STATE[state[vertical]])
+        line_state = _STATE_OF_RANK[top].astype(np.int64)
+    if slip is not None:
+        magnitude = np.linalg.norm(slip[vertical], axis=1)
+        order = np.lexsort((magnitude, column))          # by column, largest slip last
+        is_last = np.r_[column[order][1:] != column[order][:-1], True]
+        line_slip = np.zeros((n_lines, 2))
+        line_slip[column[order][is_last]] = slip[vertical][order[is_last], :2]
+    return traces, line_opening, line_state, line_slip, column
+
+
+def _draw_plan_traces(plotter, mesh, opening, state, slip):
+    """Plan view of a mostly vertical Mesh3D: traces of the vertical elements on top,
+    the non-vertical elements as surfaces (as :func:`_draw`) underneath."""
+    vertical = vertical_elements(mesh)
+    traces, line_opening, line_state, line_slip, _ = plan_traces(mesh, opening, state, slip)
+    others = np.flatnonzero(~vertical)
+    every_state = np.zeros(mesh.n_elements, dtype=np.int64) if state is None else state
+    coloured = every_state != INTACT_NATURAL
+    clim = None
+    if opening is not None and np.any(coloured):
+        clim = _opening_range_mm(1e3 * opening[coloured])
+    # surfaces of the non-vertical elements at their own height ...
+    if others.size:
+        if state is None:
+            _add_coloured(plotter, mesh, others, opening, clim=clim)
+        else:
+            _add_coloured(plotter, mesh, others[state[others] != INTACT_NATURAL], opening, clim=clim)
+            _add_intact(plotter, mesh, others[state[others] == INTACT_NATURAL])
+            _add_failed_outline(plotter, mesh, others[state[others] == FAILED_NATURAL])
+        if slip is not None and np.any(slip[others]):
+            _add_slip_arrows(plotter, mesh.subset(others), slip[others])
+    # ... and the traces above every element (the camera looks down -z), with room
+    # for their red borders (:func:`_add_failed_outline`) in between
+    lift = float(np.max(mesh.corners()[..., 2])) + 0.2 * _diagonal(mesh)
+    lines = np.arange(traces.n_elements)
+    if line_state is None:
+        _add_coloured(plotter, traces, lines, line_opening, lift=lift, clim=clim)
+    else:
+        _add_coloured(plotter, traces, lines[line_state != INTACT_NATURAL], line_opening, lift=lift, clim=clim)
+        _add_intact(plotter, traces, lines[line_state == INTACT_NATURAL], lift=lift)
+        _add_failed_outline(plotter, traces, lines[line_state == FAILED_NATURAL], lift=lift)
+        _add_legend(plotter, state)
+    if line_slip is not None and np.any(line_slip):
+        _add_slip_arrows(plotter, traces, line_slip, lift=lift)
+
+
+# ---------------------------------------------------------------------------------
 # Output
 # ---------------------------------------------------------------------------------
 
@@ -326,7 +461,7 @@ def _screenshot(plotter, window_size):
 
 
 def snapshot(mesh, path, opening=None, state=None, slip=None, view="oblique", title=None,
-             window_size=(1200, 900)):
+             window_size=(1200, 900), plan_style="auto"):
     """Render one offscreen PNG of the fractures.
 
     Parameters
@@ -346,6 +481,14 @@ def snapshot(mesh, path, opening=None, state=None, slip=None, view="oblique", ti
     view : {"plan", "oblique"}
         ``plan`` looks down ``-z`` (parallel projection), ``oblique`` is isometric.
         Ignored for a Mesh2D (always seen from ``+z``).
+    plan_style : {"auto", "traces", "surfaces"}
+        How a plan view draws a Mesh3D. ``traces``: each vertical element as its
+        horizontal trace, one line per column coloured by the largest opening over the
+        height (:func:`plan_traces`), non-vertical elements as surfaces underneath;
+        ``surfaces``: every element as a surface (vertical ones are then edge on and
+        invisible); ``auto``: traces when vertical elements hold at least half the
+        area (:func:`is_mostly_vertical`), else surfaces. Ignored for other views and
+        for a Mesh2D.
     title : str, optional
         Text at the top of the image.
     window_size : (width, height)
@@ -359,19 +502,30 @@ def snapshot(mesh, path, opening=None, state=None, slip=None, view="oblique", ti
     ------
     InputError
         Fields of the wrong shape or with NaN/inf, a ``state`` outside {0, 1, 2}, an
-        unknown ``view``.
+        unknown ``view`` or ``plan_style``, ``plan_style="traces"`` for a mesh without
+        vertical elements.
     HmatddmError
         pyvista cannot render offscreen on this machine.
     """
     _check_mesh(mesh)
     if view not in VIEWS:
         raise InputError(f"view must be one of {VIEWS}, got {view!r}")
+    if plan_style not in PLAN_STYLES:
+        raise InputError(f"plan_style must be one of {PLAN_STYLES}, got {plan_style!r}")
     window_size = _check_window_size(window_size)
     opening, state, slip = _check_fields(mesh, opening, state, slip)
+    traces = view == "plan" and isinstance(mesh, Mesh3D) and (
+        plan_style == "traces" or (plan_style == "auto" and is_mostly_vertical(mesh)))
+    if traces and not np.any(vertical_elements(mesh)):
+        raise InputError(f"plan_style='traces' needs vertical elements (|n_z| <= {VERTICAL_NORMAL_Z}); "
+                         "this mesh has none")
     pyvista = _pyvista()
     plotter = _new_plotter(pyvista, window_size)
     try:
-        _draw(plotter, mesh, opening, state, slip)
+        if traces:
+            _draw_plan_traces(plotter, mesh, opening, state, slip)
+        else:
+            _draw(plotter, mesh, opening, state, slip)
         if title is not None:
             plotter.add_text(str(title), position="upper_edge", font_size=12)
         if isinstance(mesh, Mesh3D):
@@ -387,8 +541,8 @@ def snapshots(mesh, folder, stem, **fields):
     """Write ``folder/<stem>_plan.png`` and ``folder/<stem>_oblique.png``.
 
     ``fields`` are passed to :func:`snapshot` (``opening``, ``state``, ``slip``,
-    ``title``, ``window_size``). A Mesh2D has one view only, so only the plan image is
-    written. Returns the list of written paths (plan first).
+    ``title``, ``window_size``, ``plan_style``). A Mesh2D has one view only, so only the
+    plan image is written; a 3D plan view of vertical fractures draws their traces. Returns the list of written paths (plan first).
     """
     if "view" in fields:
         raise InputError("snapshots writes every view; call snapshot(..., view=...) for one view")
@@ -397,5 +551,6 @@ def snapshots(mesh, folder, stem, **fields):
     return [snapshot(mesh, folder / f"{stem}_{view}.png", view=view, **fields) for view in views]
 
 
-__all__ = ["snapshot", "snapshots", "element_geometry", "slip_arrow_length",
-           "HYDRAULIC", "INTACT_NATURAL", "FAILED_NATURAL", "VIEWS"]
+__all__ = ["snapshot", "snapshots", "element_geometry", "slip_arrow_length", "plan_traces",
+           "is_mostly_vertical", "vertical_elements", "HYDRAULIC", "INTACT_NATURAL", "FAILED_NATURAL", "VIEWS",
+           "PLAN_STYLES"]
