@@ -8,6 +8,8 @@
     hmatddm sweep [--realizations N]  natural-fracture network ensembles on Dask (ref. Fig. 6.9)
 
 Exit codes: 0 ok, 1 a check failed (validate), 2 bad input, 3 did not converge,
+4 an output could not be written (the disk is full or the folder is not writable; every
+finished step is checkpointed, so free space and continue with --resume),
 130 interrupted (Ctrl-C; a run can be continued with --resume).
 """
 import argparse
@@ -16,7 +18,7 @@ import shlex
 import sys
 from pathlib import Path
 
-EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT, EXIT_NOT_CONVERGED, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
+EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT, EXIT_NOT_CONVERGED, EXIT_OUTPUT, EXIT_INTERRUPTED = 0, 1, 2, 3, 4, 130
 DEFAULT_SCENE = "default"
 DEFAULT_OUT_ROOT = "hmatddm-runs"
 
@@ -87,8 +89,24 @@ def _load_run_scene(args):
     return scene, out
 
 
+def _output_failed(out, error, args):
+    """The message when an output could not be written during a run."""
+    from .runner import CHECKPOINT_DIR
+    from .simulation import checkpoint as checkpoints
+
+    kept = checkpoints.list_checkpoints(out / CHECKPOINT_DIR)
+    if kept:
+        where = (f"Every step up to step {kept[-1]} is checkpointed in {out / CHECKPOINT_DIR}; "
+                 f"{'free disk space' if error.disk_full else 'make the folder writable'}, then continue with: "
+                 f"{_resume_command(args, out)}")
+    else:
+        where = "No step was lost (none had finished); fix the folder or choose another --out and run again."
+    print(f"hmatddm: error: {error}.\nhmatddm: {where}", file=sys.stderr)
+    return EXIT_OUTPUT
+
+
 def _run(args):
-    from .errors import ConvergenceError
+    from .errors import ConvergenceError, OutputError
     from .runner import SceneRun
     from .scene import build_simulation
 
@@ -111,6 +129,8 @@ def _run(args):
         print(f"\nhmatddm: interrupted {where}; every finished step is checkpointed in {out / 'checkpoints'}. "
               f"Continue with: {_resume_command(args, out)}", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except OutputError as error:
+        return _output_failed(out, error, args)
     except ConvergenceError as error:
         record = run.last_record
         where = f"after step {record['step']} (t = {record['time']:g} s)" if record is not None else "in the first step"
@@ -177,14 +197,19 @@ def build_parser():
                                      description="Hydraulic fractures with the displacement discontinuity "
                                                  "method, made fast by H-matrices (SI units throughout).",
                                      epilog="Exit codes: 0 ok, 1 check failed, 2 bad input, 3 did not converge, "
-                                            "130 interrupted.")
+                                            "4 output not written (disk full or folder not writable; "
+                                            "free space and continue with run --resume), 130 interrupted.")
     sub = parser.add_subparsers(dest="command", required=True)
 
     run = sub.add_parser("run", help="run a scene and write summary.json, VTU/PVD, checkpoints and PNGs",
                          description="Run a scene (an embedded name, see `hmatddm scenes`, or a TOML file; "
                                      "default: the embedded 'default') and write DIR/summary.json, "
                                      "DIR/fractures.pvd with DIR/vtu/*.vtu, DIR/checkpoints, "
-                                     "DIR/snapshots/*.png and DIR/history.png.")
+                                     "DIR/snapshots/*.png and DIR/history.png.",
+                         epilog="Exit codes: 0 done, 2 bad input, 3 did not converge (the outputs of the last "
+                                "converged step are written), 4 an output could not be written (disk full or "
+                                "folder not writable: every finished step is checkpointed; free space and "
+                                "continue with --resume), 130 interrupted (continue with --resume).")
     run.add_argument("scene", nargs="?", metavar="SCENE",
                      help="embedded scene name or .toml file (default: 'default'; with --resume and no SCENE, "
                           "the scene stored in DIR)")
@@ -231,12 +256,15 @@ def build_parser():
 
 
 def main(argv=None):
-    from .errors import ConvergenceError, InputError
+    from .errors import ConvergenceError, InputError, OutputError
     from .simulation import CheckpointError
 
     args = build_parser().parse_args(argv)
     try:
         return args.handler(args)
+    except OutputError as exc:  # before CheckpointError: a checkpoint that cannot be written is an output error
+        print(f"hmatddm: error: {exc}", file=sys.stderr)
+        return EXIT_OUTPUT
     except (InputError, CheckpointError) as exc:
         print(f"hmatddm: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT

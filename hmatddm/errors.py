@@ -29,3 +29,58 @@ class ConvergenceError(HmatddmError, RuntimeError):
         super().__init__(message)
         self.residual = residual
         self.iterations = iterations
+
+
+class OutputError(HmatddmError, OSError):
+    """An output file could not be written: the disk is full, the folder is not
+    writable, the file system is read-only. The message names the file and its folder.
+
+    Derives from ``OSError`` too, so ``except OSError`` keeps working.
+
+    Attributes
+    ----------
+    path : str or None
+        The file that could not be written.
+    errno : int or None
+        The system's error number (``errno.ENOSPC`` for a full disk).
+    """
+
+    def __init__(self, message, path=None, errno=None):
+        super().__init__(message)
+        self.path = None if path is None else str(path)
+        self.errno = errno
+
+    @property
+    def disk_full(self):
+        """Whether the disk (or the user's quota on it) is full."""
+        import errno
+
+        return self.errno in (errno.ENOSPC, getattr(errno, "EDQUOT", errno.ENOSPC))
+
+    @staticmethod
+    def describe(error, folder):
+        """Why ``error`` (an OSError) stopped a write into ``folder``, in words."""
+        import errno as codes
+
+        folder = str(folder)
+        code = getattr(error, "errno", None)
+        if code == codes.ENOSPC:
+            return f"no space left on the disk holding {folder!r} (the disk is full)"
+        if code == getattr(codes, "EDQUOT", None):
+            return f"the disk quota for {folder!r} is exhausted (the disk is full for this user)"
+        if code in (codes.EACCES, codes.EPERM):
+            return f"{folder!r} is not writable (permission denied)"
+        if code == codes.EROFS:
+            return f"{folder!r} is on a read-only file system"
+        return error.strerror or str(error)
+
+    @classmethod
+    def from_os_error(cls, error, path, what=None):
+        """The OutputError for ``error`` (an OSError) raised while writing ``path``;
+        ``what`` names the file in the message (default: its path)."""
+        from pathlib import Path
+
+        path = Path(path)
+        reason = cls.describe(error, path.parent)
+        return cls(f"could not write {what or str(path)}: {reason}", path=path,
+                   errno=getattr(error, "errno", None))

@@ -31,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import HmatddmError, InputError
+from .errors import HmatddmError, InputError, OutputError
 from .io import atomic_output, read_vtu, write_pvd, write_vtu
 from .mesh import Mesh2D, Mesh3D
 from .simulation import checkpoint as checkpoints
@@ -309,9 +309,11 @@ class SceneRun:
         """Run to ``numerics.end_time``; returns the summary dict.
 
         Raises InputError (bad scene, folder already holding a run), CheckpointError
-        (checkpoints of another run), ConvergenceError (after writing the outputs of
-        the last converged step) and lets KeyboardInterrupt through (the checkpoint of
-        the last finished step is on disk).
+        (checkpoints of another run), OutputError (a file could not be written: full
+        disk, folder not writable; a failed checkpoint leaves the previous one as the
+        newest, so a resume after freeing space continues from it), ConvergenceError
+        (after writing the outputs of the last converged step) and lets
+        KeyboardInterrupt through (the checkpoint of the last finished step is on disk).
         """
         from .errors import ConvergenceError
         from .scene import build_simulation
@@ -362,6 +364,10 @@ class SceneRun:
         out = self.out
         if out.exists() and not out.is_dir():
             raise InputError(f"--out {str(out)!r} exists and is not a folder")
+        try:  # an unwritable or full output folder is reported before any step is computed
+            checkpoints.check_writable(out, what="output folder")
+        except checkpoints.CheckpointWriteError as error:  # not a checkpoint problem: a plain OutputError
+            raise OutputError(str(error), path=error.path, errno=error.errno) from None
         has_checkpoint = bool(checkpoints.list_checkpoints(out / CHECKPOINT_DIR))
         if self.resume and has_checkpoint:
             simulation.load_checkpoint()
@@ -442,6 +448,8 @@ class SceneRun:
             try:
                 self.written["snapshots"] = write_snapshots(self.out, mesh, fields, state.step, state.time,
                                                             self.scene.name)
+            except OutputError:
+                raise
             except HmatddmError as error:  # e.g. no offscreen OpenGL on this machine
                 self.note(f"hmatddm: warning: no snapshots written: {error}")
         if output["history_plot"]:

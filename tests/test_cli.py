@@ -178,3 +178,14 @@ def test_crossing_scene_runs_and_reports_the_crossing(tmp_path, capsys):
     vtus = sorted((out / "vtu").glob("*.vtu"))
     _, _, data = read_vtu(vtus[-1])
     assert set(np.unique(data["state"]).tolist()) >= {0, 1}  # hydraulic and intact natural elements
+
+
+def test_exit_codes_are_distinct_and_documented_in_the_help():
+    codes = (cli.EXIT_OK, cli.EXIT_FAILED, cli.EXIT_BAD_INPUT, cli.EXIT_NOT_CONVERGED, cli.EXIT_OUTPUT,
+             cli.EXIT_INTERRUPTED)
+    assert codes == (0, 1, 2, 3, 4, 130)
+    parser = cli.build_parser()
+    assert "4 output not written (disk full or folder not writable" in parser.epilog
+    run = parser._subparsers._group_actions[0].choices["run"]
+    assert "4 an output could not be written (disk full" in run.epilog
+    assert "4 an output could not be written" in cli.__doc__

@@ -5,12 +5,16 @@
   time slider.
 * :func:`read_vtu`, :func:`read_pvd`: read them back (for tests and post-processing).
 * :func:`atomic_output`: the write-to-a-temporary-then-rename helper every writer uses,
-  so that a reader (or a crash) never sees a half-written file.
+  so that a reader (or a crash) never sees a half-written file, and a failed write (a
+  full disk, a folder that is not writable) raises :class:`~hmatddm.errors.OutputError`
+  naming the file, its folder and the reason, with the previous file left intact.
 """
 import contextlib
 import os
 import secrets
 from pathlib import Path
+
+from ..errors import HmatddmError, OutputError
 
 
 def _new_temporary(path):
@@ -35,22 +39,34 @@ def atomic_output(path):
     atomic on POSIX and Windows), on an exception it is removed and ``path`` is left
     untouched. The folder is created if missing.
 
+    An ``OSError`` while creating the folder, writing or renaming (``ENOSPC``: the disk
+    is full; ``EACCES``: not writable) is raised as :class:`~hmatddm.errors.OutputError`
+    (itself an ``OSError``) whose message names ``path``, its folder and the reason.
+
     Example::
 
         with atomic_output("out/summary.json") as temporary:
             temporary.write_text(text)
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    temporary = _new_temporary(path)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        temporary = _new_temporary(path)
+    except OSError as error:
+        raise OutputError.from_os_error(error, path) from error
     try:
         yield temporary
         os.replace(temporary, path)
-    except BaseException:
-        temporary.unlink(missing_ok=True)
+    except BaseException as error:
+        try:
+            temporary.unlink(missing_ok=True)
+        except OSError:
+            pass
+        if isinstance(error, OSError) and not isinstance(error, HmatddmError):
+            raise OutputError.from_os_error(error, path) from error
         raise
 
 
 from .vtk import read_pvd, read_vtu, write_pvd, write_vtu  # noqa: E402  (vtk uses atomic_output)
 
-__all__ = ["write_vtu", "write_pvd", "read_vtu", "read_pvd", "atomic_output"]
+__all__ = ["write_vtu", "write_pvd", "read_vtu", "read_pvd", "atomic_output", "OutputError"]

@@ -11,6 +11,12 @@ renamed (``os.replace`` is atomic on POSIX and Windows), the ``.json`` last, so 
 checkpoint whose ``.json`` exists is complete. :func:`load_latest` verifies the
 checksum and falls back to the previous checkpoint when the newest is truncated or
 corrupted, saying so in a logged warning.
+
+When a write fails (full disk, lost permission) :func:`save` removes what it wrote
+of the new checkpoint, keeps every older one and raises
+:class:`CheckpointWriteError`, an :class:`~hmatddm.errors.OutputError` whose message
+names the folder and says when the disk is full; the newest checkpoint on disk is
+then the previous, complete one, and a resume after freeing space continues from it.
 """
 import hashlib
 import json
@@ -22,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import HmatddmError
+from ..errors import HmatddmError, OutputError
 
 logger = logging.getLogger(__name__)
 _NAME = re.compile(r"^step-(\d{6,})\.json$")
@@ -33,7 +39,15 @@ class CheckpointError(HmatddmError):
     """No usable checkpoint, or a checkpoint folder that cannot be written."""
 
 
+class CheckpointWriteError(CheckpointError, OutputError):
+    """A checkpoint could not be written (full disk, folder not writable); both a
+    CheckpointError and an OutputError (``disk_full`` tells the two apart)."""
+
+
 def _atomic_write(path, write):
+    """Write ``path`` through ``write(stream)`` into a temporary file that is flushed,
+    fsync'ed and renamed over ``path``; on any error the temporary is removed and
+    ``path`` is untouched. Returns ``path``."""
     path = Path(path)
     handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
     try:
@@ -46,17 +60,23 @@ def _atomic_write(path, write):
         if os.path.exists(temporary):
             os.unlink(temporary)
         raise
+    return path
 
 
-def check_writable(folder):
-    """Create ``folder`` if needed and prove a file can be written there."""
+def check_writable(folder, what="checkpoint folder"):
+    """Create ``folder`` if needed and prove a file can be written there.
+
+    Raises CheckpointWriteError (an OutputError) naming ``what`` and ``folder`` and the
+    reason: not writable, read-only, or the disk is full."""
     folder = Path(folder)
     try:
         folder.mkdir(parents=True, exist_ok=True)
         _atomic_write(folder / ".write-test", lambda stream: stream.write(b"ok"))
         (folder / ".write-test").unlink()
     except OSError as error:
-        raise CheckpointError(f"checkpoint folder {str(folder)!r} is not writable: {error.strerror or error}") from None
+        raise CheckpointWriteError(f"{what} {str(folder)!r} is not writable: "
+                                   f"{OutputError.describe(error, folder)}", path=folder,
+                                   errno=getattr(error, "errno", None)) from None
     return folder
 
 
@@ -73,14 +93,24 @@ def save(folder, step, arrays, metadata, keep=3):
     np.savez(buffer, **{key: np.asarray(value) for key, value in arrays.items()})
     payload = buffer.getvalue()
     digest = hashlib.sha256(payload).hexdigest()
+    document = dict(metadata, format_version=FORMAT_VERSION, step=step, arrays_sha256=digest)
+    text = json.dumps(document, indent=1, sort_keys=True, allow_nan=False).encode()
+    written = None
     try:
-        _atomic_write(folder / f"{stem}.npz", lambda stream: stream.write(payload))
-        document = dict(metadata, format_version=FORMAT_VERSION, step=step, arrays_sha256=digest)
-        text = json.dumps(document, indent=1, sort_keys=True, allow_nan=False).encode()
+        written = _atomic_write(folder / f"{stem}.npz", lambda stream: stream.write(payload))
         _atomic_write(folder / f"{stem}.json", lambda stream: stream.write(text))
     except OSError as error:
-        raise CheckpointError(f"could not write checkpoint {stem} in {str(folder)!r}: "
-                              f"{error.strerror or error}") from None
+        if written is not None:  # new arrays, old or no metadata: remove both, free the space
+            for path in (written, folder / f"{stem}.json"):
+                try:
+                    path.unlink()
+                except OSError:
+                    pass
+        reason = OutputError.from_os_error(error, folder / f"{stem}.json", what=f"checkpoint {stem}")
+        kept = list_checkpoints(folder)
+        previous = (f"; the newest complete checkpoint is step {kept[-1]}, which a resume continues from"
+                    if kept else "")
+        raise CheckpointWriteError(f"{reason}{previous}", path=reason.path, errno=reason.errno) from None
     for old in list_checkpoints(folder)[:-keep]:
         for suffix in (".json", ".npz"):
             try:
