@@ -20,6 +20,13 @@ Four schemes:
 
 Segregated schemes relax (ref. Eq. 4.47) with ``alpha``; when an iteration diverges
 or does not converge, ``alpha`` is halved and the step restarted (ref. Fig. 4.10).
+
+Closed elements (:mod:`hmatddm.coupled.contact`): with a ``contact`` model the
+elasticity rows of closed elements become ``S (A DD + B p - f) + D DD = g`` (stick or
+Coulomb slip) in every scheme, the active set is updated after every nonlinear
+iteration, and a step converges only when the active set no longer changes.
+Elements with a ``fixed_pressure`` (natural elements that failed remotely and are not
+connected to an injection point) keep that pressure: their flow row is ``p_i = p_fixed``.
 """
 import math
 import time
@@ -95,11 +102,39 @@ class StepProblem:
     width_old: np.ndarray    # (N,) w^n
     pressure_old: np.ndarray  # (N,) p^n
     leak_off_rate: np.ndarray  # (N,) Lambda_i
+    contact: object = None     # ContactModel or None
+    fixed_pressure: np.ndarray = None  # (N,) pressure of drained elements, NaN where free
 
     def __post_init__(self):
         self.n, self.d = self.normals.shape
         self.coupling = self.flow.coupling_matrix(self.dt)
         self.compliance_term = self.flow.areas * self.compliance / self.dt  # diagonal of C'
+        self.fixed = np.zeros(self.n, bool) if self.fixed_pressure is None else np.isfinite(self.fixed_pressure)
+        if np.any(self.fixed):
+            keep = sp.diags((~self.fixed).astype(np.float64))
+            self.coupling = (keep @ self.coupling).tocsr()
+            self.compliance_term = np.where(self.fixed, 0.0, self.compliance_term)
+
+    def rows(self):
+        """Contact rows of the current active set (None: every element fluid-loaded)."""
+        return None if self.contact is None else self.contact.rows()
+
+    def elastic_apply(self, dd, p, rows):
+        """Elasticity rows ``A dd + B p`` (with contact: ``S (A dd + B p) + D dd``)."""
+        traction = self.elastic.matvec(dd) + self.b_times(p)
+        return traction if rows is None else rows.apply(traction, dd)
+
+    def elastic_rhs(self, rows, p=None):
+        """Right-hand side ``f`` (``f - B p`` with ``p``), through the contact rows."""
+        rhs = self.far_field if p is None else self.far_field - self.b_times(p)
+        return rhs if rows is None else rows.rhs(rhs)
+
+    def update_contact(self, dd, p):
+        """Active-set update after an iterate; the number of elements that changed."""
+        if self.contact is None:
+            return 0
+        residual = self.elastic.matvec(dd) + self.b_times(p) - self.far_field
+        return self.contact.update(dd, residual)
 
     def width(self, dd):
         return np.sum(dd.reshape(self.n, self.d) * self.normals, axis=1)
@@ -108,11 +143,19 @@ class StepProblem:
         return (self.normals * p[:, None]).ravel()
 
     def flow_matrices(self, dd):
-        return self.flow.assemble(self.width(dd), self.width_old, self.pressure_old, self.dt, self.leak_off_rate)
+        matrix, rhs = self.flow.assemble(self.width(dd), self.width_old, self.pressure_old, self.dt,
+                                         self.leak_off_rate)
+        if np.any(self.fixed):  # drained elements: p_i = p_fixed, scaled like the other rows
+            diagonal = matrix.diagonal()
+            scale = float(np.mean(np.abs(diagonal[~self.fixed]))) if np.any(~self.fixed) else 1.0
+            free = (~self.fixed).astype(np.float64)
+            matrix = (sp.diags(free) @ matrix + sp.diags(scale * self.fixed)).tocsr()
+            rhs = np.where(self.fixed, scale * np.nan_to_num(self.fixed_pressure), rhs)
+        return matrix, rhs
 
 
 def _relative_change(new, old):
-    scale = np.max(np.abs(old))
+    scale = max(np.max(np.abs(old)), np.max(np.abs(new)))
     change = np.max(np.abs(new - old))
     if scale == 0.0:
         return 0.0 if change == 0.0 else math.inf
@@ -135,8 +178,9 @@ def _segregated_iteration(problem, settings, dd, p, alpha, counters):
         p_new = spla.spsolve(matrix.tocsc(), rhs)
     if not np.all(np.isfinite(p_new)):
         raise _Diverged("the flow solve gave non-finite pressures")
+    rows = problem.rows()
     try:
-        dd_new, iterations = problem.elastic.solve(problem.far_field - problem.b_times(p_new), x0=dd)
+        dd_new, iterations = problem.elastic.solve(problem.elastic_rhs(rows, p_new), x0=dd, rows=rows)
     except ConvergenceError as error:
         counters["linear"] += error.iterations or 0
         raise _Diverged(str(error)) from None
@@ -153,7 +197,8 @@ class _CoupledLinearSystem:
         n, d = problem.n, problem.d
         self.s_u = max(float(np.max(np.abs(dd))), 1e-12)
         self.s_p = max(float(np.max(np.abs(p))), 1.0)
-        blocks = problem.elastic.diagonal_blocks()
+        self.rows = problem.rows()
+        self.blocks = blocks = problem.elastic.diagonal_blocks(self.rows)
         self.block_inverse = np.linalg.inv(blocks)  # (N, d, d), M_u^-1 without s_u
         self.flow_diagonal = self.flow_matrix.diagonal()
         size = n * d + n
@@ -167,8 +212,7 @@ class _CoupledLinearSystem:
     def unscale_left(self, z):
         """Inverse of :meth:`left_scale`."""
         n, d = self.problem.n, self.problem.d
-        blocks = self.problem.elastic.diagonal_blocks()
-        u = np.einsum("eij,ej->ei", blocks, z[:n * d].reshape(n, d)).ravel() * self.s_u
+        u = np.einsum("eij,ej->ei", self.blocks, z[:n * d].reshape(n, d)).ravel() * self.s_u
         return u, z[n * d:] * self.s_p * self.flow_diagonal
 
     def split(self, y):
@@ -178,12 +222,12 @@ class _CoupledLinearSystem:
     def _matvec(self, y):
         dd, p = self.split(np.asarray(y).ravel())
         problem = self.problem
-        u = problem.elastic.matvec(dd) + problem.b_times(p)
+        u = problem.elastic_apply(dd, p, self.rows)
         q = problem.coupling @ dd + self.flow_matrix @ p
         return self.left_scale(u, q)
 
     def rhs(self, flow_rhs):
-        return self.left_scale(self.problem.far_field, flow_rhs)
+        return self.left_scale(self.problem.elastic_rhs(self.rows), flow_rhs)
 
     def compliance_preconditioner(self, omega):
         """Inverse of the scaled fracture-compliance split, as a LinearOperator."""
@@ -195,7 +239,9 @@ class _CoupledLinearSystem:
         def apply(z):
             r_u, r_p = self.unscale_left(np.asarray(z).ravel())
             p = flow_lu.solve(r_p)
-            dd = problem.elastic.approximate_inverse(r_u - problem.b_times(p))
+            b_p = problem.b_times(p)
+            dd = problem.elastic.approximate_inverse(r_u - (b_p if self.rows is None else self.rows.select_rows(b_p)),
+                                                     self.rows)
             return np.concatenate([dd / self.s_u, p / self.s_p])
 
         return spla.LinearOperator((nd + problem.n,) * 2, matvec=apply, dtype=np.float64)
@@ -229,7 +275,8 @@ def solve_step(problem, settings, dd_guess, p_guess, relaxation):
 
     Returns ``(dd, p, info)``; ``info`` has ``nonlinear_iterations`` (all attempts),
     ``linear_iterations`` (GMRES iterations), ``relaxation`` (the alpha that
-    converged), ``restarts`` and ``solve_seconds``. Raises ConvergenceError when even
+    converged), ``restarts``, ``solve_seconds`` and ``contact_changes`` (active-set
+    changes over the step). Raises ConvergenceError when even
     ``min_relaxation`` fails.
     """
     start = time.perf_counter()
@@ -237,8 +284,11 @@ def solve_step(problem, settings, dd_guess, p_guess, relaxation):
     counters = {"nonlinear": 0, "linear": 0}
     alpha = relaxation
     restarts = 0
+    contact_changes = 0
     while True:
         dd, p = dd_guess.copy(), p_guess.copy()
+        if problem.contact is not None:
+            problem.contact.reset()
         history = []
         try:
             for _ in range(settings.max_iterations):
@@ -249,9 +299,13 @@ def solve_step(problem, settings, dd_guess, p_guess, relaxation):
                 change_p = _relative_change(p_new, p)
                 change_u = _relative_change(dd_new, dd)
                 dd, p = dd_new, p_new
-                if change_p < settings.tolerance_pressure and change_u < settings.tolerance_opening:
+                changed = problem.update_contact(dd, p)
+                contact_changes += changed
+                if (change_p < settings.tolerance_pressure and change_u < settings.tolerance_opening
+                        and changed == 0):
                     info = dict(nonlinear_iterations=counters["nonlinear"], linear_iterations=counters["linear"],
-                                relaxation=alpha, restarts=restarts, solve_seconds=time.perf_counter() - start)
+                                relaxation=alpha, restarts=restarts, solve_seconds=time.perf_counter() - start,
+                                contact_changes=contact_changes)
                     return dd, p, info
                 history.append(max(change_p, change_u))
                 # divergence: the change grew for 5 iterations in a row AND doubled over its

@@ -130,7 +130,7 @@ def build_simulation(scene, checkpoint_dir=None):
         alpha=numerics.get("alpha"), scheme=scheme_settings(scene), growing_fractures=growing,
         checkpoint_dir=checkpoint_dir, keep_checkpoints=numerics["keep_checkpoints"],
         natural_fractures=natural_mesh(scene), natural=natural_properties(scene),
-        remote_failure=scene.get("network", {}).get("remote_failure", True))
+        remote_failure=scene.get("network", {}).get("remote_failure", True), contact=numerics["contact"])
 
 
 def natural_network(scene):

@@ -21,6 +21,7 @@ import math
 import numpy as np
 
 from ..coupled import SCHEMES, SchemeSettings
+from ..coupled.contact import CONTACT_MODES
 from ..errors import InputError
 from ..fracture.criteria import OLSON_CORRECTION
 from ..fracture.growth import CRITERIA, TURNING
@@ -277,6 +278,8 @@ NUMERICS = {
     "minimum_width": Key("number", low=0.0, low_open=True, unit="m"),
     "singular_correction": Key("choice", "none", choices=SINGULAR_CORRECTIONS),
     "alpha": Key("number", low=1.0),
+    "contact": Key("choice", "natural", choices=CONTACT_MODES,
+                   doc="elements that close with contact and Coulomb friction: natural, all, none"),
     "keep_checkpoints": Key("integer", 3, low=1),
 }
 

@@ -23,6 +23,7 @@ import numpy as np
 from .. import topology
 from .._validation import finite_array, finite_scalar, positive_scalar
 from ..coupled import ElasticSolver, SchemeSettings, StepProblem, solve_step
+from ..coupled.contact import CONTACT_MODES, OPEN, SLIP, STICK, ContactLaw, ContactModel
 from ..errors import InputError
 from ..flow import Cluster, Fluid, LeakOff, LubricationModel, fracture_compliance
 from ..fracture import Propagation, evaluate_tips, new_elements
@@ -53,11 +54,23 @@ class State:
     relaxation: float
     injected_volume: float
     leaked_volume: float
-    origin: np.ndarray = None         # (N,) 0 hydraulic element, 1 activated natural element
+    origin: np.ndarray = None         # (N,) 0 hydraulic, 1 activated natural, 2 remotely failed natural
     natural_index: np.ndarray = None  # (N,) index in the natural mesh, -1 for hydraulic elements
     intact: np.ndarray = None         # (M,) natural elements still intact (stress targets)
     failed: np.ndarray = None         # (M,) intact natural elements failing Coulomb's criterion
     extra_faces: np.ndarray = None    # (K, 6) flow connections (i, j, length, d_i, d_j, edge of i) at intersections
+    contact_status: np.ndarray = None  # (N,) OPEN / STICK / SLIP (hmatddm.coupled.contact)
+    slip_direction: np.ndarray = None  # (N, d) unit slip direction of slipping elements
+    failure_pressure: np.ndarray = None  # (N,) pore pressure of remotely failed elements (NaN otherwise)
+
+    def __post_init__(self):
+        n, d = self.dd.shape
+        if self.contact_status is None:
+            self.contact_status = np.zeros(n, np.int64)
+        if self.slip_direction is None:
+            self.slip_direction = np.zeros((n, d))
+        if self.failure_pressure is None:
+            self.failure_pressure = np.full(n, np.nan)
 
 
 def _mesh_arrays(mesh):
@@ -120,7 +133,15 @@ class Simulation:
         Their strength and the crossing criterion (default properties if None).
     remote_failure : bool
         Check intact natural elements against Coulomb's criterion after every step
-        (ref. Sec. 5.3); the failed ones are reported (``natural_failed``).
+        (ref. Sec. 5.3). Failed elements join the system (closed, stick or Coulomb
+        slip, at the undrained pore pressure of the moment they failed while no fluid
+        reaches them) and the step is solved again; their slip is in ``dd`` and the
+        records (``natural_failed``, ``natural_slipping``, ``max_slip``).
+    contact : {"natural", "all", "none"}
+        Which elements obey the contact condition (open / stick / Coulomb slip,
+        :mod:`hmatddm.coupled.contact`): natural-fracture elements (activated or
+        failed; the friction and cohesion of ``natural``), every element (hydraulic
+        elements close without friction), or none (elements may interpenetrate).
     rebuild_fraction, max_border_bytes
         ``hmatrix`` backend: elements added by growth join the operator as exact
         border blocks (:class:`~hmatddm.extended_operator.ExtendedElasticityOperator`)
@@ -133,7 +154,7 @@ class Simulation:
                  backend="hmatrix", eps=DEFAULT_EPS, eta=DEFAULT_ETA, leaf_size=DEFAULT_LEAF_SIZE,
                  singular_correction="none", alpha=None, scheme="krylov", growing_fractures=None,
                  checkpoint_dir=None, keep_checkpoints=3, rebuild_fraction=0.25, max_border_bytes=2**28,
-                 natural_fractures=None, natural=None, remote_failure=True):
+                 natural_fractures=None, natural=None, remote_failure=True, contact="natural"):
         if not isinstance(mesh, (Mesh2D, Mesh3D)):
             raise InputError(f"mesh must be a Mesh2D or Mesh3D, got {type(mesh).__name__}")
         if not isinstance(material, Elastic):
@@ -172,6 +193,9 @@ class Simulation:
         self.injection_elements = np.array([c.nearest_element(mesh) for c in clusters], dtype=np.int64)
         self.network = None
         self.remote_failure = bool(remote_failure)
+        if contact not in CONTACT_MODES:
+            raise InputError(f"contact must be one of {CONTACT_MODES}, got {contact!r}")
+        self.contact = contact
         if natural_fractures is not None:
             if type(natural_fractures) is not type(mesh):
                 raise InputError(f"natural_fractures must be a {type(mesh).__name__} like mesh, "
@@ -216,7 +240,7 @@ class Simulation:
                      far_field_stress=self.far_field_stress.tolist(), time_step=self.time_step,
                      initial_pressure=self.initial_pressure, initial_opening=self.initial_opening,
                      minimum_width=self.minimum_width, height=self.height, operator=self.operator_options,
-                     settings=repr(self.settings),
+                     settings=repr(self.settings), contact=self.contact, remote_failure=self.remote_failure,
                      growing=None if self.growing_fractures is None else self.growing_fractures.tolist())
         digest = hashlib.sha256(json.dumps(parts, sort_keys=True, default=str).encode())
         meshes = [self.mesh0] + ([] if self.network is None else [self.network.mesh])
@@ -272,8 +296,33 @@ class Simulation:
                                 minimum_width=self.minimum_width)
 
     # -- one step -------------------------------------------------------------------------
+    def contact_law(self, origin):
+        """The :class:`~hmatddm.coupled.contact.ContactLaw` of elements with ``origin``."""
+        natural = origin >= 1
+        enabled = {"natural": natural, "all": np.ones_like(natural), "none": np.zeros_like(natural)}[self.contact]
+        friction = np.zeros(len(origin))
+        cohesion = np.zeros(len(origin))
+        if self.network is not None:
+            friction[natural] = self.network.properties.friction
+            cohesion[natural] = self.network.properties.cohesion
+        return ContactLaw(enabled, friction, cohesion)
+
+    def drained(self, mesh, faces, origin):
+        """Remotely failed elements that no fluid path connects to an injection point."""
+        failed = origin == 2
+        if not np.any(failed):
+            return failed
+        from scipy.sparse import coo_matrix
+        from scipy.sparse.csgraph import connected_components
+
+        n = mesh.n_elements
+        graph = coo_matrix((np.ones(faces.n_faces), (faces.first, faces.second)), shape=(n, n))
+        _, label = connected_components(graph, directed=False)
+        fed = np.isin(label, label[self.injection_elements])
+        return failed & ~fed
+
     def _solve(self, mesh, dd_old_width, p_old, creation_time, dd_guess, p_guess, t_old, t_new, relaxation,
-               extra_faces):
+               extra_faces, origin=None, dd_start=None, contact_state=None, failure_pressure=None):
         edges = topology.element_edges(mesh, self.height)
         faces = topology.element_faces(mesh, edges)
         if len(extra_faces):
@@ -281,16 +330,36 @@ class Simulation:
             faces = faces.append(i.astype(np.int64), j.astype(np.int64), length, d_i, d_j, edge_i.astype(np.int64))
         flow = self.flow_model(mesh, faces)
         op = self.operator(mesh)
-        problem = StepProblem(elastic=ElasticSolver(op, rtol=self.settings.linear_rtol), normals=mesh.normals,
+        elastic = ElasticSolver(op, rtol=self.settings.linear_rtol)
+        origin = np.zeros(mesh.n_elements, np.int64) if origin is None else origin
+        contact, fixed_pressure = None, None
+        law = self.contact_law(origin)
+        if np.any(law.enabled):
+            status, direction = contact_state
+            contact = ContactModel(law, mesh.normals, dd_start, status, direction,
+                                   elastic.normal_stiffness(mesh.normals))
+        drained = self.drained(mesh, faces, origin)
+        if np.any(drained):
+            fixed_pressure = np.where(drained, failure_pressure, np.nan)
+            p_guess = np.where(drained, failure_pressure, p_guess)
+        problem = StepProblem(elastic=elastic, normals=mesh.normals,
                               far_field=self.far_field_traction(mesh), flow=flow,
                               compliance=fracture_compliance(mesh, self.material), dt=t_new - t_old,
                               width_old=dd_old_width, pressure_old=p_old,
-                              leak_off_rate=flow.leak_off_rate(creation_time, t_old, t_new))
+                              leak_off_rate=flow.leak_off_rate(creation_time, t_old, t_new),
+                              contact=contact, fixed_pressure=fixed_pressure)
         dd, p, info = solve_step(problem, self.settings, dd_guess.ravel(), p_guess, relaxation)
+        if contact is not None:
+            info["contact"] = (contact.status.copy(), contact.direction.copy())
+            info["contact_frozen"] = contact.frozen
+        else:
+            info["contact"] = contact_state
+            info["contact_frozen"] = 0
+        info["drained"] = drained
         return dd.reshape(mesh.n_elements, mesh.dim), p, info, edges, faces, flow
 
     def step(self):
-        """Advance one time step (with growth passes); returns the record."""
+        """Advance one time step (with growth and remote-failure passes); returns the record."""
         start = time.perf_counter()
         s = self.state
         t_old, t_new = s.time, s.time + self.time_step
@@ -299,41 +368,60 @@ class Simulation:
         p_old = s.pressure.copy()
         creation = s.creation_time.copy()
         dd, p = s.dd.copy(), s.pressure.copy()
+        dd_start = s.dd.copy()
         origin, natural_index = s.origin.copy(), s.natural_index.copy()
         intact, extra = s.intact.copy(), s.extra_faces.copy()
-        totals = dict(nonlinear_iterations=0, linear_iterations=0, restarts=0)
-        self._events = dict(natural_crossed=0, natural_deflected=0)
+        contact_state = (s.contact_status.copy(), s.slip_direction.copy())
+        failure_pressure = s.failure_pressure.copy()
+        totals = dict(nonlinear_iterations=0, linear_iterations=0, restarts=0, contact_changes=0)
+        self._events = dict(natural_crossed=0, natural_deflected=0, natural_newly_failed=0, contact_frozen=0)
         added = 0
         passes = 0
         relaxation = s.relaxation
         builds = self.operator_builds
+        max_passes = 50 if self.propagation is None else self.propagation.max_growth_passes
         while True:
-            dd, p, info, edges, faces, flow = self._solve(mesh, width_old, p_old, creation, dd, p,
-                                                          t_old, t_new, relaxation, extra)
+            dd, p, info, edges, faces, flow = self._solve(mesh, width_old, p_old, creation, dd, p, t_old, t_new,
+                                                          relaxation, extra, origin, dd_start, contact_state,
+                                                          failure_pressure)
             relaxation = info["relaxation"]
+            contact_state = info["contact"]
+            self._events["contact_frozen"] = max(self._events["contact_frozen"], info["contact_frozen"])
+            drained = info["drained"]
             for key in totals:
-                totals[key] += info[key]
-            if self.propagation is None or passes >= self.propagation.max_growth_passes:
+                totals[key] += info.get(key, 0)
+            if passes >= max_passes:
                 break
-            grown = self._grow(mesh, edges, faces, dd, origin, natural_index, intact)
+            grown = None
+            if self.propagation is not None:
+                grown = self._grow(mesh, edges, faces, dd, origin, natural_index, intact, drained)
+            if grown is None:
+                grown = self._remote_failures(mesh, dd, intact)
             if grown is None:
                 break
-            new_mesh, parent, new_natural, connections = grown
+            new_mesh, parent, new_natural, connections, new_origin, new_pressure = grown
             passes += 1
             added += new_mesh.n_elements
             first_new = mesh.n_elements
+            m = new_mesh.n_elements
             mesh = concatenate([mesh, new_mesh])
-            width_old = np.concatenate([width_old, np.zeros(new_mesh.n_elements)])
-            p_old = np.concatenate([p_old, p_old[parent]])
-            creation = np.concatenate([creation, np.full(new_mesh.n_elements, t_old)])
-            guess = dd[parent]
-            activated = new_natural >= 0
+            width_old = np.concatenate([width_old, np.zeros(m)])
+            has_parent = parent >= 0
+            p_old = np.concatenate([p_old, np.where(has_parent, p_old[np.maximum(parent, 0)], new_pressure)])
+            creation = np.concatenate([creation, np.full(m, t_old)])
+            guess = np.where(has_parent[:, None], dd[np.maximum(parent, 0)], 0.0)
+            activated = new_origin == 1
             guess[activated] = self.minimum_width * new_mesh.normals[activated]
             dd = np.concatenate([dd, guess])
-            p = np.concatenate([p, p[parent]])
-            origin = np.concatenate([origin, activated.astype(np.int64)])
+            dd_start = np.concatenate([dd_start, guess])
+            p = np.concatenate([p, np.where(has_parent, p[np.maximum(parent, 0)], new_pressure)])
+            origin = np.concatenate([origin, new_origin])
             natural_index = np.concatenate([natural_index, new_natural])
-            intact[new_natural[activated]] = False
+            intact[new_natural[new_natural >= 0]] = False
+            failure_pressure = np.concatenate([failure_pressure, np.where(new_origin == 2, new_pressure, np.nan)])
+            status = np.where(new_origin == 2, STICK, OPEN).astype(np.int64)
+            contact_state = (np.concatenate([contact_state[0], status]),
+                             np.concatenate([contact_state[1], np.zeros((m, mesh.dim))]))
             for k, tip_element, length, d_tip, d_natural, tip_edge in connections:
                 extra = np.vstack([extra, [tip_element, first_new + k, length, d_tip, d_natural, tip_edge]])
 
@@ -342,18 +430,38 @@ class Simulation:
         injected = s.injected_volume + self.time_step * sum(c.rate for c in self.clusters)
         leaked = s.leaked_volume + float(np.sum(leak)) * self.time_step
         failed = s.failed.copy()
-        if self.network is not None and self.remote_failure:
-            failed, *_ = self.network.remote_failure(mesh, dd, self.material, self.far_field_stress, intact)
+        if self.network is not None:
+            failed[natural_index[origin == 2]] = True
         self.state = State(mesh, dd, p, creation, t_new, s.step + 1, relaxation, injected, leaked,
                            origin=origin, natural_index=natural_index, intact=intact, failed=failed,
-                           extra_faces=extra)
+                           extra_faces=extra, contact_status=contact_state[0], slip_direction=contact_state[1],
+                           failure_pressure=failure_pressure)
         record = self._record(flow, width, totals, added, passes, relaxation, time.perf_counter() - start,
                               self.operator_builds - builds)
         self.records.append(record)
         return record
 
-    def _grow(self, mesh, edges, faces, dd, origin, natural_index, intact):
-        """Elements to add: ``(new_mesh, parent, natural_index_of_new, connections)`` or None.
+    def _remote_failures(self, mesh, dd, intact):
+        """Intact natural elements that fail (ref. Sec. 5.3) as new elements to join the
+        system, or None: ``(mesh, parent=-1, natural_index, [], origin=2, pore_pressure)``."""
+        if self.network is None or not self.remote_failure or not np.any(intact):
+            return None
+        failed, _, _, pore_change = self.network.remote_failure(mesh, dd, self.material, self.far_field_stress,
+                                                                intact, self.operator_options["singular_correction"])
+        index = np.flatnonzero(failed)
+        if index.size == 0:
+            return None
+        self._events["natural_newly_failed"] += int(index.size)
+        pressure = self.network.properties.pore_pressure + pore_change[index]
+        m = index.size
+        return (self.network.mesh.subset(index), -np.ones(m, np.int64), index.astype(np.int64), [],
+                np.full(m, 2, np.int64), pressure)
+
+    def _grow(self, mesh, edges, faces, dd, origin, natural_index, intact, drained=None):
+        """Elements to add: ``(new_mesh, parent, natural_index_of_new, connections, origin_of_new,
+        pressure_of_new)`` or None (the new pressures come from the parents; NaN here).
+
+        Tips of drained elements (remotely failed, not reached by the fluid) do not grow.
 
         New elements come from :func:`new_elements`; with natural fractures each
         candidate is checked against the intact natural elements (see
@@ -364,6 +472,9 @@ class Simulation:
         if self.growing_fractures is not None:
             keep = np.isin(mesh.fracture_id[element], self.growing_fractures)
             element, edge = element[keep], edge[keep]
+        if drained is not None and np.any(drained):
+            keep = ~drained[element]
+            element, edge = element[keep], edge[keep]
         if element.size == 0:
             return None
         tips = evaluate_tips(mesh, edges, element, edge, dd, self.material, self.propagation)
@@ -372,7 +483,8 @@ class Simulation:
             return None
         grown, parent, rows = result
         if self.network is None:
-            return grown, parent, -np.ones(grown.n_elements, np.int64), []
+            m = grown.n_elements
+            return grown, parent, -np.ones(m, np.int64), [], np.zeros(m, np.int64), np.full(m, np.nan)
         network = self.network
         available = intact.copy()
         kept, activated, activated_parent, connections = [], [], [], []
@@ -422,7 +534,9 @@ class Simulation:
         new_natural = np.concatenate([-np.ones(len(kept), np.int64), np.asarray(activated, dtype=np.int64)])
         connections = [(len(kept) + k, tip, length, d_tip, d_nat, edge)
                        for k, tip, length, d_tip, d_nat, edge in connections]
-        return new_mesh, np.concatenate(parents), new_natural, connections
+        m = new_mesh.n_elements
+        return (new_mesh, np.concatenate(parents), new_natural, connections,
+                (new_natural >= 0).astype(np.int64), np.full(m, np.nan))
 
     def _record(self, flow, width, totals, added, passes, relaxation, seconds, builds):
         s = self.state
@@ -439,8 +553,17 @@ class Simulation:
             elements_added=int(added), growth_passes=int(passes), operator_builds=int(builds))
         if self.network is not None:
             record["natural_active"] = int(np.count_nonzero(s.origin == 1))
-            record["natural_failed"] = int(np.count_nonzero(s.failed))
+            record["natural_failed"] = int(np.count_nonzero(s.origin == 2))
             record.update(self._events)
+        record["contact_changes"] = int(totals["contact_changes"])
+        if self.contact != "none":
+            natural = s.origin >= 1 if self.contact == "natural" else np.ones(mesh.n_elements, bool)
+            opening = np.sum(s.dd * mesh.normals, axis=1)
+            slip = np.linalg.norm(s.dd - opening[:, None] * mesh.normals, axis=1)
+            record["closed_elements"] = int(np.count_nonzero(natural & (s.contact_status != OPEN)))
+            record["slipping_elements"] = int(np.count_nonzero(natural & (s.contact_status == SLIP)))
+            record["max_slip"] = float(np.max(slip[natural], initial=0.0))
+            record["min_opening"] = float(np.min(opening))
         if mesh.dim == 3:
             record["radius"] = float(np.sqrt(area / np.pi))
         else:
@@ -452,7 +575,7 @@ class Simulation:
         active elements first, then the intact natural elements (zero DD, the pore
         pressure). ``state``: 0 hydraulic, 1 intact natural, 2 activated or failed natural."""
         s = self.state
-        state = np.where(s.origin == 1, 2, 0).astype(np.int64)
+        state = np.where(s.origin >= 1, 2, 0).astype(np.int64)
         if self.network is None or not np.any(s.intact):
             return s.mesh, s.dd, s.pressure, state
         intact = np.flatnonzero(s.intact)
@@ -490,7 +613,8 @@ class Simulation:
         s = self.state
         arrays = dict(_mesh_arrays(s.mesh), dd=s.dd, pressure=s.pressure, creation_time=s.creation_time,
                       origin=s.origin, natural_index=s.natural_index, intact=s.intact, failed=s.failed,
-                      extra_faces=s.extra_faces)
+                      extra_faces=s.extra_faces, contact_status=s.contact_status, slip_direction=s.slip_direction,
+                      failure_pressure=s.failure_pressure)
         metadata = dict(time=s.time, step=s.step, relaxation=s.relaxation, injected_volume=s.injected_volume,
                         leaked_volume=s.leaked_volume, records=self.records, fingerprint=self.fingerprint(),
                         compressed_elements=self.compressed_elements)
@@ -507,7 +631,9 @@ class Simulation:
                            int(metadata["step"]), float(metadata["relaxation"]), float(metadata["injected_volume"]),
                            float(metadata["leaked_volume"]), origin=arrays["origin"],
                            natural_index=arrays["natural_index"], intact=arrays["intact"], failed=arrays["failed"],
-                           extra_faces=arrays["extra_faces"])
+                           extra_faces=arrays["extra_faces"], contact_status=arrays.get("contact_status"),
+                           slip_direction=arrays.get("slip_direction"),
+                           failure_pressure=arrays.get("failure_pressure"))
         self.records = list(metadata["records"])
         # rebuild the compressed base exactly as the interrupted run had it, so the
         # resumed run applies the same operator (bit for bit)

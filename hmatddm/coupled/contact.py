@@ -1,0 +1,319 @@
+"""Contact and Coulomb friction on closed fracture elements: open / stick / slip.
+
+A fracture element that the fluid cannot hold open closes: its faces touch and carry a
+contact traction ``c`` (tension positive, our sign). With the elasticity equation of
+an element written as its residual (DESIGN.md sec. 1, ref. Eq. 4.4 with fluid)::
+
+    c_i = (A DD + B p - f)_i        (the part of the rock traction the fluid does not carry)
+
+the element obeys, per step (``s`` the slip, ``s^n`` its value at the start of the step,
+``mu`` the friction coefficient, ``C_0`` the cohesion; ref. Eq. 5.17 is the same
+Coulomb law for intact natural fractures)::
+
+    open:   w_i >= 0,  c_i = 0
+    stick:  w_i = 0,   s_i = s_i^n,                |c_s| <= C_0 - mu c_n,  c_n <= 0
+    slip:   w_i = 0,   c_s = (C_0 - mu c_n) m,     m = (s_i - s_i^n)/|s_i - s_i^n|
+
+(``c_n = c.n`` is compressive, ``c_s`` the tangential part.) Each status replaces the
+element's rows of the elasticity equation by a block-diagonal combination
+``S_i (A DD + B p - f)_i + D_i DD_i = g_i``:
+
+* open:  ``S = I``, ``D = 0``, ``g = 0`` (the plain fluid-loaded equation);
+* stick: ``S = 0``, ``D = k I``, ``g = k s^n`` (DDs fixed; ``k`` the element's own normal
+  stiffness, so the rows keep the scale of a traction);
+* slip:  normal row ``k n.DD = 0``; row ``(m + mu n).c = C_0`` (the friction law); in 3D
+  also ``(n x m).c = 0`` (the contact traction is aligned with the slip).
+
+Because ``S`` and ``D`` are block diagonal, the modified operator ``S A + D`` keeps the
+H-matrix matvec, and its near field (for the ILU), dense matrix (for the LU) and element
+diagonal blocks (for the scaling of the fully coupled system) are ``S`` times those of
+``A`` plus ``D``.
+
+The status is an active set updated once per nonlinear iteration
+(:meth:`ContactModel.update`): an open element with ``w < -tol_w`` closes (stick); a
+closed element whose contact traction turns tensile by more than ``k tol_w`` opens; a
+stuck element whose shear exceeds its strength by more than ``k tol_w`` slips along its
+shear traction; a slipping element whose slip increment reverses by more than ``tol_w``
+sticks. The band ``tol_w = relative_tolerance * max|w|`` (``k`` the element's own
+stiffness, so ``k tol_w`` is the traction of that much opening) keeps the active set
+from flipping on round-off when an element sits at the boundary between two states
+(fluid pressure equal to the normal stress): the error it allows is ``tol_w`` of
+opening, a ``relative_tolerance`` (1e-4) of the largest opening. A step has converged only when no status changed. An element
+that changes status more than ``max_flips`` times in one step keeps its last status (and
+is counted in :attr:`ContactModel.frozen`) so the active set cannot cycle forever.
+An element held like this is closed and stuck from then on in the step: its DDs are
+bounded and its friction law is violated at most by the traction of the last cycle.
+"""
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..errors import InputError
+
+OPEN, STICK, SLIP = 0, 1, 2
+CONTACT_MODES = ("natural", "all", "none")  # which elements of a simulation may close
+STATUS_NAMES = {OPEN: "open", STICK: "stick", SLIP: "slip"}
+
+
+@dataclass
+class ContactLaw:
+    """Which elements may close, and their Coulomb strength.
+
+    Parameters
+    ----------
+    enabled : (N,) bool
+        Elements subject to the contact condition (others stay fluid-loaded at any w).
+    friction : (N,) float >= 0
+        Coulomb friction coefficient mu.
+    cohesion : (N,) float >= 0
+        Cohesion C_0, Pa.
+    """
+
+    enabled: np.ndarray
+    friction: np.ndarray
+    cohesion: np.ndarray
+
+    def __post_init__(self):
+        self.enabled = np.asarray(self.enabled, dtype=bool)
+        n = self.enabled.shape[0]
+        for name in ("friction", "cohesion"):
+            value = np.asarray(getattr(self, name), dtype=np.float64)
+            if value.shape != (n,) or not np.all(np.isfinite(value)) or np.any(value < 0.0):
+                raise InputError(f"contact {name} must be {n} finite values >= 0")
+            setattr(self, name, value)
+
+
+class ContactRows:
+    """The block-diagonal row operators ``S`` (N, d, d), ``D`` (N, d, d) and right-hand
+    side ``g`` (N, d) of one set of statuses (see the module docstring)."""
+
+    def __init__(self, select, direct, rhs, key):
+        self.select, self.direct, self.g = select, direct, rhs
+        self.n, self.d = select.shape[0], select.shape[1]
+        self.key = key
+
+    def _blocks(self, blocks, x):
+        return np.einsum("eij,ej->ei", blocks, np.asarray(x, dtype=np.float64).reshape(self.n, self.d)).ravel()
+
+    def select_rows(self, v):
+        """``S v`` for a flat traction vector ``v``."""
+        return self._blocks(self.select, v)
+
+    def apply(self, traction, dd):
+        """``S traction + D dd`` (flat) with ``traction = A dd (+ B p)``."""
+        return self._blocks(self.select, traction) + self._blocks(self.direct, dd)
+
+    def rhs(self, v):
+        """``S v + g`` (flat)."""
+        return self._blocks(self.select, v) + self.g.ravel()
+
+    def modify_blocks(self, blocks):
+        """``S_i A_ii + D_i`` for element diagonal blocks ``A_ii`` (N, d, d)."""
+        return np.einsum("eij,ejk->eik", self.select, blocks) + self.direct
+
+    def _sparse(self, blocks):
+        n, d = self.n, self.d
+        rows = np.repeat(np.arange(n * d).reshape(n, d), d, axis=1).ravel()
+        cols = np.tile(np.arange(n * d).reshape(n, 1, d), (1, d, 1)).ravel()
+        return sp.csr_matrix((blocks.ravel(), (rows, cols)), shape=(n * d, n * d))
+
+    def modify_sparse(self, matrix):
+        """``S M + D`` for a sparse (near-field) matrix ``M`` in element-major order."""
+        return (self._sparse(self.select) @ matrix + self._sparse(self.direct)).tocsc()
+
+    def modify_dense(self, matrix, first_row=0):
+        """``S M + D`` for a dense matrix whose rows are elements ``first_row..`` and whose
+        columns are all elements (``D`` lands on the matching diagonal)."""
+        d = self.d
+        rows = matrix.shape[0] // d
+        select = self.select[first_row:first_row + rows]
+        out = np.einsum("eij,ejc->eic", select, matrix.reshape(rows, d, -1)).reshape(matrix.shape)
+        if matrix.shape[1] == self.n * d:
+            index = np.arange(first_row, first_row + rows)
+            view = out.reshape(rows, d, self.n, d)
+            view[np.arange(rows), :, index, :] += self.direct[index]
+        return out
+
+    def modify_rows(self, matrix, first_row):
+        """``S M`` for an off-diagonal dense block (rows of elements ``first_row..``)."""
+        d = self.d
+        rows = matrix.shape[0] // d
+        select = self.select[first_row:first_row + rows]
+        return np.einsum("eij,ejc->eic", select, matrix.reshape(rows, d, -1)).reshape(matrix.shape)
+
+    def subset(self, start, stop):
+        """The rows of elements ``start..stop-1`` (for a block of a partitioned operator)."""
+        return ContactRows(self.select[start:stop], self.direct[start:stop], self.g[start:stop],
+                           (self.key, start, stop))
+
+
+class ContactModel:
+    """The active set of one time step (statuses, slip directions, step-start slip).
+
+    Parameters
+    ----------
+    law : ContactLaw
+    normals : (N, d)
+    dd_start : (N, d) DDs at the start of the step (their tangential part is ``s^n``)
+    status : (N,) int, initial statuses (``OPEN``, ``STICK``, ``SLIP``)
+    direction : (N, d) unit slip directions of slipping elements (zeros otherwise)
+    stiffness : (N,) the elements' own normal stiffness ``|n.A_ii.n|``, Pa/m
+    max_flips : int
+    relative_tolerance : float, the band ``tol_w / max|w|`` of the status tests
+    """
+
+    def __init__(self, law, normals, dd_start, status, direction, stiffness, max_flips=4, relative_tolerance=1e-4,
+                 penalty=None):
+        self.law = law
+        self.normals = np.asarray(normals, dtype=np.float64)
+        self.n, self.d = self.normals.shape
+        dd_start = np.asarray(dd_start, dtype=np.float64).reshape(self.n, self.d)
+        opening = np.sum(dd_start * self.normals, axis=1)
+        self.shear_start = dd_start - opening[:, None] * self.normals
+        self.initial_status = np.where(law.enabled, np.asarray(status, dtype=np.int64), OPEN)
+        self.initial_direction = np.asarray(direction, dtype=np.float64).reshape(self.n, self.d).copy()
+        self.stiffness = np.asarray(stiffness, dtype=np.float64)
+        self.max_flips = int(max_flips)
+        self.relative_tolerance = float(relative_tolerance)
+        self.penalty = penalty
+        self.reset()
+
+    def reset(self):
+        """Back to the statuses the step started with (a relaxation restart)."""
+        self.status = self.initial_status.copy()
+        self.direction = self.initial_direction.copy()
+        self.flips = np.zeros(self.n, dtype=np.int64)
+        self._rows = None
+
+    @property
+    def frozen(self):
+        """Elements whose status stopped changing because they flipped too often."""
+        return int(np.count_nonzero(self.flips > self.max_flips))
+
+    @property
+    def closed(self):
+        return self.status != OPEN
+
+    def _tangents(self):
+        """(N, d-1, d) tangent basis: the slip direction (and n x m) for slipping
+        elements, a fixed in-plane basis otherwise."""
+        normals = self.normals
+        if self.d == 2:
+            tangent = np.stack([-normals[:, 1], normals[:, 0]], axis=1)
+            slip = self.status == SLIP
+            tangent[slip] = self.direction[slip]
+            return tangent[:, None, :]
+        helper = np.where((np.abs(normals[:, 2]) < 0.9)[:, None], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0])
+        first = np.cross(normals, helper)
+        first /= np.linalg.norm(first, axis=1)[:, None]
+        slip = self.status == SLIP
+        first[slip] = self.direction[slip]
+        return np.stack([first, np.cross(normals, first)], axis=1)
+
+    def rows(self):
+        """The :class:`ContactRows` of the current statuses (``None`` when all are open).
+
+        Rows in the local frame ``(n, t_1[, t_2])`` of each element: open rows are the
+        residual along them; a closed element's normal row is ``k n.DD = 0`` (or, with
+        a ``penalty`` factor, ``c_n = penalty k w``); stick rows fix the tangential DDs,
+        slip rows are the friction law along ``m = t_1`` and no traction across it.
+        """
+        if self._rows is not None or not np.any(self.closed):
+            return self._rows
+        n, d = self.n, self.d
+        normals = self.normals
+        tangents = self._tangents()
+        k = self.stiffness
+        select = np.zeros((n, d, d))
+        direct = np.zeros((n, d, d))
+        g = np.zeros((n, d))
+        closed, stick, slip = self.status != OPEN, self.status == STICK, self.status == SLIP
+        # normal row
+        select[:, 0, :] = np.where(closed[:, None], 0.0, normals)
+        direct[closed, 0, :] = k[closed, None] * normals[closed]
+        if self.penalty is not None:
+            select[closed, 0, :] = normals[closed]
+            direct[closed, 0, :] = -self.penalty * k[closed, None] * normals[closed]
+        # tangential rows
+        for j in range(d - 1):
+            t = tangents[:, j, :]
+            select[~closed, 1 + j, :] = t[~closed]
+            direct[stick, 1 + j, :] = k[stick, None] * t[stick]
+            g[stick, 1 + j] = k[stick] * np.sum(t[stick] * self.shear_start[stick], axis=1)
+        if np.any(slip):
+            m = tangents[slip, 0, :]
+            select[slip, 1, :] = m + self.law.friction[slip, None] * normals[slip]
+            g[slip, 1] = self.law.cohesion[slip]
+            if d == 3:
+                select[slip, 2, :] = tangents[slip, 1, :]
+        key = (self.status.tobytes(), np.round(self.direction, 3).tobytes())
+        self._rows = ContactRows(select, direct, g, hash(key))
+        return self._rows
+
+    def update(self, dd, contact_traction):
+        """Update the statuses from the iterate ``dd`` (N*d,) and the contact traction
+        ``c = A dd + B p - f`` (N*d,); returns the number of elements that changed."""
+        n, d = self.n, self.d
+        dd = np.asarray(dd).reshape(n, d)
+        c = np.asarray(contact_traction).reshape(n, d)
+        normals = self.normals
+        opening = np.sum(dd * normals, axis=1)
+        c_n = np.sum(c * normals, axis=1)
+        c_s = c - c_n[:, None] * normals
+        tau = np.linalg.norm(c_s, axis=1)
+        strength = self.law.cohesion - self.law.friction * c_n
+        increment = dd - opening[:, None] * normals - self.shear_start
+        new_status = self.status.copy()
+        new_direction = self.direction.copy()
+        enabled = self.law.enabled
+        scale = np.max(np.abs(opening)) if n else 0.0
+        tol_w = self.relative_tolerance * max(scale, 1e-30)
+        tol_c = self.stiffness * tol_w
+        is_open, closed, slip = self.status == OPEN, self.status != OPEN, self.status == SLIP
+        # open -> stick when the faces interpenetrate
+        close = enabled & is_open & (opening < -tol_w)
+        new_status[close] = STICK
+        # closed -> open when the contact traction turns tensile
+        release = enabled & closed & (c_n > tol_c)
+        new_status[release] = OPEN
+        # stick -> slip when the shear exceeds the strength
+        stay = enabled & closed & ~release
+        to_slip = stay & (self.status == STICK) & (tau > strength + tol_c)
+        new_status[to_slip] = SLIP
+        new_direction[to_slip] = c_s[to_slip] / tau[to_slip, None]
+        # slip: follow the slip increment; stick again if it reverses
+        slipping = stay & slip
+        along = np.sum(increment * self.direction, axis=1)
+        increment_norm = np.linalg.norm(increment, axis=1)
+        reverse = slipping & (along < -tol_w)
+        new_status[reverse] = STICK
+        follow = slipping & ~reverse & (increment_norm > 0.0)
+        if d == 3:
+            new_direction[follow] = increment[follow] / increment_norm[follow, None]
+        new_direction[new_status != SLIP] = 0.0
+        # elements that flipped too often are held closed and stuck (the most constrained
+        # state: bounded DDs, a friction law violated at most by the last oscillation)
+        changed = new_status != self.status
+        self.flips += changed
+        frozen = self.flips > self.max_flips
+        new_status[frozen] = STICK
+        new_direction[frozen] = 0.0
+        changed = (new_status != self.status) | (
+            (new_status == SLIP) & (np.abs(new_direction - self.direction).max(axis=1) > 1e-3))
+        self.status, self.direction = new_status, new_direction
+        n_changed = int(np.count_nonzero(changed))
+        if n_changed:
+            self._rows = None
+        return n_changed
+
+    def contact_traction_summary(self, dd, contact_traction):
+        """``(effective_normal_stress, shear_traction, slip)`` per element for output."""
+        n, d = self.n, self.d
+        c = np.asarray(contact_traction).reshape(n, d)
+        c_n = np.sum(c * self.normals, axis=1)
+        shear = np.linalg.norm(c - c_n[:, None] * self.normals, axis=1)
+        dd = np.asarray(dd).reshape(n, d)
+        slip = dd - np.sum(dd * self.normals, axis=1)[:, None] * self.normals
+        closed = self.closed
+        return np.where(closed, -c_n, 0.0), np.where(closed, shear, 0.0), np.linalg.norm(slip, axis=1)
