@@ -24,7 +24,7 @@ A growing radial fracture (ref. Ch. 4)::
 """
 from . import analytical, kernels, mesh, network, topology
 from .coupled import SchemeSettings
-from .errors import ConvergenceError, HmatddmError, InputError
+from .errors import ConvergenceError, HmatddmError, InputError, OutputError
 from .flow import Cluster, Fluid, LeakOff
 from .fracture import NaturalFractureProperties, Propagation
 from .material import Elastic
@@ -37,6 +37,6 @@ __version__ = "0.1.0"
 
 __all__ = [
     "Elastic", "Mesh2D", "Mesh3D", "ElasticityOperator", "solve", "opening", "slip", "stress_at",
-    "mean_stress_at", "mesh", "analytical", "kernels", "topology", "HmatddmError", "InputError", "ConvergenceError",
+    "mean_stress_at", "mesh", "analytical", "kernels", "topology", "HmatddmError", "InputError", "ConvergenceError", "OutputError",
     "Fluid", "LeakOff", "Cluster", "Propagation", "NaturalFractureProperties", "network", "SchemeSettings", "Simulation", "CheckpointError",
 ]
