@@ -8,10 +8,10 @@ centre (a near miss: at commit 46bf670 the entry is ~5700 x the self term and no
 averaging applies); with exact coordinates the NaN averaging applies. benchmarks/bench_intersection.py has the
 full table (every scheme, both alphas, both backends, 2D too) and the plot.
 
-The engine does not yet stop a growing tip at an element of ANOTHER active fracture (it
-grows straight through) nor connect the two fractures' flow there: the scene stops
-fracture 2 with ``Propagation(bounds=...)`` (y >= -0.25 m), and the two strict xfails
-at the end state what is missing.
+The engine stops a growing tip whose next element would cut an element of another
+hydraulic fracture and connects the two by a flow face (``Simulation._junctions``); the
+comparison runs also bound fracture 2 at y >= -0.25 m (``Propagation(bounds=...)``) so
+that they do not depend on that rule, and the last two tests check the rule itself.
 
 Tolerances: every scheme stops when the relative change of p and DD between two
 iterations is below 1e-6 (ref. Eqs 4.43-4.44, the engine default); a linearly converging
@@ -184,20 +184,16 @@ def _flow_connected(sim, i, j):
     return (min(i, j), max(i, j)) in pairs
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "engine gap: Simulation._grow only checks intact natural fractures; a tip whose next element "
-    "cuts an active element of another fracture grows straight through it (reproducer: "
-    "python benchmarks/bench_intersection.py --reproduce)"))
 def test_growing_tip_stops_at_another_active_fracture():
+    """Without the y bound the engine itself stops fracture 2 at fracture 1."""
     sim, _ = intersection_run("krylov", alpha=1.0, geometry="exact", bounded=False)
     mesh = sim.state.mesh
     assert not np.any((mesh.fracture_id == 1) & (mesh.centers[:, 1] < -0.1))
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "engine gap: two active fractures that meet are not connected hydraulically (faces join "
-    "coincident edges only; extra_faces are added only when a tip deflects into a natural fracture)"))
 def test_fractures_that_meet_share_their_fluid():
-    sim, _ = intersection_run("krylov", alpha=1.0, geometry="exact")
+    """The arrested tip is connected to the element it reached by a flow face."""
+    sim, records = intersection_run("krylov", alpha=1.0, geometry="exact", bounded=False)
+    assert sum(r["junctions"] for r in records) >= 1
     i, j = junction_elements(sim.state.mesh)
     assert _flow_connected(sim, i, j)

@@ -374,7 +374,8 @@ class Simulation:
         contact_state = (s.contact_status.copy(), s.slip_direction.copy())
         failure_pressure = s.failure_pressure.copy()
         totals = dict(nonlinear_iterations=0, linear_iterations=0, restarts=0, contact_changes=0)
-        self._events = dict(natural_crossed=0, natural_deflected=0, natural_newly_failed=0, contact_frozen=0)
+        self._events = dict(natural_crossed=0, natural_deflected=0, natural_newly_failed=0, contact_frozen=0,
+                            junctions=0)
         added = 0
         passes = 0
         relaxation = s.relaxation
@@ -401,8 +402,13 @@ class Simulation:
                 break
             new_mesh, parent, new_natural, connections, new_origin, new_pressure = grown
             passes += 1
-            added += new_mesh.n_elements
             first_new = mesh.n_elements
+            for k, tip_element, length, d_tip, d_natural, tip_edge in connections:
+                target = first_new + k if k >= 0 else -1 - k
+                extra = np.vstack([extra, [tip_element, target, length, d_tip, d_natural, tip_edge]])
+            if new_mesh is None:  # only new connections to elements already in the system
+                continue
+            added += new_mesh.n_elements
             m = new_mesh.n_elements
             mesh = concatenate([mesh, new_mesh])
             width_old = np.concatenate([width_old, np.zeros(m)])
@@ -422,8 +428,6 @@ class Simulation:
             status = np.where(new_origin == 2, STICK, OPEN).astype(np.int64)
             contact_state = (np.concatenate([contact_state[0], status]),
                              np.concatenate([contact_state[1], np.zeros((m, mesh.dim))]))
-            for k, tip_element, length, d_tip, d_natural, tip_edge in connections:
-                extra = np.vstack([extra, [tip_element, first_new + k, length, d_tip, d_natural, tip_edge]])
 
         width = np.sum(dd * mesh.normals, axis=1)
         leak = flow.leak_off_rate(creation, t_old, t_new) * flow.areas * (p - self.leak_off.pore_pressure)
@@ -482,24 +486,40 @@ class Simulation:
         if result is None:
             return None
         grown, parent, rows = result
+        grown, parent, rows, junctions = self._junctions(mesh, edges, tips, grown, parent, rows, origin)
+        if grown is None:
+            return None, np.zeros(0, np.int64), np.zeros(0, np.int64), junctions, np.zeros(0, np.int64), np.zeros(0)
         if self.network is None:
             m = grown.n_elements
-            return grown, parent, -np.ones(m, np.int64), [], np.zeros(m, np.int64), np.full(m, np.nan)
+            return grown, parent, -np.ones(m, np.int64), junctions, np.zeros(m, np.int64), np.full(m, np.nan)
         network = self.network
         available = intact.copy()
-        kept, activated, activated_parent, connections = [], [], [], []
+        # natural elements already in the system (activated, or failed remotely): a tip
+        # that reaches one connects to it instead of adding an element on top of it
+        active_of = -np.ones(network.mesh.n_elements, np.int64)
+        joined = natural_index >= 0
+        active_of[natural_index[joined]] = np.flatnonzero(joined)
+        reachable = available | (active_of >= 0)
+        linked = set()
+        kept, activated, activated_parent, connections = [], [], [], list(junctions)
         for k in range(grown.n_elements):
             row, tip = rows[k], parent[k]
             distance, nearest = network.tree.query(grown.centers[k])
             size = min(float(grown.radii[k]), float(network.mesh.radii[nearest]))
-            if available[nearest] and distance < 0.5 * size:
-                # the next element is an intact natural element: the fluid runs into it
-                available[nearest] = False
-                activated.append(nearest)
-                activated_parent.append(tip)
+            if reachable[nearest] and distance < 0.5 * size:
+                if available[nearest]:
+                    # the next element is an intact natural element: the fluid runs into it
+                    available[nearest] = reachable[nearest] = False
+                    activated.append(nearest)
+                    activated_parent.append(tip)
+                elif (tip, active_of[nearest]) not in linked:
+                    # it is already in the system: connect the tip to it
+                    linked.add((tip, active_of[nearest]))
+                    connections.append((-1 - active_of[nearest], tip, *self._link(mesh, edges, tip, tips.edge[row],
+                                                                                 nearest, grown.centers[k], size)))
                 continue
             hinge = edges.midpoints[tip, tips.edge[row]]
-            hit = network.encounter(grown, k, hinge, available)
+            hit = network.encounter(grown, k, hinge, reachable)
             if hit is None:
                 kept.append(k)
                 continue
@@ -510,15 +530,14 @@ class Simulation:
                 kept.append(k)
                 continue
             self._events["natural_deflected"] += 1
-            available[target] = False
-            if mesh.dim == 3:
-                length = min(float(edges.length[tip, tips.edge[row]]), 2.0 * float(network.vertical_half[target]))
-                gap = np.linalg.norm(network.mesh.centers[target, :2] - point)
-            else:
-                length = self.height
-                gap = np.linalg.norm(network.mesh.centers[target] - point)
-            connections.append((len(activated), tip, length, float(edges.half_width[tip, tips.edge[row]]),
-                                max(gap, 0.1 * size), int(tips.edge[row])))
+            link = self._link(mesh, edges, tip, tips.edge[row], target, point, size)
+            if not available[target]:  # deflected into an element already in the system
+                if (tip, active_of[target]) not in linked:
+                    linked.add((tip, active_of[target]))
+                    connections.append((-1 - active_of[target], tip, *link))
+                continue
+            available[target] = reachable[target] = False
+            connections.append((len(activated), tip, *link))
             activated.append(target)
             activated_parent.append(tip)
         pieces, parents = [], []
@@ -528,15 +547,72 @@ class Simulation:
         if activated:
             pieces.append(network.mesh.subset(np.asarray(activated)))
             parents.append(np.asarray(activated_parent, dtype=np.int64))
+        connections = [(len(kept) + k if k >= 0 else k, tip, length, d_tip, d_nat, edge)
+                       for k, tip, length, d_tip, d_nat, edge in connections]
         if not pieces:
-            return None
+            if not connections:
+                return None
+            return None, np.zeros(0, np.int64), np.zeros(0, np.int64), connections, np.zeros(0, np.int64), np.zeros(0)
         new_mesh = concatenate(pieces)
         new_natural = np.concatenate([-np.ones(len(kept), np.int64), np.asarray(activated, dtype=np.int64)])
-        connections = [(len(kept) + k, tip, length, d_tip, d_nat, edge)
-                       for k, tip, length, d_tip, d_nat, edge in connections]
         m = new_mesh.n_elements
         return (new_mesh, np.concatenate(parents), new_natural, connections,
                 (new_natural >= 0).astype(np.int64), np.full(m, np.nan))
+
+    def _junctions(self, mesh, edges, tips, grown, parent, rows, origin):
+        """Candidates that would cut a hydraulic element of another fracture: the tip
+        stops there and a flow face connects it to that element (ref. Sec. 6.2.3, Figs
+        6.5-6.7). Returns the remaining ``(grown, parent, rows)`` (``grown`` None when
+        none remains) and the connections ``(-1 - element, tip, length, d_tip, d_other,
+        edge)``."""
+        hydraulic = origin == 0
+        if np.unique(mesh.fracture_id[hydraulic]).size < 2:
+            return grown, parent, rows, []
+        active = NaturalNetwork(mesh, None)
+        keep, connections, linked = [], [], set()
+        for k in range(grown.n_elements):
+            row, tip = rows[k], parent[k]
+            others = hydraulic & (mesh.fracture_id != mesh.fracture_id[tip])
+            hinge = edges.midpoints[tip, tips.edge[row]]
+            hit = active.encounter(grown, k, hinge, others)
+            if hit is not None:
+                # touching only end to end or at the other's tip is not a cut: the element
+                # is kept and ends on the other fracture (ref. Fig. 6.5b); the next pass connects
+                reach = 2.0 * (grown.centers[k, :2] - hinge[:2])
+                along = active.p1[hit[0]] - active.p0[hit[0]]
+                t = float(np.dot(hit[1][:2] - active.p0[hit[0]], along)) / float(np.dot(along, along))
+                if (float(np.dot(hit[1][:2] - hinge[:2], reach)) >= (1.0 - 1e-6) * float(np.dot(reach, reach))
+                        or not 1e-6 < t < 1.0 - 1e-6):
+                    hit = None
+            if hit is None:
+                keep.append(k)
+                continue
+            target, point = hit
+            if (tip, target) not in linked:
+                linked.add((tip, target))
+                size = min(float(grown.radii[k]), float(mesh.radii[target]))
+                connections.append((-1 - target, tip, *self._link(mesh, edges, tip, tips.edge[row], target, point,
+                                                                  size, active)))
+        if not connections:
+            return grown, parent, rows, []
+        self._events["junctions"] = self._events.get("junctions", 0) + len(connections)
+        if not keep:
+            return None, None, None, connections
+        keep = np.asarray(keep)
+        return grown.subset(keep), parent[keep], rows[keep], connections
+
+    def _link(self, mesh, edges, tip, edge, target, point, size, network=None):
+        """``(length, d_tip, d_natural, edge)`` of the flow face from a tip edge to the
+        element ``target`` of ``network`` (default: the natural network) it reaches at
+        ``point``."""
+        network = self.network if network is None else network
+        if mesh.dim == 3:
+            length = min(float(edges.length[tip, edge]), 2.0 * float(network.vertical_half[target]))
+            gap = np.linalg.norm(network.mesh.centers[target, :2] - point[:2])
+        else:
+            length = self.height
+            gap = np.linalg.norm(network.mesh.centers[target] - point)
+        return length, float(edges.half_width[tip, edge]), max(gap, 0.1 * size), int(edge)
 
     def _record(self, flow, width, totals, added, passes, relaxation, seconds, builds):
         s = self.state
@@ -551,6 +627,7 @@ class Simulation:
             linear_iterations=int(totals["linear_iterations"]), solve_seconds=float(seconds),
             leaked_volume=s.leaked_volume, relaxation=float(relaxation), restarts=int(totals["restarts"]),
             elements_added=int(added), growth_passes=int(passes), operator_builds=int(builds))
+        record["junctions"] = int(self._events["junctions"])
         if self.network is not None:
             record["natural_active"] = int(np.count_nonzero(s.origin == 1))
             record["natural_failed"] = int(np.count_nonzero(s.origin == 2))
