@@ -38,7 +38,7 @@ sticks. The band ``tol_w = relative_tolerance * max|w|`` (``k`` the element's ow
 stiffness, so ``k tol_w`` is the traction of that much opening) keeps the active set
 from flipping on round-off when an element sits at the boundary between two states
 (fluid pressure equal to the normal stress): the error it allows is ``tol_w`` of
-opening, a ``relative_tolerance`` (1e-4) of the largest opening. A step has converged only when no status changed. An element
+opening, a ``relative_tolerance`` (1e-3) of the largest opening. A step has converged only when no status changed. An element
 that changes status more than ``max_flips`` times in one step keeps its last status (and
 is counted in :attr:`ContactModel.frozen`) so the active set cannot cycle forever.
 An element held like this is closed and stuck from then on in the step: its DDs are
@@ -163,7 +163,7 @@ class ContactModel:
     relative_tolerance : float, the band ``tol_w / max|w|`` of the status tests
     """
 
-    def __init__(self, law, normals, dd_start, status, direction, stiffness, max_flips=4, relative_tolerance=1e-4,
+    def __init__(self, law, normals, dd_start, status, direction, stiffness, max_flips=4, relative_tolerance=1e-3,
                  penalty=None):
         self.law = law
         self.normals = np.asarray(normals, dtype=np.float64)

@@ -500,7 +500,9 @@ class Simulation:
         joined = natural_index >= 0
         active_of[natural_index[joined]] = np.flatnonzero(joined)
         reachable = available | (active_of >= 0)
-        linked = set()
+        # pairs already connected (a tip never links to itself or to a neighbour twice)
+        linked = {(int(a), int(b)) for a, b in zip(faces.first, faces.second)}
+        linked |= {(b, a) for a, b in linked}
         kept, activated, activated_parent, connections = [], [], [], list(junctions)
         for k in range(grown.n_elements):
             row, tip = rows[k], parent[k]
@@ -512,14 +514,14 @@ class Simulation:
                     available[nearest] = reachable[nearest] = False
                     activated.append(nearest)
                     activated_parent.append(tip)
-                elif (tip, active_of[nearest]) not in linked:
+                elif active_of[nearest] != tip and (tip, active_of[nearest]) not in linked:
                     # it is already in the system: connect the tip to it
                     linked.add((tip, active_of[nearest]))
                     connections.append((-1 - active_of[nearest], tip, *self._link(mesh, edges, tip, tips.edge[row],
                                                                                  nearest, grown.centers[k], size)))
                 continue
             hinge = edges.midpoints[tip, tips.edge[row]]
-            hit = network.encounter(grown, k, hinge, reachable)
+            hit = network.encounter(grown, k, hinge, available)
             if hit is None:
                 kept.append(k)
                 continue
@@ -532,7 +534,7 @@ class Simulation:
             self._events["natural_deflected"] += 1
             link = self._link(mesh, edges, tip, tips.edge[row], target, point, size)
             if not available[target]:  # deflected into an element already in the system
-                if (tip, active_of[target]) not in linked:
+                if active_of[target] != tip and (tip, active_of[target]) not in linked:
                     linked.add((tip, active_of[target]))
                     connections.append((-1 - active_of[target], tip, *link))
                 continue
