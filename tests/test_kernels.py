@@ -127,3 +127,68 @@ def test_mean_stress_influence_is_trace_of_stress():
     out2 = np.empty(2)
     line2d.mean_stress_pair(x[:2], np.zeros(2), frame2, 0.5, G, NU, out2)
     assert np.allclose(out2, np.trace(line_stress(x[:2], np.zeros(2), frame2, 0.5), axis1=1, axis2=2) / 2)
+
+
+# ------------------------------------------------------ near-miss points (near > 0)
+def test_line_point_near_a_tip_is_treated_as_on_it():
+    """Within ``near`` of an end point (beyond it, on the element or off its line) the
+    point is singular: NaN without averaging, else exactly the averaged value at the tip;
+    beyond ``near`` the plain kernel (~1/gap) is used."""
+    frame, center, a = np.eye(2), np.zeros(2), 1.0
+    out, work = np.empty((2, 2, 2)), np.empty((2, 2, 2))
+    at_tip = line_stress([a, 0.0], center, frame, a, shift=1e-3)
+    for gap in (1e-9, 1e-4, 0.3):
+        for point in ([a + gap, 0.0], [a - gap, 0.0], [a, gap], [a + 0.6 * gap, -0.8 * gap]):
+            line2d.stress_pair(np.array(point), center, frame, a, G, NU, 0.0, out, work, 0.4)
+            assert np.all(np.isnan(out))
+            line2d.stress_pair(np.array(point), center, frame, a, G, NU, 1e-3, out, work, 0.4)
+            np.testing.assert_allclose(out, at_tip, rtol=1e-12, atol=0)
+        # without near (the default) the entry is finite and of order 1/gap
+        raw = line_stress([a, gap], center, frame, a)
+        assert np.all(np.isfinite(raw)) and np.abs(raw).max() > 0.05 * G / gap
+    line2d.stress_pair(np.array([a, 0.41]), center, frame, a, G, NU, 0.0, out, work, 0.4)
+    np.testing.assert_array_equal(out, line_stress([a, 0.41], center, frame, a))
+
+
+def test_rectangle_point_near_an_edge_is_treated_as_on_it():
+    frame, center, a, b = np.eye(3), np.zeros(3), 1.0, 0.5
+    out, work = np.empty((3, 3, 3)), np.empty((3, 3, 3))
+    cases = [([a, 0.2, 0.0], [(1e-7, 0, 0), (-1e-7, 0, 0), (0, 0, 1e-7), (0.03, 0, -0.035)]),  # x1 = a edge
+             ([-0.3, -b, 0.0], [(0, -1e-7, 0), (0, 0.02, 0), (0, 0, -0.01)]),                    # x2 = -b edge
+             ([a, b, 0.0], [(1e-7, 1e-7, 0), (0.01, 0.02, 0.03), (0.02, 0.01, -0.01)]),         # corner
+             ([0.99, b, 0.0], [(0, 0.03, 0), (0, -0.005, 0.02)])]  # near the corner, but nearest to an edge
+    for on_edge, offsets in cases:
+        at_edge = rect_stress(on_edge, center, frame, a, b, shift=1e-3)
+        assert np.all(np.isfinite(at_edge))
+        for offset in offsets:
+            point = np.add(on_edge, offset)
+            rectangle3d.stress_pair(point, center, frame, a, b, G, NU, 0.0, out, work, 0.05)
+            assert np.all(np.isnan(out))
+            rectangle3d.stress_pair(point, center, frame, a, b, G, NU, 1e-3, out, work, 0.05)
+            np.testing.assert_allclose(out, at_edge, rtol=1e-12, atol=1e-12 * np.abs(at_edge).max())
+    far = np.array([a + 0.06, 0.2, 0.0])  # 0.06 > near = 0.05: the plain kernel
+    rectangle3d.stress_pair(far, center, frame, a, b, G, NU, 0.0, out, work, 0.05)
+    np.testing.assert_array_equal(out, rect_stress(far, center, frame, a, b))
+
+
+@settings(max_examples=60, deadline=None)
+@given(x=st.tuples(st.floats(-3, 3), st.floats(-3, 3), st.floats(-1, 1)),
+       a=st.floats(0.1, 2.0), b=st.floats(0.1, 2.0))
+def test_nearest_boundary_point_against_brute_force(x, a, b):
+    """The distance to the rectangle's edges against a dense sampling of the edges."""
+    distance, p1, p2, u1, u2 = rectangle3d.nearest_boundary_point(*x, a, b)
+    t = np.linspace(-1.0, 1.0, 20001)
+    edges = np.concatenate([np.column_stack([np.full_like(t, s * a), t * b]) for s in (-1, 1)]
+                           + [np.column_stack([t * a, np.full_like(t, s * b)]) for s in (-1, 1)])
+    sampled = np.sqrt(((edges - np.array(x[:2])) ** 2).sum(axis=1) + x[2] ** 2)
+    step = 2.0 * max(a, b) / 20000
+    assert sampled.min() - step <= distance <= sampled.min() + 1e-12
+    assert np.hypot(p1 - x[0], p2 - x[1]) ** 2 + x[2] ** 2 == pytest.approx(distance**2, rel=1e-9, abs=1e-18)
+    assert abs(abs(p1) - a) < 1e-12 or abs(abs(p2) - b) < 1e-12  # on the boundary
+    assert np.hypot(u1, u2) == pytest.approx(1.0)
+
+
+def test_line_tip_distance():
+    assert line2d.tip_distance(1.3, 0.4, 1.0) == pytest.approx(0.5)
+    assert line2d.tip_distance(-0.6, -0.3, 1.0) == pytest.approx(0.5)
+    assert line2d.tip_distance(0.0, 0.0, 1.0) == pytest.approx(1.0)

@@ -14,6 +14,8 @@ using ``g_yy = -g_xx``, ``g_xyy = -g_xxx``, ``g_yyy = -g_xxy`` (harmonicity) and
 ref. App. A eqs 15-19 (eqs 18-19 there print ``r^2`` where ``r^4`` belongs). The only
 singular points are the segment's two end points (dislocations), handled as in
 :mod:`hmatddm.kernels.rectangle3d`; points on the extension of the segment are regular.
+Points merely *near* an end point (a near-miss junction) are treated as on it when the
+caller passes a ``near`` distance (see :func:`traction_block`).
 """
 import math
 
@@ -67,19 +69,34 @@ def local_stress(x, y, a, shear_modulus, poisson_ratio, out):
 
 
 @njit(cache=True)
-def local_stress_corrected(x, y, a, shear_modulus, poisson_ratio, singular_shift, out):
-    """:func:`local_stress`; at an end point either NaN (``singular_shift <= 0``) or the
-    mean of the values ``+-singular_shift * a`` along the segment (ref. Sec. 6.2.3)."""
-    if not on_tip(x, y, a):
+def tip_distance(x, y, a):
+    """Distance from the local point ``(x, y)`` to the nearer end point of the segment."""
+    d = abs(x) - a
+    return math.sqrt(d * d + y * y)
+
+
+@njit(cache=True)
+def local_stress_corrected(x, y, a, shear_modulus, poisson_ratio, singular_shift, out, near=0.0):
+    """:func:`local_stress`, with singular points handled by the reference's averaging
+    (ref. Sec. 6.2.3).
+
+    A point is singular when it lies on an end point (:func:`on_tip`) or, for
+    ``near > 0``, within the distance ``near`` of one (a near-miss junction, where the
+    exact value is ~1/gap). Such points give NaN when ``singular_shift <= 0`` (the
+    caller reports them); otherwise the point is moved onto the end point and the
+    stress is the mean of the values ``+-singular_shift * a`` along the segment from it.
+    """
+    if not (on_tip(x, y, a) or (near > 0.0 and tip_distance(x, y, a) <= near)):
         local_stress(x, y, a, shear_modulus, poisson_ratio, out)
         return
     if singular_shift <= 0.0:
         out[:] = np.nan
         return
+    tip = a if x >= 0.0 else -a
     delta = singular_shift * a
     tmp = np.empty((2, 2, 2))
-    local_stress(x + delta, y, a, shear_modulus, poisson_ratio, out)
-    local_stress(x - delta, y, a, shear_modulus, poisson_ratio, tmp)
+    local_stress(tip + delta, 0.0, a, shear_modulus, poisson_ratio, out)
+    local_stress(tip - delta, 0.0, a, shear_modulus, poisson_ratio, tmp)
     for k in range(2):
         for i in range(2):
             for j in range(2):
@@ -87,14 +104,16 @@ def local_stress_corrected(x, y, a, shear_modulus, poisson_ratio, singular_shift
 
 
 @njit(cache=True)
-def traction_pair(point, normal, center, frame, a, shear_modulus, poisson_ratio, singular_shift, out, work):
+def traction_pair(point, normal, center, frame, a, shear_modulus, poisson_ratio, singular_shift, out, work,
+                  near=0.0):
     """``out[p, q]``: global traction component p at ``point`` (receiver ``normal``) for a
-    unit global DD component q of the segment (ref. Eqs 2.57-2.58)."""
+    unit global DD component q of the segment (ref. Eqs 2.57-2.58). ``near``: see
+    :func:`local_stress_corrected`."""
     dx = point[0] - center[0]
     dy = point[1] - center[1]
     x = frame[0, 0] * dx + frame[0, 1] * dy
     y = frame[1, 0] * dx + frame[1, 1] * dy
-    local_stress_corrected(x, y, a, shear_modulus, poisson_ratio, singular_shift, work)
+    local_stress_corrected(x, y, a, shear_modulus, poisson_ratio, singular_shift, work, near)
     m0 = frame[0, 0] * normal[0] + frame[0, 1] * normal[1]
     m1 = frame[1, 0] * normal[0] + frame[1, 1] * normal[1]
     t00 = work[0, 0, 0] * m0 + work[0, 0, 1] * m1
@@ -109,13 +128,14 @@ def traction_pair(point, normal, center, frame, a, shear_modulus, poisson_ratio,
 
 
 @njit(cache=True)
-def stress_pair(point, center, frame, a, shear_modulus, poisson_ratio, singular_shift, out, work):
-    """Global stress at ``point`` from unit global DD components: ``out[q, i, j]``."""
+def stress_pair(point, center, frame, a, shear_modulus, poisson_ratio, singular_shift, out, work, near=0.0):
+    """Global stress at ``point`` from unit global DD components: ``out[q, i, j]``
+    (``near``: see :func:`local_stress_corrected`)."""
     dx = point[0] - center[0]
     dy = point[1] - center[1]
     x = frame[0, 0] * dx + frame[0, 1] * dy
     y = frame[1, 0] * dx + frame[1, 1] * dy
-    local_stress_corrected(x, y, a, shear_modulus, poisson_ratio, singular_shift, work)
+    local_stress_corrected(x, y, a, shear_modulus, poisson_ratio, singular_shift, work, near)
     for q in range(2):
         for i in range(2):
             for j in range(2):
@@ -132,13 +152,17 @@ def traction_block(data, rows, cols, out):
     """Block generator kernel for 2D meshes, as :func:`rectangle3d.traction_block`.
 
     ``data = (centers, frames, half_length, half_length, params, self_max)`` (the half
-    length is passed twice so that 2D and 3D data tuples have the same layout).
+    length is passed twice so that 2D and 3D data tuples have the same layout), with
+    ``params = [G, nu, singular_shift, alpha, near_fraction]``. A collocation point
+    closer than ``near_fraction * min(a_i, a_j)`` (half lengths of receiver and source)
+    to an end point of another element is singular (see :func:`local_stress_corrected`).
     """
     centers, frames, half_length, _unused, params, self_max = data
     g = params[0]
     nu = params[1]
     shift = params[2]
     alpha = params[3]
+    near_fraction = params[4] if params.shape[0] > 4 else 0.0
     work = np.empty((2, 2, 2))
     pair = np.empty((2, 2))
     for ia in range(rows.shape[0]):
@@ -147,12 +171,26 @@ def traction_block(data, rows, cols, out):
         normal = frames[i, 1]
         for jb in range(cols.shape[0]):
             j = cols[jb]
-            traction_pair(point, normal, centers[j], frames[j], half_length[j], g, nu, shift, pair, work)
+            near = 0.0
+            if i != j:
+                near = near_fraction * min(half_length[i], half_length[j])
+            traction_pair(point, normal, centers[j], frames[j], half_length[j], g, nu, shift, pair, work, near)
             if alpha > 0.0 and i != j:
                 scale_to_self(pair, alpha * self_max[j])
             for p in range(2):
                 for q in range(2):
                     out[2 * ia + p, 2 * jb + q] = pair[p, q]
+
+
+@njit(cache=True)
+def edge_distance(data, i, j):
+    """Distance from element ``i``'s collocation point to the nearer end of element ``j``."""
+    centers, frames, half_length = data[0], data[1], data[2]
+    dx = centers[i, 0] - centers[j, 0]
+    dy = centers[i, 1] - centers[j, 1]
+    x = frames[j, 0, 0] * dx + frames[j, 0, 1] * dy
+    y = frames[j, 1, 0] * dx + frames[j, 1, 1] * dy
+    return tip_distance(x, y, half_length[j])
 
 
 @njit(cache=True, parallel=True)
@@ -207,3 +245,18 @@ def mean_stress_pair(point, center, frame, a, shear_modulus, poisson_ratio, out)
     m1 = -c * gxx
     for q in range(2):
         out[q] = frame[0, q] * m0 + frame[1, q] * m1
+
+
+@njit(cache=True)
+def singular_pairs(data, rows, cols, out):
+    """``out[k]`` = True when the influence block of receiver ``rows[k]`` and source
+    ``cols[k]`` (from :func:`traction_block`) is not finite: a singular pair."""
+    pair = np.empty((2, 2))
+    for k in range(rows.shape[0]):
+        traction_block(data, rows[k:k + 1], cols[k:k + 1], pair)
+        finite = True
+        for p in range(2):
+            for q in range(2):
+                if not np.isfinite(pair[p, q]):
+                    finite = False
+        out[k] = not finite

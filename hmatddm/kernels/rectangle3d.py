@@ -18,8 +18,9 @@ rectangle is symmetric, so derivatives pick up a sign per reflected index). Ther
 terms ``r + x1bar`` and ``r + x2bar`` vanish only ON the element's edges, and are computed
 as ``(x2bar^2 + x3^2)/(r - x1bar)`` when ``x1bar < 0`` to avoid cancellation. Points on the
 extension of an edge are therefore regular; points exactly on an edge (a dislocation line,
-where the stress is infinite) are reported through ``singular`` and handled by the caller
-(see :mod:`hmatddm.kernels.correction`).
+where the stress is infinite) are singular and handled by :func:`local_stress_corrected`
+(see :mod:`hmatddm.kernels.correction`), as are points within a caller-given ``near``
+distance of an edge (near-miss junctions, where the exact value is ~1/gap).
 
 Sign convention: DD = u(+) - u(-), + being the side ``n = e1 x e2`` points to; an opening
 (DD . n > 0) induces compression on the element itself (DESIGN.md section 1).
@@ -168,28 +169,67 @@ def _to_local(point, center, frame):
 
 
 @njit(cache=True)
-def local_stress_corrected(x1, x2, x3, a, b, shear_modulus, poisson_ratio, singular_shift, out):
-    """:func:`local_stress`, with points on an edge handled by the reference's averaging
-    (ref. Sec. 6.2.3): if ``singular_shift > 0`` the stress is the mean of the values at
-    two points moved by ``+-singular_shift * min(a, b)`` across the edge, in the element
-    plane; otherwise such points give NaN (the caller reports them)."""
-    if not on_edge(x1, x2, x3, a, b):
+def nearest_boundary_point(x1, x2, x3, a, b):
+    """Nearest point of the rectangle's boundary (its four edges) to a local point.
+
+    Returns ``(distance, p1, p2, u1, u2)``: the distance, the in-plane point ``(p1, p2)``
+    (``p3 = 0``) and the unit in-plane direction ``(u1, u2)`` across the edge there
+    (``e1`` on the ``x1 = +-a`` edges, ``e2`` on the ``x2 = +-b`` edges, the diagonal at a
+    corner, as the reference's averaging needs).
+    """
+    ax1 = abs(x1)
+    ax2 = abs(x2)
+    zsq = x3 * x3
+    tol = 1e-12 * (a + b)
+    e1 = ax1 - a  # to the x1 = +-a edges (segments |x2| <= b)
+    o2 = max(ax2 - b, 0.0)
+    d1sq = e1 * e1 + o2 * o2 + zsq
+    e2 = ax2 - b  # to the x2 = +-b edges (segments |x1| <= a)
+    o1 = max(ax1 - a, 0.0)
+    d2sq = e2 * e2 + o1 * o1 + zsq
+    if d1sq <= d2sq:
+        p1 = math.copysign(a, x1)
+        p2 = math.copysign(min(ax2, b), x2)
+        u1 = 1.0
+        u2 = 1.0 if ax2 >= b - tol else 0.0
+        distance = math.sqrt(d1sq)
+    else:
+        p1 = math.copysign(min(ax1, a), x1)
+        p2 = math.copysign(b, x2)
+        u1 = 1.0 if ax1 >= a - tol else 0.0
+        u2 = 1.0
+        distance = math.sqrt(d2sq)
+    norm = math.sqrt(u1 * u1 + u2 * u2)
+    return distance, p1, p2, u1 / norm, u2 / norm
+
+
+@njit(cache=True)
+def local_stress_corrected(x1, x2, x3, a, b, shear_modulus, poisson_ratio, singular_shift, out, near=0.0):
+    """:func:`local_stress`, with singular points handled by the reference's averaging
+    (ref. Sec. 6.2.3).
+
+    A point is singular when it lies on an edge (:func:`on_edge`) or, for ``near > 0``,
+    within the distance ``near`` of one (a near-miss junction, where the exact value is
+    ~1/gap). Such points give NaN when ``singular_shift <= 0`` (the caller reports them);
+    otherwise the point is moved onto the nearest boundary point and the stress is the
+    mean of the values at two points ``+-singular_shift * min(a, b)`` across the edge
+    from there, in the element plane (diagonally at a corner).
+    """
+    exact = on_edge(x1, x2, x3, a, b)
+    if not exact and near <= 0.0:
+        local_stress(x1, x2, x3, a, b, shear_modulus, poisson_ratio, out)
+        return
+    distance, p1, p2, u1, u2 = nearest_boundary_point(x1, x2, x3, a, b)
+    if not exact and distance > near:
         local_stress(x1, x2, x3, a, b, shear_modulus, poisson_ratio, out)
         return
     if singular_shift <= 0.0:
         out[:] = np.nan
         return
     delta = singular_shift * min(a, b)
-    # direction across the edge: e1 on the x1 = +-a edges, e2 on the x2 = +-b edges,
-    # the diagonal at a corner
-    u1 = 1.0 if abs(abs(x1) - a) <= 1e-12 * (a + b) else 0.0
-    u2 = 1.0 if abs(abs(x2) - b) <= 1e-12 * (a + b) else 0.0
-    norm = math.sqrt(u1 * u1 + u2 * u2)
-    u1 /= norm
-    u2 /= norm
     tmp = np.empty((3, 3, 3))
-    local_stress(x1 + delta * u1, x2 + delta * u2, x3, a, b, shear_modulus, poisson_ratio, out)
-    local_stress(x1 - delta * u1, x2 - delta * u2, x3, a, b, shear_modulus, poisson_ratio, tmp)
+    local_stress(p1 + delta * u1, p2 + delta * u2, 0.0, a, b, shear_modulus, poisson_ratio, out)
+    local_stress(p1 - delta * u1, p2 - delta * u2, 0.0, a, b, shear_modulus, poisson_ratio, tmp)
     for k in range(3):
         for i in range(3):
             for j in range(3):
@@ -197,12 +237,13 @@ def local_stress_corrected(x1, x2, x3, a, b, shear_modulus, poisson_ratio, singu
 
 
 @njit(cache=True)
-def traction_pair(point, normal, center, frame, a, b, shear_modulus, poisson_ratio, singular_shift, out, work):
+def traction_pair(point, normal, center, frame, a, b, shear_modulus, poisson_ratio, singular_shift, out, work,
+                  near=0.0):
     """Traction ``sigma . normal`` at ``point`` (global) from unit global DD components of
     one element: ``out[p, q]`` = traction component p for DD_q = 1 (ref. Eqs 2.57-2.58).
-    ``work`` is a (3, 3, 3) scratch array."""
+    ``work`` is a (3, 3, 3) scratch array; ``near``: see :func:`local_stress_corrected`."""
     x1, x2, x3 = _to_local(point, center, frame)
-    local_stress_corrected(x1, x2, x3, a, b, shear_modulus, poisson_ratio, singular_shift, work)
+    local_stress_corrected(x1, x2, x3, a, b, shear_modulus, poisson_ratio, singular_shift, work, near)
     # receiver normal in the source's local frame
     m0 = frame[0, 0] * normal[0] + frame[0, 1] * normal[1] + frame[0, 2] * normal[2]
     m1 = frame[1, 0] * normal[0] + frame[1, 1] * normal[1] + frame[1, 2] * normal[2]
@@ -230,10 +271,11 @@ def traction_pair(point, normal, center, frame, a, b, shear_modulus, poisson_rat
 
 
 @njit(cache=True)
-def stress_pair(point, center, frame, a, b, shear_modulus, poisson_ratio, singular_shift, out, work):
-    """Global stress at ``point`` from unit global DD components: ``out[q, i, j]``."""
+def stress_pair(point, center, frame, a, b, shear_modulus, poisson_ratio, singular_shift, out, work, near=0.0):
+    """Global stress at ``point`` from unit global DD components: ``out[q, i, j]``
+    (``near``: see :func:`local_stress_corrected`)."""
     x1, x2, x3 = _to_local(point, center, frame)
-    local_stress_corrected(x1, x2, x3, a, b, shear_modulus, poisson_ratio, singular_shift, work)
+    local_stress_corrected(x1, x2, x3, a, b, shear_modulus, poisson_ratio, singular_shift, work, near)
     for q in range(3):
         for i in range(3):
             for j in range(3):
@@ -251,32 +293,53 @@ def stress_pair(point, center, frame, a, b, shear_modulus, poisson_ratio, singul
 def traction_block(data, rows, cols, out):
     """Block generator kernel (see :class:`hmatddm.hmatrix.BlockGenerator`).
 
-    ``data = (centers, frames, half_a, half_b, params)`` with ``params =
-    [shear_modulus, poisson_ratio, singular_shift, alpha]`` and ``out`` of shape
-    ``(3 len(rows), 3 len(cols))``: traction at the collocation points of ``rows`` (with
-    their normals) from unit global DD components of ``cols``. ``alpha > 0`` applies the
-    reference's scaling of blocks larger than the self-influence (ref. Eq. 6.11), which
-    needs ``data[5]``: the max-abs entry of each element's self block.
+    ``data = (centers, frames, half_a, half_b, params, self_max)`` with ``params =
+    [shear_modulus, poisson_ratio, singular_shift, alpha, near_fraction]`` and ``out`` of
+    shape ``(3 len(rows), 3 len(cols))``: traction at the collocation points of ``rows``
+    (with their normals) from unit global DD components of ``cols``.
+
+    * A collocation point on an edge of another element, or closer to one than
+      ``near_fraction * min(size_i, size_j)`` (``size = min(half_a, half_b)`` of the
+      receiver ``i`` and the source ``j``: a near-miss junction), is singular: NaN
+      without averaging (``singular_shift = 0``), else the reference's averaging at the
+      nearest edge point (:func:`local_stress_corrected`).
+    * ``alpha > 0`` applies the reference's scaling of blocks larger than the
+      self-influence (ref. Eq. 6.11), which needs ``data[5]``: the max-abs entry of each
+      element's self block.
     """
     centers, frames, half_a, half_b, params, self_max = data
     g = params[0]
     nu = params[1]
     shift = params[2]
     alpha = params[3]
+    near_fraction = params[4] if params.shape[0] > 4 else 0.0
     work = np.empty((3, 3, 3))
     pair = np.empty((3, 3))
     for ia in range(rows.shape[0]):
         i = rows[ia]
         point = centers[i]
         normal = frames[i, 2]
+        size_i = min(half_a[i], half_b[i])
         for jb in range(cols.shape[0]):
             j = cols[jb]
-            traction_pair(point, normal, centers[j], frames[j], half_a[j], half_b[j], g, nu, shift, pair, work)
+            near = 0.0
+            if i != j:
+                near = near_fraction * min(size_i, half_a[j], half_b[j])
+            traction_pair(point, normal, centers[j], frames[j], half_a[j], half_b[j], g, nu, shift, pair, work,
+                          near)
             if alpha > 0.0 and i != j:
                 scale_to_self(pair, alpha * self_max[j])
             for p in range(3):
                 for q in range(3):
                     out[3 * ia + p, 3 * jb + q] = pair[p, q]
+
+
+@njit(cache=True)
+def edge_distance(data, i, j):
+    """Distance from element ``i``'s collocation point to the nearest edge of element ``j``."""
+    centers, frames, half_a, half_b = data[0], data[1], data[2], data[3]
+    x1, x2, x3 = _to_local(centers[i], centers[j], frames[j])
+    return nearest_boundary_point(x1, x2, x3, half_a[j], half_b[j])[0]
 
 
 @njit(cache=True, parallel=True)
@@ -325,3 +388,18 @@ def mean_stress_pair(point, center, frame, a, b, shear_modulus, poisson_ratio, o
     m2 = -c * (j[0] + j[1])
     for q in range(3):
         out[q] = frame[0, q] * m0 + frame[1, q] * m1 + frame[2, q] * m2
+
+
+@njit(cache=True)
+def singular_pairs(data, rows, cols, out):
+    """``out[k]`` = True when the influence block of receiver ``rows[k]`` and source
+    ``cols[k]`` (from :func:`traction_block`) is not finite: a singular pair."""
+    pair = np.empty((3, 3))
+    for k in range(rows.shape[0]):
+        traction_block(data, rows[k:k + 1], cols[k:k + 1], pair)
+        finite = True
+        for p in range(3):
+            for q in range(3):
+                if not np.isfinite(pair[p, q]):
+                    finite = False
+        out[k] = not finite
