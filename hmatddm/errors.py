@@ -84,3 +84,11 @@ class OutputError(HmatddmError, OSError):
         reason = cls.describe(error, path.parent)
         return cls(f"could not write {what or str(path)}: {reason}", path=path,
                    errno=getattr(error, "errno", None))
+
+
+class MeshQualityWarning(UserWarning):
+    """The mesh is valid but too coarse for its geometry: the constant-DD solution can
+    be wrong there (e.g. two fractures closer than their elements resolve, see
+    :func:`hmatddm.mesh.close_parallel_pairs`). The message names the elements and the
+    element size that fixes it. Turn it into an error with
+    ``warnings.simplefilter("error", hd.errors.MeshQualityWarning)``."""
