@@ -16,6 +16,7 @@ import hashlib
 import json
 import logging
 import time
+import warnings
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -24,7 +25,7 @@ from .. import topology
 from .._validation import finite_array, finite_scalar, positive_scalar
 from ..coupled import ElasticSolver, SchemeSettings, StepProblem, solve_step
 from ..coupled.contact import CONTACT_MODES, OPEN, SLIP, STICK, ContactLaw, ContactModel
-from ..errors import InputError
+from ..errors import InputError, MeshQualityWarning
 from ..flow import Cluster, Fluid, LeakOff, LubricationModel, fracture_compliance
 from ..fracture import Propagation, evaluate_tips, new_elements
 from ..fracture.crossing import NaturalFractureProperties
@@ -220,6 +221,7 @@ class Simulation:
         self._operator = None
         self._base = None
         self.operator_builds = 0
+        self._mesh_quality_warned = False
 
     # -- setup ------------------------------------------------------------------------
     def _initial_state(self):
@@ -274,7 +276,18 @@ class Simulation:
         return m <= self.rebuild_fraction * n0 and border_bytes <= self.max_border_bytes
 
     def _build_base(self, mesh):
-        self._base = ElasticityOperator(mesh, self.material, **self.operator_options)
+        # the mesh-quality check runs at every build of a growing mesh: warn once per run
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", MeshQualityWarning)
+            self._base = ElasticityOperator(mesh, self.material, **self.operator_options)
+        for warning in caught:
+            if issubclass(warning.category, MeshQualityWarning):
+                if not self._mesh_quality_warned:
+                    self._mesh_quality_warned = True
+                    warnings.warn(f"{warning.message} (warned once per simulation)", MeshQualityWarning,
+                                  stacklevel=2)
+            else:
+                warnings.warn_explicit(warning.message, warning.category, warning.filename, warning.lineno)
         self.operator_builds += 1
         return self._base
 
