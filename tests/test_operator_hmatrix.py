@@ -30,7 +30,10 @@ def tilted_rectangles(seed=4):
 
 
 def segment_network(seed=5):
-    """A 2D DFN-like set of straight fractures, each cut into segments."""
+    """A 2D DFN-like set of straight fractures, each cut into segments. Meshed
+    independently, crossings put element ends within half an element of other
+    fractures' collocation points (9 of them, 0.28-0.48 half sizes): near-miss
+    junctions, which need singular_correction="average" (OPTIONS)."""
     rng = np.random.default_rng(seed)
     parts = []
     for k in range(40):
@@ -55,18 +58,20 @@ def elliptical_opening(mesh):
 
 
 MESHES = {"planar crack": planar_crack, "tilted rectangles": tilted_rectangles, "2D segments": segment_network}
+OPTIONS = {"2D segments": dict(singular_correction="average")}
 
 
 @pytest.fixture(scope="module")
 def dense_operators(material):
-    return {name: hd.ElasticityOperator(make(), material, backend="dense") for name, make in MESHES.items()}
+    return {name: hd.ElasticityOperator(make(), material, backend="dense", **OPTIONS.get(name, {}))
+            for name, make in MESHES.items()}
 
 
 @pytest.mark.parametrize("eps", [1e-3, 1e-6])
 @pytest.mark.parametrize("name", list(MESHES))
 def test_every_admissible_block_meets_eps(material, name, eps):
     mesh = MESHES[name]()
-    op = hd.ElasticityOperator(mesh, material, backend="hmatrix", eps=eps, leaf_size=32)
+    op = hd.ElasticityOperator(mesh, material, backend="hmatrix", eps=eps, leaf_size=32, **OPTIONS.get(name, {}))
     assert op.stats["n_admissible"] > 10, "the test mesh must have far-field blocks"
     worst = op.check_against_dense(n_samples=400)
     assert worst <= 10 * eps, f"{name}: worst admissible block error {worst:.2e} > 10 eps"
@@ -77,7 +82,7 @@ def test_matvec_and_solution_agree_with_dense(material, dense_operators, name):
     eps = 1e-6
     dense = dense_operators[name]
     mesh = dense.mesh
-    op = hd.ElasticityOperator(mesh, material, backend="hmatrix", eps=eps, leaf_size=32)
+    op = hd.ElasticityOperator(mesh, material, backend="hmatrix", eps=eps, leaf_size=32, **OPTIONS.get(name, {}))
     rng = np.random.default_rng(0)
     for x in (rng.normal(size=op.shape[1]), elliptical_opening(mesh)):
         exact = dense @ x
