@@ -1,0 +1,159 @@
+"""Induced stress at points (hmatddm.solve.stress_at / mean_stress_at): the contracted
+kernels against the per-component kernels, and the compressed (tree) sum against the exact
+direct sum on a DFN-like scene."""
+import numpy as np
+import pytest
+
+import hmatddm as hd
+from hmatddm.kernels import element_data, line2d, rectangle3d
+from hmatddm.network import NetworkSpec, generate_network
+
+
+@pytest.fixture(scope="module")
+def material():
+    return hd.Elastic(6.62e9, 0.25)
+
+
+def _random_mesh3d(rng, n=30):
+    centers = rng.uniform(-5, 5, (n, 3))
+    e1 = rng.normal(size=(n, 3))
+    e1 /= np.linalg.norm(e1, axis=1)[:, None]
+    e2 = np.cross(e1, rng.normal(size=(n, 3)))
+    e2 /= np.linalg.norm(e2, axis=1)[:, None]
+    return hd.Mesh3D.from_rectangles(centers, e1, e2, rng.uniform(0.2, 1.0, n), rng.uniform(0.2, 1.0, n))
+
+
+def _reference3d(mesh, material, dd, points, shift=0.0):
+    """The per-DD-component kernel of hmatddm.kernels.rectangle3d (the original evaluation)."""
+    centers, frames, half_a, half_b, params, _ = element_data(mesh, material, singular_shift=shift)
+    out = np.empty((len(points), 3, 3))
+    rectangle3d.stress_at_points(np.ascontiguousarray(points), centers, frames, half_a, half_b, params, dd, out)
+    return out
+
+
+def test_direct_3d_matches_component_kernel(material):
+    rng = np.random.default_rng(0)
+    mesh = _random_mesh3d(rng)
+    dd = rng.normal(size=(mesh.n_elements, 3)) * 1e-3
+    points = rng.uniform(-6, 6, (200, 3))
+    reference = _reference3d(mesh, material, dd, points)
+    stress = hd.stress_at(mesh, material, dd, points, method="direct")
+    assert np.max(np.abs(stress - reference)) <= 1e-12 * np.max(np.abs(reference))
+    assert np.allclose(stress, np.transpose(stress, (0, 2, 1)), rtol=0, atol=0)
+    mean = hd.mean_stress_at(mesh, material, dd, points, method="direct")
+    trace = np.trace(reference, axis1=1, axis2=2) / 3.0
+    assert np.max(np.abs(mean - trace)) <= 1e-12 * np.max(np.abs(reference))
+
+
+def test_edge_points_3d_average_or_refuse(material):
+    rng = np.random.default_rng(1)
+    mesh = _random_mesh3d(rng, 8)
+    dd = rng.normal(size=(mesh.n_elements, 3)) * 1e-3
+    on_edge = mesh.centers[:4] + mesh.half_a[:4, None] * mesh.frames[:4, 0]
+    reference = _reference3d(mesh, material, dd, on_edge, shift=1e-3)
+    stress = hd.stress_at(mesh, material, dd, on_edge, singular_correction="average", method="direct")
+    assert np.max(np.abs(stress - reference)) <= 1e-12 * np.max(np.abs(reference))
+    mean = hd.mean_stress_at(mesh, material, dd, on_edge, singular_correction="average")
+    assert np.allclose(mean, np.trace(reference, axis1=1, axis2=2) / 3.0, rtol=1e-12, atol=0)
+    for function in (hd.stress_at, hd.mean_stress_at):
+        with pytest.raises(hd.InputError, match="edge"):
+            function(mesh, material, dd, on_edge)
+
+
+def test_direct_2d_matches_component_kernel(material):
+    rng = np.random.default_rng(2)
+    mesh = hd.mesh.line([0.0, 0.0], [3.0, 1.0], 12)
+    dd = rng.normal(size=(12, 2)) * 1e-3
+    points = rng.uniform(-3, 4, (150, 2))
+    centers, frames, half_a, _, params, _ = element_data(mesh, material)
+    reference = np.empty((150, 2, 2))
+    line2d.stress_at_points(points, centers, frames, half_a, params, dd, reference)
+    assert np.max(np.abs(hd.stress_at(mesh, material, dd, points) - reference)) <= 1e-12 * np.max(np.abs(reference))
+    mean = hd.mean_stress_at(mesh, material, dd, points)
+    expected = (1.0 + material.poisson_ratio) * np.trace(reference, axis1=1, axis2=2) / 3.0
+    assert np.max(np.abs(mean - expected)) <= 1e-12 * np.max(np.abs(reference))
+
+
+@pytest.fixture(scope="module")
+def dfn_scene():
+    """Three vertical hydraulic fractures (elliptical opening plus some slip) and the
+    centres of a full-height natural-fracture network as targets (ref. Sec. 6.3)."""
+    spec = NetworkSpec(region=(-30.0, 30.0, -40.0, 40.0), density=0.05, length_exponent=2.0, l_min=1.0,
+                       l_max=20.0, mean_azimuths_deg=(45.0,), kappas=(5.0,), height=4.0, seed=3)
+    natural = generate_network(spec).to_mesh3d(1.0, 4)
+    length = 30
+    parts = [hd.mesh.rectangle([x, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], length, 4.0, length, 4,
+                               fracture_id=k) for k, x in enumerate((-10.0, 0.0, 10.0))]
+    mesh = hd.mesh.concatenate(parts)
+    y, z = mesh.centers[:, 1], mesh.centers[:, 2]
+    opening = 1e-3 * np.sqrt(np.clip(1 - (y / (length / 2)) ** 2, 0, 1)) * np.sqrt(np.clip(1 - (z / 2) ** 2, 0.05, 1))
+    dd = opening[:, None] * mesh.normals + 0.2 * opening[:, None] * np.array([0.0, 1.0, 0.3])
+    return mesh, dd, natural.centers
+
+
+@pytest.mark.parametrize("eps", [1e-4, 1e-6])
+def test_tree_matches_direct_on_dfn_scene(material, dfn_scene, eps):
+    mesh, dd, points = dfn_scene
+    exact = hd.stress_at(mesh, material, dd, points, singular_correction="average", method="direct")
+    info = {}
+    approx = hd.stress_at(mesh, material, dd, points, singular_correction="average", method="tree", eps=eps,
+                          info=info)
+    assert info["method"] == "tree" and info["pairs_compressed"] > 0.25 * len(points) * mesh.n_elements
+    scale = np.max(np.abs(exact))
+    assert np.max(np.abs(approx - exact)) <= eps * scale
+    exact_mean = hd.mean_stress_at(mesh, material, dd, points, method="direct")
+    approx_mean = hd.mean_stress_at(mesh, material, dd, points, method="tree", eps=eps)
+    assert np.max(np.abs(approx_mean - exact_mean)) <= eps * np.max(np.abs(exact_mean))
+
+
+def test_tree_error_follows_eps(material, dfn_scene):
+    mesh, dd, points = dfn_scene
+    exact = hd.stress_at(mesh, material, dd, points, method="direct")
+    errors = [np.max(np.abs(hd.stress_at(mesh, material, dd, points, method="tree", eps=eps) - exact))
+              for eps in (1e-3, 1e-5, 1e-7)]
+    assert errors[0] > errors[1] > errors[2]
+
+
+def test_tree_coplanar_targets_and_zero_dd(material):
+    """Points in the plane of the elements (ahead of a planar crack) and elements without
+    DD: the compressed sum must not stop on zero pivots nor lose the far field."""
+    mesh = hd.mesh.rectangle([0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], 40.0, 6.0, 40, 6)
+    dd = 1e-3 * mesh.normals
+    dd[mesh.centers[:, 1] > 10.0] = 0.0
+    y = np.linspace(25.0, 80.0, 400)
+    z = np.linspace(-2.5, 2.5, 6)
+    yy, zz = np.meshgrid(y, z)
+    points = np.column_stack([np.zeros(yy.size), yy.ravel(), zz.ravel()])
+    points = np.concatenate([points, points + [3.0, 0.0, 0.0]])
+    exact = hd.stress_at(mesh, material, dd, points, method="direct")
+    approx = hd.stress_at(mesh, material, dd, points, method="tree", eps=1e-6)
+    assert np.max(np.abs(approx - exact)) <= 1e-6 * np.max(np.abs(exact))
+
+
+def test_results_do_not_depend_on_thread_count(material, dfn_scene):
+    numba = pytest.importorskip("numba")
+    mesh, dd, points = dfn_scene
+    if numba.config.NUMBA_NUM_THREADS < 2:
+        pytest.skip("needs two numba threads")
+    results = []
+    previous = numba.get_num_threads()
+    try:
+        for threads in (1, 2):
+            numba.set_num_threads(threads)
+            results.append([hd.stress_at(mesh, material, dd, points, method=method) for method in ("direct", "tree")])
+    finally:
+        numba.set_num_threads(previous)
+    for one, two in zip(*results):
+        assert np.array_equal(one, two)
+
+
+def test_auto_method_and_bad_input(material, dfn_scene):
+    mesh, dd, points = dfn_scene
+    info = {}
+    hd.stress_at(mesh, material, dd, points[:10], info=info)
+    assert info["method"] == "direct"
+    with pytest.raises(hd.InputError, match="method"):
+        hd.stress_at(mesh, material, dd, points, method="fmm")
+    with pytest.raises(hd.InputError, match="eps"):
+        hd.mean_stress_at(mesh, material, dd, points, eps=2.0)
+    assert hd.stress_at(mesh, material, dd, np.zeros((0, 3))).shape == (0, 3, 3)
