@@ -12,6 +12,17 @@ Every approximation is then recompressed (QR of both factors, SVD of the small
 core, truncation of the singular-value tail at eps), which typically halves the ACA
 rank at no accuracy cost.
 
+The stopping test ``||u|| ||v|| <= eps ||S_k||`` only looks at the last cross, and the
+pivots are chosen from the last residual rows and columns: on a block that mixes
+scales (rows and columns of a large fracture plus several small ones) every pivot
+lands in the large part, whose rows and columns do not see the interaction of the
+small parts with each other, and the ACA stops at 2-3e-2 error whatever eps. So,
+as in ACA+ (Grasedyck 2005; Bebendorf's "ACA with a check"), convergence is only
+accepted after a check: the exact residual of a few row and column elements that no
+pivot has visited (the unvisited ones farthest, in cluster-tree order, from every
+visited one) must be small; a probe that fails becomes the next pivot and the
+iteration goes on.
+
 Conventions: a block is given by its row elements (m_e of them) and column elements
 (n_e); it has m = d*m_e rows and n = d*n_e columns and is approximated by U V^T with
 U (m x k) and V (n x k). The ACA and the recompression work on the transposed
@@ -37,6 +48,15 @@ NEGLIGIBLE = 1e-14
 ACA_TOLERANCE_FACTOR = 0.1
 # Consecutive negligible pivots tolerated before the block is declared converged.
 MAX_FAILED_PIVOTS = 4
+# Convergence check (ACA+-like): when the stopping test passes, CHECK_PROBES row
+# elements and CHECK_PROBES column elements not yet visited are evaluated exactly
+# (alternately, each the unvisited element farthest in cluster-tree order from the
+# visited ones). A probe fails when its residual, extrapolated to the whole block
+# (times sqrt of the element count), exceeds CHECK_FACTOR * eps * ||S_k||_F (eps of
+# the ACA, i.e. ACA_TOLERANCE_FACTOR * the block's eps); it is then used as the next
+# pivot. Cost on ordinary blocks: 2 * CHECK_PROBES extra row/column evaluations.
+CHECK_PROBES = 2
+CHECK_FACTOR = 3.0
 
 
 @njit(cache=True, nogil=True)
@@ -216,6 +236,41 @@ def _add_cross(ut, vt, rank, residual_rows, residual_cols, first_col, threshold)
     return added, update_norm2, 2.0 * cross
 
 
+@njit(cache=True, nogil=True)
+def _farthest_unvisited(visited):
+    """Unvisited index farthest from every visited one (|i - j| in cluster-tree order,
+    a proxy of the geometric distance); -1 when all are visited. O(len)."""
+    count = visited.shape[0]
+    left = np.empty(count, dtype=np.int64)
+    last = -1
+    for i in range(count):
+        if visited[i]:
+            last = i
+        left[i] = i - last if last >= 0 else count
+    best = -1
+    best_distance = -1
+    last = -1
+    for i in range(count - 1, -1, -1):
+        if visited[i]:
+            last = i
+            continue
+        distance = left[i]
+        if last >= 0 and last - i < distance:
+            distance = last - i
+        if distance > best_distance:
+            best_distance = distance
+            best = i
+    return best
+
+
+@njit(cache=True, nogil=True, fastmath=FAST)
+def _squared_norm(array):
+    total = 0.0
+    for x in array.ravel():
+        total += x * x
+    return total
+
+
 # The ACA is a resumable state machine (cached, kernel-independent): each call of
 # aca_advance consumes the rows or columns just evaluated and says what to evaluate
 # next. Only the small loop in aca_tensor / the storage driver calls the kernel, so
@@ -226,10 +281,35 @@ REQUEST_ROW = 1  # evaluate the d rows of row element `index` into `rows` (d x n
 REQUEST_COL = 2  # evaluate the d columns of column element `index` into `cols` (m x d)
 
 # Slots of the integer state array.
-_PHASE, _RANK, _FAILURES, _PROBE, _ROW, _COL, _ROW_HOP, _COL_HOP = range(8)
-_PHASE_PIVOT_ROW, _PHASE_PIVOT_COL, _PHASE_PROBE_COL = 0, 1, 2
+_PHASE, _RANK, _FAILURES, _PROBE, _ROW, _COL, _ROW_HOP, _COL_HOP, _CHECKS, _CHECK_INDEX = range(10)
+_PHASE_PIVOT_ROW, _PHASE_PIVOT_COL, _PHASE_PROBE_COL, _PHASE_CHECK_ROW, _PHASE_CHECK_COL = 0, 1, 2, 3, 4
 # Slots of the float state array.
 _SCALE, _NORM2, _EPS = range(3)
+
+@njit(cache=True, nogil=True)
+def _next_check(row_visited, col_visited, ints):
+    """Request of the next convergence-check probe, or REQUEST_DONE when all passed.
+
+    Probes alternate row, column, row, ... (2 * CHECK_PROBES in all); a side with no
+    unvisited element left is skipped.
+    """
+    while ints[_CHECKS] < 2 * CHECK_PROBES:
+        k = ints[_CHECKS]
+        ints[_CHECKS] = k + 1
+        if k % 2 == 0:
+            row = _farthest_unvisited(row_visited)
+            if row >= 0:
+                ints[_CHECK_INDEX] = row
+                ints[_PHASE] = _PHASE_CHECK_ROW
+                return REQUEST_ROW, row
+        else:
+            col = _farthest_unvisited(col_visited)
+            if col >= 0:
+                ints[_CHECK_INDEX] = col
+                ints[_PHASE] = _PHASE_CHECK_COL
+                return REQUEST_COL, col
+    return REQUEST_DONE, 0
+
 
 # Explicit signatures of the state-machine steps: with them the kernel-specific build
 # driver can take these compiled functions as first-class function arguments and
@@ -259,7 +339,7 @@ def aca_start(n_row_elements, n_col_elements, dof, eps):
     m = n_row_elements * d
     n = n_col_elements * d
     capacity = min(min(m, n) + d, 4 * d)
-    ints = np.zeros(8, dtype=np.int64)
+    ints = np.zeros(10, dtype=np.int64)
     ints[_ROW_HOP] = _coprime_hop(n_row_elements)
     ints[_COL_HOP] = _coprime_hop(n_col_elements)
     ints[_PHASE] = _PHASE_PIVOT_ROW
@@ -279,7 +359,10 @@ def aca_advance(ut, vt, rows, cols, row_visited, col_visited, ints, floats):
     column element with the largest residual entry and request it; after that
     column element (``cols`` holds its raw columns) add the cross C P^+ R and request
     the row element with the largest residual in C; a negligible residual row is
-    skipped by probing an unvisited column element for a row with a residual.
+    skipped by probing an unvisited column element for a row with a residual. When
+    the stopping test passes, the convergence check requests its probes (see
+    CHECK_PROBES): a probe row with a large residual becomes the next pivot row, a
+    probe column with a large residual gives the next pivot row (its largest residual).
     Returns (ut, vt, request, index); ut, vt may have been reallocated to grow.
     """
     d = rows.shape[0]
@@ -288,10 +371,18 @@ def aca_advance(ut, vt, rows, cols, row_visited, col_visited, ints, floats):
     max_rank = min(m, n)
     rank = ints[_RANK]
     phase = ints[_PHASE]
-    if phase == _PHASE_PIVOT_ROW:
-        row = ints[_ROW]
+    if phase == _PHASE_PIVOT_ROW or phase == _PHASE_CHECK_ROW:
+        row = ints[_ROW] if phase == _PHASE_PIVOT_ROW else ints[_CHECK_INDEX]
         floats[_SCALE] = max(floats[_SCALE], _max_abs(rows))
         _subtract_rows(rows, ut, vt, rank, row * d)
+        if phase == _PHASE_CHECK_ROW:
+            row_visited[row] = True
+            limit = CHECK_FACTOR * floats[_EPS]
+            if row_visited.shape[0] * _squared_norm(rows) <= limit * limit * floats[_NORM2]:
+                request, index = _next_check(row_visited, col_visited, ints)
+                return ut, vt, request, index
+            ints[_CHECKS] = 0  # the check failed: this row is the next pivot
+            ints[_ROW] = row
         col, largest = _best_element(rows, col_visited, d)
         if col < 0:
             return ut, vt, REQUEST_DONE, 0
@@ -311,6 +402,22 @@ def aca_advance(ut, vt, rows, cols, row_visited, col_visited, ints, floats):
         ints[_PHASE] = _PHASE_PROBE_COL
         return ut, vt, REQUEST_COL, probe
     floats[_SCALE] = max(floats[_SCALE], _max_abs(cols))
+    if phase == _PHASE_CHECK_COL:
+        probe = ints[_CHECK_INDEX]
+        _subtract_cols(cols, ut, vt, rank, probe * d)
+        limit = CHECK_FACTOR * floats[_EPS]
+        if col_visited.shape[0] * _squared_norm(cols) <= limit * limit * floats[_NORM2]:
+            col_visited[probe] = True
+            request, index = _next_check(row_visited, col_visited, ints)
+            return ut, vt, request, index
+        ints[_CHECKS] = 0  # the check failed: pivot on this column's largest residual row
+        row, _ = _best_row_element(cols, row_visited, d)
+        if row < 0:
+            return ut, vt, REQUEST_DONE, 0
+        row_visited[row] = True
+        ints[_ROW] = row
+        ints[_PHASE] = _PHASE_PIVOT_ROW
+        return ut, vt, REQUEST_ROW, row
     if phase == _PHASE_PROBE_COL:
         probe = ints[_PROBE]
         _subtract_cols(cols, ut, vt, rank, probe * d)
@@ -339,8 +446,11 @@ def aca_advance(ut, vt, rows, cols, row_visited, col_visited, ints, floats):
     ints[_RANK] = rank
     floats[_NORM2] = max(floats[_NORM2] + update_norm2 + cross, 0.0)
     ints[_FAILURES] = 0
-    if update_norm2 <= floats[_EPS] ** 2 * floats[_NORM2] or rank >= max_rank:
+    if rank >= max_rank:
         return ut, vt, REQUEST_DONE, 0
+    if update_norm2 <= floats[_EPS] ** 2 * floats[_NORM2]:
+        request, index = _next_check(row_visited, col_visited, ints)
+        return ut, vt, request, index
     row, _ = _best_row_element(cols, row_visited, d)
     if row < 0:
         return ut, vt, REQUEST_DONE, 0
