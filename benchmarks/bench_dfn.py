@@ -434,8 +434,10 @@ def compare_paths(rows_a, rows_b, tolerance=1e-3):
 # ---------------------------------------------------------------------------------------
 
 def plot_plan(sim, path, title=""):
-    """Plan view: intact natural fractures (grey), failed ones (orange), activated natural
-    elements (blue), hydraulic elements (red); one line per element column."""
+    """Plan view at the end of a run, whole region (left) and zoomed on the fractures
+    (right): intact natural fractures grey, remotely failed ones orange, activated
+    natural elements blue, hydraulic elements red; one line per element column (the
+    traces of the vertical rectangles, :func:`hmatddm.simulation.natural.plan_segments`)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -444,35 +446,42 @@ def plot_plan(sim, path, title=""):
 
     s = sim.state
     natural = sim.network.mesh
-    # one plan segment per column: keep the row nearest mid-height of every element column
+
     def columns(mesh, mask):
         p0, p1, _ = plan_segments(mesh)
         keys = np.round(np.column_stack([p0, p1]), 4)
         index = np.flatnonzero(mask)
+        if index.size == 0:
+            return np.zeros((0, 2, 2))
         _, first = np.unique(keys[index], axis=0, return_index=True)
         index = index[first]
         return np.stack([p0[index], p1[index]], axis=1)
 
-    fig, ax = plt.subplots(figsize=(7, 11))
-    intact = s.intact & ~s.failed
-    for mask, colour, width, label in ((intact, "0.6", 0.6, "natural, intact"),
-                                       (s.failed, "tab:orange", 1.2, "natural, remote failure")):
-        if np.any(mask):
-            ax.add_collection(LineCollection(columns(natural, mask), colors=colour, linewidths=width, label=label))
-    for mask, colour, label in ((s.origin == 1, "tab:blue", "natural, activated"),
-                                (s.origin == 0, "tab:red", "hydraulic")):
-        if np.any(mask):
-            ax.add_collection(LineCollection(columns(s.mesh, mask), colors=colour, linewidths=2.0, label=label))
-    x_min, x_max, y_min, y_max = sim_region(sim)
-    ax.set_xlim(x_min, x_max)
-    ax.set_ylim(y_min, y_max)
-    ax.set_aspect("equal")
-    ax.set_xlabel("x (m)  [S_hmin]")
-    ax.set_ylabel("y (m)  [S_Hmax]")
-    ax.set_title(title or f"t = {s.time:g} s")
-    ax.legend(loc="upper right", fontsize=8)
+    layers = [(columns(natural, s.intact & ~s.failed), "0.6", 0.6, "natural, intact"),
+              (columns(natural, s.failed), "tab:orange", 1.2, "natural, remote failure"),
+              (columns(s.mesh, s.origin == 1), "tab:blue", 2.5, "natural, activated"),
+              (columns(s.mesh, s.origin == 0), "tab:red", 2.0, "hydraulic")]
+    active = np.concatenate([layers[2][0], layers[3][0]]).reshape(-1, 2)
+    margin = 8.0
+    zoom = (active[:, 0].min() - margin, active[:, 0].max() + margin,
+            active[:, 1].min() - margin, active[:, 1].max() + margin)
+    fig, axes = plt.subplots(1, 2, figsize=(13, 9), gridspec_kw=dict(width_ratios=[1, 1.3]))
+    for ax, (x_min, x_max, y_min, y_max) in zip(axes, (sim_region(sim), zoom)):
+        for segments, colour, width, label in layers:
+            if len(segments):
+                ax.add_collection(LineCollection(segments, colors=colour, linewidths=width, label=label))
+        ax.set_xlim(x_min, x_max)
+        ax.set_ylim(y_min, y_max)
+        ax.set_aspect("equal")
+        ax.set_xlabel("x (m), S_hmin direction")
+        ax.set_ylabel("y (m), S_Hmax direction")
+    axes[0].add_patch(plt.Rectangle((zoom[0], zoom[2]), zoom[1] - zoom[0], zoom[3] - zoom[2], fill=False,
+                                    edgecolor="k", linestyle="--", linewidth=0.8))
+    axes[1].legend(loc="upper right", fontsize=8)
+    axes[1].set_title("zoom")
+    fig.suptitle(title or f"t = {s.time:g} s")
     fig.tight_layout()
-    fig.savefig(path, dpi=130)
+    fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
 
@@ -523,6 +532,9 @@ def main(argv=None):
                         help="region of the natural fractures, m")
     parser.add_argument("--backend", default="hmatrix", choices=("hmatrix", "dense"))
     parser.add_argument("--eps", type=float, default=None, help="H-matrix accuracy (default 1e-4)")
+    parser.add_argument("--density", type=float, default=None,
+                        help="areal density of natural fractures, 1/m^2 (default 0.05, ref. Table 6.1)")
+    parser.add_argument("--seed", type=int, default=None, help="seed of the network (default 1)")
     parser.add_argument("--no-remote-failure", action="store_true")
     parser.add_argument("--checkpoints", action="store_true", help="write checkpoints to OUT/checkpoints-BACKEND")
     parser.add_argument("--no-remote-check", action="store_true",
@@ -546,6 +558,10 @@ def main(argv=None):
         changes["region"] = tuple(args.region)
     if args.eps is not None:
         changes["eps"] = args.eps
+    if args.density is not None:
+        changes["density"] = args.density
+    if args.seed is not None:
+        changes["seed"] = args.seed
     if args.no_remote_failure:
         changes["remote_failure"] = False
     scene = replace(base, **changes)
