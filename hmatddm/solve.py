@@ -408,8 +408,11 @@ def _aca_block(mode, n_out, points, targets, centers, frames, half_a, half_b, pa
     Partial ACA with rank-1 crosses: a pivot point's ``n_out`` rows are evaluated at once
     (one kernel call per element) and used for as many crosses as they carry; the next
     pivot point is the unvisited one with the largest entry of the last column; zero
-    pivots are skipped, not taken as convergence. Stops when ``|u_k| |v_k| <= eps |C_k|_F``
-    (incremental Frobenius norm) holds for two crosses in a row.
+    pivots are skipped, not taken as convergence. Convergence needs ``|u_k| |v_k| <= eps
+    |C_k|_F`` (incremental Frobenius norm) for two crosses in a row, then two probe points
+    (unvisited, farthest in cluster order from the visited ones) whose residual rows are
+    at most an ``eps`` share of the block, ``m |r|^2 <= eps^2 |C_k|^2`` (as ACA+ does: the
+    stop test alone sees only the last cross); a failing probe becomes the next pivot.
     """
     m = targets.size
     n = sources.size
@@ -419,6 +422,7 @@ def _aca_block(mode, n_out, points, targets, centers, frames, half_a, half_b, pa
     v = np.empty((max_rank, n))
     residual = np.empty((n_out, n))
     row_done = np.zeros(m, dtype=np.bool_)
+    row_gap = np.zeros(m, dtype=np.int64)
     col_done = np.zeros(n, dtype=np.bool_)
     rank = 0
     norm2 = 0.0
@@ -427,9 +431,9 @@ def _aca_block(mode, n_out, points, targets, centers, frames, half_a, half_b, pa
     evaluations = 0
     row = m // 2
     rows_left = m
-    converged = False
+    probes = 0  # > 0: the current point is a convergence probe
     hop = 1
-    while not converged and rows_left > 0:
+    while rows_left > 0:
         row_done[row] = True
         rows_left -= 1
         _point_row(mode, points, targets[row], sources, centers, frames, half_a, half_b, params, dd, residual, value,
@@ -444,7 +448,19 @@ def _aca_block(mode, n_out, points, targets, centers, frames, half_a, half_b, pa
                 if weight != 0.0:
                     for jb in range(n):
                         residual[c, jb] -= weight * v[k, jb]
-        while True:  # crosses from this point's rows
+        if probes > 0:
+            size = 0.0
+            for c in range(n_out):
+                for jb in range(n):
+                    size += residual[c, jb] * residual[c, jb]
+            if m * size <= eps * eps * norm2:
+                if probes >= 2:
+                    break
+                probes += 1
+            else:
+                probes = 0
+                small = 0
+        while probes == 0:  # crosses from this point's rows
             best = 0.0
             best_c = -1
             best_j = -1
@@ -499,15 +515,31 @@ def _aca_block(mode, n_out, points, targets, centers, frames, half_a, half_b, pa
             else:
                 small = 0
             if small >= 2:
-                converged = True
+                probes = 1
                 break
-        if converged or rows_left == 0:
+        if rows_left == 0:
             break
         if evaluations + n > budget:
             return -1
-        # next pivot point: the largest entry of the last column among unvisited points
         next_row = -1
-        if rank > 0:
+        if probes > 0:  # probe: the unvisited point farthest in cluster order from the visited
+            best_gap = -1
+            last = -m
+            for tb in range(m):  # distance to the nearest visited point on the left ...
+                if row_done[tb]:
+                    last = tb
+                else:
+                    row_gap[tb] = tb - last
+            last = 2 * m
+            for tb in range(m - 1, -1, -1):  # ... and on the right
+                if row_done[tb]:
+                    last = tb
+                else:
+                    gap = min(row_gap[tb], last - tb)
+                    if gap > best_gap:
+                        best_gap = gap
+                        next_row = tb
+        elif rank > 0:  # next pivot: the largest entry of the last column among unvisited points
             best = 0.0
             for tb in range(m):
                 if not row_done[tb]:

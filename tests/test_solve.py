@@ -157,3 +157,24 @@ def test_auto_method_and_bad_input(material, dfn_scene):
     with pytest.raises(hd.InputError, match="eps"):
         hd.mean_stress_at(mesh, material, dd, points, eps=2.0)
     assert hd.stress_at(mesh, material, dd, np.zeros((0, 3))).shape == (0, 3, 3)
+
+
+def test_tree_mixed_element_sizes(material):
+    """Blocks mixing a large fracture's 1 m elements with a few small fractures of 0.1 m
+    elements (the case that defeats a stop test looking only at the last cross): every
+    component within eps of the largest, against the exact sum."""
+    rng = np.random.default_rng(5)
+    parts = [hd.mesh.rectangle([0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], 40.0, 8.0, 40, 8)]
+    for k in range(6):
+        center = [rng.uniform(-3, 3), rng.uniform(-20, 20), rng.uniform(-4, 4)]
+        parts.append(hd.mesh.rectangle(center, [1.0, 1.0, 0.0], [0.0, 0.0, 1.0], 0.3, 0.3, 3, 3, fracture_id=k + 1))
+    mesh = hd.mesh.concatenate(parts)
+    dd = 1e-3 * mesh.normals
+    small = mesh.fracture_id > 0
+    dd[small] = 0.3 * rng.normal(size=(int(small.sum()), 3))  # small fractures with large DDs
+    points = np.column_stack([rng.uniform(-60, 60, 6000), rng.uniform(-80, 80, 6000), rng.uniform(-4, 4, 6000)])
+    points = points[np.abs(points[:, 0]) > 5.0]
+    exact = hd.stress_at(mesh, material, dd, points, method="direct")
+    for eps in (1e-3, 1e-5):
+        approx = hd.stress_at(mesh, material, dd, points, method="tree", eps=eps)
+        assert np.max(np.abs(approx - exact)) <= eps * np.max(np.abs(exact))
