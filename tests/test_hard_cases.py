@@ -527,15 +527,13 @@ def test_tilted_penny_against_sneddon(material):
     assert 0 < errors[1] < 0.65 * errors[0]  # staircase error ~ h
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "the default preconditioner is frame dependent: the same penny needs 9 GMRES iterations "
-    "aligned with the axes and 13 tilted (13 vs 20 at h = R/16); the exact near-field LU needs 6 "
-    "and block Jacobi 25 in both frames. DDs are global-frame unknowns, so a tilted element's "
-    "normal-normal coupling is spread over all 9 entries of its 3x3 blocks, and the entry-wise "
-    "drop rules of the ILU (threshold 1e-2 of the row's diagonal block, spilu drop_tol 1e-3) "
-    "drop more of it. Fix belongs in hmatddm/hmatrix/preconditioners.py (drop whole d x d blocks "
-    "by block norm, or factor the near field in the element frames)"))
 def test_tilted_penny_needs_no_more_gmres_iterations(material):
+    """DDs are global-frame unknowns, so a tilted element's normal-normal coupling is
+    spread over all 9 entries of its 3x3 blocks; the former default ILU dropped
+    entries one by one (threshold of the row's diagonal, spilu drop_tol) and needed 9
+    iterations aligned and 13 tilted (13 vs 20 at h = R/16). The default is now a
+    block ILU(0) on element blocks kept by Frobenius norm (hmatddm/hmatrix/
+    preconditioners.py): 7 and 7 (11 and 11 at R/16)."""
     iterations = []
     for normal in ([0, 0, 1], TILTED):
         mesh = hd.mesh.penny([0, 0, 0], normal, 1.0, 0.125)

@@ -244,10 +244,77 @@ def test_near_field_csr_holds_exact_near_blocks(tensor_problems):
     assert np.array_equal(h.element_diagonal_blocks(), dense[mask].reshape(1200, 3, 3))
     leaf = h.near_field_csr(part="leaf_diagonal")
     assert diagonal.nonzero()[0].size < leaf.nnz < near.nnz
-    thinned = h.near_field_csr(threshold=1e-2)
+    thinned = h.near_field_csr(threshold=1.0)  # 1/r with a weak self term: blocks rival the diagonal
     assert thinned.nnz < near.nnz
     with pytest.raises(InputError, match="part"):
         h.near_field_csr(part="far")
+
+
+def ddm_like_generator(side, seed=0):
+    """A planar-crack-like tensor kernel (d = 3): 1/r^3, shear and normal uncoupled, on a
+    jittered side x side grid of a tilted unit square, with a self term ~ 1/h^3 like the
+    hypersingular DDM kernel (the near field decays like (h/r)^3 of the diagonal)."""
+    rng = np.random.default_rng(seed)
+    h = 1.0 / side
+    u, v = np.meshgrid((np.arange(side) + 0.5) * h, (np.arange(side) + 0.5) * h)
+    uv = np.column_stack([u.ravel(), v.ravel()]) + rng.uniform(-0.2, 0.2, (side * side, 2)) * h
+    e1 = np.array([1.0, 0.0, 0.3]) / np.sqrt(1.09)
+    e2 = np.array([0.0, 1.0, 0.5])
+    e2 -= (e2 @ e1) * e1
+    e2 /= np.linalg.norm(e2)
+    scales = np.array([1.0, 0.6, 3.0])
+    return tensor_generator(uv[:, :1] * e1 + uv[:, 1:] * e2, scales=scales, coupling=0.0, exponent=3.0,
+                            self_value=4.0 * scales / h**3)
+
+
+def element_block_pattern(matrix):
+    """Set of (row element, column element) pairs of a BSR matrix."""
+    rows = np.repeat(np.arange(matrix.shape[0] // matrix.blocksize[0]), np.diff(matrix.indptr))
+    return set(zip(rows.tolist(), matrix.indices.tolist()))
+
+
+def rotate_elements(dense, rotations):
+    """Q A Q^T for Q = diag(rotations): every element's unknowns in another frame."""
+    n, d = rotations.shape[:2]
+    blocks = dense.reshape(n, d, n, d)
+    return np.einsum("iab,ibjc,jdc->iajd", rotations, blocks, rotations).reshape(dense.shape)
+
+
+def random_rotations(n, rng):
+    q, r = np.linalg.qr(rng.standard_normal((n, 3, 3)))
+    q *= np.sign(np.diagonal(r, axis1=1, axis2=2))[:, None, :]
+    q[np.linalg.det(q) < 0, :, 0] *= -1
+    return q
+
+
+def test_near_field_threshold_keeps_whole_blocks_by_frobenius_norm_in_any_frame():
+    """Element block (i, j) is kept when ||A_ij||_F >= t sqrt(||A_ii||_F ||A_jj||_F): the
+    same blocks whatever the frame of each element's unknowns (an entry-wise rule keeps
+    a tilted element's couplings differently from an aligned one's)."""
+    generator = ddm_like_generator(30)
+    n, d, threshold = 900, 3, 1e-2
+    h = HMatrix.build(generator, eps=1e-4, leaf_size=32)
+    dense = generator.to_dense()
+    norms = np.linalg.norm(dense.reshape(n, d, n, d), axis=(1, 3))
+    diagonal = np.diag(norms)
+    full = h.near_field_bsr()
+    kept = h.near_field_bsr(threshold=threshold)
+    expected = {(i, j) for i, j in element_block_pattern(full)
+                if i == j or norms[i, j] >= threshold * np.sqrt(diagonal[i] * diagonal[j])}
+    assert element_block_pattern(kept) == expected and len(expected) < 0.5 * len(element_block_pattern(full))
+    assert kept.blocksize == (d, d) and kept.has_sorted_indices
+    assert all(np.all(np.diff(kept.indices[a:b]) > 0) for a, b in zip(kept.indptr[:-1], kept.indptr[1:]))
+    mask = kept.toarray() != 0
+    assert np.array_equal(kept.toarray()[mask], dense[mask])  # exact entries
+    csr = h.near_field_csr(threshold=threshold)  # the same blocks, without their exact zeros
+    assert abs(csr - kept.tocsr()).max() == 0 and csr.nnz == np.count_nonzero(kept.data)
+    rotations = random_rotations(n, np.random.default_rng(7))
+    rotated = HMatrix.build(matrix_generator(rotate_elements(dense, rotations), generator.points, dof=d),
+                            eps=1e-4, leaf_size=32)
+    assert element_block_pattern(rotated.near_field_bsr(threshold=threshold)) == expected
+    assert h.near_field_bsr(part="element_diagonal").nnz == n * d * d
+    with pytest.raises(InputError, match="threshold"):
+        h.near_field_bsr(threshold=-1.0)
 
 
 # ----------------------------------------------------------------------------- validation

@@ -7,7 +7,7 @@ Knows nothing about elasticity: it compresses the matrix of any
 
 from .generator import BlockGenerator
 from .hmatrix import HMatrix
-from .preconditioners import block_jacobi, default_preconditioner, near_field_ilu, near_field_lu
+from .preconditioners import block_jacobi, default_preconditioner, near_field_block_ilu, near_field_ilu, near_field_lu
 from .solvers import gmres
 
 __all__ = [
@@ -16,6 +16,7 @@ __all__ = [
     "block_jacobi",
     "default_preconditioner",
     "gmres",
+    "near_field_block_ilu",
     "near_field_ilu",
     "near_field_lu",
 ]

@@ -264,30 +264,37 @@ class HMatrix(LinearOperator):
         return float(errors.max()) if errors.size else 0.0
 
     # ------------------------------------------------------------------ near field
+    def _near_field_arguments(self, part, threshold):
+        if part not in ("near", "leaf_diagonal", "element_diagonal"):
+            raise InputError(f"part must be 'near', 'leaf_diagonal' or 'element_diagonal', got {part!r}")
+        if isinstance(threshold, bool) or not (
+            isinstance(threshold, (int, float, np.floating, np.integer)) and threshold >= 0 and math.isfinite(threshold)
+        ):
+            raise InputError(f"threshold must be a finite number >= 0, got {threshold!r}")
+        s = self.storage
+        selected = np.flatnonzero(s.dense_is_near)
+        diagonal = s.dense_row_start[selected] == s.dense_col_start[selected]
+        if part != "near":
+            selected = selected[diagonal]
+        element_norm = _element_norms(self.dof, s.dense_row_start, s.dense_row_stop, s.dense_offset, s.dense_values,
+                                      np.flatnonzero(s.dense_is_near & (s.dense_row_start == s.dense_col_start)),
+                                      self.n_elements)
+        return (self.dof, s.dense_row_start, s.dense_row_stop, s.dense_col_start, s.dense_col_stop, s.dense_offset,
+                s.dense_values, selected.astype(np.int64), self.tree.permutation.astype(np.int64), element_norm,
+                float(threshold), part == "element_diagonal")
+
     def near_field_csr(self, part="near", threshold=0.0):
         """Sparse CSR matrix (original ordering) of part of the stored exact blocks.
 
         part: ``"near"`` (all near-field leaf blocks; they include the diagonal
         blocks), ``"leaf_diagonal"`` (the leaf x leaf diagonal blocks only) or
         ``"element_diagonal"`` (the d x d block of each element). ``threshold`` >= 0
-        drops entries with ``|a_ij| < threshold * max|diagonal block of row i|``.
-        Cost O(selected entries).
+        drops whole d x d element blocks (see :meth:`near_field_bsr`: block (i, j) is
+        kept when ``||A_ij||_F >= threshold * sqrt(||A_ii||_F ||A_jj||_F)``, and
+        always for i == j), so that which couplings are kept does not depend on the
+        frame of the unknowns; exact zeros are not stored. Cost O(selected entries).
         """
-        if part not in ("near", "leaf_diagonal", "element_diagonal"):
-            raise InputError(f"part must be 'near', 'leaf_diagonal' or 'element_diagonal', got {part!r}")
-        if not (isinstance(threshold, (int, float, np.floating, np.integer)) and threshold >= 0):
-            raise InputError(f"threshold must be a number >= 0, got {threshold!r}")
-        s = self.storage
-        selected = np.flatnonzero(s.dense_is_near)
-        diagonal = s.dense_row_start[selected] == s.dense_col_start[selected]
-        if part != "near":
-            selected = selected[diagonal]
-        row_scale = _row_scale(self.dof, s.dense_row_start, s.dense_row_stop, s.dense_col_start, s.dense_offset,
-                               s.dense_values, np.flatnonzero(s.dense_is_near & (s.dense_row_start == s.dense_col_start)),
-                               self.n_elements)
-        arguments = (self.dof, s.dense_row_start, s.dense_row_stop, s.dense_col_start, s.dense_col_stop,
-                     s.dense_offset, s.dense_values, selected.astype(np.int64), self._unknown_permutation, row_scale,
-                     float(threshold), part == "element_diagonal")
+        arguments = self._near_field_arguments(part, threshold)
         n = self.shape[0]
         indptr = np.zeros(n + 1, dtype=np.int64)
         _csr_pass(*arguments, indptr, indptr[:0], np.zeros(0, dtype=np.int32), np.zeros(0), False)
@@ -297,6 +304,33 @@ class HMatrix(LinearOperator):
         data = np.empty(indptr[-1])
         _csr_pass(*arguments, indptr, indptr[:-1].copy(), indices, data, True)
         return sp.csr_matrix((data, indices, indptr.astype(index_dtype)), shape=self.shape)
+
+    def near_field_bsr(self, part="near", threshold=0.0):
+        """Block-sparse (BSR, blocks d x d, original element ordering, sorted column
+        indices) matrix of part of the stored exact blocks.
+
+        ``part`` as in :meth:`near_field_csr`. ``threshold`` >= 0 keeps element block
+        (i, j) when ``||A_ij||_F >= threshold * sqrt(||A_ii||_F ||A_jj||_F)`` (Frobenius
+        norms, A_ii the element's own diagonal block) and always keeps i == j; blocks
+        that are exactly zero are not stored. Frobenius norms do not change under a
+        rotation of the unknowns of each element, so the kept pattern is the same in
+        every frame (the entry-wise rule it replaces kept a tilted element's couplings
+        differently from an aligned one's). Cost O(selected entries).
+        """
+        arguments = self._near_field_arguments(part, threshold)
+        d = self.dof
+        counts = np.zeros(self.n_elements + 1, dtype=np.int64)
+        _bsr_pass(*arguments, counts, counts[:0], np.zeros(0, dtype=np.int64), np.zeros((0, d, d)), False)
+        indptr = np.cumsum(counts)
+        indices = np.empty(indptr[-1], dtype=np.int64)
+        data = np.empty((indptr[-1], d, d))
+        _bsr_pass(*arguments, indptr, indptr[:-1].copy(), indices, data, True)
+        _sort_block_rows(indptr, indices, data)
+        index_dtype = np.int32 if max(indptr[-1], self.n_elements) < np.iinfo(np.int32).max else np.int64
+        matrix = sp.bsr_matrix((data, indices.astype(index_dtype), indptr.astype(index_dtype)), shape=self.shape,
+                               blocksize=(d, d))
+        matrix.has_sorted_indices = True
+        return matrix
 
     def element_diagonal_blocks(self):
         """(N, d, d) array: the exact d x d diagonal block of each element (original order)."""
@@ -327,51 +361,125 @@ class HMatrix(LinearOperator):
 
 
 @njit(cache=True)
-def _row_scale(dof, row_start, row_stop, col_start, offset, values, diagonal_blocks, n_elements):
-    """Largest |entry| of each unknown's row within its element's d x d diagonal block (permuted)."""
+def _element_norms(dof, row_start, row_stop, offset, values, diagonal_blocks, n_elements):
+    """Frobenius norm of each element's d x d diagonal block (tree positions)."""
     d = dof
-    scale = np.zeros(n_elements * d)
+    norms = np.zeros(n_elements)
     for b in diagonal_blocks:
         me = row_stop[b] - row_start[b]
         n = d * me
         for a in range(me):
+            total = 0.0
             for p in range(d):
-                row = d * a + p
-                largest = 0.0
+                base = offset[b] + (d * a + p) * n + d * a
                 for q in range(d):
-                    largest = max(largest, abs(values[offset[b] + row * n + d * a + q]))
-                scale[d * row_start[b] + row] = largest
-    return scale
+                    total += values[base + q] ** 2
+            norms[row_start[b] + a] = np.sqrt(total)
+    return norms
 
 
 @njit(cache=True)
-def _csr_pass(dof, row_start, row_stop, col_start, col_stop, offset, values, selected, unknown_permutation,
-              row_scale, threshold, element_diagonal, indptr, cursor, indices, data, fill):
-    """CSR of the selected dense blocks (original ordering), in two passes.
+def _keep_blocks(d, values, base, n, me, ne, r_el, c_el, element_norm, threshold, element_diagonal, keep):
+    """keep[a, c]: element block (a, c) of a stored block kept by the Frobenius rule."""
+    for a in range(me):
+        for c in range(ne):
+            same = r_el + a == c_el + c
+            if element_diagonal and not same:
+                keep[a, c] = False
+                continue
+            total = 0.0
+            for p in range(d):
+                row = base + (d * a + p) * n + d * c
+                for q in range(d):
+                    total += values[row + q] ** 2
+            if total == 0.0:
+                keep[a, c] = False
+            elif same:
+                keep[a, c] = True
+            else:
+                limit = threshold * threshold * element_norm[r_el + a] * element_norm[c_el + c]
+                keep[a, c] = total >= limit
+
+
+@njit(cache=True)
+def _csr_pass(dof, row_start, row_stop, col_start, col_stop, offset, values, selected, permutation,
+              element_norm, threshold, element_diagonal, indptr, cursor, indices, data, fill):
+    """CSR of the kept element blocks of the selected dense blocks (original ordering),
+    without their exact zeros, in two passes.
 
     fill=False: count the kept entries of each row into indptr[row + 1].
     fill=True: write them at cursor[row] (initialised to indptr[:-1]).
     """
     d = dof
     for b in selected:
-        r0 = d * row_start[b]
-        c0 = d * col_start[b]
-        m = d * (row_stop[b] - row_start[b])
-        n = d * (col_stop[b] - col_start[b])
-        for i in range(m):
-            limit = threshold * row_scale[r0 + i]
-            row = unknown_permutation[r0 + i]
-            base = offset[b] + i * n
-            for j in range(n):
-                if element_diagonal and (i // d) != (j // d):
+        me = row_stop[b] - row_start[b]
+        ne = col_stop[b] - col_start[b]
+        n = d * ne
+        keep = np.empty((me, ne), dtype=np.bool_)
+        _keep_blocks(d, values, offset[b], n, me, ne, row_start[b], col_start[b], element_norm, threshold,
+                     element_diagonal, keep)
+        for a in range(me):
+            row_element = permutation[row_start[b] + a]
+            for p in range(d):
+                row = d * row_element + p
+                base = offset[b] + (d * a + p) * n
+                for c in range(ne):
+                    if not keep[a, c]:
+                        continue
+                    col_element = permutation[col_start[b] + c]
+                    for q in range(d):
+                        value = values[base + d * c + q]
+                        if value == 0.0:
+                            continue
+                        if fill:
+                            position = cursor[row]
+                            indices[position] = d * col_element + q
+                            data[position] = value
+                            cursor[row] = position + 1
+                        else:
+                            indptr[row + 1] += 1
+
+
+@njit(cache=True)
+def _bsr_pass(dof, row_start, row_stop, col_start, col_stop, offset, values, selected, permutation,
+              element_norm, threshold, element_diagonal, indptr, cursor, indices, data, fill):
+    """BSR (element blocks, original ordering) of the kept element blocks, two passes
+    as :func:`_csr_pass` (counts in indptr[row_element + 1])."""
+    d = dof
+    for b in selected:
+        me = row_stop[b] - row_start[b]
+        ne = col_stop[b] - col_start[b]
+        n = d * ne
+        keep = np.empty((me, ne), dtype=np.bool_)
+        _keep_blocks(d, values, offset[b], n, me, ne, row_start[b], col_start[b], element_norm, threshold,
+                     element_diagonal, keep)
+        for a in range(me):
+            row_element = permutation[row_start[b] + a]
+            for c in range(ne):
+                if not keep[a, c]:
                     continue
-                a = values[base + j]
-                if a == 0.0 or abs(a) < limit:
+                if not fill:
+                    indptr[row_element + 1] += 1
                     continue
-                if fill:
-                    position = cursor[row]
-                    indices[position] = unknown_permutation[c0 + j]
-                    data[position] = a
-                    cursor[row] = position + 1
-                else:
-                    indptr[row + 1] += 1
+                position = cursor[row_element]
+                indices[position] = permutation[col_start[b] + c]
+                for p in range(d):
+                    base = offset[b] + (d * a + p) * n + d * c
+                    for q in range(d):
+                        data[position, p, q] = values[base + q]
+                cursor[row_element] = position + 1
+
+
+@njit(cache=True)
+def _sort_block_rows(indptr, indices, data):
+    """Sort the column indices (and blocks) of every block row in place."""
+    for i in range(indptr.size - 1):
+        start, stop = indptr[i], indptr[i + 1]
+        if stop - start < 2:
+            continue
+        order = np.argsort(indices[start:stop])
+        sorted_indices = indices[start:stop][order]
+        sorted_data = data[start:stop][order]
+        for k in range(stop - start):
+            indices[start + k] = sorted_indices[k]
+            data[start + k] = sorted_data[k]
