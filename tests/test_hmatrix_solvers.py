@@ -148,6 +148,59 @@ def test_default_preconditioner_falls_back_on_a_singular_near_field(caplog):
     assert np.all(np.isfinite(M @ np.ones(100)))
 
 
+# ----------------------------------------------------------------------------- GMRES restarts
+
+
+def cyclic_shift(n):
+    """A e_i = e_(i+1 mod n): with b = e_0 every Krylov space of dimension k < n
+    leaves the residual at ||b||, so any restarted GMRES(m < n) stagnates forever."""
+    return np.roll(np.eye(n), 1, axis=0)
+
+
+def test_gmres_grows_the_restart_of_a_stagnating_cycle_and_matches_the_dense_solve():
+    n = 40
+    A, b = cyclic_shift(n), np.eye(n)[0]
+    x, info = gmres(A, b, rtol=1e-10, restart=10, maxiter=10)
+    np.testing.assert_allclose(x, np.linalg.solve(A, b), atol=1e-12)
+    # the stagnating cycle was continued (10 -> 20 -> 40), not restarted: no lost work
+    assert info["iterations"] == n and info["cycles"] == 1 and info["restart"] == n
+
+
+def test_gmres_growth_is_capped_and_the_budget_bounded():
+    n = 40
+    A, b = cyclic_shift(n), np.eye(n)[0]
+    for max_restart, grown in ((10, ""), (20, "grown on stagnation to 20")):
+        with pytest.raises(ConvergenceError, match="did not converge") as caught:
+            gmres(A, b, rtol=1e-10, restart=10, maxiter=5, max_restart=max_restart)
+        assert caught.value.iterations == 50  # restart * maxiter, whatever the restart grew to
+        assert caught.value.residual == pytest.approx(1.0)
+        assert grown in str(caught.value) and "budget" in str(caught.value)
+    with pytest.raises(InputError, match="max_restart"):
+        gmres(A, b, restart=10, max_restart=5)
+
+
+def test_gmres_takes_scipys_iterations_while_the_restart_does_not_grow(spd_problem):
+    h, _, b = spd_problem
+    M = near_field_ilu(h, part="leaf_diagonal", drop_tol=1e-3, fill_factor=5)
+    count = [0]
+
+    def callback(_):
+        count[0] += 1
+
+    reference, _ = spla.gmres(h, b, M=M, rtol=1e-9, atol=0.0, restart=100, maxiter=10, callback=callback,
+                              callback_type="pr_norm")
+    x, info = gmres(h, b, M=M, rtol=1e-9, restart=100, maxiter=10)
+    assert info["iterations"] == count[0] and info["restart"] == 100
+    np.testing.assert_allclose(x, reference, rtol=1e-12, atol=0)
+
+
+def test_gmres_restarts_without_growth_while_cycles_converge_fast(spd_problem):
+    h, dense, b = spd_problem
+    x, info = gmres(h, b, rtol=1e-10, restart=5, maxiter=40)
+    assert info["restart"] == 5 and info["cycles"] > 1  # plain restarts: every cycle gains > 10x
+    assert np.linalg.norm(dense @ x - b) / np.linalg.norm(b) < 1e-9
+
+
 # ----------------------------------------------------------------------------- block ILU
 
 
