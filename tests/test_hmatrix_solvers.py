@@ -201,6 +201,13 @@ def test_gmres_restarts_without_growth_while_cycles_converge_fast(spd_problem):
     assert np.linalg.norm(dense @ x - b) / np.linalg.norm(b) < 1e-9
 
 
+def test_gmres_refuses_a_non_finite_preconditioner():
+    A = np.diag(np.arange(1.0, 11.0))
+    M = spla.LinearOperator(A.shape, matvec=lambda x: np.full(10, np.nan), dtype=np.float64)
+    with pytest.raises(ConvergenceError, match="non-finite"):
+        gmres(A, np.ones(10), M=M)
+
+
 # ----------------------------------------------------------------------------- block ILU
 
 

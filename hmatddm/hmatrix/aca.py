@@ -484,8 +484,10 @@ def aca_tensor(kernel, data, row_elements, col_elements, dof, eps):
     pivot columns; a negligible residual row (a zero part of the block) is skipped
     by probing an unvisited column for a better row instead of stopping. Stops when
     the last update satisfies ||U_k V_k^T||_F <= eps ||S_k||_F (the norm of the
-    approximation S_k is updated incrementally, cross terms included), when the
-    rank reaches min(m, n), or when every row or column element has been used.
+    approximation S_k is updated incrementally, cross terms included) and the
+    convergence check passes (unvisited probe rows and columns with a residual
+    below CHECK_FACTOR * eps ||S_k||_F, extrapolated to the block), when the rank
+    reaches min(m, n), or when every row or column element has been used.
 
     Returns (U, V, rank) with U (m x rank), V (n x rank); rank 0 for a zero block.
     """

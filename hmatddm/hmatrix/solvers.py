@@ -243,8 +243,11 @@ def gmres(A, b, M=None, rtol=1e-8, restart=50, maxiter=20, x0=None, max_restart=
             cycles += 1
             start_norm = residual_norm
             presid = krylov.start(psolve(r))
-            if not (presid > 0.0 and math.isfinite(presid)):
-                break  # M r is zero or not finite: nothing to iterate on
+            if not math.isfinite(presid):
+                raise ConvergenceError(f"GMRES: the preconditioner returned non-finite values after {iterations} "
+                                       "iterations", residual=residual_norm / b_norm, iterations=iterations)
+            if presid == 0.0:
+                break  # M r = 0 with r != 0: M is singular, nothing to iterate on
             while True:
                 while krylov.size < length and iterations < budget:
                     presid = krylov.step(matvec, psolve, lartg)
