@@ -22,7 +22,14 @@ A growing radial fracture (ref. Ch. 4)::
                         propagation=hd.Propagation(toughness=5e6), initial_pressure=10e6)
     records = sim.run(end_time=50.0)
 """
-from . import analytical, kernels, mesh, network, topology
+import os
+
+# numba's OpenMP workers spin-wait by default; on a shared 2-core machine that made one
+# small H-matvec take 9.5 ms instead of 0.45 ms (measured, benchmarks/bench_dfn.py).
+# Must be set before numba starts its threads; an explicit user setting wins.
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+
+from . import analytical, kernels, mesh, network, topology  # noqa: E402
 from .coupled import SchemeSettings
 from .errors import ConvergenceError, HmatddmError, InputError, OutputError
 from .flow import Cluster, Fluid, LeakOff

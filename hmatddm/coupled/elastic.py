@@ -134,13 +134,19 @@ class ElasticSolver:
         return np.abs(np.einsum("ei,eij,ej->e", normals, blocks, normals))
 
 
+# scalar ILU of the contact-modified near field (its rows mix element frames, so the
+# block ILU of the default preconditioner does not apply); the entries kept are those of
+# the default preconditioner's block threshold
+_CONTACT_ILU = {"drop_tol": 1e-3, "fill_factor": 5.0}
+
+
 def _modified_near_field_inverse(operator, rows):
     """ILU of ``S A_near + D`` (the default preconditioner's near field with contact rows),
     falling back to block Jacobi of the modified diagonal blocks."""
     hmatrix = operator.hmatrix
     matrix = rows.modify_sparse(hmatrix.near_field_csr(part="near", threshold=DEFAULT_ILU["threshold"]))
     try:
-        factor = spla.spilu(matrix, drop_tol=DEFAULT_ILU["drop_tol"], fill_factor=DEFAULT_ILU["fill_factor"])
+        factor = spla.spilu(matrix, drop_tol=_CONTACT_ILU["drop_tol"], fill_factor=_CONTACT_ILU["fill_factor"])
         inverse = spla.LinearOperator(operator.shape, matvec=factor.solve, dtype=np.float64)
         if np.all(np.isfinite(inverse @ np.ones(operator.shape[0]))):
             return inverse

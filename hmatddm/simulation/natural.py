@@ -46,7 +46,7 @@ def _segment_intersection(a0, a1, b0, b1):
     """Parameter ``s`` along a (in [0, 1]) where segments a and b cross, or None."""
     da, db = a1 - a0, b1 - b0
     denominator = da[0] * db[1] - da[1] * db[0]
-    if abs(denominator) < 1e-12 * np.linalg.norm(da) * np.linalg.norm(db):
+    if denominator == 0.0 or abs(denominator) < 1e-12 * np.linalg.norm(da) * np.linalg.norm(db):
         return None
     w = b0 - a0
     s = (w[0] * db[1] - w[1] * db[0]) / denominator
