@@ -22,7 +22,7 @@ from .kernels.line2d import stress_pair as _stress_pair2d
 from .kernels.rectangle3d import _INV_8PI, _r_plus
 from .kernels.rectangle3d import local_stress_corrected as _local_stress_corrected
 from .kernels.rectangle3d import on_edge as _on_edge
-from .kernels.rectangle3d import potential_derivatives as _potential_derivatives
+from .kernels.rectangle3d import g_derivatives as _g_derivatives
 from .material import Elastic
 from .mesh import Mesh2D, Mesh3D
 
@@ -233,24 +233,8 @@ def _pair3d(mode, px, py, pz, j, centers, frames, half_a, half_b, g, nu, shift, 
         j11, j22, j13, j23 = _second_derivatives(abs(x1), abs(x2), z, a, b)
         out[0] = 2.0 * (1.0 + nu) / 3.0 * c * (s1 * s3 * j13 * d0 + s2 * s3 * j23 * d1 - (j11 + j22) * d2)
         return
-    (j11, j22, j12, j13, j23, j111, j112, j113, j122, j123, j222,
-     j223) = _potential_derivatives(abs(x1), abs(x2), z, a, b)
-    g11 = c * j11
-    g22 = c * j22
-    g33 = -(g11 + g22)
-    g12 = c * s1 * s2 * j12
-    g13 = c * s1 * s3 * j13
-    g23 = c * s2 * s3 * j23
-    zg111 = c * s3 * s1 * z * j111
-    zg112 = c * s3 * s2 * z * j112
-    zg113 = c * z * j113
-    zg122 = c * s3 * s1 * z * j122
-    zg123 = c * s1 * s2 * z * j123
-    zg222 = c * s3 * s2 * z * j222
-    zg223 = c * z * j223
-    zg133 = -(zg111 + zg122)
-    zg233 = -(zg112 + zg222)
-    zg333 = -(zg113 + zg223)
+    (g11, g22, g33, g12, g13, g23, zg111, zg112, zg113, zg122, zg123, zg222, zg223, zg133, zg233,
+     zg333) = _g_derivatives(x1, x2, x3, a, b, g, nu)
     m = 1.0 - 2.0 * nu
     s00 = d0 * (2.0 * g13 - zg111) + d1 * (2.0 * nu * g23 - zg112) + d2 * (g33 + m * g22 - zg113)
     s01 = d0 * ((1.0 - nu) * g23 - zg112) + d1 * ((1.0 - nu) * g13 - zg122) - d2 * (m * g12 + zg123)

@@ -99,11 +99,14 @@ def on_edge(x1, x2, x3, a, b):
     return False
 
 
-@njit(cache=True)
-def local_stress(x1, x2, x3, a, b, shear_modulus, poisson_ratio, out):
-    """Stress at local point ``(x1, x2, x3)`` from a unit DD along each local axis.
+@njit(cache=True, inline="always")
+def g_derivatives(x1, x2, x3, a, b, shear_modulus, poisson_ratio):
+    """The derivatives of ``g`` that the stress needs at local point ``(x1, x2, x3)``
+    (ref. App. A eqs 22-42, scaled by 2G/(8 pi (1 - nu)) and reflected from the octant
+    x >= 0 with the sign of each index; ``x3 g_ijk`` keeps ``|x3|``)::
 
-    ``out[k, i, j]`` (3x3x3) receives sigma_ij for DD_k = 1 (ref. Eq. 2.59), in Pa per m.
+        (g11, g22, g33, g12, g13, g23,
+         zg111, zg112, zg113, zg122, zg123, zg222, zg223, zg133, zg233, zg333)
     """
     s1 = 1.0 if x1 >= 0.0 else -1.0
     s2 = 1.0 if x2 >= 0.0 else -1.0
@@ -111,26 +114,29 @@ def local_stress(x1, x2, x3, a, b, shear_modulus, poisson_ratio, out):
     z = abs(x3)
     (j11, j22, j12, j13, j23, j111, j112, j113, j122, j123, j222,
      j223) = potential_derivatives(abs(x1), abs(x2), z, a, b)
-    nu = poisson_ratio
-    c = -2.0 * shear_modulus * _INV_8PI / (1.0 - nu)  # 2G times the factor of g
-    # g derivatives at the original point: reflection signs per index (x3 g_..3 keeps |x3|)
+    c = -2.0 * shear_modulus * _INV_8PI / (1.0 - poisson_ratio)  # 2G times the factor of g
     g11 = c * j11
     g22 = c * j22
-    g33 = -(g11 + g22)
-    g12 = c * s1 * s2 * j12
-    g13 = c * s1 * s3 * j13
-    g23 = c * s2 * s3 * j23
-    # x3 * g_ijk, with the reflection signs folded in
     zg111 = c * s3 * s1 * z * j111
     zg112 = c * s3 * s2 * z * j112
     zg113 = c * z * j113
     zg122 = c * s3 * s1 * z * j122
-    zg123 = c * s1 * s2 * z * j123
     zg222 = c * s3 * s2 * z * j222
     zg223 = c * z * j223
-    zg133 = -(zg111 + zg122)
-    zg233 = -(zg112 + zg222)
-    zg333 = -(zg113 + zg223)
+    return (g11, g22, -(g11 + g22), c * s1 * s2 * j12, c * s1 * s3 * j13, c * s2 * s3 * j23,
+            zg111, zg112, zg113, zg122, c * s1 * s2 * z * j123, zg222, zg223,
+            -(zg111 + zg122), -(zg112 + zg222), -(zg113 + zg223))
+
+
+@njit(cache=True)
+def local_stress(x1, x2, x3, a, b, shear_modulus, poisson_ratio, out):
+    """Stress at local point ``(x1, x2, x3)`` from a unit DD along each local axis.
+
+    ``out[k, i, j]`` (3x3x3) receives sigma_ij for DD_k = 1 (ref. Eq. 2.59), in Pa per m.
+    """
+    nu = poisson_ratio
+    (g11, g22, g33, g12, g13, g23, zg111, zg112, zg113, zg122, zg123, zg222, zg223, zg133, zg233,
+     zg333) = g_derivatives(x1, x2, x3, a, b, shear_modulus, poisson_ratio)
     # DD along e1
     out[0, 0, 0] = 2.0 * g13 - zg111
     out[0, 0, 1] = (1.0 - nu) * g23 - zg112
