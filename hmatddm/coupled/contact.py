@@ -53,7 +53,6 @@ from ..errors import InputError
 
 OPEN, STICK, SLIP = 0, 1, 2
 CONTACT_MODES = ("natural", "all", "none")  # which elements of a simulation may close
-STATUS_NAMES = {OPEN: "open", STICK: "stick", SLIP: "slip"}
 
 
 @dataclass
@@ -163,8 +162,7 @@ class ContactModel:
     relative_tolerance : float, the band ``tol_w / max|w|`` of the status tests
     """
 
-    def __init__(self, law, normals, dd_start, status, direction, stiffness, max_flips=4, relative_tolerance=1e-3,
-                 penalty=None):
+    def __init__(self, law, normals, dd_start, status, direction, stiffness, max_flips=4, relative_tolerance=1e-3):
         self.law = law
         self.normals = np.asarray(normals, dtype=np.float64)
         self.n, self.d = self.normals.shape
@@ -176,7 +174,6 @@ class ContactModel:
         self.stiffness = np.asarray(stiffness, dtype=np.float64)
         self.max_flips = int(max_flips)
         self.relative_tolerance = float(relative_tolerance)
-        self.penalty = penalty
         self.reset()
 
     def reset(self):
@@ -215,9 +212,9 @@ class ContactModel:
         """The :class:`ContactRows` of the current statuses (``None`` when all are open).
 
         Rows in the local frame ``(n, t_1[, t_2])`` of each element: open rows are the
-        residual along them; a closed element's normal row is ``k n.DD = 0`` (or, with
-        a ``penalty`` factor, ``c_n = penalty k w``); stick rows fix the tangential DDs,
-        slip rows are the friction law along ``m = t_1`` and no traction across it.
+        residual along them; a closed element's normal row is ``k n.DD = 0``; stick rows
+        fix the tangential DDs; slip rows are the friction law along ``m = t_1`` and no
+        traction across it.
         """
         if self._rows is not None or not np.any(self.closed):
             return self._rows
@@ -232,9 +229,6 @@ class ContactModel:
         # normal row
         select[:, 0, :] = np.where(closed[:, None], 0.0, normals)
         direct[closed, 0, :] = k[closed, None] * normals[closed]
-        if self.penalty is not None:
-            select[closed, 0, :] = normals[closed]
-            direct[closed, 0, :] = -self.penalty * k[closed, None] * normals[closed]
         # tangential rows
         for j in range(d - 1):
             t = tangents[:, j, :]
@@ -306,14 +300,3 @@ class ContactModel:
         if n_changed:
             self._rows = None
         return n_changed
-
-    def contact_traction_summary(self, dd, contact_traction):
-        """``(effective_normal_stress, shear_traction, slip)`` per element for output."""
-        n, d = self.n, self.d
-        c = np.asarray(contact_traction).reshape(n, d)
-        c_n = np.sum(c * self.normals, axis=1)
-        shear = np.linalg.norm(c - c_n[:, None] * self.normals, axis=1)
-        dd = np.asarray(dd).reshape(n, d)
-        slip = dd - np.sum(dd * self.normals, axis=1)[:, None] * self.normals
-        closed = self.closed
-        return np.where(closed, -c_n, 0.0), np.where(closed, shear, 0.0), np.linalg.norm(slip, axis=1)
