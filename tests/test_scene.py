@@ -77,6 +77,8 @@ BAD_SCENES = [
     ("numerics.relaxation", 0.001, "numerics.min_relaxation must be <= numerics.relaxation = 0.001, "
                                    "got 0.00390625"),
     ("numerics.min_relaxation", 1.0, None),  # fine: no halving of the relaxation
+    ("numerics.relaxation_growth", 0.5, "numerics.relaxation_growth must be >= 1, got 0.5"),
+    ("numerics.relaxation_growth", 1.0, None),  # fine: keep the alpha a step needed (ref. Fig. 4.10)
     ("output.snapshots", "yes", "output.snapshots must be true or false, got 'yes'"),
     ("output.every", 0, "output.every must be an integer >= 1, got 0"),
     ("cluster[0].position", [0.0, 0.0], "cluster[0].position must be a list of 3 coordinates (m), got 2"),
@@ -310,3 +312,11 @@ def test_reference_values_follow_the_closed_forms():
     assert hs.reference_values(validate(raw(TINY_2D)), [record]) is None
     curves = hs.reference_curves(scene)
     assert set(curves) == {"time", "radius", "max_opening", "net_pressure"} and curves["time"][-1] == 2.0
+
+
+def test_relaxation_growth_reaches_the_scheme_settings():
+    from hmatddm.scene.build import scheme_settings
+
+    default = scheme_settings(validate(raw()))
+    assert default.relaxation_growth == (2.0 if default.scheme in ("krylov", "fully-coupled") else 1.0)
+    assert scheme_settings(validate(set_key(raw(), "numerics.relaxation_growth", 1.5))).relaxation_growth == 1.5

@@ -42,6 +42,7 @@ from ..errors import ConvergenceError, InputError
 from ..hmatrix import gmres
 
 SCHEMES = ("fixed-width", "fracture-compliance", "fully-coupled", "krylov")
+COUPLED_SCHEMES = ("fully-coupled", "krylov")
 
 
 @dataclass(frozen=True)
@@ -58,6 +59,12 @@ class SchemeSettings:
     max_iterations : nonlinear iterations per attempt
     linear_rtol : relative residual asked of every GMRES solve
     linear_maxiter : GMRES restart cycles (of ``linear_restart`` iterations)
+    relaxation_growth : float >= 1, the factor by which a simulation raises alpha again
+        (up to ``relaxation``) after a step that converged without a restart. ``None``:
+        2 for the coupled schemes, whose iteration needs no relaxation (ref. Sec. 4.5.3)
+        and only halves alpha to get through a hard step (e.g. a contact active set
+        that settles slowly), and 1 for the segregated schemes, which keep the alpha
+        they needed, as in ref. Fig. 4.10.
     """
 
     scheme: str = "krylov"
@@ -70,10 +77,17 @@ class SchemeSettings:
     linear_rtol: float = 1e-9
     linear_restart: int = 100
     linear_maxiter: int = 20
+    relaxation_growth: float = None
 
     def __post_init__(self):
         if self.scheme not in SCHEMES:
             raise InputError(f"scheme must be one of {SCHEMES}, got {self.scheme!r}")
+        if self.relaxation_growth is None:
+            object.__setattr__(self, "relaxation_growth", 2.0 if self.scheme in COUPLED_SCHEMES else 1.0)
+        growth = finite_scalar("relaxation_growth", self.relaxation_growth)
+        if growth < 1.0:
+            raise InputError(f"relaxation_growth must be >= 1, got {growth}")
+        object.__setattr__(self, "relaxation_growth", growth)
         for name, low, high in (("omega", 0.0, 1.0), ("relaxation", 1e-12, 1.0), ("min_relaxation", 1e-12, 1.0)):
             value = finite_scalar(name, getattr(self, name))
             if not low <= value <= high:
@@ -280,7 +294,7 @@ def solve_step(problem, settings, dd_guess, p_guess, relaxation):
     ``min_relaxation`` fails.
     """
     start = time.perf_counter()
-    iterate = _coupled_iteration if settings.scheme in ("fully-coupled", "krylov") else _segregated_iteration
+    iterate = _coupled_iteration if settings.scheme in COUPLED_SCHEMES else _segregated_iteration
     counters = {"nonlinear": 0, "linear": 0}
     alpha = relaxation
     restarts = 0

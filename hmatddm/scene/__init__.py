@@ -91,6 +91,8 @@ The format, annotated (``=`` values are the defaults unless marked REQUIRED)::
     max_iterations = 400           # nonlinear iterations per attempt, >= 1
     relaxation = 1.0               # initial alpha, (0, 1]
     min_relaxation = 0.00390625    # smallest alpha tried, (0, relaxation]
+    # relaxation_growth = 2.0      # >= 1, alpha grows back by it after a step without restart
+                                   # (default 2 for krylov / fully-coupled, 1 for the segregated)
     omega = 1.0                    # fracture-compliance weight, [0, 1]
     linear_rtol = 1e-9             # GMRES relative residual, (0, 1)
     linear_restart = 100           # GMRES Krylov dimension, >= 1

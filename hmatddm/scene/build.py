@@ -108,7 +108,7 @@ def leak_off(scene):
 
 def scheme_settings(scene):
     numerics = scene["numerics"]
-    return SchemeSettings(**{key: numerics[key] for key in SCHEME_KEYS})
+    return SchemeSettings(**{key: numerics[key] for key in SCHEME_KEYS if numerics.get(key) is not None})
 
 
 def build_simulation(scene, checkpoint_dir=None):

@@ -270,6 +270,8 @@ NUMERICS = {
     "relaxation": Key("number", _scheme_default("relaxation"), low=0.0, high=1.0, low_open=True),
     "min_relaxation": Key("number", _scheme_default("min_relaxation"), low=0.0, high=1.0, low_open=True),
     "omega": Key("number", _scheme_default("omega"), low=0.0, high=1.0),
+    "relaxation_growth": Key("number", low=1.0,
+                             doc="factor raising alpha after a step without restart (default 2 coupled, 1 segregated)"),
     "linear_rtol": Key("number", _scheme_default("linear_rtol"), **_UNIT_INTERVAL),
     "linear_restart": Key("integer", _scheme_default("linear_restart"), low=1),
     "linear_maxiter": Key("integer", _scheme_default("linear_maxiter"), low=1),
@@ -284,7 +286,7 @@ NUMERICS = {
 }
 
 SCHEME_KEYS = ("scheme", "omega", "relaxation", "min_relaxation", "tolerance_pressure", "tolerance_opening",
-               "max_iterations", "linear_rtol", "linear_restart", "linear_maxiter")  # -> SchemeSettings
+               "max_iterations", "linear_rtol", "linear_restart", "linear_maxiter", "relaxation_growth")  # -> SchemeSettings
 
 OUTPUT = {
     "every": Key("integer", 1, low=1, doc="write a .vtu every k steps (the last step always)"),

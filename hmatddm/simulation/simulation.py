@@ -449,7 +449,10 @@ class Simulation:
         failed = s.failed.copy()
         if self.network is not None:
             failed[natural_index[origin == 2]] = True
-        self.state = State(mesh, dd, p, creation, t_new, s.step + 1, relaxation, injected, leaked,
+        next_relaxation = relaxation
+        if totals["restarts"] == 0:  # an easy step: let alpha grow back (SchemeSettings.relaxation_growth)
+            next_relaxation = min(self.settings.relaxation, relaxation * self.settings.relaxation_growth)
+        self.state = State(mesh, dd, p, creation, t_new, s.step + 1, next_relaxation, injected, leaked,
                            origin=origin, natural_index=natural_index, intact=intact, failed=failed,
                            extra_faces=extra, contact_status=contact_state[0], slip_direction=contact_state[1],
                            failure_pressure=failure_pressure)
