@@ -115,3 +115,43 @@ def test_bad_natural_properties():
         NaturalFractureProperties(skempton=1.5)
     with pytest.raises(InputError, match="natural.critical_radius"):
         NaturalFractureProperties(critical_radius=0.0)
+
+
+def test_two_tips_reaching_one_natural_element_activate_it_once(monkeypatch):
+    """A hydraulic tip and the tip of an activated natural element that reach the same
+    intact natural element in one growth pass: it is activated once and the second tip
+    is connected to it (before, a hydraulic element was added on top of it, a singular
+    pair that stopped the 3D DFN benchmark at t = 64 s)."""
+    from types import SimpleNamespace
+
+    from hmatddm import topology
+    from hmatddm.simulation import simulation as simulation_module
+
+    # natural fracture in the plane y = 0: 4 x 2 elements of 1 m, centres z = -0.5, 0.5
+    natural = hd.mesh.rectangle([2.0, 0.0, 0.0], [1, 0, 0], [0, 0, 1], 4.0, 2.0, 4, 2)
+    target = int(np.argmin(np.linalg.norm(natural.centers - [2.5, 0.0, -0.5], axis=1)))
+    above = int(np.argmin(np.linalg.norm(natural.centers - [2.5, 0.0, 0.5], axis=1)))
+    hydraulic = hd.mesh.rectangle([2.5, -1.0, -0.5], [0, 1, 0], [0, 0, 1], 1.0, 1.0, 1, 1)
+    sim = hd.Simulation(hydraulic, hd.Elastic(10e9, 0.25), hd.Fluid(1e-3, 4.4e-10),
+                        [hd.Cluster((2.5, -1.0, -0.5), 1e-3, 0.0)], -np.diag([20e6, 30e6, 40e6]), 1.0,
+                        propagation=hd.Propagation(toughness=1e6), backend="dense", natural_fractures=natural,
+                        natural=NaturalFractureProperties(**TABLE_5_1, crossing="mohr-coulomb"))
+    # the active mesh: the hydraulic element and the activated natural element above the target
+    mesh = hd.mesh.concatenate([hydraulic, natural.subset(np.array([above]))])
+    origin, natural_index = np.array([0, 1]), np.array([-1, above])
+    intact = np.ones(natural.n_elements, bool)
+    intact[above] = False
+    edges = topology.element_edges(mesh, None)
+    faces = topology.element_faces(mesh, edges)
+    # both tips propose the target element as their next element
+    candidates = hd.mesh.concatenate([natural.subset(np.array([target]))] * 2)
+    tips = SimpleNamespace(edge=np.array([0, 0]), k_1=np.zeros(2), k_2=np.zeros(2), theta=np.zeros(2))
+    monkeypatch.setattr(simulation_module, "evaluate_tips", lambda *args, **kwargs: tips)
+    monkeypatch.setattr(simulation_module, "new_elements",
+                        lambda *args, **kwargs: (candidates, np.array([0, 1]), np.array([0, 1])))
+    sim._events = dict(natural_crossed=0, natural_deflected=0, junctions=0)
+    new_mesh, parent, new_natural, connections, new_origin, _ = sim._grow(
+        mesh, edges, faces, np.zeros((2, 3)), origin, natural_index, intact)
+    assert new_mesh.n_elements == 1 and list(new_natural) == [target] and list(new_origin) == [1]
+    assert list(parent) == [0]
+    assert [(k, tip) for k, tip, *_ in connections] == [(0, 1)]
