@@ -22,7 +22,7 @@ from scipy.spatial import cKDTree
 
 from ..fracture.crossing import crosses
 from ..mesh import Mesh3D
-from ..solve import mean_stress_at, stress_at
+from ..solve import stress_at
 
 
 def plan_segments(mesh):
@@ -114,7 +114,11 @@ class NaturalNetwork:
         points = self.mesh.centers[targets]
         stress = stress_at(active_mesh, material, dd, points, singular_correction=singular_correction)
         if self.properties.skempton > 0.0:
-            pore_change[targets] = -self.properties.skempton * mean_stress_at(active_mesh, material, dd, points)
+            # mean of the induced stress (ref. Eqs 5.24-5.28), from the same evaluation: in
+            # 2D plane strain sigma_zz = nu (sigma_xx + sigma_yy) joins the trace
+            trace = np.trace(stress, axis1=1, axis2=2)
+            mean = trace / 3.0 if stress.shape[1] == 3 else (1.0 + material.poisson_ratio) * trace / 3.0
+            pore_change[targets] = -self.properties.skempton * mean
         stress = stress + far_field
         normals = self.mesh.normals[targets]
         traction = np.einsum("mij,mj->mi", stress, normals)
