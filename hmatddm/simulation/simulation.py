@@ -74,6 +74,21 @@ class State:
             self.failure_pressure = np.full(n, np.nan)
 
 
+def with_links(faces, links):
+    """The flow faces plus the intersection links ``(K, 6)`` (i, j, length, d_i, d_j, edge
+    of i), except links between elements that already share an edge: a tip linked to a
+    natural element that another tip activated beside it in the same growth pass gets
+    its face from the mesh topology, and a second face would double the conductance."""
+    if len(links) == 0:
+        return faces
+    shared = set(zip(faces.first.tolist(), faces.second.tolist()))
+    shared |= {(b, a) for a, b in shared}
+    i, j, length, d_i, d_j, edge_i = np.asarray(links, dtype=np.float64).T
+    i, j, edge_i = i.astype(np.int64), j.astype(np.int64), edge_i.astype(np.int64)
+    keep = np.array([(a, b) not in shared for a, b in zip(i.tolist(), j.tolist())], dtype=bool)
+    return faces.append(i[keep], j[keep], length[keep], d_i[keep], d_j[keep], edge_i[keep])
+
+
 def _mesh_arrays(mesh):
     if isinstance(mesh, Mesh3D):
         return dict(centers=mesh.centers, frames=mesh.frames, half_a=mesh.half_a, half_b=mesh.half_b,
@@ -337,10 +352,7 @@ class Simulation:
     def _solve(self, mesh, dd_old_width, p_old, creation_time, dd_guess, p_guess, t_old, t_new, relaxation,
                extra_faces, origin=None, dd_start=None, contact_state=None, failure_pressure=None):
         edges = topology.element_edges(mesh, self.height)
-        faces = topology.element_faces(mesh, edges)
-        if len(extra_faces):
-            i, j, length, d_i, d_j, edge_i = extra_faces.T
-            faces = faces.append(i.astype(np.int64), j.astype(np.int64), length, d_i, d_j, edge_i.astype(np.int64))
+        faces = with_links(topology.element_faces(mesh, edges), extra_faces)
         flow = self.flow_model(mesh, faces)
         op = self.operator(mesh)
         elastic = ElasticSolver(op, rtol=self.settings.linear_rtol)
@@ -521,35 +533,44 @@ class Simulation:
         linked |= {(b, a) for a, b in linked}
         kept, activated, activated_parent, connections = [], [], [], list(junctions)
         activated_at = {}  # natural element -> its place in `activated` (this pass)
+
+        def activate(target, tip):
+            available[target] = reachable[target] = False
+            activated_at[int(target)] = len(activated)
+            activated.append(target)
+            activated_parent.append(tip)
+
+        def connect(tip, row, target, point, size):
+            """A flow face from ``tip`` to natural element ``target``, which is already in the
+            system or was activated by another tip in this pass (two tips reaching the same
+            element would otherwise put a hydraulic element on top of it, a singular pair:
+            found by the 3D DFN benchmark); never to itself, never twice."""
+            if active_of[target] >= 0:
+                other, index = int(active_of[target]), -1 - int(active_of[target])
+            else:
+                place = activated_at[int(target)]
+                other, index = ("new", place), place
+                if activated_parent[place] == tip:
+                    return
+            if other == tip or (tip, other) in linked:
+                return
+            linked.add((tip, other))
+            connections.append((index, tip, *self._link(mesh, edges, tip, tips.edge[row], target, point, size)))
+
         for k in range(grown.n_elements):
-            row, tip = rows[k], parent[k]
+            row, tip = rows[k], int(parent[k])
             distance, nearest = network.tree.query(grown.centers[k])
             size = min(float(grown.radii[k]), float(network.mesh.radii[nearest]))
-            if reachable[nearest] and distance < 0.5 * size:
+            if distance < 0.5 * size and (reachable[nearest] or int(nearest) in activated_at):
                 if available[nearest]:
                     # the next element is an intact natural element: the fluid runs into it
-                    available[nearest] = reachable[nearest] = False
-                    activated_at[int(nearest)] = len(activated)
-                    activated.append(nearest)
-                    activated_parent.append(tip)
-                elif active_of[nearest] != tip and (tip, active_of[nearest]) not in linked:
-                    # it is already in the system: connect the tip to it
-                    linked.add((tip, active_of[nearest]))
-                    connections.append((-1 - active_of[nearest], tip, *self._link(mesh, edges, tip, tips.edge[row],
-                                                                                 nearest, grown.centers[k], size)))
-                continue
-            if int(nearest) in activated_at and distance < 0.5 * size:
-                # another tip activated this natural element in this pass (two tips reaching
-                # the same element would otherwise put a hydraulic element on top of it, a
-                # singular pair: measured in the 3D DFN benchmark at t = 64 s): connect to it
-                place = activated_at[int(nearest)]
-                if activated_parent[place] != tip and (tip, ("new", place)) not in linked:
-                    linked.add((tip, ("new", place)))
-                    connections.append((place, tip, *self._link(mesh, edges, tip, tips.edge[row], nearest,
-                                                                grown.centers[k], size)))
+                    activate(nearest, tip)
+                else:
+                    # it is in the system or was activated in this pass: connect the tip to it
+                    connect(tip, row, nearest, grown.centers[k], size)
                 continue
             hinge = edges.midpoints[tip, tips.edge[row]]
-            hit = network.encounter(grown, k, hinge, available)
+            hit = network.encounter(grown, k, hinge, available)  # intact elements only
             if hit is None:
                 kept.append(k)
                 continue
@@ -560,16 +581,9 @@ class Simulation:
                 kept.append(k)
                 continue
             self._events["natural_deflected"] += 1
-            link = self._link(mesh, edges, tip, tips.edge[row], target, point, size)
-            if not available[target]:  # deflected into an element already in the system
-                if active_of[target] != tip and (tip, active_of[target]) not in linked:
-                    linked.add((tip, active_of[target]))
-                    connections.append((-1 - active_of[target], tip, *link))
-                continue
-            available[target] = reachable[target] = False
-            connections.append((len(activated), tip, *link))
-            activated.append(target)
-            activated_parent.append(tip)
+            connections.append((len(activated), tip, *self._link(mesh, edges, tip, tips.edge[row], target, point,
+                                                                 size)))
+            activate(target, tip)
         pieces, parents = [], []
         if kept:
             pieces.append(grown.subset(np.asarray(kept)))
