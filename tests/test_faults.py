@@ -24,7 +24,7 @@ import numpy as np
 import pytest
 
 import hmatddm as hd
-from hmatddm import cli, io as hio, runner
+from hmatddm import cli, io as hio
 from hmatddm.errors import OutputError
 from hmatddm.simulation import checkpoint as checkpoints
 from hmatddm.simulation.checkpoint import CheckpointWriteError
