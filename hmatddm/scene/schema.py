@@ -286,7 +286,8 @@ NUMERICS = {
 }
 
 SCHEME_KEYS = ("scheme", "omega", "relaxation", "min_relaxation", "tolerance_pressure", "tolerance_opening",
-               "max_iterations", "linear_rtol", "linear_restart", "linear_maxiter", "relaxation_growth")  # -> SchemeSettings
+               "max_iterations", "linear_rtol", "linear_restart", "linear_maxiter",
+               "relaxation_growth")  # -> SchemeSettings
 
 OUTPUT = {
     "every": Key("integer", 1, low=1, doc="write a .vtu every k steps (the last step always)"),

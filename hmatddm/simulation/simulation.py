@@ -189,7 +189,8 @@ class Simulation:
             raise InputError(f"backend must be one of {BACKENDS}, got {backend!r}")
         d = mesh.dim
         self.far_field_stress = finite_array("far_field_stress", far_field_stress, (d, d))
-        if not np.allclose(self.far_field_stress, self.far_field_stress.T, rtol=0, atol=1e-9 * (1 + np.abs(self.far_field_stress).max())):
+        scale = 1.0 + np.abs(self.far_field_stress).max()
+        if not np.allclose(self.far_field_stress, self.far_field_stress.T, rtol=0, atol=1e-9 * scale):
             raise InputError("far_field_stress must be a symmetric tensor")
         self.mesh0 = mesh
         self.material, self.fluid, self.clusters, self.leak_off = material, fluid, clusters, leak_off
