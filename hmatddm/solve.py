@@ -181,10 +181,11 @@ def _rotate_out3d(s00, s11, s22, s01, s02, s12, frame, out):
 
 
 @njit(cache=True)
-def _pair3d_edge(mode, x1, x2, x3, d0, d1, d2, frame, a, b, g, nu, shift, out, work):
-    """:func:`_pair3d` for a point on an edge of the element: the reference's averaging
-    across the edge (ref. Sec. 6.2.3), or NaN when ``shift`` is 0."""
-    _local_stress_corrected(x1, x2, x3, a, b, g, nu, shift, work)
+def _pair3d_edge(mode, x1, x2, x3, d0, d1, d2, frame, a, b, g, nu, shift, near, out, work):
+    """:func:`_pair3d` for a point on an edge of the element, or within the distance
+    ``near`` of one: the reference's averaging across the edge (ref. Sec. 6.2.3), or NaN
+    when ``shift`` is 0."""
+    _local_stress_corrected(x1, x2, x3, a, b, g, nu, shift, work, near)
     t00 = work[0, 0, 0] * d0 + work[1, 0, 0] * d1 + work[2, 0, 0] * d2
     t11 = work[0, 1, 1] * d0 + work[1, 1, 1] * d1 + work[2, 1, 1] * d2
     t22 = work[0, 2, 2] * d0 + work[1, 2, 2] * d1 + work[2, 2, 2] * d2
@@ -198,14 +199,28 @@ def _pair3d_edge(mode, x1, x2, x3, d0, d1, d2, frame, a, b, g, nu, shift, out, w
 
 
 @njit(cache=True, inline="always")
-def _pair3d(mode, px, py, pz, j, centers, frames, half_a, half_b, g, nu, shift, dd, out, work):
+def _near_boundary(x1, x2, x3, a, b, distance):
+    """Whether the local point may lie within ``distance`` of the rectangle's boundary
+    (a cheap test; :func:`hmatddm.kernels.rectangle3d.local_stress_corrected` decides)."""
+    if abs(x3) > distance:
+        return False
+    u = abs(x1)
+    v = abs(x2)
+    if u > a + distance or v > b + distance:
+        return False
+    return abs(u - a) <= distance or abs(v - b) <= distance
+
+
+@njit(cache=True, inline="always")
+def _pair3d(mode, px, py, pz, j, centers, frames, half_a, half_b, g, nu, shift, near_fraction, dd, out, work):
     """Contribution at the point ``(px, py, pz)`` of rectangle ``j`` carrying its global
     DD ``dd[j]``: ``out[:6]`` the global stress (xx, yy, zz, xy, xz, yz) for
     ``_STRESS3D`` (ref. Eqs 2.57-2.59: the rows of
     :func:`hmatddm.kernels.rectangle3d.local_stress` contracted with the local DD, then
     one rotation), ``out[0]`` the mean stress for ``_MEAN3D`` (ref. Eq. 5.28: the trace
     is ``2 (1 + nu) [g_13, g_23, g_33] . DD_local``). ``work``: (3, 3, 3) scratch for
-    points on an edge."""
+    points on an edge, or within ``near_fraction`` of the element's smaller half size of
+    one (a near miss, treated as on it)."""
     frame = frames[j]
     a = half_a[j]
     b = half_b[j]
@@ -221,8 +236,9 @@ def _pair3d(mode, px, py, pz, j, centers, frames, half_a, half_b, g, nu, shift, 
     d0 = frame[0, 0] * e0 + frame[0, 1] * e1 + frame[0, 2] * e2
     d1 = frame[1, 0] * e0 + frame[1, 1] * e1 + frame[1, 2] * e2
     d2 = frame[2, 0] * e0 + frame[2, 1] * e1 + frame[2, 2] * e2
-    if _on_edge(x1, x2, x3, a, b):
-        _pair3d_edge(mode, x1, x2, x3, d0, d1, d2, frame, a, b, g, nu, shift, out, work)
+    near = near_fraction * min(a, b)
+    if _on_edge(x1, x2, x3, a, b) or (near > 0.0 and _near_boundary(x1, x2, x3, a, b, near)):
+        _pair3d_edge(mode, x1, x2, x3, d0, d1, d2, frame, a, b, g, nu, shift, near, out, work)
         return
     s1 = 1.0 if x1 >= 0.0 else -1.0
     s2 = 1.0 if x2 >= 0.0 else -1.0
@@ -246,11 +262,11 @@ def _pair3d(mode, px, py, pz, j, centers, frames, half_a, half_b, g, nu, shift, 
 
 
 @njit(cache=True)
-def _pair2d(mode, point, center, frame, a, g, nu, shift, dd, out, work, pair):
+def _pair2d(mode, point, center, frame, a, g, nu, shift, near_fraction, dd, out, work, pair):
     """2D (plane strain) twin of :func:`_pair3d`: ``out[:3]`` = (xx, yy, xy) for
     ``_STRESS2D``, ``out[0]`` = ``(1 + nu)(s_xx + s_yy)/3`` for ``_MEAN2D``.
     ``work``, ``pair``: (2, 2, 2) scratch."""
-    _stress_pair2d(point, center, frame, a, g, nu, shift, pair, work)
+    _stress_pair2d(point, center, frame, a, g, nu, shift, pair, work, near_fraction * a)
     sxx = pair[0, 0, 0] * dd[0] + pair[1, 0, 0] * dd[1]
     syy = pair[0, 1, 1] * dd[0] + pair[1, 1, 1] * dd[1]
     if mode == _MEAN2D:
@@ -267,8 +283,8 @@ def _pair2d(mode, point, center, frame, a, g, nu, shift, dd, out, work, pair):
 
 @njit(cache=True, inline="always")
 def _pair2d_at(mode, points, t, j, centers, frames, half_a, params, dd, out, work2, pair2):
-    _pair2d(mode, points[t], centers[j], frames[j], half_a[j], params[0], params[1], params[2], dd[j], out, work2,
-            pair2)
+    _pair2d(mode, points[t], centers[j], frames[j], half_a[j], params[0], params[1], params[2], params[4], dd[j],
+            out, work2, pair2)
 
 
 @njit(cache=True)
@@ -280,15 +296,15 @@ def _point_sum(mode, points, t, sources, centers, frames, half_a, half_b, params
     if mode == _STRESS3D:
         pz = points[t, 2]
         for j in sources:
-            _pair3d(_STRESS3D, px, py, pz, j, centers, frames, half_a, half_b, params[0], params[1], params[2], dd,
-                    value, work3)
+            _pair3d(_STRESS3D, px, py, pz, j, centers, frames, half_a, half_b, params[0], params[1], params[2],
+                    params[4], dd, value, work3)
             for c in range(6):
                 acc[t, c] += value[c]
     elif mode == _MEAN3D:
         pz = points[t, 2]
         for j in sources:
-            _pair3d(_MEAN3D, px, py, pz, j, centers, frames, half_a, half_b, params[0], params[1], params[2], dd,
-                    value, work3)
+            _pair3d(_MEAN3D, px, py, pz, j, centers, frames, half_a, half_b, params[0], params[1], params[2],
+                    params[4], dd, value, work3)
             acc[t, 0] += value[0]
     else:
         n_out = 3 if mode == _STRESS2D else 1
@@ -308,14 +324,14 @@ def _point_row(mode, points, t, sources, centers, frames, half_a, half_b, params
         pz = points[t, 2]
         for b in range(sources.size):
             _pair3d(_STRESS3D, px, py, pz, sources[b], centers, frames, half_a, half_b, params[0], params[1],
-                    params[2], dd, value, work3)
+                    params[2], params[4], dd, value, work3)
             for c in range(6):
                 row[c, b] = value[c]
     elif mode == _MEAN3D:
         pz = points[t, 2]
         for b in range(sources.size):
             _pair3d(_MEAN3D, px, py, pz, sources[b], centers, frames, half_a, half_b, params[0], params[1],
-                    params[2], dd, value, work3)
+                    params[2], params[4], dd, value, work3)
             row[0, b] = value[0]
     else:
         n_out = 3 if mode == _STRESS2D else 1
@@ -334,14 +350,14 @@ def _element_column(mode, points, targets, j, centers, frames, half_a, half_b, p
         for a in range(targets.size):
             t = targets[a]
             _pair3d(_STRESS3D, points[t, 0], points[t, 1], points[t, 2], j, centers, frames, half_a, half_b,
-                    params[0], params[1], params[2], dd, value, work3)
+                    params[0], params[1], params[2], params[4], dd, value, work3)
             for c in range(6):
                 column[6 * a + c] = value[c]
     elif mode == _MEAN3D:
         for a in range(targets.size):
             t = targets[a]
             _pair3d(_MEAN3D, points[t, 0], points[t, 1], points[t, 2], j, centers, frames, half_a, half_b,
-                    params[0], params[1], params[2], dd, value, work3)
+                    params[0], params[1], params[2], params[4], dd, value, work3)
             column[a] = value[0]
     else:
         n_out = 3 if mode == _STRESS2D else 1
@@ -651,7 +667,7 @@ def _split_blocks(cost, n_chunks):
     return offsets, blocks
 
 
-def _evaluate(mesh, material, dd, points, mode, singular_correction, method, eps, info):
+def _evaluate(mesh, material, dd, points, mode, singular_correction, method, eps, info, near_fraction=0.0):
     """Shared driver of :func:`stress_at` and :func:`mean_stress_at`: ``(M, n_out)``."""
     if not isinstance(mesh, (Mesh2D, Mesh3D)):
         raise InputError(f"mesh must be a Mesh2D or Mesh3D, got {type(mesh).__name__}")
@@ -661,6 +677,9 @@ def _evaluate(mesh, material, dd, points, mode, singular_correction, method, eps
         raise InputError(f"singular_correction must be one of ('none', 'average'), got {singular_correction!r}")
     if method not in METHODS:
         raise InputError(f"method must be one of {METHODS}, got {method!r}")
+    near_fraction = finite_scalar("near_fraction", near_fraction)
+    if not 0.0 <= near_fraction < 1.0:
+        raise InputError(f"near_fraction must be in [0, 1), got {near_fraction}")
     eps = DEFAULT_STRESS_EPS if eps is None else finite_scalar("eps", eps)
     if not 0.0 < eps < 1.0:
         raise InputError(f"eps must be in (0, 1), got {eps}")
@@ -670,7 +689,8 @@ def _evaluate(mesh, material, dd, points, mode, singular_correction, method, eps
     # contiguous float64 arrays: one compiled specialisation of each driver, whatever
     # slicing or concatenation produced the mesh
     centers, frames, half_a, half_b, params = (np.ascontiguousarray(a, dtype=np.float64) for a in
-                                               element_data(mesh, material, singular_shift=shift)[:5])
+                                               element_data(mesh, material, singular_shift=shift,
+                                                            near_fraction=near_fraction)[:5])
     n_out = _N_OUT[mode]
     m, n = len(points), mesh.n_elements
     out = np.zeros((m, n_out))
@@ -709,11 +729,19 @@ def _evaluate(mesh, material, dd, points, mode, singular_correction, method, eps
     return out
 
 
-def _bad_points(values):
-    return np.flatnonzero(~np.all(np.isfinite(values), axis=1))
+def _refuse_singular(values, near_fraction):
+    """InputError naming the first point whose stress is singular (NaN: on an edge, or
+    within ``near_fraction`` of one, without ``singular_correction='average'``)."""
+    bad = np.flatnonzero(~np.all(np.isfinite(values), axis=1))
+    if bad.size:
+        where = "on an element edge" if near_fraction == 0.0 else \
+            f"on an element edge or within near_fraction = {near_fraction:g} half sizes of one"
+        raise InputError(f"points[{int(bad[0])}] lies {where}, where the stress is singular; "
+                         "move it or pass singular_correction='average'")
 
 
-def stress_at(mesh, material, dd, points, singular_correction="none", method="auto", eps=None, info=None):
+def stress_at(mesh, material, dd, points, singular_correction="none", method="auto", eps=None, info=None,
+              near_fraction=0.0):
     """Stress (M, d, d) induced at ``points`` (M, d) by the DDs ``dd`` (global frame),
     ref. Eq. 2.59. In 2D the in-plane components of the plane-strain stress.
 
@@ -726,6 +754,13 @@ def stress_at(mesh, material, dd, points, singular_correction="none", method="au
     singular_correction : ``"none"`` or ``"average"``
         Points on an element edge raise :class:`InputError` unless ``"average"``
         (the mean of two points moved across the edge, ref. Sec. 6.2.3).
+    near_fraction : float in [0, 1)
+        Points within ``near_fraction`` of an element's smaller half size of its edge
+        (its end in 2D) count as on it (a near miss, where the exact stress is ~1/gap):
+        averaged with ``"average"``, refused with ``"none"``. 0 (default): exact hits
+        only, so the field close to a crack tip can be sampled. The remote-failure check
+        of a simulation uses :data:`hmatddm.operators.NEAR_SINGULAR_FRACTION` (0.5), the
+        threshold of the DDM operator.
     method : ``"auto"`` (default), ``"direct"`` or ``"tree"``
         ``"direct"``: exact summation over all elements, O(M N), parallel over points.
         ``"tree"``: cluster trees of the points and of the elements; blocks of clusters
@@ -747,17 +782,15 @@ def stress_at(mesh, material, dd, points, singular_correction="none", method="au
         compressed blocks).
     """
     mode = _STRESS3D if isinstance(mesh, Mesh3D) else _STRESS2D
-    values = _evaluate(mesh, material, dd, points, mode, singular_correction, method, eps, info)
-    bad = _bad_points(values)
-    if bad.size:
-        raise InputError(f"points[{int(bad[0])}] lies on an element edge, where the stress is singular; "
-                         "move it or pass singular_correction='average'")
+    values = _evaluate(mesh, material, dd, points, mode, singular_correction, method, eps, info, near_fraction)
+    _refuse_singular(values, near_fraction)
     if mesh.dim == 3:
         return values[:, [0, 3, 4, 3, 1, 5, 4, 5, 2]].reshape(-1, 3, 3)
     return values[:, [0, 2, 2, 1]].reshape(-1, 2, 2)
 
 
-def mean_stress_at(mesh, material, dd, points, singular_correction="none", method="auto", eps=None, info=None):
+def mean_stress_at(mesh, material, dd, points, singular_correction="none", method="auto", eps=None, info=None,
+                   near_fraction=0.0):
     """Mean stress ``tr(sigma)/3`` (M,) induced at ``points`` (ref. Eqs 5.24-5.28).
 
     In 2D (plane strain) ``sigma_zz = nu (sigma_xx + sigma_yy)`` is included, so the
@@ -766,9 +799,6 @@ def mean_stress_at(mesh, material, dd, points, singular_correction="none", metho
     potential the trace needs (about half the cost of the full stress).
     """
     mode = _MEAN3D if isinstance(mesh, Mesh3D) else _MEAN2D
-    values = _evaluate(mesh, material, dd, points, mode, singular_correction, method, eps, info)
-    bad = _bad_points(values)
-    if bad.size:
-        raise InputError(f"points[{int(bad[0])}] lies on an element edge, where the stress is singular; "
-                         "move it or pass singular_correction='average'")
+    values = _evaluate(mesh, material, dd, points, mode, singular_correction, method, eps, info, near_fraction)
+    _refuse_singular(values, near_fraction)
     return values[:, 0]

@@ -60,6 +60,39 @@ def test_edge_points_3d_average_or_refuse(material):
             function(mesh, material, dd, on_edge)
 
 
+def test_near_miss_points_are_averaged_like_edge_points(material):
+    """A point a hair's breadth beyond an element edge (a near miss, stress ~1/gap) is
+    treated as on the edge with ``near_fraction``: the remote-failure check must not see a
+    spurious near-singular stress at a natural element whose centre sits at a hydraulic
+    element's edge. 3D and 2D."""
+    rng = np.random.default_rng(2)
+    mesh = _random_mesh3d(rng, 8)
+    dd = rng.normal(size=(mesh.n_elements, 3)) * 1e-3
+    on_edge = mesh.centers[:4] + mesh.half_a[:4, None] * mesh.frames[:4, 0]
+    near = on_edge + 1e-7 * mesh.half_a[:4, None] * mesh.frames[:4, 0]  # just outside
+    edge_value = hd.stress_at(mesh, material, dd, on_edge, singular_correction="average")
+    plain = hd.stress_at(mesh, material, dd, near, singular_correction="average")
+    scale = np.max(np.abs(edge_value))
+    assert np.max(np.abs(plain - edge_value)) > 10.0 * scale  # ~1/gap without the treatment
+    for method in ("direct", "tree"):
+        treated = hd.stress_at(mesh, material, dd, near, singular_correction="average", method=method,
+                               near_fraction=0.5)
+        assert np.max(np.abs(treated - edge_value)) <= 1e-4 * scale
+    mean = hd.mean_stress_at(mesh, material, dd, near, singular_correction="average", near_fraction=0.5)
+    np.testing.assert_allclose(mean, np.trace(edge_value, axis1=1, axis2=2) / 3.0, rtol=0, atol=1e-4 * scale)
+    with pytest.raises(hd.InputError, match="near_fraction"):
+        hd.stress_at(mesh, material, dd, near, near_fraction=0.5)
+    with pytest.raises(hd.InputError, match="near_fraction"):
+        hd.stress_at(mesh, material, dd, near, near_fraction=1.5)
+    # 2D: a point just beyond a segment's end
+    line = hd.mesh.line([-1.0, 0.0], [1.0, 0.0], 4)
+    dd2 = rng.normal(size=(4, 2)) * 1e-3
+    tip, beyond = np.array([[1.0, 0.0]]), np.array([[1.0 + 1e-8, 1e-8]])
+    tip_value = hd.stress_at(line, material, dd2, tip, singular_correction="average")
+    treated = hd.stress_at(line, material, dd2, beyond, singular_correction="average", near_fraction=0.5)
+    assert np.max(np.abs(treated - tip_value)) <= 1e-4 * np.max(np.abs(tip_value))
+
+
 def test_direct_2d_matches_component_kernel(material):
     rng = np.random.default_rng(2)
     mesh = hd.mesh.line([0.0, 0.0], [3.0, 1.0], 12)

@@ -22,6 +22,7 @@ from scipy.spatial import cKDTree
 
 from ..fracture.crossing import crosses
 from ..mesh import Mesh3D
+from ..operators import NEAR_SINGULAR_FRACTION
 from ..solve import stress_at
 
 
@@ -112,7 +113,11 @@ class NaturalNetwork:
         if targets.size == 0:
             return failed, normal_stress, shear_stress, pore_change
         points = self.mesh.centers[targets]
-        stress = stress_at(active_mesh, material, dd, points, singular_correction=singular_correction)
+        # targets within half an element size of an active element's edge are near misses
+        # (stress ~1/gap): averaged like the DDM operator's collocation points
+        near = NEAR_SINGULAR_FRACTION if singular_correction == "average" else 0.0
+        stress = stress_at(active_mesh, material, dd, points, singular_correction=singular_correction,
+                           near_fraction=near)
         if self.properties.skempton > 0.0:
             # mean of the induced stress (ref. Eqs 5.24-5.28), from the same evaluation: in
             # 2D plane strain sigma_zz = nu (sigma_xx + sigma_yy) joins the trace
