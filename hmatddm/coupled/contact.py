@@ -246,7 +246,9 @@ class ContactModel:
             g[slip, 1] = self.law.cohesion[slip]
             if d == 3:
                 select[slip, 2, :] = tangents[slip, 1, :]
-        key = (self.status.tobytes(), np.round(self.direction, 3).tobytes())
+        # exact: the dense backend solves with the cached LU of these rows, so two sets of
+        # rows may share a factorisation only when they are the same rows
+        key = (self.status.tobytes(), self.direction.tobytes())
         self._rows = ContactRows(select, direct, g, hash(key))
         return self._rows
 
