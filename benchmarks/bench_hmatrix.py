@@ -83,7 +83,7 @@ def _segment_distance(s, t):
 
 
 def smooth_field(mesh):
-    """Elliptical opening over each fracture (DESIGN.md sec. 4: the field that matters)."""
+    """Elliptical opening over each fracture (docs/conventions.md §7: the field that matters)."""
     dd = np.zeros((mesh.n_elements, 3))
     for k in np.unique(mesh.fracture_id):
         idx = np.flatnonzero(mesh.fracture_id == k)

@@ -4,7 +4,7 @@ matvec time and accuracy, and the solution of a pressurised crack with both.
 A 3D square crack of 64 x 64 unit elements (4096 elements, 12288 unknowns) in the x-y
 plane. The matvec error is measured on a smooth field (an elliptical opening), where
 the hypersingular operator cancels its near field and the far-field approximation
-shows (DESIGN.md section 4). ``hmatddm bench`` prints the same table at several sizes.
+shows (docs/conventions.md §7). ``hmatddm bench`` prints the same table at several sizes.
 
 Run: ``python examples/hmatrix_vs_dense.py`` (about 25 s; the dense matrix takes 1.2 GB).
 """

@@ -1,6 +1,6 @@
 """hmatddm: hydraulic fractures with the displacement discontinuity method and H-matrices.
 
-Conventions (DESIGN.md section 1): SI units, tension positive, ``DD = u(+) - u(-)`` with
+Conventions (docs/conventions.md §1): SI units, tension positive, ``DD = u(+) - u(-)`` with
 ``+`` the face the element normal points to, opening ``w = DD . n > 0`` when open, DD and
 tractions in the global frame, element-major.
 

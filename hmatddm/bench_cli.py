@@ -3,7 +3,7 @@
 For square planar cracks of growing size, both backends are built and compared:
 build time, memory, matvec time (median of a few products) and the relative error of
 the H-matrix matvec against the dense one on a SMOOTH field, an elliptical opening
-``w = sqrt(1 - (x/a)^2 - (y/b)^2)`` (DESIGN.md section 4: the hypersingular operator
+``w = sqrt(1 - (x/a)^2 - (y/b)^2)`` (docs/conventions.md §7: the hypersingular operator
 cancels its near field on smooth inputs, so this is where far-field ACA error shows).
 The full benchmarks (to N = 100k, eps sweeps) are in ``benchmarks/``.
 """

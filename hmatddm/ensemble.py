@@ -1,4 +1,4 @@
-"""Ensembles of seeded realizations on Dask (DESIGN.md sec. 5; ref. Fig. 6.9).
+"""Ensembles of seeded realizations on Dask (docs/conventions.md §8; ref. Fig. 6.9).
 
 :func:`sweep` runs a task for every point of a parameter grid and every seed on a Dask
 cluster: a ``LocalCluster`` by default, or the scheduler at ``scheduler`` (an address

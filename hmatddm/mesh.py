@@ -11,7 +11,7 @@ Local frames are stored row-wise: ``frames[i]`` is the rotation whose rows are t
 element's unit tangent(s) and unit normal, ``(t, n)`` in 2D and ``(e1, e2, n)`` in 3D,
 with ``n = e1 x e2`` (right-handed). In 2D ``n`` is ``t`` turned by +90 degrees.
 The normal points to the ``+`` face: a displacement discontinuity ``DD = u(+) - u(-)``
-opens the crack when ``DD . n > 0`` (DESIGN.md section 1).
+opens the crack when ``DD . n > 0`` (docs/conventions.md §1).
 """
 import warnings
 from dataclasses import dataclass

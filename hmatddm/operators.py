@@ -1,6 +1,6 @@
 """The elasticity operator: DD (global frame) -> traction sigma.n at the collocation points.
 
-One interface, two backends (DESIGN.md sections 1-3):
+One interface, two backends (docs/conventions.md §§1, 2, 6):
 
 * ``"dense"``: the full influence matrix (ref. Eq. 2.47 with the coefficients of
   ref. Eqs 2.57-2.59), assembled in parallel by the numba kernels. The reference path.

@@ -91,7 +91,7 @@ def _dd_array(mesh, dd):
 
 
 def opening(mesh, dd):
-    """Opening ``w = DD . n`` (N,), positive for an open crack (DESIGN.md section 1)."""
+    """Opening ``w = DD . n`` (N,), positive for an open crack (docs/conventions.md §1)."""
     dd = _dd_array(mesh, dd)
     return np.einsum("ij,ij->i", dd, mesh.normals)
 

@@ -1,4 +1,4 @@
-"""Whole-element ACA and recompression on explicit blocks (DESIGN.md section 4).
+"""Whole-element ACA and recompression on explicit blocks (docs/conventions.md §7).
 
 Blocks are explicit dense matrices read through ``matrix_kernel``, so every case
 (zero rows, rank-deficient pivots, decoupled tensor components) is exact and known.
@@ -111,7 +111,7 @@ def test_decoupled_components_whole_element_versus_scalar_aca(eps):
     """A DDM-like kernel of a planar crack: components p never couple to q != p.
 
     A scalar ACA started on a 'shear' row only ever visits shear rows and misses the
-    other components whatever the tolerance (DESIGN.md section 4); whole-element
+    other components whatever the tolerance (docs/conventions.md §7); whole-element
     pivots see all d components at once.
     """
     rng = np.random.default_rng(4)

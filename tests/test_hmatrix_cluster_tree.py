@@ -1,4 +1,4 @@
-"""Cluster tree and block cluster tree of hmatddm.hmatrix (DESIGN.md section 4)."""
+"""Cluster tree and block cluster tree of hmatddm.hmatrix (docs/conventions.md §7)."""
 
 import numpy as np
 import pytest

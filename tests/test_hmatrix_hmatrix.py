@@ -1,4 +1,4 @@
-"""HMatrix build, matvec and checks against the dense twin (DESIGN.md section 4).
+"""HMatrix build, matvec and checks against the dense twin (docs/conventions.md §7).
 
 Every compressed result is compared with the exact matrix: sampled entries of EACH
 admissible block, matvecs on random vectors, and the full matrix for small N.

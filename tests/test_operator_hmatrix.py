@@ -1,4 +1,4 @@
-"""The hmatrix backend against the dense path on the same DDM problems (DESIGN.md sec. 4).
+"""The hmatrix backend against the dense path on the same DDM problems (docs/conventions.md §7).
 
 Per-block errors are checked on sampled exact entries of EVERY admissible block (the
 global error is dominated by the near field and hides ACA failures), and matvec /

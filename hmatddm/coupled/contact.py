@@ -2,7 +2,7 @@
 
 A fracture element that the fluid cannot hold open closes: its faces touch and carry a
 contact traction ``c`` (tension positive, our sign). With the elasticity equation of
-an element written as its residual (DESIGN.md sec. 1, ref. Eq. 4.4 with fluid)::
+an element written as its residual (docs/conventions.md §1, ref. Eq. 4.4 with fluid)::
 
     c_i = (A DD + B p - f)_i        (the part of the rock traction the fluid does not carry)
 

@@ -7,7 +7,7 @@ Eq. 4.36)::
     c_f (S_i w_i^k + V_wi) (p_i - p_i^n)/dt + S_i (w_i - w_i^n)/dt
         + S_i Lambda_i (p_i - p_r) - sum_e K_e^k (p_j - p_i) = q_wi
 
-with the opening ``w_i = n_i . DD_i`` (our sign convention, DESIGN.md section 1; the
+with the opening ``w_i = n_i . DD_i`` (our sign convention, docs/conventions.md §1; the
 reference writes ``w = -n . Delta u``). In matrix form ``C DD + D p = g`` (ref.
 Eqs 4.37-4.40) with
 

@@ -23,7 +23,7 @@ where the stress is infinite) are singular and handled by :func:`local_stress_co
 distance of an edge (near-miss junctions, where the exact value is ~1/gap).
 
 Sign convention: DD = u(+) - u(-), + being the side ``n = e1 x e2`` points to; an opening
-(DD . n > 0) induces compression on the element itself (DESIGN.md section 1).
+(DD . n > 0) induces compression on the element itself (docs/conventions.md §1).
 """
 import math
 

@@ -1,7 +1,7 @@
 """Natural fractures inside the time loop (ref. Ch. 5): encounters, crossing, activation,
 remote failure.
 
-Intact natural-fracture elements are stress *targets*, not unknowns (DESIGN.md sec. 2).
+Intact natural-fracture elements are stress *targets*, not unknowns (docs/conventions.md §5).
 They join the active system when fluid reaches them:
 
 * a growing tip whose next element would cut an intact natural element applies the
