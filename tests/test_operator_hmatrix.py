@@ -29,6 +29,18 @@ def tilted_rectangles(seed=4):
     return hd.mesh.concatenate(parts)
 
 
+#: The random 2D network has 6 pairs of near-parallel elements of different fractures
+#: closer than constant elements resolve (asserted in
+#: test_segment_network_is_flagged_for_close_parallel_pairs); every other test here
+#: compares backends on it, for which the warning is expected and not the subject.
+pytestmark = pytest.mark.filterwarnings("ignore::hmatddm.errors.MeshQualityWarning")
+
+
+def test_segment_network_is_flagged_for_close_parallel_pairs(material):
+    with pytest.warns(hd.errors.MeshQualityWarning, match="6 pair"):
+        hd.ElasticityOperator(segment_network(), material, backend="dense", singular_correction="average")
+
+
 def segment_network(seed=5):
     """A 2D DFN-like set of straight fractures, each cut into segments. Meshed
     independently, crossings put element ends within half an element of other
