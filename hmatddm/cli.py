@@ -6,6 +6,7 @@
     hmatddm bench [--quick] [--json]  H-matrix against dense: build time, memory, matvec time, error
     hmatddm render DIR                snapshots and history plot of a finished or partial run
     hmatddm sweep [--realizations N]  natural-fracture network ensembles on Dask (ref. Fig. 6.9)
+    hmatddm microseismic DIR          event catalogue (events.csv) and map of a finished run (ref. Ch. 7)
 
 Exit codes: 0 ok, 1 a check failed (validate), 2 bad input, 3 did not converge,
 4 an output could not be written (the disk is full or the folder is not writable; every
@@ -176,6 +177,16 @@ def _render(args):
     return EXIT_OK
 
 
+def _microseismic(args):
+    from .microseismic.catalogue import catalogue_for_folder
+
+    paths, catalogue = catalogue_for_folder(args.dir, scene=args.scene)
+    _say(args, f"{len(catalogue.events)} microseismic events")
+    for path in paths:
+        _say(args, f"wrote {path}")
+    return EXIT_OK
+
+
 # ---------------------------------------------------------------------------------
 # parser and main
 # ---------------------------------------------------------------------------------
@@ -243,6 +254,13 @@ def build_parser():
     render.add_argument("dir", metavar="DIR", help="the --out folder of `hmatddm run`")
     render.add_argument("--quiet", action="store_true", help="do not list the written files")
     render.set_defaults(handler=_render)
+    microseismic = sub.add_parser("microseismic", help="event catalogue (events.csv) and map of a finished run "
+                                                       "(ref. Ch. 7)")
+    microseismic.add_argument("dir", metavar="DIR", help="the --out folder of `hmatddm run`")
+    microseismic.add_argument("--scene", metavar="FILE", help="scene file or embedded name whose [microseismic] "
+                                                              "section to use (default: the run's own scene)")
+    microseismic.add_argument("--quiet", action="store_true", help="do not list the written files")
+    microseismic.set_defaults(handler=_microseismic)
     sweep = sub.add_parser("sweep", help="natural-fracture network ensembles on Dask: intersection frequency "
                                          "(ref. Fig. 6.9) over a grid of densities and length exponents")
     sweep.add_argument("--density", type=float, nargs="+", default=[0.05, 0.1], help="areal densities, 1/m^2")

@@ -352,6 +352,7 @@ class SceneRun:
     def _clear(self):
         """Remove the files an earlier run wrote (only ours, by name)."""
         names = [self.out / SUMMARY, self.out / PVD, self.out / HISTORY, self.out / SCENE_FILE]
+        names += [self.out / name for name in ("events.csv", "microseismic_map.png")]  # hmatddm.microseismic
         folder = self.out / CHECKPOINT_DIR
         names += list(folder.glob("step-*.json")) + list(folder.glob("step-*.npz"))
         names += list((self.out / VTU_DIR).glob("step-*.vtu")) + list((self.out / SNAPSHOT_DIR).glob("step-*.png"))
@@ -454,6 +455,16 @@ class SceneRun:
                 self.note(f"hmatddm: warning: no snapshots written: {error}")
         if output["history_plot"]:
             self.written["history"] = write_history(self.out, self.records, self.scene.data)
+        if "microseismic" in self.scene.data:  # events.csv and the event map (ref. Ch. 7)
+            from .microseismic.catalogue import write_catalogue
+
+            try:
+                self.written["microseismic"], _ = write_catalogue(self.out, self.scene.data["microseismic"],
+                                                                  name=self.scene.name)
+            except OutputError:
+                raise
+            except HmatddmError as error:  # e.g. a receiver on an event: the run itself is fine
+                self.note(f"hmatddm: warning: no microseismic catalogue written: {error}")
         return self._write_summary()
 
 

@@ -159,6 +159,10 @@ class Key:
                 self._list(f"{path}[{i}]", row, dim, "numbers")
                 rows.append([self._number(path, v, f"{path}[{i}][{j}]") for j, v in enumerate(row)])
             return rows
+        if kind == "points":  # a list of points of `length` coordinates (e.g. well positions)
+            self._list(path, value, None, f"[{', '.join(['x', 'y', 'z'][:self.length])}] points")
+            return [Key("point", length=self.length, unit=self.unit).check(f"{path}[{i}]", v, dim)
+                    for i, v in enumerate(value)]
         if kind == "pairs":
             self._list(path, value, None, "[low, high] pairs")
             pairs = []
@@ -331,6 +335,22 @@ NATURAL_FRACTURE = {
     "p1": Key("point", REQUIRED, length=2, unit="m"),
 }
 
+MICROSEISMIC = {  # synthetic monitoring of the run (ref. Ch. 7): hmatddm.microseismic
+    "wells": Key("points", REQUIRED, length=2, unit="m", doc="plan positions [x, y] of vertical observation wells"),
+    "receiver_top": Key("number", 20.0, unit="m"),
+    "receiver_bottom": Key("number", -20.0, unit="m"),
+    "receiver_spacing": Key("number", 5.0, **_POSITIVE_LENGTH),
+    "p_wave_speed": Key("number", 4000.0, low=0.0, low_open=True, unit="m/s"),
+    "s_wave_speed": Key("number", 2350.0, low=0.0, low_open=True, unit="m/s"),
+    "density": Key("number", 3000.0, low=0.0, low_open=True, unit="kg/m^3"),
+    "shear_ratio": Key("number", 2.0, low=0.0, doc="events: |slip| >= shear_ratio |opening| (ref. Eq. 7.29)"),
+    "rotation_noise_deg": Key("number", 0.0, low=0.0, unit="deg"),
+    "travel_time_noise": Key("number", 0.0, low=0.0, unit="s"),
+    "amplitude_noise": Key("number", 0.0, low=0.0, doc="share of the largest amplitude"),
+    "seed": Key("integer", 0, low=0),
+    "merge": Key("boolean", False, doc="merge neighbouring elements failing in the same step"),
+}
+
 # name -> (keys, array of tables?, required?)
 SECTIONS = {
     "material": (MATERIAL, False, True),
@@ -345,6 +365,7 @@ SECTIONS = {
     "reference": (REFERENCE, False, False),
     "network": (NETWORK, False, False),
     "natural_fracture": (NATURAL_FRACTURE, True, False),
+    "microseismic": (MICROSEISMIC, False, False),
 }
 FILLED_WHEN_ABSENT = ("leak_off", "output")  # optional sections echoed with their defaults
 
@@ -611,6 +632,10 @@ def validate(raw, name=None):
             echo = _check_stress(echo, dim)
         elif section == "network":
             echo = _check_network(echo, set(value))
+        elif section == "microseismic":
+            from ..microseismic.catalogue import check_section
+
+            echo = check_section(echo)
         scene[section] = echo
 
     numerics = scene["numerics"]

@@ -1,0 +1,1 @@
+"""Synthetic microseismic events from simulations (ref. Ch. 7)."""
