@@ -1,0 +1,135 @@
+"""The catalogue of a run (ref. Sec. 7.4): a small run whose natural fracture slips gives
+events.csv and a map through `hmatddm run` and `hmatddm microseismic DIR`; the
+[microseismic] scene section refuses bad input naming the key."""
+import numpy as np
+import pytest
+
+from hmatddm import cli
+from hmatddm.errors import InputError
+from hmatddm.microseismic.catalogue import EVENTS_CSV, MAP_PNG, read_events_csv
+from hmatddm.scene import load_scene, parse_scene
+
+# a pressurised crack next to a critically stressed natural fracture (as tests/test_contact.py):
+# its four elements fail remotely in the first step and slip
+SLIP_SCENE = """
+dimension = 2
+height = 2.0
+[material]
+shear_modulus = 10e9
+poisson_ratio = 0.25
+[fluid]
+viscosity = 1e-3
+compressibility = 1e-9
+[stress]
+s_hmin = 9e6
+s_hmax = 14e6
+[[cluster]]
+position = [0.0, 0.0]
+rate = 1e-3
+[[initial_fracture]]
+shape = "line"
+p0 = [-2.0, 0.0]
+p1 = [2.0, 0.0]
+element_size = 0.5
+[leak_off]
+pore_pressure = 5e6
+[network]
+friction_coefficient = 0.3
+element_size = 0.5
+[[natural_fracture]]
+p0 = [2.133974596215561, 0.1]
+p1 = [3.866025403784439, 1.1]
+[numerics]
+time_step = 1.0
+end_time = 2.0
+backend = "dense"
+initial_pressure = 9.5e6
+initial_opening = 1e-4
+singular_correction = "average"
+alpha = 1.0
+[output]
+snapshots = false
+history_plot = false
+"""
+MICROSEISMIC = """
+[microseismic]
+wells = [[20.0, 0.0], [0.0, 20.0]]
+"""
+
+
+def _png_is_not_blank(path):
+    from matplotlib.image import imread
+
+    image = imread(path)
+    return image.shape[0] > 100 and float(np.std(image[..., :3])) > 0.01
+
+
+@pytest.fixture(scope="module")
+def run_folder(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("slip")
+    scene = folder / "slip.toml"
+    scene.write_text(SLIP_SCENE + MICROSEISMIC)
+    out = folder / "out"
+    assert cli.main(["run", str(scene), "--out", str(out), "--quiet"]) == cli.EXIT_OK
+    return folder, out
+
+
+def test_run_writes_a_catalogue_with_exact_noise_free_locations(run_folder):
+    _, out = run_folder
+    columns = read_events_csv(out / EVENTS_CSV)
+    assert len(columns["event"]) == 4  # the natural fracture's four elements
+    np.testing.assert_array_equal(columns["time_s"], 1.0)  # they fail and slip in the first step
+    np.testing.assert_allclose(columns["located_x_m"], columns["x_m"], atol=1e-6)
+    np.testing.assert_allclose(columns["located_y_m"], columns["y_m"], atol=1e-6)
+    assert np.all(columns["location_error_m"] < 1e-5)
+    np.testing.assert_allclose(columns["area_m2"], 0.5 * 2.0)  # element length times the flow height
+    assert np.all(columns["dc"] > 0.99)  # closed and slipping: shear events
+    mu = 3000.0 * 2350.0 ** 2
+    np.testing.assert_allclose(columns["M0_Nm"], mu * columns["potency_m3"], rtol=1e-5)
+    np.testing.assert_allclose(columns["Mw"], 2 / 3 * np.log10(columns["M0_Nm"]) - 6.0, atol=1e-5)
+    assert _png_is_not_blank(out / MAP_PNG)
+
+
+def test_microseismic_command_on_a_finished_run(run_folder, capsys):
+    folder, out = run_folder
+    (out / EVENTS_CSV).unlink()
+    (out / MAP_PNG).unlink()
+    assert cli.main(["microseismic", str(out)]) == cli.EXIT_OK
+    assert "4 microseismic events" in capsys.readouterr().out
+    assert (out / EVENTS_CSV).is_file() and _png_is_not_blank(out / MAP_PNG)
+    # another monitoring set-up from a scene file: one well with noise
+    noisy = folder / "noisy.toml"
+    noisy.write_text(SLIP_SCENE + "[microseismic]\nwells = [[20.0, 0.0]]\nrotation_noise_deg = 10.0\n"
+                     "travel_time_noise = 2e-3\nseed = 3\n")
+    assert cli.main(["microseismic", str(out), "--scene", str(noisy), "--quiet"]) == cli.EXIT_OK
+    columns = read_events_csv(out / EVENTS_CSV)
+    assert len(columns["event"]) == 4 and np.all(columns["location_error_m"] > 1e-3)
+    # a well through an event: refused, naming the field
+    x, y = float(columns["x_m"][0]), float(columns["y_m"][0])
+    on_source = folder / "on_source.toml"
+    on_source.write_text(SLIP_SCENE + f"[microseismic]\nwells = [[{x!r}, {y!r}]]\n")
+    assert cli.main(["microseismic", str(out), "--scene", str(on_source)]) == cli.EXIT_BAD_INPUT
+    assert "wells: receiver" in capsys.readouterr().err
+    # a scene without the section
+    assert cli.main(["microseismic", str(out), "--scene", "kgd"]) == cli.EXIT_BAD_INPUT
+    assert "has no [microseismic] section" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("section, message", [
+    ("wells = []", "microseismic.wells must hold at least one"),
+    ("receiver_spacing = 5.0", r"microseismic.wells \(m\) is required"),
+    ("wells = [[1.0, 2.0]]\nreceiver_spacing = 0.0", "microseismic.receiver_spacing must be > 0"),
+    ("wells = [[1.0, 2.0]]\np_wave_speed = -4000.0", "microseismic.p_wave_speed must be > 0"),
+    ("wells = [[1.0, 2.0]]\ns_wave_speed = 4000.0", "microseismic.s_wave_speed must be < sqrt"),
+    ("wells = [[1.0, 2.0]]\nreceiver_bottom = 30.0", "microseismic.receiver_bottom must be <="),
+    ("wells = [[1.0]]", r"microseismic.wells\[0\] must be a list of 2"),
+    ("wells = [[1.0, 2.0]]\nwave_speed = 1.0", "unknown key 'microseismic.wave_speed'"),
+])
+def test_bad_microseismic_sections_name_the_key(section, message):
+    with pytest.raises(InputError, match=message):
+        parse_scene(SLIP_SCENE + "[microseismic]\n" + section + "\n")
+
+
+def test_dfn_3cluster_has_a_microseismic_section():
+    section = load_scene("dfn-3cluster").data["microseismic"]
+    assert len(section["wells"]) == 2 and section["p_wave_speed"] == 4000.0
