@@ -44,29 +44,41 @@ def _fracture_ids(fracture_id, n):
 
 @dataclass(frozen=True, eq=False)
 class Mesh2D:
-    """Straight constant-DD line elements (plane strain).
+    """Straight DD line elements (plane strain): constant by default, linear or
+    quadratic with ``element_order`` 1 or 2 (ref. Sec. 3.5, App. B).
 
     Attributes
     ----------
-    centers : (N, 2) collocation points (segment midpoints), m
+    centers : (N, 2) segment midpoints (the collocation points of constant elements), m
     frames : (N, 2, 2) rows ``(tangent, normal)``
     half_length : (N,) half segment lengths, m
     fracture_id : (N,) integer label of the fracture each element belongs to
+    element_order : 0, 1 or 2
+        Order of the DD's variation along each element: ``element_order + 1`` nodes
+        inside the element (:mod:`hmatddm.shape_functions`), which are also its
+        collocation points (:attr:`collocation_points`); unknowns element-major, then
+        node-major, then component (docs/conventions.md §2).
     """
 
     centers: np.ndarray
     frames: np.ndarray
     half_length: np.ndarray
     fracture_id: np.ndarray
+    element_order: int = 0
 
     dim = 2
 
+    def __post_init__(self):
+        from .shape_functions import check_order
+
+        object.__setattr__(self, "element_order", check_order(self.element_order))
+
     @classmethod
-    def from_segments(cls, p0, p1, fracture_id=None):
+    def from_segments(cls, p0, p1, fracture_id=None, element_order=0):
         """Elements from segment end points ``p0`` and ``p1``, both (N, 2).
 
         The tangent points from ``p0`` to ``p1``; the normal is the tangent turned by
-        +90 degrees (counter-clockwise).
+        +90 degrees (counter-clockwise). ``element_order``: see the class.
         """
         p0 = finite_array("p0", p0, (None, 2))
         p1 = finite_array("p1", p1, (None, 2))
@@ -84,11 +96,36 @@ class Mesh2D:
         normal = np.column_stack([-tangent[:, 1], tangent[:, 0]])
         frames = np.stack([tangent, normal], axis=1)
         return cls(0.5 * (p0 + p1), np.ascontiguousarray(frames), 0.5 * length,
-                   _fracture_ids(fracture_id, len(p0)))
+                   _fracture_ids(fracture_id, len(p0)), element_order)
 
     @property
     def n_elements(self):
         return len(self.centers)
+
+    @property
+    def n_nodes(self):
+        """Nodes (collocation points) per element: ``element_order + 1``."""
+        return self.element_order + 1
+
+    def with_element_order(self, element_order):
+        """The same segments with elements of another order (0, 1 or 2)."""
+        return Mesh2D(self.centers, self.frames, self.half_length, self.fracture_id, element_order)
+
+    def points_at(self, xi):
+        """(N, M, 2): the points at intrinsic coordinates ``xi`` (M,) in [-1, 1] of every element."""
+        xi = finite_array("xi", np.atleast_1d(np.asarray(xi, dtype=float)), (None,))
+        if np.any(np.abs(xi) > 1.0):
+            raise InputError(f"xi must lie in [-1, 1] (intrinsic coordinate along an element), got {xi}")
+        offset = self.half_length[:, None, None] * xi[None, :, None] * self.tangents[:, None, :]
+        return self.centers[:, None, :] + offset
+
+    @property
+    def collocation_points(self):
+        """(N * n_nodes, 2): the nodes where the traction is collocated, element-major
+        then node-major (the centres for constant elements)."""
+        from .shape_functions import nodes
+
+        return self.points_at(nodes(self.element_order)).reshape(-1, 2)
 
     @property
     def normals(self):
@@ -120,14 +157,14 @@ class Mesh2D:
     def subset(self, index):
         index = np.asarray(index)
         return Mesh2D(self.centers[index], self.frames[index], self.half_length[index],
-                      self.fracture_id[index])
+                      self.fracture_id[index], self.element_order)
 
     def transformed(self, rotation, translation=(0.0, 0.0)):
         """The same mesh moved rigidly: ``x -> rotation @ x + translation``."""
         rotation = np.asarray(rotation, dtype=float)
         return Mesh2D(self.centers @ rotation.T + np.asarray(translation, dtype=float),
                       np.ascontiguousarray(self.frames @ rotation.T), self.half_length.copy(),
-                      self.fracture_id.copy())
+                      self.fracture_id.copy(), self.element_order)
 
 
 @dataclass(frozen=True, eq=False)
@@ -149,6 +186,18 @@ class Mesh3D:
     fracture_id: np.ndarray
 
     dim = 3
+    #: Only constant elements exist in 3D (higher-order elements are 2D, :class:`Mesh2D`).
+    element_order = 0
+    n_nodes = 1
+
+    def with_element_order(self, element_order):
+        """This mesh for ``element_order`` 0; anything else is refused (3D elements are constant)."""
+        from .shape_functions import check_order
+
+        if check_order(element_order) != 0:
+            raise InputError(f"element_order must be 0 for a Mesh3D (linear and quadratic DD elements exist "
+                             f"for 2D meshes only, Mesh2D), got {element_order!r}")
+        return self
 
     @classmethod
     def from_rectangles(cls, centers, e1, e2, half_a, half_b, fracture_id=None):
@@ -283,8 +332,9 @@ def penny(center, normal, radius, h, fracture_id=0):
                                   fracture_id=np.full(n, int(fracture_id)))
 
 
-def line(p0, p1, n, fracture_id=0):
-    """A straight 2D crack from ``p0`` to ``p1`` cut into ``n`` equal segments."""
+def line(p0, p1, n, fracture_id=0, element_order=0):
+    """A straight 2D crack from ``p0`` to ``p1`` cut into ``n`` equal segments of
+    ``element_order`` 0 (constant), 1 (linear) or 2 (quadratic)."""
     p0 = finite_array("p0", p0, (2,))
     p1 = finite_array("p1", p1, (2,))
     n = positive_int("n", n)
@@ -292,7 +342,8 @@ def line(p0, p1, n, fracture_id=0):
         raise InputError("p0 and p1 must differ (a crack of zero length)")
     s = np.linspace(0.0, 1.0, n + 1)[:, None]
     nodes = p0 + s * (p1 - p0)
-    return Mesh2D.from_segments(nodes[:-1], nodes[1:], fracture_id=np.full(n, int(fracture_id)))
+    return Mesh2D.from_segments(nodes[:-1], nodes[1:], fracture_id=np.full(n, int(fracture_id)),
+                                element_order=element_order)
 
 
 def concatenate(meshes):
@@ -304,8 +355,11 @@ def concatenate(meshes):
     if any(type(m) is not kind for m in meshes):
         raise InputError("meshes must all be Mesh2D or all Mesh3D")
     if kind is Mesh2D:
+        orders = sorted({m.element_order for m in meshes})
+        if len(orders) > 1:
+            raise InputError(f"meshes must all have the same element_order, got {orders}")
         return Mesh2D(*(np.concatenate([getattr(m, f) for m in meshes])
-                        for f in ("centers", "frames", "half_length", "fracture_id")))
+                        for f in ("centers", "frames", "half_length", "fracture_id")), orders[0])
     return Mesh3D(*(np.concatenate([getattr(m, f) for m in meshes])
                     for f in ("centers", "frames", "half_a", "half_b", "fracture_id")))
 

@@ -9,7 +9,9 @@ One interface, two backends (docs/conventions.md §§1, 2, 6):
   kernels in the tests.
 
 Unknowns are element-major: ``[e0_x, e0_y, (e0_z,) e1_x, ...]``. A pressurised crack
-with net pressure ``p`` satisfies ``op @ dd = -p n``.
+with net pressure ``p`` satisfies ``op @ dd = -p n``. A 2D mesh of linear or quadratic
+elements (``mesh.element_order`` 1 or 2) has ``2 (order + 1)`` unknowns per element,
+node-major inside the element (docs/conventions.md §2), collocated at its nodes.
 """
 import time
 
@@ -110,7 +112,7 @@ class ElasticityOperator(LinearOperator):
         self.mesh = mesh
         self.material = material
         self.backend = backend
-        self.dof = mesh.dim
+        self.dof = mesh.dim * mesh.n_nodes  # unknowns per element
         self.singular_correction = singular_correction
         self.alpha = alpha
         n = mesh.n_elements * self.dof
@@ -250,7 +252,7 @@ def influence_data(mesh, material, singular_correction="none", alpha=None):
     if alpha is not None:
         data = element_data(mesh, material, singular_shift=shift, near_fraction=NEAR_SINGULAR_FRACTION)
         self_max = np.empty(mesh.n_elements)
-        block = np.empty((mesh.dim, mesh.dim))
+        block = np.empty((mesh.dim * mesh.n_nodes, mesh.dim * mesh.n_nodes))
         for i in range(mesh.n_elements):
             index = np.array([i], dtype=np.int64)
             kernels.traction_block(data, index, index, block)

@@ -37,14 +37,17 @@ def _as_element_major(name, values, n_elements, dof):
 
 
 def solve(operator, traction, rtol=1e-10, maxiter=None, restart=100, x0=None, return_info=False):
-    """DDs (N, d) in the global frame such that ``operator @ dd = traction``.
+    """DDs (N, d) in the global frame such that ``operator @ dd = traction``; nodal DDs
+    (N, n, 2) for a 2D mesh of ``element_order`` 1 or 2 (n = order + 1 nodes).
 
     Parameters
     ----------
     operator : ElasticityOperator
     traction : (N, d) or (N*d,) array
         Traction sigma.n at the collocation points, element-major, global frame
-        (``-p * mesh.normals`` for a crack under net pressure ``p``).
+        (``-p * mesh.normals`` for a crack under net pressure ``p``). Linear and quadratic
+        elements: (N, n, 2), (N*n, 2) or flat at the nodes, or (N, 2) applied at every
+        node of its element (:func:`hmatddm.nodal.nodal_array`).
     rtol : float
         Relative residual ``||b - A x|| / ||b||`` asked of GMRES (``hmatrix``), in (0, 1).
         The dense backend solves directly (LU) and ignores it.
@@ -67,7 +70,12 @@ def solve(operator, traction, rtol=1e-10, maxiter=None, restart=100, x0=None, re
     if not 0.0 < rtol < 1.0:
         raise InputError(f"rtol must be in (0, 1), got {rtol}")
     n, d = operator.mesh.n_elements, operator.dof
-    b = _as_element_major("traction", traction, n, d)
+    if operator.mesh.n_nodes > 1:
+        from .nodal import nodal_array
+
+        b = nodal_array("traction", traction, operator.mesh, uniform=True).reshape(-1)
+    else:
+        b = _as_element_major("traction", traction, n, d)
     if operator.backend == "dense":
         import scipy.linalg
 
@@ -77,12 +85,16 @@ def solve(operator, traction, rtol=1e-10, maxiter=None, restart=100, x0=None, re
     else:
         from .hmatrix import gmres
 
-        guess = None if x0 is None else _as_element_major("x0", x0, n, d)
+        guess = None
+        if x0 is not None and operator.mesh.n_nodes > 1:
+            guess = nodal_array("x0", x0, operator.mesh).reshape(-1)
+        elif x0 is not None:
+            guess = _as_element_major("x0", x0, n, d)
         x, info = gmres(operator, b, M=operator.preconditioner(), rtol=rtol, restart=restart,
                         maxiter=maxiter if maxiter is not None else 20, x0=guess)
     if not np.all(np.isfinite(x)):
         raise ConvergenceError("the solution contains NaN or inf", residual=float("nan"))
-    dd = x.reshape(n, d)
+    dd = x.reshape(n, d) if operator.mesh.n_nodes == 1 else x.reshape(n, operator.mesh.n_nodes, -1)
     return (dd, info) if return_info else dd
 
 
@@ -91,13 +103,24 @@ def _dd_array(mesh, dd):
 
 
 def opening(mesh, dd):
-    """Opening ``w = DD . n`` (N,), positive for an open crack (docs/conventions.md §1)."""
+    """Opening ``w = DD . n`` (N,), positive for an open crack (docs/conventions.md §1);
+    nodal openings (N, n) for linear and quadratic elements (anywhere along the elements:
+    :func:`hmatddm.nodal.opening_at`)."""
+    if getattr(mesh, "n_nodes", 1) > 1:
+        from . import nodal
+
+        return nodal.opening(mesh, dd)
     dd = _dd_array(mesh, dd)
     return np.einsum("ij,ij->i", dd, mesh.normals)
 
 
 def slip(mesh, dd):
-    """Tangential part of the DD, ``DD - w n`` (N, d), in the global frame."""
+    """Tangential part of the DD, ``DD - w n`` (N, d), in the global frame ((N, n, 2) at
+    the nodes of linear and quadratic elements)."""
+    if getattr(mesh, "n_nodes", 1) > 1:
+        from . import nodal
+
+        return nodal.slip(mesh, dd)
     dd = _dd_array(mesh, dd)
     return dd - opening(mesh, dd)[:, None] * mesh.normals
 
@@ -780,7 +803,15 @@ def stress_at(mesh, material, dd, points, singular_correction="none", method="au
         Filled with what was done: ``method``, ``seconds``, block counts, largest rank,
         ``pairs_exact`` / ``pairs_compressed`` (point-element pairs summed exactly / inside
         compressed blocks).
+
+    Linear and quadratic elements (``mesh.element_order`` 1 or 2, ``dd`` nodal): summed
+    directly (:func:`hmatddm.nodal.stress_at`; ``method="tree"`` is refused, ``eps``
+    unused); on an element the mean of its two faces' ``s_xx`` (which jumps there).
     """
+    if getattr(mesh, "n_nodes", 1) > 1:
+        from . import nodal
+
+        return nodal.stress_at(mesh, material, dd, points, singular_correction, method, info, near_fraction)
     mode = _STRESS3D if isinstance(mesh, Mesh3D) else _STRESS2D
     values = _evaluate(mesh, material, dd, points, mode, singular_correction, method, eps, info, near_fraction)
     _refuse_singular(values, near_fraction)
@@ -798,6 +829,9 @@ def mean_stress_at(mesh, material, dd, points, singular_correction="none", metho
     :func:`stress_at`; in 3D the kernel evaluates only the second derivatives of the
     potential the trace needs (about half the cost of the full stress).
     """
+    if getattr(mesh, "n_nodes", 1) > 1:
+        stress = stress_at(mesh, material, dd, points, singular_correction, method, eps, info, near_fraction)
+        return (1.0 + material.poisson_ratio) * (stress[:, 0, 0] + stress[:, 1, 1]) / 3.0
     mode = _MEAN3D if isinstance(mesh, Mesh3D) else _MEAN2D
     values = _evaluate(mesh, material, dd, points, mode, singular_correction, method, eps, info, near_fraction)
     _refuse_singular(values, near_fraction)
