@@ -21,14 +21,11 @@ from scipy.sparse.linalg import LinearOperator
 from ._validation import finite_scalar, positive_int
 from .errors import InputError
 from .kernels import element_data, kernel_module
+from .layered.medium import LayeredMedium
 from .material import Elastic
 from .mesh import Mesh2D, Mesh3D, check_parallel_spacing
 
-BACKENDS = ("dense", "hmatrix")
-SINGULAR_CORRECTIONS = ("none", "average")
-DEFAULT_EPS = 1e-4
-DEFAULT_ETA = 3.0
-DEFAULT_LEAF_SIZE = 32  # 64 costs ~25% more memory at N=100k in 3D (8.4 GB vs 6.8 GB)
+from .options import BACKENDS, DEFAULT_EPS, DEFAULT_ETA, DEFAULT_LEAF_SIZE, SINGULAR_CORRECTIONS  # noqa: F401
 _AVERAGE_SHIFT = 1e-3  # fraction of the element half size used by the NaN averaging
 
 #: A collocation point closer than this fraction of the smaller half size (of the
@@ -54,7 +51,12 @@ class ElasticityOperator(LinearOperator):
     Parameters
     ----------
     mesh : Mesh2D or Mesh3D
-    material : Elastic
+    material : Elastic or LayeredMedium
+        A :class:`hmatddm.LayeredMedium` (2D, constant elements) adds the image terms of
+        ref. Ch. 3 to the closed-form kernel of each source element's layer; its
+        ``images``, ``image_tol`` and ``gauss_points`` set them, and ``stats["n_images"]``
+        reports the number used. Elements must not straddle interfaces
+        (:func:`hmatddm.layered.split_at_interfaces`).
     backend : {"dense", "hmatrix"}
     eps : float
         ACA / recompression tolerance of the ``hmatrix`` backend, in (0, 1).
@@ -89,8 +91,9 @@ class ElasticityOperator(LinearOperator):
                  leaf_size=DEFAULT_LEAF_SIZE, singular_correction="none", alpha=None):
         if not isinstance(mesh, (Mesh2D, Mesh3D)):
             raise InputError(f"mesh must be a Mesh2D or Mesh3D, got {type(mesh).__name__}")
-        if not isinstance(material, Elastic):
-            raise InputError(f"material must be an hmatddm.Elastic, got {type(material).__name__}")
+        if not isinstance(material, (Elastic, LayeredMedium)):
+            raise InputError(f"material must be an hmatddm.Elastic or hmatddm.LayeredMedium, got "
+                             f"{type(material).__name__}")
         if backend not in BACKENDS:
             raise InputError(f"backend must be one of {BACKENDS}, got {backend!r}")
         if singular_correction not in SINGULAR_CORRECTIONS:
@@ -143,6 +146,8 @@ class ElasticityOperator(LinearOperator):
                 self._refuse_singular()
             self._stats = dict(self._hmatrix.stats)
             self._stats["backend"] = "hmatrix"
+        if isinstance(material, LayeredMedium):
+            self._stats["n_images"] = int(self.data[7][0])
         self._lu = None
         self._preconditioner = None
 
@@ -246,8 +251,10 @@ def influence_data(mesh, material, singular_correction="none", alpha=None):
     """``(kernel_module, element_data)`` that fill exact influence blocks of ``mesh``
     with the same options (NaN averaging of singular and near-singular points,
     Eq. 6.11 scaling) as the operator uses."""
-    kernels = kernel_module(mesh)
     shift = _AVERAGE_SHIFT if singular_correction == "average" else 0.0
+    if isinstance(material, LayeredMedium):  # ref. Ch. 3: closed form + image terms
+        return _layered_influence_data(mesh, material, shift, alpha)
+    kernels = kernel_module(mesh)
     self_max = None
     if alpha is not None:
         data = element_data(mesh, material, singular_shift=shift, near_fraction=NEAR_SINGULAR_FRACTION)
@@ -259,6 +266,21 @@ def influence_data(mesh, material, singular_correction="none", alpha=None):
             self_max[i] = np.max(np.abs(block))
     return kernels, element_data(mesh, material, singular_shift=shift, alpha=alpha or 0.0, self_max=self_max,
                                  near_fraction=NEAR_SINGULAR_FRACTION)
+
+
+def _layered_influence_data(mesh, medium, shift, alpha):
+    from .layered import images2d, influence2d
+
+    if mesh.dim == 2 and mesh.element_order > 0:  # linear / quadratic elements (ref. Sec. 3.5)
+        from . import layered_higher_order
+
+        n_images = layered_higher_order.image_count(mesh, medium, shift)
+        return layered_higher_order, layered_higher_order.influence_data(mesh, medium, shift, alpha or 0.0,
+                                                                         NEAR_SINGULAR_FRACTION, n_images)
+    data = influence2d.influence_data(mesh, medium, shift, 0.0, NEAR_SINGULAR_FRACTION, 0)
+    n_images = influence2d.choose_images(mesh, medium, data)
+    data = influence2d.influence_data(mesh, medium, shift, alpha or 0.0, NEAR_SINGULAR_FRACTION, n_images)
+    return images2d, data
 
 
 def element_sizes(mesh):

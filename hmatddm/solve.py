@@ -23,6 +23,7 @@ from .kernels.rectangle3d import _INV_8PI, _r_plus
 from .kernels.rectangle3d import local_stress_corrected as _local_stress_corrected
 from .kernels.rectangle3d import on_edge as _on_edge
 from .kernels.rectangle3d import g_derivatives as _g_derivatives
+from .layered.medium import LayeredMedium
 from .material import Elastic
 from .mesh import Mesh2D, Mesh3D
 
@@ -771,7 +772,9 @@ def stress_at(mesh, material, dd, points, singular_correction="none", method="au
     Parameters
     ----------
     mesh : Mesh2D or Mesh3D
-    material : Elastic
+    material : Elastic or LayeredMedium
+        A :class:`hmatddm.LayeredMedium` (2D constant elements) sums directly with the
+        image terms (ref. Ch. 3); ``method``, ``eps`` and ``info`` do not apply.
     dd : (N, d) or (N*d,) DDs, global frame
     points : (M, d)
     singular_correction : ``"none"`` or ``"average"``
@@ -808,10 +811,14 @@ def stress_at(mesh, material, dd, points, singular_correction="none", method="au
     directly (:func:`hmatddm.nodal.stress_at`; ``method="tree"`` is refused, ``eps``
     unused); on an element the mean of its two faces' ``s_xx`` (which jumps there).
     """
-    if getattr(mesh, "n_nodes", 1) > 1:
+    if getattr(mesh, "n_nodes", 1) > 1:  # homogeneous or layered
         from . import nodal
 
         return nodal.stress_at(mesh, material, dd, points, singular_correction, method, info, near_fraction)
+    if isinstance(material, LayeredMedium):  # ref. Ch. 3 image terms, direct sum
+        from .layered.influence2d import stress_at as layered_stress_at
+
+        return layered_stress_at(mesh, material, dd, points, singular_correction, near_fraction)
     mode = _STRESS3D if isinstance(mesh, Mesh3D) else _STRESS2D
     values = _evaluate(mesh, material, dd, points, mode, singular_correction, method, eps, info, near_fraction)
     _refuse_singular(values, near_fraction)

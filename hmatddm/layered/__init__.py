@@ -1,0 +1,27 @@
+"""Plane-layered elastic media (ref. Ch. 3): the medium and its image-method kernels.
+
+* :class:`LayeredMedium`: interfaces, per-layer moduli (a void layer is a free surface),
+  optional per-layer in-situ stress and toughness.
+* :mod:`.images2d`: complementary (image) stress of DDs in 2D plane strain by the general
+  image method (ref. Secs 3.2-3.3), numba; loaded on first use.
+* :func:`split_at_interfaces`: cut a 2D mesh's elements where they cross interfaces.
+"""
+import importlib
+
+from .medium import LayeredMedium
+
+
+def __getattr__(name):
+    if name in ("images2d", "influence2d"):
+        return importlib.import_module(f"{__name__}.{name}")
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def split_at_interfaces(mesh, medium):
+    """See :func:`hmatddm.layered.influence2d.split_at_interfaces`."""
+    from .influence2d import split_at_interfaces as split
+
+    return split(mesh, medium)
+
+
+__all__ = ["LayeredMedium", "split_at_interfaces", "images2d"]

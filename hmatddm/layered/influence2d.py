@@ -1,0 +1,158 @@
+"""Influence data of a 2D mesh of constant DD elements in a :class:`LayeredMedium`:
+element layers, the straddling check, the interface splitter and the automatic number
+of images. The kernels are :mod:`.images2d` (same block-generator contract as
+:mod:`hmatddm.kernels.line2d`)."""
+import numpy as np
+
+from ..errors import InputError
+from ..mesh import Mesh2D
+from . import images2d
+from .medium import MAX_IMAGES
+
+#: Largest number of sub-segments of an element for the image quadrature.
+MAX_SUBDIVISIONS = 64
+#: Relative tolerance (of the element length) within which an end point counts as on
+#: an interface.
+_ON_INTERFACE = 1e-9
+
+
+def element_layers(mesh, medium):
+    """(N,) layer of each element of a 2D mesh; InputError naming the first element
+    that straddles an interface, lies along one, or sits in a void layer."""
+    if mesh.dim != 2:
+        raise InputError("a LayeredMedium works with 2D meshes (Mesh2D) only, so far")
+    p0, p1 = mesh.endpoints
+    d = np.asarray(medium.interfaces)
+    tol = _ON_INTERFACE * np.maximum(mesh.half_length, 1e-300)
+    lo = np.minimum(p0[:, 1], p1[:, 1])
+    hi = np.maximum(p0[:, 1], p1[:, 1])
+    for k, height in enumerate(d):
+        inside = (lo < height - tol) & (hi > height + tol)
+        if np.any(inside):
+            e = int(np.flatnonzero(inside)[0])
+            raise InputError(f"element {e} (fracture {int(mesh.fracture_id[e])}) straddles interface {k} at "
+                             f"height {height:g} (its ends are at heights {p0[e, 1]:g} and {p1[e, 1]:g}); elements "
+                             "must end on interfaces: split them with hd.layered.split_at_interfaces(mesh, medium)")
+        along = (np.abs(p0[:, 1] - height) <= tol) & (np.abs(p1[:, 1] - height) <= tol)
+        if np.any(along):
+            e = int(np.flatnonzero(along)[0])
+            raise InputError(f"element {e} lies along interface {k} (height {height:g}); an element must lie "
+                             "inside one layer (move it off the interface)")
+    layers = medium.layer_of(0.5 * (lo + hi)).astype(np.int64)
+    void = np.flatnonzero(np.asarray(medium.shear_modulus)[layers] == 0.0)
+    if void.size:
+        e = int(void[0])
+        raise InputError(f"element {e} lies in layer {int(layers[e])}, which is void (shear_modulus = 0)")
+    return layers
+
+
+def split_at_interfaces(mesh, medium):
+    """A copy of a constant-element 2D ``mesh`` whose elements crossing interfaces are
+    cut there (pieces keep the element's direction and fracture id); elements inside one
+    layer are kept as they are. Returns ``(mesh, parent)`` with ``parent[k]`` the index
+    of the original element of new element ``k``."""
+    if mesh.dim != 2:
+        raise InputError("split_at_interfaces works with 2D meshes (Mesh2D) only")
+    p0, p1 = mesh.endpoints
+    d = np.asarray(medium.interfaces)
+    new0, new1, parent = [], [], []
+    for e in range(mesh.n_elements):
+        a, b = p0[e], p1[e]
+        cuts = [0.0, 1.0]
+        dy = b[1] - a[1]
+        tol = _ON_INTERFACE * mesh.half_length[e]
+        for height in d:
+            if min(a[1], b[1]) < height - tol and max(a[1], b[1]) > height + tol:
+                cuts.append((height - a[1]) / dy)
+        cuts = sorted(cuts)
+        for s0, s1 in zip(cuts[:-1], cuts[1:]):
+            q0 = a + s0 * (b - a)
+            q1 = a + s1 * (b - a)
+            for k in range(len(d)):  # land cut points exactly on the interface
+                if abs(q0[1] - d[k]) <= tol:
+                    q0[1] = d[k]
+                if abs(q1[1] - d[k]) <= tol:
+                    q1[1] = d[k]
+            new0.append(q0)
+            new1.append(q1)
+            parent.append(e)
+    parent = np.array(parent, dtype=np.int64)
+    split = Mesh2D.from_segments(np.array(new0), np.array(new1), fracture_id=mesh.fracture_id[parent])
+    return split, parent
+
+
+def influence_data(mesh, medium, singular_shift, alpha, near_fraction, n_images):
+    """The data tuple of :func:`images2d.traction_block` (see there)."""
+    layers = element_layers(mesh, medium)
+    interfaces, g, nu = medium.arrays()
+    params = np.array([0.0, 0.0, float(singular_shift), float(alpha), float(near_fraction)])
+    settings = np.array([float(n_images), float(medium.gauss_points), float(MAX_SUBDIVISIONS)])
+    self_max = np.zeros(mesh.n_elements)
+    data = (mesh.centers, mesh.frames, mesh.half_length, mesh.half_length, params, self_max, layers, settings,
+            interfaces, g, nu)
+    if alpha > 0.0:
+        block = np.empty((2, 2))
+        for i in range(mesh.n_elements):
+            index = np.array([i], dtype=np.int64)
+            images2d.traction_block(data, index, index, block)
+            self_max[i] = np.max(np.abs(block))
+    return data
+
+
+def with_images(data, n_images):
+    """The data tuple with another number of images."""
+    settings = data[7].copy()
+    settings[0] = float(n_images)
+    return data[:7] + (settings,) + data[8:]
+
+
+def choose_images(mesh, medium, data, max_samples=24, seed=0):
+    """``medium.images`` when it is a number; for ``"auto"`` the smallest number of
+    images after which one more image changes a sampled block (up to ``max_samples``
+    receivers x sources, chosen evenly) by less than ``medium.image_tol`` of its largest
+    entry (max norm). Single-layer media: 0."""
+    if medium.images != "auto":
+        return medium.images
+    if medium.n_layers == 1 or medium.is_homogeneous:
+        return 0
+    n = mesh.n_elements
+    rows = np.unique(np.linspace(0, n - 1, min(n, max_samples)).round().astype(np.int64))
+    cols = rows
+    previous = np.empty((2 * len(rows), 2 * len(cols)))
+    images2d.traction_block(with_images(data, 0), rows, cols, previous)
+    current = np.empty_like(previous)
+    for k in range(1, MAX_IMAGES + 1):
+        images2d.traction_block(with_images(data, k), rows, cols, current)
+        scale = max(np.max(np.abs(current)), 1e-300)
+        if np.max(np.abs(current - previous)) <= medium.image_tol * scale:
+            return k - 1
+        previous, current = current, previous
+    return MAX_IMAGES
+
+
+def stress_at(mesh, medium, dd, points, singular_correction="none", near_fraction=0.0, n_images=None):
+    """Stress (M, 2, 2) at ``points`` (M, 2) in a layered medium from the DDs ``dd`` of a
+    constant-element 2D mesh (direct sum; points in void layers get zero; a point on an
+    interface belongs to the layer above). ``n_images``: None = ``medium.images``, or
+    for ``"auto"`` the number an :class:`ElasticityOperator` of ``mesh`` would choose."""
+    from .._validation import finite_array
+
+    if getattr(mesh, "element_order", 0) > 0:
+        raise InputError("a LayeredMedium supports constant elements (element_order 0) so far")
+    points = finite_array("points", points, (None, 2))
+    dd = finite_array("dd", dd).reshape(mesh.n_elements, 2)
+    shift = 1e-3 if singular_correction == "average" else 0.0
+    data = influence_data(mesh, medium, shift, 0.0, near_fraction, 0)
+    if n_images is None:
+        n_images = choose_images(mesh, medium, data)
+    data = with_images(data, n_images)
+    centers, frames, half, _, params, _, layers, settings, interfaces, g, nu = data
+    out = np.zeros((len(points), 2, 2))
+    point_layer = medium.layer_of(points[:, 1]).astype(np.int64)
+    images2d.stress_at_points(np.ascontiguousarray(points), point_layer, centers, frames, half, layers, params,
+                              settings, interfaces, g, nu, np.ascontiguousarray(dd), out)
+    bad = np.flatnonzero(~np.all(np.isfinite(out.reshape(len(points), -1)), axis=1))
+    if bad.size:
+        raise InputError(f"points[{int(bad[0])}] lies on an element end, where the stress is singular; move it or "
+                         "pass singular_correction='average'")
+    return out

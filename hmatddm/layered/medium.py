@@ -1,0 +1,162 @@
+"""A plane-layered elastic medium (ref. Ch. 3, Fig. 3.2).
+
+Interfaces are planes normal to the project's vertical axis: the second coordinate
+``y`` in 2D (the third, ``z``, in 3D), which is the reference's ``x3`` in Ch. 3. Layers
+are listed from the top down; interface ``k`` at height ``interfaces[k]`` separates
+layer ``k`` (above) from layer ``k + 1`` (below), so heights must strictly decrease.
+The top and bottom layers are half-spaces. A layer of zero shear modulus is void
+(ref. Sec. 3.4.1: gamma = 0 turns an interface into a free surface); only the top or
+the bottom layer may be void.
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._validation import finite_scalar
+from ..errors import InputError
+from ..material import Elastic
+
+#: Default largest number of reflections of a Hansen potential (``images="auto"`` stops
+#: earlier when the next image changes the sampled influence block by < ``image_tol``).
+MAX_IMAGES = 30
+
+
+@dataclass(frozen=True, eq=False)
+class LayeredMedium:
+    """Parallel elastic layers bonded at planar interfaces (ref. Sec. 3.3).
+
+    Parameters
+    ----------
+    interfaces : sequence of float
+        Interface heights (m, along the vertical axis), strictly decreasing (top down);
+        ``n_layers - 1`` of them.
+    shear_modulus : sequence of float
+        G of each layer, top down (Pa), >= 0; 0 only for the top or bottom layer (void:
+        a free surface).
+    poisson_ratio : sequence of float
+        nu of each layer, in [0, 0.5).
+    in_situ_stress : None or (n_layers, d, d)
+        Optional per-layer in-situ stress tensor (Pa, tension positive).
+    toughness : None or sequence of float
+        Optional per-layer fracture toughness K_Ic (Pa m^0.5), >= 0.
+    images : int >= 0 or "auto"
+        Largest number of reflections of a Hansen potential (ref. Fig. 3.4, n_max);
+        transmissions are not counted. ``"auto"``: the smallest number (<= ``MAX_IMAGES``)
+        for which one more image changes a sampled influence block by less than
+        ``image_tol`` (relative, max norm); the operator reports it in ``stats``.
+    image_tol : float in (0, 1)
+    gauss_points : int >= 1
+        Gauss points per sub-segment for the regular image terms (ref. Eqs 3.12-3.13);
+        sub-segments are added where an image lies close to the receiver.
+    """
+
+    interfaces: tuple
+    shear_modulus: tuple
+    poisson_ratio: tuple
+    in_situ_stress: object = None
+    toughness: object = None
+    images: object = "auto"
+    image_tol: float = 1e-6
+    gauss_points: int = 4
+
+    def __post_init__(self):
+        d = _float_list("interfaces", self.interfaces)
+        g = _float_list("shear_modulus", self.shear_modulus)
+        nu = _float_list("poisson_ratio", self.poisson_ratio)
+        if len(g) < 1:
+            raise InputError("shear_modulus must list at least one layer")
+        if len(d) != len(g) - 1:
+            raise InputError(f"interfaces must hold n_layers - 1 = {len(g) - 1} heights (one fewer than the "
+                             f"layers in shear_modulus), got {len(d)}")
+        if len(nu) != len(g):
+            raise InputError(f"poisson_ratio must hold one value per layer ({len(g)}), got {len(nu)}")
+        for k in range(len(d) - 1):
+            if not d[k] > d[k + 1]:
+                raise InputError(f"interfaces must be strictly decreasing (listed top down, no overlap); "
+                                 f"interfaces[{k}] = {d[k]} and interfaces[{k + 1}] = {d[k + 1]}")
+        for k, value in enumerate(g):
+            if value < 0.0:
+                raise InputError(f"shear_modulus[{k}] must be >= 0 Pa (0: a void layer, a free surface), got {value}")
+            if value == 0.0 and 0 < k < len(g) - 1:
+                raise InputError(f"shear_modulus[{k}] = 0 (void) is allowed only for the top or bottom layer")
+        if len(g) > 1 and all(value == 0.0 for value in g):
+            raise InputError("shear_modulus must be > 0 in at least one layer")
+        if len(g) == 1 and g[0] == 0.0:
+            raise InputError("shear_modulus[0] must be > 0 for a single layer")
+        for k, value in enumerate(nu):
+            if not 0.0 <= value < 0.5:
+                raise InputError(f"poisson_ratio[{k}] must be in [0, 0.5), got {value}")
+        object.__setattr__(self, "interfaces", tuple(d))
+        object.__setattr__(self, "shear_modulus", tuple(g))
+        object.__setattr__(self, "poisson_ratio", tuple(nu))
+        if self.in_situ_stress is not None:
+            s = np.array(self.in_situ_stress, dtype=np.float64)
+            if s.ndim != 3 or s.shape[0] != len(g) or s.shape[1] != s.shape[2] or s.shape[1] not in (2, 3):
+                raise InputError(f"in_situ_stress must have shape ({len(g)}, d, d) with d = 2 or 3, got {s.shape}")
+            if not np.all(np.isfinite(s)) or not np.allclose(s, np.swapaxes(s, 1, 2)):
+                raise InputError("in_situ_stress must hold finite symmetric tensors")
+            s.setflags(write=False)
+            object.__setattr__(self, "in_situ_stress", s)
+        if self.toughness is not None:
+            k_ic = _float_list("toughness", self.toughness)
+            if len(k_ic) != len(g) or any(value < 0.0 for value in k_ic):
+                raise InputError(f"toughness must hold {len(g)} values >= 0 Pa m^0.5, got {list(k_ic)}")
+            object.__setattr__(self, "toughness", tuple(k_ic))
+        if self.images != "auto":
+            if isinstance(self.images, bool) or not isinstance(self.images, (int, np.integer)) or self.images < 0:
+                raise InputError(f"images must be an integer >= 0 or 'auto', got {self.images!r}")
+            object.__setattr__(self, "images", int(self.images))
+        tol = finite_scalar("image_tol", self.image_tol)
+        if not 0.0 < tol < 1.0:
+            raise InputError(f"image_tol must be in (0, 1), got {tol}")
+        object.__setattr__(self, "image_tol", tol)
+        if isinstance(self.gauss_points, bool) or not isinstance(self.gauss_points, (int, np.integer)) \
+                or not 1 <= self.gauss_points <= 32:
+            raise InputError(f"gauss_points must be an integer in [1, 32], got {self.gauss_points!r}")
+        object.__setattr__(self, "gauss_points", int(self.gauss_points))
+
+    # -- queries ---------------------------------------------------------------------
+    @property
+    def n_layers(self):
+        return len(self.shear_modulus)
+
+    @property
+    def is_homogeneous(self):
+        """True when every layer has the same (non-zero) moduli: images vanish."""
+        return len(set(self.shear_modulus)) == 1 and len(set(self.poisson_ratio)) == 1
+
+    def layer_of(self, height):
+        """Layer index of each height (array-like); a point on an interface belongs to
+        the layer above it."""
+        h = np.asarray(height, dtype=np.float64)
+        d = np.asarray(self.interfaces)
+        return np.sum(h[..., None] < d, axis=-1) if d.size else np.zeros(h.shape, dtype=np.int64)
+
+    def material(self, layer):
+        """The :class:`hmatddm.Elastic` of a (non-void) layer."""
+        if not 0 <= layer < self.n_layers:
+            raise InputError(f"layer must be in [0, {self.n_layers - 1}], got {layer}")
+        if self.shear_modulus[layer] == 0.0:
+            raise InputError(f"layer {layer} is void (shear_modulus = 0): it has no elastic material")
+        return Elastic(self.shear_modulus[layer], self.poisson_ratio[layer])
+
+    def arrays(self):
+        """``(interfaces, shear_modulus, poisson_ratio)`` as float arrays (numba kernels)."""
+        return (np.array(self.interfaces, dtype=np.float64), np.array(self.shear_modulus, dtype=np.float64),
+                np.array(self.poisson_ratio, dtype=np.float64))
+
+    @classmethod
+    def homogeneous(cls, material, **options):
+        """One layer of ``material`` (an :class:`hmatddm.Elastic`)."""
+        return cls((), (material.shear_modulus,), (material.poisson_ratio,), **options)
+
+
+def _float_list(name, values):
+    try:
+        items = np.asarray(values, dtype=np.float64).ravel()
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be a sequence of numbers") from None
+    for k, v in enumerate(items):
+        if not np.isfinite(v):
+            raise InputError(f"{name}[{k}] must be a finite number, got {v}")
+    return [float(v) for v in items]
