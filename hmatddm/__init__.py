@@ -22,25 +22,27 @@ A growing radial fracture (ref. Ch. 4)::
                         propagation=hd.Propagation(toughness=5e6), initial_pressure=10e6)
     records = sim.run(end_time=50.0)
 """
-import os
-
-# numba's OpenMP workers spin-wait by default; on a shared 2-core machine that made one
-# small H-matvec take 9.5 ms instead of 0.45 ms (measured, benchmarks/bench_dfn.py).
-# Must be set before numba starts its threads; an explicit user setting wins.
-os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
-
-from . import analytical, kernels, mesh, network, topology  # noqa: E402
-from .coupled import SchemeSettings
-from .errors import ConvergenceError, HmatddmError, InputError, OutputError
-from .flow import Cluster, Fluid, LeakOff
-from .fracture import NaturalFractureProperties, Propagation
-from .material import Elastic
-from .mesh import Mesh2D, Mesh3D
-from .operators import ElasticityOperator
-from .simulation import CheckpointError, Simulation
-from .solve import mean_stress_at, opening, slip, solve, stress_at
+from ._lazy import attach
 
 __version__ = "0.1.0"
+
+# Everything below is imported on first use (PEP 562), so that ``import hmatddm`` is
+# quick and loads neither numba, the H-matrix engine, scipy.special, pyvista nor
+# matplotlib. The package changes no environment variable: the ``hmatddm`` command sets
+# ``OMP_WAIT_POLICY=PASSIVE`` (unless already set) before numba starts its threads, and
+# a Python program on a shared machine can do the same (see the README, "Threads").
+_EXPORTS = {
+    "SchemeSettings": ".coupled", "ConvergenceError": ".errors", "HmatddmError": ".errors",
+    "InputError": ".errors", "OutputError": ".errors", "Cluster": ".flow", "Fluid": ".flow", "LeakOff": ".flow",
+    "NaturalFractureProperties": ".fracture", "Propagation": ".fracture", "Elastic": ".material",
+    "Mesh2D": ".mesh", "Mesh3D": ".mesh", "ElasticityOperator": ".operators", "CheckpointError": ".simulation",
+    "Simulation": ".simulation", "mean_stress_at": ".solve", "opening": ".solve", "slip": ".solve",
+    "solve": ".solve", "stress_at": ".solve",
+}
+_SUBMODULES = ("analytical", "kernels", "mesh", "network", "topology", "simulation", "scene", "render", "io",
+               "hmatrix", "coupled", "flow", "fracture", "operators", "runner", "errors", "material",
+               "ensemble", "validate", "extended_operator", "cli", "bench_cli")
+__getattr__, __dir__ = attach(__name__, _EXPORTS, _SUBMODULES)
 
 __all__ = [
     "Elastic", "Mesh2D", "Mesh3D", "ElasticityOperator", "solve", "opening", "slip", "stress_at",

@@ -15,6 +15,7 @@ finished step is checkpointed, so free space and continue with --resume),
 """
 import argparse
 import json
+import os
 import shlex
 import sys
 from pathlib import Path
@@ -75,14 +76,17 @@ def _resume_command(args, out):
 
 def _load_run_scene(args):
     """The scene to run and the output folder."""
-    from .runner import SCENE_FILE
     from .scene import load_scene
 
     overrides = list(args.set or [])
     if args.backend:
         overrides.append(f'numerics.backend="{args.backend}"')
-    stored = Path(args.out) / SCENE_FILE if args.out else None
-    if args.scene is None and args.resume and stored is not None and stored.is_file():
+    stored = None
+    if args.scene is None and args.resume and args.out:
+        from .runner import SCENE_FILE
+
+        stored = Path(args.out) / SCENE_FILE
+    if stored is not None and stored.is_file():
         scene = load_scene(str(stored), overrides=overrides)  # the scene the run in DIR was started with
     else:
         scene = load_scene(args.scene or DEFAULT_SCENE, overrides=overrides)
@@ -106,16 +110,60 @@ def _output_failed(out, error, args):
     return EXIT_OUTPUT
 
 
-def _run(args):
-    from .errors import ConvergenceError, OutputError
-    from .runner import SceneRun
-    from .scene import build_simulation
+def _interrupted(args, out, run):
+    """The Ctrl-C message: names the newest checkpoint on disk (the step a resume starts
+    from), not the last step computed (whose checkpoint may not have been written)."""
+    from .runner import CHECKPOINT_DIR
+    from .simulation import checkpoint as checkpoints
 
+    kept = checkpoints.list_checkpoints(out / CHECKPOINT_DIR)
+    if kept:
+        times = {int(r["step"]): r["time"] for r in run.records}
+        when = f" (t = {times[kept[-1]]:g} s)" if kept[-1] in times else ""
+        where = (f"the newest checkpoint is step {kept[-1]}{when} in {out / CHECKPOINT_DIR}. "
+                 f"Continue from it with: {_resume_command(args, out)}")
+    else:
+        where = "before the first step finished (nothing to resume); run it again"
+    print(f"\nhmatddm: interrupted; {where}", file=sys.stderr)
+    return EXIT_INTERRUPTED
+
+
+def _stopped_at_size_limit(args, out, run, error):
+    from .runner import CHECKPOINT_DIR
+    from .simulation import checkpoint as checkpoints
+
+    kept = checkpoints.list_checkpoints(out / CHECKPOINT_DIR)
+    limit = 2 * error.limit
+    where = (f"every step up to step {kept[-1]} is checkpointed; to continue with a higher limit: "
+             f"{_resume_command(args, out)} --set numerics.max_elements={max(limit, error.elements)}"
+             if kept else "no step had finished")
+    print(f"hmatddm: stopped: {error} (numerics.max_elements); the outputs of the last finished step are in "
+          f"{out}; {where}", file=sys.stderr)
+    return EXIT_BAD_INPUT
+
+
+def _run(args):
+    import warnings
+
+    from .errors import ConvergenceError, InputError, NoInjectionWarning, OutputError, SizeLimitError
+    from .scene.preflight import check_scene
+
+    if args.resume and args.overwrite:
+        raise InputError("--resume continues the run in --out and --overwrite starts it over: give one of them, "
+                         "not both")
     scene, out = _load_run_scene(args)
+    size = check_scene(scene.data)  # values, geometry, size: every refusal before the engine loads
+    if all(cluster["rate"] == 0.0 for cluster in scene.data["cluster"]):
+        print("hmatddm: warning: every cluster has rate = 0 m^3/s: nothing drives the fractures, which only relax "
+              "from numerics.initial_pressure", file=sys.stderr)
     if args.check:
-        build_simulation(scene.data)  # geometry checks (clusters on fractures, overlaps)
         _say(args, json.dumps(scene.to_dict(), indent=1))
+        if not args.quiet:
+            print("hmatddm: estimate: " + "\nhmatddm: estimate: ".join(size.lines()), file=sys.stderr)
         return EXIT_OK
+    warnings.simplefilter("ignore", NoInjectionWarning)  # said above, once
+    from .runner import SceneRun
+
     run = SceneRun(scene, out, resume=args.resume, overwrite=args.overwrite, quiet=args.quiet)
     if not args.quiet:
         numerics = scene.numerics
@@ -124,12 +172,9 @@ def _run(args):
     try:
         summary = run.execute()
     except KeyboardInterrupt:
-        record = run.last_record
-        where = (f"after step {record['step']} (t = {record['time']:g} s)" if record is not None
-                 else "before the first step finished")
-        print(f"\nhmatddm: interrupted {where}; every finished step is checkpointed in {out / 'checkpoints'}. "
-              f"Continue with: {_resume_command(args, out)}", file=sys.stderr)
-        return EXIT_INTERRUPTED
+        return _interrupted(args, out, run)
+    except SizeLimitError as error:
+        return _stopped_at_size_limit(args, out, run, error)
     except OutputError as error:
         return _output_failed(out, error, args)
     except ConvergenceError as error:
@@ -273,17 +318,30 @@ def build_parser():
     return parser
 
 
-def main(argv=None):
-    from .errors import ConvergenceError, InputError, OutputError
-    from .simulation import CheckpointError
+def _checkpoint_error():
+    """CheckpointError, if its module was loaded (else nothing could have raised it, and
+    InputError stands in)."""
+    from .errors import InputError
 
+    module = sys.modules.get("hmatddm.simulation.checkpoint")
+    return module.CheckpointError if module is not None else InputError
+
+
+def main(argv=None):
+    # numba's OpenMP workers spin-wait by default; on a shared 2-core machine that made one
+    # small H-matvec take 9.5 ms instead of 0.45 ms (benchmarks/bench_dfn.py). The command
+    # (not the library, which changes no environment variable) asks them to wait passively,
+    # before numba starts its threads; an explicit OMP_WAIT_POLICY wins.
+    os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
     args = build_parser().parse_args(argv)
+    from .errors import ConvergenceError, InputError, OutputError
+
     try:
         return args.handler(args)
     except OutputError as exc:  # before CheckpointError: a checkpoint that cannot be written is an output error
         print(f"hmatddm: error: {exc}", file=sys.stderr)
         return EXIT_OUTPUT
-    except (InputError, CheckpointError) as exc:
+    except (InputError, _checkpoint_error()) as exc:
         print(f"hmatddm: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except ConvergenceError as exc:

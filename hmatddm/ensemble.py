@@ -27,14 +27,25 @@ def intersection_frequency_task(parameters, seed):
     ``parameters``: keys of :class:`hmatddm.network.NetworkSpec` (e.g. ``density``,
     ``length_exponent``, ``region``); the reference's Table 6.1 values are the defaults.
     """
-    from .network import NetworkSpec, generate_network, intersection_frequency
+    from .network import generate_network, intersection_frequency
+
+    network = generate_network(_network_spec(parameters, seed))
+    return {"intersection_frequency": float(intersection_frequency(network)),
+            "n_fractures": int(network.n_fractures)}
+
+
+def _network_spec(parameters, seed):
+    """The :class:`hmatddm.network.NetworkSpec` of one grid point (Table 6.1 defaults);
+    InputError naming the parameter when a value is out of range."""
+    from .network import NetworkSpec
 
     spec_args = dict(region=(-50.0, 50.0, -50.0, 50.0), density=0.05, length_exponent=2.0, l_min=1.0,
                      l_max=30.0, mean_azimuths_deg=(45.0,), kappas=(5.0,))
     spec_args.update(parameters)
-    network = generate_network(NetworkSpec(seed=int(seed), **spec_args))
-    return {"intersection_frequency": float(intersection_frequency(network)),
-            "n_fractures": int(network.n_fractures)}
+    try:
+        return NetworkSpec(seed=int(seed), **spec_args)
+    except TypeError as error:  # an unknown parameter name
+        raise InputError(f"grid parameter not understood by NetworkSpec: {error}") from None
 
 
 def parameter_grid(**axes):
@@ -62,6 +73,9 @@ def sweep(grid, realizations=10, task=intersection_frequency_task, scheduler=Non
     if not grid or not all(isinstance(point, dict) for point in grid):
         raise InputError("grid must be a non-empty list of parameter dicts")
     realizations = positive_int("realizations", realizations)
+    if task is intersection_frequency_task:  # refuse bad values here, not in a worker's traceback
+        for point in grid:
+            _network_spec(point, first_seed)
     jobs = [(point, first_seed + k) for point in grid for k in range(realizations)]
     cluster = None
     if scheduler is None:

@@ -14,6 +14,19 @@ class InputError(HmatddmError, ValueError):
     """Invalid user input; the message names the field and its allowed range."""
 
 
+class SizeLimitError(InputError):
+    """A growing simulation would pass its element limit (``max_elements`` of
+    :class:`hmatddm.Simulation`, ``numerics.max_elements`` of a scene). Raised before the
+    step is accepted: the state (and the newest checkpoint) is the last finished step, so a
+    run can continue with a higher limit. ``elements`` is the count the step reached,
+    ``limit`` the limit."""
+
+    def __init__(self, message, elements=0, limit=0):
+        super().__init__(message)
+        self.elements = elements
+        self.limit = limit
+
+
 class ConvergenceError(HmatddmError, RuntimeError):
     """An iterative solver did not reach its tolerance.
 
@@ -92,3 +105,9 @@ class MeshQualityWarning(UserWarning):
     :func:`hmatddm.mesh.close_parallel_pairs`). The message names the elements and the
     element size that fixes it. Turn it into an error with
     ``warnings.simplefilter("error", hd.errors.MeshQualityWarning)``."""
+
+
+class NoInjectionWarning(UserWarning):
+    """Every cluster injects at rate 0: nothing drives the fractures, which only relax
+    from their initial pressure (a scene without a [reference] would otherwise start
+    such a run silently)."""

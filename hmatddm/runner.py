@@ -34,8 +34,8 @@ import numpy as np
 from .errors import HmatddmError, InputError, OutputError
 from .io import atomic_output, read_vtu, write_pvd, write_vtu
 from .mesh import Mesh2D, Mesh3D
+from .progress import Progress
 from .simulation import checkpoint as checkpoints
-from .solve import opening, slip
 
 SUMMARY = "summary.json"
 SCENE_FILE = "scene.toml"
@@ -113,91 +113,15 @@ def _vtu_steps(out):
     return sorted(steps)
 
 
-def _format_seconds(seconds):
-    seconds = max(0.0, float(seconds))
-    if seconds < 60:
-        return f"{seconds:.0f}s"
-    minutes, seconds = divmod(int(round(seconds)), 60)
-    if minutes < 60:
-        return f"{minutes}m{seconds:02d}s"
-    hours, minutes = divmod(minutes, 60)
-    return f"{hours}h{minutes:02d}m"
-
-
 # ---------------------------------------------------------------------------------
-# Progress
-# ---------------------------------------------------------------------------------
-
-class Progress:
-    """A one-line progress display on ``stream`` (stderr by default).
-
-    On a terminal the line is redrawn in place after every step: step, simulated time
-    against the end time with a bar, elements, nonlinear (and linear) iterations,
-    seconds of the last step and an estimate of the time left. When the stream is not
-    a terminal (a log file, CI), a plain line is printed every ``ceil(steps / 10)``
-    steps and at the end. ``enabled=False`` prints nothing.
-    """
-
-    BAR = 20
-
-    def __init__(self, end_time, time_step, stream=None, enabled=True, start_time=0.0):
-        self.stream = sys.stderr if stream is None else stream
-        self.enabled = enabled
-        self.end_time, self.time_step = float(end_time), float(time_step)
-        self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
-        steps = max(1, math.ceil(self.end_time / self.time_step - 1e-9))
-        self.every = max(1, math.ceil(steps / 10))
-        self.started = time.perf_counter()
-        self.start_time = float(start_time)
-        self._drawn = False
-        self._width = 0
-
-    def _line(self, record):
-        fraction = min(1.0, max(0.0, record["time"] / self.end_time))
-        filled = int(round(fraction * self.BAR))
-        bar = "#" * filled + "-" * (self.BAR - filled)
-        elapsed = time.perf_counter() - self.started
-        done = (record["time"] - self.start_time) / max(self.end_time - self.start_time, 1e-300)
-        left = elapsed * (1.0 - done) / done if 0.0 < done < 1.0 else 0.0
-        return (f"step {record['step']:>4}  t {record['time']:g}/{self.end_time:g} s [{bar}] {100 * fraction:3.0f}%"
-                f"  elements {record['n_elements']}  iterations {record['nonlinear_iterations']}"
-                f" ({record['linear_iterations']} linear)  {record['solve_seconds']:.1f} s/step"
-                f"  left ~{_format_seconds(left)}")
-
-    def update(self, record):
-        if not self.enabled:
-            return
-        line = self._line(record)
-        if self.tty:
-            self.stream.write("\r" + line.ljust(self._width))
-            self._width = len(line)
-            self._drawn = True
-        elif record["step"] % self.every == 0 or record["time"] >= self.end_time - 1e-9 * self.time_step:
-            self.stream.write(line + "\n")
-        self.stream.flush()
-
-    def note(self, text):
-        """Print a message on its own line (below the progress line)."""
-        if not self.enabled:
-            return
-        self.close()
-        self.stream.write(text + "\n")
-        self.stream.flush()
-
-    def close(self):
-        if self.enabled and self.tty and self._drawn:
-            self.stream.write("\n")
-            self.stream.flush()
-        self._drawn = False
-        self._width = 0
-
-
 # ---------------------------------------------------------------------------------
 # Fields, VTU and pictures
 # ---------------------------------------------------------------------------------
 
 def cell_fields(mesh, dd, pressure, stress, state=None):
     """Per-element fields written to the .vtu files (see the module docstring)."""
+    from .solve import opening, slip  # numba: loaded when a run writes, not when it is checked
+
     dd = np.asarray(dd, dtype=float).reshape(mesh.n_elements, mesh.dim)
     normal_stress = np.einsum("ei,ij,ej->e", mesh.normals, stress, mesh.normals)
     return {"opening": opening(mesh, dd), "slip": slip(mesh, dd), "pressure": np.asarray(pressure, dtype=float),
@@ -315,9 +239,12 @@ class SceneRun:
         (after writing the outputs of the last converged step) and lets
         KeyboardInterrupt through (the checkpoint of the last finished step is on disk).
         """
-        from .errors import ConvergenceError
+        from .errors import ConvergenceError, SizeLimitError
         from .scene import build_simulation
 
+        if self.resume and self.overwrite:
+            raise InputError("--resume continues the run in the folder and --overwrite starts it over: give one "
+                             "of them, not both")
         self._started = time.perf_counter()
         scene = self.scene.data
         numerics = scene["numerics"]
@@ -332,9 +259,13 @@ class SceneRun:
         if step == 0 or (step % scene["output"]["every"] == 0 and self._last_vtu_step != step):
             self._write_vtu(simulation.state)  # t = 0, or a step whose .vtu an interruption cut off
         self._write_summary()
+        if start_time > numerics["end_time"] + 1e-9 * numerics["time_step"]:
+            raise InputError(f"the run in {str(self.out)!r} is already at t = {start_time:g} s, past "
+                             f"numerics.end_time = {numerics['end_time']:g} s; give a later end time (--set "
+                             "numerics.end_time=...) or --overwrite to start over")
         try:
             simulation.run(numerics["end_time"], callback=self._after_step)
-        except ConvergenceError:
+        except (ConvergenceError, SizeLimitError):
             self.progress.close()
             self._finish()
             raise
@@ -346,8 +277,16 @@ class SceneRun:
 
     # -- folder -------------------------------------------------------------------------
     def _holds_a_run(self):
-        return ((self.out / SUMMARY).exists() or bool(checkpoints.list_checkpoints(self.out / CHECKPOINT_DIR))
-                or bool(_vtu_steps(self.out)))
+        """Whether the folder holds a run worth keeping: at least one finished step (a
+        checkpoint, a summary with steps, or a .vtu past step 0). A run refused or failed
+        before its first step does not claim the folder."""
+        if checkpoints.list_checkpoints(self.out / CHECKPOINT_DIR) or any(step > 0 for step in _vtu_steps(self.out)):
+            return True
+        try:
+            summary = read_summary(self.out)
+        except InputError:  # unreadable: not ours to judge, keep it
+            return True
+        return bool(summary and summary.get("steps"))
 
     def _clear(self):
         """Remove the files an earlier run wrote (only ours, by name)."""
@@ -385,13 +324,13 @@ class SceneRun:
                     self._last_vtu_step = old
             self.note(f"resuming {self.scene.name} from step {step} (t = {simulation.state.time:g} s) in {out}")
         else:
-            if self._holds_a_run():
-                if self.resume:
-                    self.note(f"no checkpoint in {out / CHECKPOINT_DIR}: starting {self.scene.name} from t = 0")
-                elif not self.overwrite:
-                    raise InputError(f"--out {str(out)!r} already holds a run; add --resume to continue it or "
-                                     "--overwrite to start over (or choose another folder)")
-                self._clear()
+            holds = self._holds_a_run()
+            if holds and not self.resume and not self.overwrite:
+                raise InputError(f"--out {str(out)!r} already holds a run; add --resume to continue it or "
+                                 "--overwrite to start over (or choose another folder)")
+            if holds and self.resume:
+                self.note(f"no checkpoint in {out / CHECKPOINT_DIR}: starting {self.scene.name} from t = 0")
+            self._clear()  # our own files only (a run without a finished step is no run); others stay
         out.mkdir(parents=True, exist_ok=True)
         from . import __version__
 

@@ -5,6 +5,9 @@ import numpy as np
 import pytest
 
 sys.path.insert(0, os.path.dirname(__file__))  # for kelvin_reference
+# as the hmatddm command does (the library itself changes no environment variable):
+# numba's OpenMP workers wait passively on this shared machine
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
 import hmatddm as hd  # noqa: E402
 

@@ -1,5 +1,6 @@
 """The command line: run, scenes, validate, bench, render; exit codes 0/1/2/3/130."""
 import json
+import os
 
 import numpy as np
 import py_compile
@@ -117,7 +118,8 @@ def test_interrupt_exits_130_and_says_how_to_resume(tiny, tmp_path, capsys, monk
     out = tmp_path / "out"
     assert cli.main(["run", str(tiny), "--out", str(out)]) == cli.EXIT_INTERRUPTED
     err = capsys.readouterr().err
-    assert "interrupted after step 1 (t = 1 s)" in err and f"hmatddm run --out {out} --resume" in err
+    assert "interrupted; the newest checkpoint is step 1 (t = 1 s)" in err
+    assert f"hmatddm run --out {out} --resume" in err
     monkeypatch.undo()
     assert cli.main(["run", "--out", str(out), "--resume", "--quiet"]) == cli.EXIT_OK
     assert len(json.loads((out / "summary.json").read_text())["steps"]) == 2
@@ -189,3 +191,53 @@ def test_exit_codes_are_distinct_and_documented_in_the_help():
     run = parser._subparsers._group_actions[0].choices["run"]
     assert "4 an output could not be written (disk full" in run.epilog
     assert "4 an output could not be written" in cli.__doc__
+
+
+T_JUNCTION = TINY_2D + '[[initial_fracture]]\nshape = "line"\np0 = [0.0, 0.0]\np1 = [0.0, 0.5]\nelement_size = 0.25\n'
+
+
+def test_quick_answers_import_nothing_heavy_and_change_no_environment(tmp_path):
+    """`import hmatddm`, `--help`, `scenes` and a refused scene (here a T junction, found
+    by the operator only once built) load neither numba, the H-matrix engine, the
+    simulation, matplotlib nor pyvista; the library sets no environment variable."""
+    scene = tmp_path / "t.toml"
+    scene.write_text(T_JUNCTION)
+    code = f"""
+import contextlib, io, os, sys
+import hmatddm, hmatddm.hmatrix
+assert "OMP_WAIT_POLICY" not in os.environ
+heavy = ("numba", "matplotlib", "pyvista", "hmatddm.hmatrix.hmatrix", "hmatddm.simulation.simulation",
+         )
+def loaded():
+    return [m for m in heavy if m in sys.modules]
+assert not loaded() and "scipy.special" not in sys.modules, loaded()
+from hmatddm import cli
+with contextlib.redirect_stdout(io.StringIO()):
+    try:
+        cli.main(["--help"])
+    except SystemExit:
+        pass
+    assert cli.main(["scenes"]) == 0
+assert not loaded(), loaded()
+err = io.StringIO()
+with contextlib.redirect_stderr(err):
+    code = cli.main(["run", {str(scene)!r}, "--out", {str(tmp_path / "out")!r}])
+assert code == 2 and "lie on or near another element's edge" in err.getvalue(), (code, err.getvalue())
+assert len(err.getvalue().strip().splitlines()) == 1
+assert not loaded(), loaded()
+print("ok")
+"""
+    env = {k: v for k, v in os.environ.items() if k != "OMP_WAIT_POLICY"}
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, env=env)
+    assert result.returncode == 0 and result.stdout.strip() == "ok", result.stderr
+    assert not (tmp_path / "out").exists()  # refused before anything was written
+
+
+def test_the_command_asks_numba_workers_to_wait_passively(monkeypatch, capsys):
+    monkeypatch.delenv("OMP_WAIT_POLICY", raising=False)
+    assert cli.main(["scenes", "--json"]) == cli.EXIT_OK
+    assert os.environ["OMP_WAIT_POLICY"] == "PASSIVE"
+    monkeypatch.setenv("OMP_WAIT_POLICY", "ACTIVE")  # an explicit setting wins
+    assert cli.main(["scenes", "--json"]) == cli.EXIT_OK
+    assert os.environ["OMP_WAIT_POLICY"] == "ACTIVE"
+    capsys.readouterr()

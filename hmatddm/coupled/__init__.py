@@ -1,5 +1,10 @@
 """Coupled elasticity-flow solution of a time step (ref. Sec. 4.4)."""
-from .elastic import ElasticSolver
-from .schemes import SCHEMES, SchemeSettings, StepProblem, solve_step
+from .._lazy import attach
+
+_EXPORTS = {
+    "ElasticSolver": ".elastic", "SCHEMES": ".schemes", "SchemeSettings": ".schemes", "StepProblem": ".schemes",
+    "solve_step": ".schemes",
+}
+__getattr__, __dir__ = attach(__name__, _EXPORTS)
 
 __all__ = ["ElasticSolver", "SCHEMES", "SchemeSettings", "StepProblem", "solve_step"]

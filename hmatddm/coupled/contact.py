@@ -55,7 +55,7 @@ import scipy.sparse as sp
 from ..errors import InputError
 
 OPEN, STICK, SLIP = 0, 1, 2
-CONTACT_MODES = ("natural", "all", "none")  # which elements of a simulation may close
+from ..options import CONTACT_MODES  # noqa: E402,F401  (which elements of a simulation may close)
 
 
 @dataclass

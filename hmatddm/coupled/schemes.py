@@ -41,7 +41,7 @@ from .._validation import finite_scalar, positive_int
 from ..errors import ConvergenceError, InputError
 from ..hmatrix import gmres
 
-SCHEMES = ("fixed-width", "fracture-compliance", "fully-coupled", "krylov")
+from ..options import SCHEME_DEFAULTS, SCHEMES  # noqa: E402,F401
 COUPLED_SCHEMES = ("fully-coupled", "krylov")
 
 
@@ -67,17 +67,17 @@ class SchemeSettings:
         they needed, as in ref. Fig. 4.10.
     """
 
-    scheme: str = "krylov"
-    omega: float = 1.0
-    relaxation: float = 1.0
-    min_relaxation: float = 1.0 / 256.0
-    tolerance_pressure: float = 1e-6
-    tolerance_opening: float = 1e-6
-    max_iterations: int = 400
-    linear_rtol: float = 1e-9
-    linear_restart: int = 100
-    linear_maxiter: int = 20
-    relaxation_growth: float = None
+    scheme: str = SCHEME_DEFAULTS["scheme"]
+    omega: float = SCHEME_DEFAULTS["omega"]
+    relaxation: float = SCHEME_DEFAULTS["relaxation"]
+    min_relaxation: float = SCHEME_DEFAULTS["min_relaxation"]
+    tolerance_pressure: float = SCHEME_DEFAULTS["tolerance_pressure"]
+    tolerance_opening: float = SCHEME_DEFAULTS["tolerance_opening"]
+    max_iterations: int = SCHEME_DEFAULTS["max_iterations"]
+    linear_rtol: float = SCHEME_DEFAULTS["linear_rtol"]
+    linear_restart: int = SCHEME_DEFAULTS["linear_restart"]
+    linear_maxiter: int = SCHEME_DEFAULTS["linear_maxiter"]
+    relaxation_growth: float = SCHEME_DEFAULTS["relaxation_growth"]
 
     def __post_init__(self):
         if self.scheme not in SCHEMES:

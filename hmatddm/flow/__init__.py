@@ -1,5 +1,10 @@
 """Lubrication flow in the fractures (ref. Sec. 4.3): fluid data and the FVM matrices."""
-from .fluid import Cluster, Fluid, LeakOff
-from .lubrication import LubricationModel, fracture_compliance
+from .._lazy import attach
+
+_EXPORTS = {
+    "Cluster": ".fluid", "Fluid": ".fluid", "LeakOff": ".fluid", "LubricationModel": ".lubrication",
+    "fracture_compliance": ".lubrication",
+}
+__getattr__, __dir__ = attach(__name__, _EXPORTS)
 
 __all__ = ["Fluid", "LeakOff", "Cluster", "LubricationModel", "fracture_compliance"]

@@ -1,8 +1,14 @@
 """Fracture mechanics at the tips (ref. Sec. 4.2.2): SIFs, criteria and growth."""
-from .criteria import (OLSON_CORRECTION, circumferential_stress_direction, energy_release_rate,
-                       equivalent_mode_one, stress_intensity_factors)
-from .crossing import CROSSING_CRITERIA, NaturalFractureProperties, crosses, near_tip_stress, plane_tractions
-from .growth import Propagation, TipState, evaluate_tips, new_elements
+from .._lazy import attach
+
+_EXPORTS = {
+    "OLSON_CORRECTION": ".criteria", "circumferential_stress_direction": ".criteria",
+    "energy_release_rate": ".criteria", "equivalent_mode_one": ".criteria", "stress_intensity_factors": ".criteria",
+    "CROSSING_CRITERIA": ".crossing", "NaturalFractureProperties": ".crossing", "crosses": ".crossing",
+    "near_tip_stress": ".crossing", "plane_tractions": ".crossing", "Propagation": ".growth", "TipState": ".growth",
+    "evaluate_tips": ".growth", "new_elements": ".growth",
+}
+__getattr__, __dir__ = attach(__name__, _EXPORTS)
 
 __all__ = ["NaturalFractureProperties", "CROSSING_CRITERIA", "crosses", "near_tip_stress", "plane_tractions",
            "Propagation", "TipState", "evaluate_tips", "new_elements", "stress_intensity_factors",

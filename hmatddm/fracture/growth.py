@@ -20,8 +20,7 @@ from ..mesh import Mesh2D, Mesh3D
 from .criteria import (OLSON_CORRECTION, circumferential_stress_direction, energy_release_rate,
                        equivalent_mode_one, stress_intensity_factors)
 
-CRITERIA = ("mcs", "energy")
-TURNING = ("none", "plan", "any")
+from ..options import CRITERIA, FRONTS, TURNING  # noqa: E402,F401
 
 
 @dataclass(frozen=True)
@@ -50,6 +49,21 @@ class Propagation:
         Re-solves of one time step after adding elements, >= 0 (0 disables growth).
     bounds : ((lo, hi), ...) or None
         Per-axis limits for new element centres (e.g. barrier layers bounding z).
+    front : {"element", "asymptotic"}
+        ``"element"``: the reference's switch, whole elements added where the criterion
+        holds (ref. Sec. 4.2.2, growth direction from ref. Eqs 4.10-4.11, so fractures
+        may turn). ``"asymptotic"``: the front is located inside the tip elements by
+        inverting the universal tip asymptote (:mod:`hmatddm.fracture.tip_asymptote`,
+        :mod:`hmatddm.fracture.front`); partially filled tip elements carry the
+        asymptote's opening. Planar fractures only (one fracture, square elements on one
+        grid in 3D, equal segments on a line in 2D), without leak-off, natural
+        fractures, contact or bounds: :class:`~hmatddm.Simulation` raises InputError
+        otherwise. ``criterion`` and ``turning`` are not used by it.
+    front_iterations : int
+        Asymptotic front: fixed-point iterations of the front per time step, >= 1.
+    front_tolerance : float
+        Asymptotic front: converged when no ribbon distance changes by more than this
+        fraction of the element size, in (0, 1).
     """
 
     toughness: float
@@ -60,6 +74,9 @@ class Propagation:
     min_turn_angle: float = np.deg2rad(1.0)
     max_growth_passes: int = 50
     bounds: tuple | None = None
+    front: str = "element"
+    front_iterations: int = 40
+    front_tolerance: float = 1e-3
 
     def __post_init__(self):
         toughness = finite_scalar("propagation.toughness", self.toughness)
@@ -68,6 +85,14 @@ class Propagation:
         object.__setattr__(self, "toughness", toughness)
         if self.criterion not in CRITERIA:
             raise InputError(f"propagation.criterion must be one of {CRITERIA}, got {self.criterion!r}")
+        if self.front not in FRONTS:
+            raise InputError(f"propagation.front must be one of {FRONTS}, got {self.front!r}")
+        object.__setattr__(self, "front_iterations",
+                           positive_int("propagation.front_iterations", self.front_iterations))
+        tolerance = finite_scalar("propagation.front_tolerance", self.front_tolerance)
+        if not 0.0 < tolerance < 1.0:
+            raise InputError(f"propagation.front_tolerance must be in (0, 1), got {tolerance}")
+        object.__setattr__(self, "front_tolerance", tolerance)
         if self.turning not in TURNING:
             raise InputError(f"propagation.turning must be one of {TURNING}, got {self.turning!r}")
         if self.critical_energy_release_rate is not None:

@@ -4,11 +4,14 @@ flat storage with a parallel matvec, near-field preconditioners and GMRES.
 Knows nothing about elasticity: it compresses the matrix of any
 :class:`BlockGenerator` (a numba kernel filling d x d element blocks).
 """
+from .._lazy import attach
 
-from .generator import BlockGenerator
-from .hmatrix import HMatrix
-from .preconditioners import block_jacobi, default_preconditioner, near_field_block_ilu, near_field_ilu, near_field_lu
-from .solvers import gmres
+_EXPORTS = {
+    "BlockGenerator": ".generator", "HMatrix": ".hmatrix", "block_jacobi": ".preconditioners",
+    "default_preconditioner": ".preconditioners", "near_field_block_ilu": ".preconditioners",
+    "near_field_ilu": ".preconditioners", "near_field_lu": ".preconditioners", "gmres": ".solvers",
+}
+__getattr__, __dir__ = attach(__name__, _EXPORTS)
 
 __all__ = [
     "BlockGenerator",

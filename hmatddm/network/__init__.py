@@ -16,10 +16,16 @@ Conventions: azimuths are strikes measured from the +x axis counter-clockwise, i
 ``kappa`` is the von Mises concentration of the doubled angle; density is fractures per
 square metre (Eq. 6.12).
 """
-from .generation import (Network, NetworkSpec, bimodal_directions, generate_network, power_law_lengths,
-                         von_mises_directions)
-from .intersections import (IntersectionGraph, Intersections, find_intersections, intersection_frequency,
-                            intersection_graph, scanline_frequency, split_at_intersections)
+from .._lazy import attach
+
+_EXPORTS = {
+    "Network": ".generation", "NetworkSpec": ".generation", "bimodal_directions": ".generation",
+    "generate_network": ".generation", "power_law_lengths": ".generation", "von_mises_directions": ".generation",
+    "IntersectionGraph": ".intersections", "Intersections": ".intersections", "find_intersections": ".intersections",
+    "intersection_frequency": ".intersections", "intersection_graph": ".intersections",
+    "scanline_frequency": ".intersections", "split_at_intersections": ".intersections",
+}
+__getattr__, __dir__ = attach(__name__, _EXPORTS)
 
 __all__ = [
     "power_law_lengths", "von_mises_directions", "bimodal_directions", "NetworkSpec", "Network",

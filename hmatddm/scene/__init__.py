@@ -149,10 +149,15 @@ from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 
+from .._lazy import attach
 from ..errors import InputError
-from .build import (build_simulation, natural_mesh, natural_network, natural_properties, confining_stress, initial_mesh,
-                    reference_curves, reference_values)
 from .schema import far_field_stress, has_natural_fractures, to_toml, validate
+
+# .build imports the engine (Simulation, scipy.special through the closed forms): it loads
+# on first use, so that validating and refusing a scene stays quick
+__getattr__, __dir__ = attach(__name__, {name: ".build" for name in (
+    "build_simulation", "natural_mesh", "natural_network", "natural_properties", "confining_stress", "initial_mesh",
+    "reference_curves", "reference_values")})
 
 
 @dataclass(frozen=True)
@@ -216,8 +221,10 @@ def embedded_text(name):
 
 
 def embedded_scenes():
-    """``{name: description}`` of every embedded scene."""
-    return {name: load_scene(name).description for name in embedded_names()}
+    """``{name: description}`` of every embedded scene (read, not validated: the tests
+    validate them, and listing them stays instant)."""
+    return {name: str(_parse(embedded_text(name), f"embedded scene {name!r}").get("description", ""))
+            for name in embedded_names()}
 
 
 def _parse(text, source):

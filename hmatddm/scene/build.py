@@ -6,14 +6,11 @@ import math
 
 import numpy as np
 
-from .. import analytical
 from .. import mesh as meshes
-from ..coupled import SchemeSettings
 from ..errors import InputError
 from ..flow import Cluster, Fluid, LeakOff
 from ..fracture import Propagation
 from ..material import Elastic
-from ..simulation import Simulation
 from .schema import SCHEME_KEYS, far_field_stress, has_natural_fractures, show
 
 _CROSSING_NAMES = {"mohr-coulomb": "mohr-coulomb", "energy-release-rate": "energy", "stress-intensity": "sif"}
@@ -99,7 +96,9 @@ def propagation(scene):
                        correction=settings["correction"], turning=settings["turning"],
                        min_turn_angle=math.radians(settings["min_turn_angle_deg"]),
                        max_growth_passes=settings["max_growth_passes"],
-                       bounds=None if bounds is None else tuple(tuple(pair) for pair in bounds))
+                       bounds=None if bounds is None else tuple(tuple(pair) for pair in bounds),
+                       front=settings["front"], front_iterations=settings["front_iterations"],
+                       front_tolerance=settings["front_tolerance"])
 
 
 def leak_off(scene):
@@ -107,6 +106,8 @@ def leak_off(scene):
 
 
 def scheme_settings(scene):
+    from ..coupled import SchemeSettings  # scipy.sparse.linalg: loaded when a run is built
+
     numerics = scene["numerics"]
     return SchemeSettings(**{key: numerics[key] for key in SCHEME_KEYS if numerics.get(key) is not None})
 
@@ -117,6 +118,8 @@ def build_simulation(scene, checkpoint_dir=None):
     Raises InputError for a cluster off the initial fractures or overlapping initial
     fractures.
     """
+    from ..simulation import Simulation  # the engine loads here, not when a scene is validated
+
     mesh = initial_mesh(scene)
     _check_clusters(scene, mesh)
     numerics = scene["numerics"]
@@ -130,7 +133,8 @@ def build_simulation(scene, checkpoint_dir=None):
         alpha=numerics.get("alpha"), scheme=scheme_settings(scene), growing_fractures=growing,
         checkpoint_dir=checkpoint_dir, keep_checkpoints=numerics["keep_checkpoints"],
         natural_fractures=natural_mesh(scene), natural=natural_properties(scene),
-        remote_failure=scene.get("network", {}).get("remote_failure", True), contact=numerics["contact"])
+        remote_failure=scene.get("network", {}).get("remote_failure", True), contact=numerics["contact"],
+        max_elements=numerics.get("max_elements"))
 
 
 def natural_network(scene):
@@ -200,6 +204,8 @@ def _closed_form(scene, times):
     """Closed-form curves at ``times`` (> 0): dict of arrays with ``time``, ``radius`` or
     ``half_length``, ``max_opening``, optionally ``net_pressure``, and
     ``dimensionless_toughness``."""
+    from .. import analytical  # scipy.special: loaded only for a [reference]
+
     kind = scene["reference"]["kind"]
     mat = material(scene)
     rate = scene["cluster"][0]["rate"]

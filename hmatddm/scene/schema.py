@@ -20,12 +20,10 @@ import math
 
 import numpy as np
 
-from ..coupled import SCHEMES, SchemeSettings
-from ..coupled.contact import CONTACT_MODES
 from ..errors import InputError
 from ..fracture.criteria import OLSON_CORRECTION
-from ..fracture.growth import CRITERIA, TURNING
-from ..operators import BACKENDS, DEFAULT_EPS, DEFAULT_ETA, DEFAULT_LEAF_SIZE, SINGULAR_CORRECTIONS
+from ..options import (BACKENDS, CONTACT_MODES, CRITERIA, DEFAULT_EPS, DEFAULT_ETA, DEFAULT_LEAF_SIZE, FRONTS,
+                       SCHEME_DEFAULTS, SCHEMES, SINGULAR_CORRECTIONS, TURNING)
 
 REQUIRED = object()  # marker: the key has no default
 ABSENT = object()    # marker: optional key without a default (left out of the echo when not given)
@@ -180,7 +178,7 @@ class Key:
 
 
 def _scheme_default(name):
-    return SchemeSettings.__dataclass_fields__[name].default
+    return SCHEME_DEFAULTS[name]
 
 
 # ---------------------------------------------------------------------------------
@@ -252,6 +250,9 @@ PROPAGATION = {
     "max_growth_passes": Key("integer", 50, low=0),
     "bounds": Key("pairs", unit="m"),
     "growing_fractures": Key("integers"),
+    "front": Key("choice", "element", choices=FRONTS),
+    "front_iterations": Key("integer", 40, low=1),
+    "front_tolerance": Key("number", 1e-3, low=0.0, high=1.0, low_open=True, high_open=True),
 }
 
 LEAK_OFF = {
@@ -287,6 +288,8 @@ NUMERICS = {
     "contact": Key("choice", "natural", choices=CONTACT_MODES,
                    doc="elements that close with contact and Coulomb friction: natural, all, none"),
     "keep_checkpoints": Key("integer", 3, low=1),
+    "max_elements": Key("integer", 200_000, low=1,
+                        doc="refuse a scene (or stop a run, resumably) with more elements than this"),
 }
 
 SCHEME_KEYS = ("scheme", "omega", "relaxation", "min_relaxation", "tolerance_pressure", "tolerance_opening",

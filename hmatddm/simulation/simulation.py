@@ -22,10 +22,10 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from .. import topology
-from .._validation import finite_array, finite_scalar, positive_scalar
+from .._validation import finite_array, finite_scalar, positive_int, positive_scalar
 from ..coupled import ElasticSolver, SchemeSettings, StepProblem, solve_step
 from ..coupled.contact import CONTACT_MODES, OPEN, SLIP, STICK, ContactLaw, ContactModel
-from ..errors import InputError, MeshQualityWarning
+from ..errors import InputError, MeshQualityWarning, NoInjectionWarning, SizeLimitError
 from ..flow import Cluster, Fluid, LeakOff, LubricationModel, fracture_compliance
 from ..fracture import Propagation, evaluate_tips, new_elements
 from ..fracture.crossing import NaturalFractureProperties
@@ -63,6 +63,9 @@ class State:
     contact_status: np.ndarray = None  # (N,) OPEN / STICK / SLIP (hmatddm.coupled.contact)
     slip_direction: np.ndarray = None  # (N, d) unit slip direction of slipping elements
     failure_pressure: np.ndarray = None  # (N,) pore pressure of remotely failed elements (NaN otherwise)
+    front_distance: np.ndarray = None  # (N,) asymptotic front: ribbon distance to the front (NaN elsewhere)
+    front_velocity: np.ndarray = None  # (N,) asymptotic front: ribbon front velocity (NaN elsewhere)
+    front_class: np.ndarray = None     # (N,) asymptotic front: 0 channel, 1 tip, 2 empty (hmatddm.fracture.front)
 
     def __post_init__(self):
         n, d = self.dd.shape
@@ -170,7 +173,7 @@ class Simulation:
                  backend="hmatrix", eps=DEFAULT_EPS, eta=DEFAULT_ETA, leaf_size=DEFAULT_LEAF_SIZE,
                  singular_correction="none", alpha=None, scheme="krylov", growing_fractures=None,
                  checkpoint_dir=None, keep_checkpoints=3, rebuild_fraction=0.25, max_border_bytes=2**28,
-                 natural_fractures=None, natural=None, remote_failure=True, contact="natural"):
+                 natural_fractures=None, natural=None, remote_failure=True, contact="natural", max_elements=None):
         if not isinstance(mesh, (Mesh2D, Mesh3D)):
             raise InputError(f"mesh must be a Mesh2D or Mesh3D, got {type(mesh).__name__}")
         if not isinstance(material, Elastic):
@@ -180,6 +183,9 @@ class Simulation:
         clusters = list(clusters)
         if not clusters or not all(isinstance(c, Cluster) for c in clusters):
             raise InputError("clusters must be a non-empty list of hmatddm.Cluster")
+        if all(c.rate == 0.0 for c in clusters):
+            warnings.warn("every cluster injects at rate 0 m^3/s: nothing drives the fractures, which only relax "
+                          "from their initial pressure", NoInjectionWarning, stacklevel=2)
         if propagation is not None and not isinstance(propagation, Propagation):
             raise InputError(f"propagation must be an hmatddm.Propagation or None, got {type(propagation).__name__}")
         leak_off = LeakOff() if leak_off is None else leak_off
@@ -227,7 +233,15 @@ class Simulation:
             self.network = NaturalNetwork(shifted, natural)
         self.checkpoint_dir = checkpoint_dir
         self.keep_checkpoints = keep_checkpoints
+        # a resource limit, not part of the run's definition: left out of the fingerprint, so
+        # that a run stopped by it resumes with a higher one
+        self.max_elements = None if max_elements is None else positive_int("max_elements", max_elements)
         self.records = []
+        self.front = None  # propagation.front == "asymptotic": its AsymptoticFront (raises for unsupported setups)
+        if propagation is not None and propagation.front == "asymptotic":
+            from .asymptotic import AsymptoticFront
+
+            self.front = AsymptoticFront(self)
         self.state = self._initial_state()
         self.rebuild_fraction = finite_scalar("rebuild_fraction", rebuild_fraction)
         if not 0.0 <= self.rebuild_fraction <= 10.0:
@@ -245,10 +259,13 @@ class Simulation:
         dd = self.initial_opening * mesh.normals
         pressure = np.full(mesh.n_elements, self.initial_pressure)
         n_natural = 0 if self.network is None else self.network.mesh.n_elements
+        front = {}
+        if self.front is not None:
+            front = dict(zip(("front_distance", "front_velocity", "front_class"), self.front.initial(mesh)))
         return State(mesh, dd, pressure, np.zeros(mesh.n_elements), 0.0, 0, self.settings.relaxation, 0.0, 0.0,
                      origin=np.zeros(mesh.n_elements, np.int64), natural_index=-np.ones(mesh.n_elements, np.int64),
                      intact=np.ones(n_natural, bool), failed=np.zeros(n_natural, bool),
-                     extra_faces=np.zeros((0, 6)))
+                     extra_faces=np.zeros((0, 6)), **front)
 
     def fingerprint(self):
         """SHA-256 of everything that defines the run (a resume must match it)."""
@@ -384,11 +401,22 @@ class Simulation:
         info["drained"] = drained
         return dd.reshape(mesh.n_elements, mesh.dim), p, info, edges, faces, flow
 
-    def step(self):
-        """Advance one time step (with growth and remote-failure passes); returns the record."""
+    def step(self, end_time=None):
+        """Advance one time step (with growth and remote-failure passes); returns the record.
+
+        With ``end_time``, a step that would reach or pass it (within 1e-9 of a step) ends
+        exactly at ``end_time``: the last step of a run is shortened, never longer.
+        Raises :class:`~hmatddm.errors.SizeLimitError` (the state stays the last finished
+        step) when growth would take the mesh past ``max_elements``.
+        """
+        if self.front is not None:  # propagation.front = "asymptotic" (hmatddm.simulation.asymptotic)
+            return self.front.step(self, end_time)
         start = time.perf_counter()
         s = self.state
         t_old, t_new = s.time, s.time + self.time_step
+        if end_time is not None and t_new >= end_time - 1e-9 * self.time_step:
+            t_new = float(end_time)
+        dt = t_new - t_old
         mesh = s.mesh
         width_old = np.sum(s.dd * mesh.normals, axis=1)
         p_old = s.pressure.copy()
@@ -437,6 +465,11 @@ class Simulation:
             added += new_mesh.n_elements
             m = new_mesh.n_elements
             mesh = concatenate([mesh, new_mesh])
+            if self.max_elements is not None and mesh.n_elements > self.max_elements:
+                raise SizeLimitError(
+                    f"growth in step {s.step + 1} (t = {t_new:g} s) would take the mesh to {mesh.n_elements} "
+                    f"elements, more than max_elements = {self.max_elements}", elements=mesh.n_elements,
+                    limit=self.max_elements)
             width_old = np.concatenate([width_old, np.zeros(m)])
             has_parent = parent >= 0
             p_old = np.concatenate([p_old, np.where(has_parent, p_old[np.maximum(parent, 0)], new_pressure)])
@@ -457,8 +490,8 @@ class Simulation:
 
         width = np.sum(dd * mesh.normals, axis=1)
         leak = flow.leak_off_rate(creation, t_old, t_new) * flow.areas * (p - self.leak_off.pore_pressure)
-        injected = s.injected_volume + self.time_step * sum(c.rate for c in self.clusters)
-        leaked = s.leaked_volume + float(np.sum(leak)) * self.time_step
+        injected = s.injected_volume + dt * sum(c.rate for c in self.clusters)
+        leaked = s.leaked_volume + float(np.sum(leak)) * dt
         failed = s.failed.copy()
         if self.network is not None:
             failed[natural_index[origin == 2]] = True
@@ -709,12 +742,17 @@ class Simulation:
         return mesh, dd, pressure, state
 
     # -- run, checkpoints, resume -------------------------------------------------------
-    def run(self, end_time, resume=False, callback=None):
+    def run(self, end_time, resume=False, callback=None, progress=False):
         """Step until ``end_time`` (s); returns the list of records.
 
-        ``resume=True`` first loads the newest good checkpoint of ``checkpoint_dir``
-        (CheckpointError when there is none or when it belongs to another run).
-        ``callback(simulation, record)`` is called after every step.
+        The last step is shortened to end exactly at ``end_time`` when ``end_time`` is not a
+        whole number of steps (no record is ever past it). ``resume=True`` first loads the
+        newest good checkpoint of ``checkpoint_dir`` (CheckpointError when there is none or
+        when it belongs to another run). ``callback(simulation, record)`` is called after
+        every step. ``progress=True`` prints a progress line to stderr (redrawn on a
+        terminal, one line every tenth of the run otherwise; a text stream instead of
+        True prints there); every step is also logged at INFO level on the
+        ``hmatddm.simulation.simulation`` logger.
         """
         end_time = positive_scalar("end_time", end_time)
         if self.checkpoint_dir is not None:
@@ -723,12 +761,27 @@ class Simulation:
             if self.checkpoint_dir is None:
                 raise InputError("resume=True needs a checkpoint_dir")
             self.load_checkpoint()
-        while self.state.time < end_time - 1e-9 * self.time_step:
-            record = self.step()
-            if self.checkpoint_dir is not None:
-                self.save_checkpoint()
-            if callback is not None:
-                callback(self, record)
+        shown = None
+        if progress:
+            from ..progress import Progress
+
+            shown = Progress(end_time, self.time_step, stream=None if progress is True else progress,
+                             start_time=self.state.time)
+        try:
+            while self.state.time < end_time - 1e-9 * self.time_step:
+                record = self.step(end_time)
+                if self.checkpoint_dir is not None:
+                    self.save_checkpoint()
+                logger.info("step %d: t = %g s of %g, %d elements, %d nonlinear iterations, %.2f s",
+                            record["step"], record["time"], end_time, record["n_elements"],
+                            record["nonlinear_iterations"], record["solve_seconds"])
+                if shown is not None:
+                    shown.update(record)
+                if callback is not None:
+                    callback(self, record)
+        finally:
+            if shown is not None:
+                shown.close()
         return self.records
 
     def save_checkpoint(self):
@@ -737,6 +790,8 @@ class Simulation:
                       origin=s.origin, natural_index=s.natural_index, intact=s.intact, failed=s.failed,
                       extra_faces=s.extra_faces, contact_status=s.contact_status, slip_direction=s.slip_direction,
                       failure_pressure=s.failure_pressure)
+        if s.front_class is not None:
+            arrays.update(front_distance=s.front_distance, front_velocity=s.front_velocity, front_class=s.front_class)
         metadata = dict(time=s.time, step=s.step, relaxation=s.relaxation, injected_volume=s.injected_volume,
                         leaked_volume=s.leaked_volume, records=self.records, fingerprint=self.fingerprint(),
                         compressed_elements=self.compressed_elements)
@@ -755,7 +810,9 @@ class Simulation:
                            natural_index=arrays["natural_index"], intact=arrays["intact"], failed=arrays["failed"],
                            extra_faces=arrays["extra_faces"], contact_status=arrays.get("contact_status"),
                            slip_direction=arrays.get("slip_direction"),
-                           failure_pressure=arrays.get("failure_pressure"))
+                           failure_pressure=arrays.get("failure_pressure"),
+                           front_distance=arrays.get("front_distance"), front_velocity=arrays.get("front_velocity"),
+                           front_class=arrays.get("front_class"))
         self.records = list(metadata["records"])
         # rebuild the compressed base exactly as the interrupted run had it, so the
         # resumed run applies the same operator (bit for bit)
