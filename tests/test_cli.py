@@ -241,3 +241,51 @@ def test_the_command_asks_numba_workers_to_wait_passively(monkeypatch, capsys):
     assert cli.main(["scenes", "--json"]) == cli.EXIT_OK
     assert os.environ["OMP_WAIT_POLICY"] == "ACTIVE"
     capsys.readouterr()
+
+
+def test_the_last_step_lands_on_end_time(tiny, tmp_path, capsys):
+    """end_time shorter than a step, or not a whole number of steps: the last step is
+    shortened to end exactly there, and nothing reports a time past it (issue 19 item 3)."""
+    out = tmp_path / "short"
+    assert cli.main(["run", str(tiny), "--out", str(out), "--set", "numerics.end_time=0.5"]) == cli.EXIT_OK
+    captured = capsys.readouterr()
+    assert "t 0.5/0.5 s" in captured.err and "t = 0.5 s, " in captured.out
+    steps = json.loads((out / "summary.json").read_text())["steps"]
+    assert [s["time"] for s in steps] == [0.5]
+    assert steps[0]["injected_volume"] == pytest.approx(0.5 * 5e-4, rel=1e-12)
+    out = tmp_path / "uneven"
+    assert cli.main(["run", str(tiny), "--out", str(out), "--quiet", "--set", "numerics.end_time=2.5"]) == 0
+    steps = json.loads((out / "summary.json").read_text())["steps"]
+    assert [s["time"] for s in steps] == [1.0, 2.0, 2.5]
+    assert steps[-1]["injected_volume"] == pytest.approx(2.5 * 5e-4, rel=1e-12)
+    # a resume to an end time the run has already passed is refused, not reported
+    assert cli.main(["run", "--out", str(out), "--resume", "--set", "numerics.end_time=2"]) == cli.EXIT_BAD_INPUT
+    assert "already at t = 2.5 s, past numerics.end_time = 2 s" in capsys.readouterr().err
+    assert [s["time"] for s in json.loads((out / "summary.json").read_text())["steps"]] == [1.0, 2.0, 2.5]
+
+
+def test_a_folder_without_a_finished_step_is_not_claimed(tiny, tmp_path, capsys):
+    """A run that stopped before its first step leaves no run behind: the corrected scene
+    runs into the same folder without --overwrite; foreign files stay (issue 19 item 4)."""
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine")
+    (out / "vtu").mkdir()
+    (out / "vtu" / "mine.vtu.txt").write_text("mine too")
+    failing = ["--set", "numerics.max_iterations=1", "--set", "numerics.min_relaxation=1.0",
+               "--set", "numerics.tolerance_pressure=1e-15"]
+    assert cli.main(["run", str(tiny), "--out", str(out), "--quiet", *failing]) == cli.EXIT_NOT_CONVERGED
+    assert json.loads((out / "summary.json").read_text())["steps"] == []
+    capsys.readouterr()
+    assert cli.main(["run", str(tiny), "--out", str(out), "--quiet"]) == cli.EXIT_OK  # no --overwrite needed
+    assert len(json.loads((out / "summary.json").read_text())["steps"]) == 2
+    assert cli.main(["run", str(tiny), "--out", str(out), "--quiet"]) == cli.EXIT_BAD_INPUT  # now it holds a run
+    assert "already holds a run" in capsys.readouterr().err
+    assert cli.main(["run", str(tiny), "--out", str(out), "--quiet", "--overwrite"]) == cli.EXIT_OK
+    assert (out / "notes.txt").read_text() == "mine" and (out / "vtu" / "mine.vtu.txt").read_text() == "mine too"
+    # --resume and --overwrite contradict each other: refused before anything is touched
+    before = sorted(p.name for p in out.rglob("*"))
+    assert cli.main(["run", str(tiny), "--out", str(out), "--resume", "--overwrite"]) == cli.EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert "--resume continues the run in --out and --overwrite starts it over" in err
+    assert len(err.strip().splitlines()) == 1 and sorted(p.name for p in out.rglob("*")) == before
