@@ -289,3 +289,38 @@ def test_a_folder_without_a_finished_step_is_not_claimed(tiny, tmp_path, capsys)
     err = capsys.readouterr().err
     assert "--resume continues the run in --out and --overwrite starts it over" in err
     assert len(err.strip().splitlines()) == 1 and sorted(p.name for p in out.rglob("*")) == before
+
+
+def test_check_prints_the_size_estimate_and_a_huge_scene_is_refused(tiny, tmp_path, capsys):
+    assert cli.main(["run", str(tiny), "--check"]) == cli.EXIT_OK
+    captured = capsys.readouterr()
+    assert json.loads(captured.out)["numerics"]["max_elements"] == 200_000
+    assert "hmatddm: estimate: elements: 3 initial + 0 natural = 3" in captured.err
+    assert "memory: dense" in captured.err and "per step" in captured.err
+    out = tmp_path / "huge"
+    assert cli.main(["run", str(tiny), "--out", str(out), "--set", "initial_fracture[0].element_size=7.5e-7"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "about 1,000,000 elements" in err
+    assert "more than numerics.max_elements = 200,000" in err and "initial_fracture[0].element_size" in err
+    assert not out.exists()
+
+
+def test_growth_past_max_elements_stops_resumably(tiny, tmp_path, capsys):
+    """A run that would outgrow numerics.max_elements stops with the outputs and the
+    checkpoint of its last step, and continues with a higher limit (issue 19 item 2)."""
+    out = tmp_path / "out"
+    code = cli.main(["run", str(tiny), "--out", str(out), "--quiet", "--set", "numerics.end_time=4",
+                     "--set", "numerics.max_elements=8"])  # the mesh grows 3 -> 7 -> 11 -> 15 -> 17
+    assert code == cli.EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert "stopped: growth in step 2 (t = 2 s) would take the mesh to 9 elements, more than max_elements = 8" in err
+    assert "every step up to step 1 is checkpointed" in err
+    assert f"hmatddm run --out {out} --resume --set numerics.max_elements=16" in err
+    summary = json.loads((out / "summary.json").read_text())
+    assert [s["n_elements"] for s in summary["steps"]] == [7]
+    assert (out / "snapshots" / "step-000001_plan.png").is_file()
+    assert cli.main(["run", "--out", str(out), "--resume", "--quiet", "--set", "numerics.max_elements=12"]) == 2
+    capsys.readouterr()
+    assert cli.main(["run", "--out", str(out), "--resume", "--quiet", "--set", "numerics.max_elements=100"]) == 0
+    steps = json.loads((out / "summary.json").read_text())["steps"]
+    assert [s["step"] for s in steps] == [1, 2, 3, 4] and steps[-1]["n_elements"] > 10
