@@ -133,3 +133,23 @@ def test_bad_microseismic_sections_name_the_key(section, message):
 def test_dfn_3cluster_has_a_microseismic_section():
     section = load_scene("dfn-3cluster").data["microseismic"]
     assert len(section["wells"]) == 2 and section["p_wave_speed"] == 4000.0
+
+
+def test_events_of_a_simulation_object_match_those_of_its_run_folder(run_folder):
+    from hmatddm.microseismic import events_from_run, onset_recorder, read_run, run_state_from_simulation
+    from hmatddm.microseismic.sources import Medium, SlipOnset
+    from hmatddm.scene import build_simulation
+
+    folder, out = run_folder
+    scene = load_scene(str(folder / "slip.toml"))
+    simulation = build_simulation(scene.data)
+    onset = SlipOnset()
+    simulation.run(scene.numerics["end_time"], callback=onset_recorder(onset))
+    medium = Medium()
+    direct = events_from_run(run_state_from_simulation(simulation, onset, height=2.0), medium)
+    from_folder = events_from_run(read_run(out), medium)
+    assert len(direct) == len(from_folder) == 4
+    np.testing.assert_allclose(direct.position, from_folder.position, atol=1e-9)
+    np.testing.assert_allclose(direct.moment_tensor, from_folder.moment_tensor, rtol=1e-6,
+                               atol=1e-6 * np.abs(direct.moment_tensor).max())
+    np.testing.assert_array_equal(direct.time, from_folder.time)

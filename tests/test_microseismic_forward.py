@@ -61,7 +61,8 @@ def test_amplitudes_match_aki_richards_far_field_closed_form():
     m0 = events.seismic_moment[0]
     # Aki & Richards (2002) Eq. 4.33 for slip along x on z = 0: P ~ sin 2theta cos phi,
     # S ~ cos 2theta cos phi (theta direction) and -cos theta sin phi (phi direction)
-    p_closed = m0 * np.abs(np.sin(2 * theta) * np.cos(phi)) / (4 * np.pi * MEDIUM.density * MEDIUM.p_wave_speed ** 3 * r)
+    p_closed = m0 * np.abs(np.sin(2 * theta) * np.cos(phi)) / (
+        4 * np.pi * MEDIUM.density * MEDIUM.p_wave_speed ** 3 * r)
     s_closed = m0 * np.hypot(np.cos(2 * theta) * np.cos(phi), np.cos(theta) * np.sin(phi)) / (
         4 * np.pi * MEDIUM.density * MEDIUM.s_wave_speed ** 3 * r)
     np.testing.assert_allclose(obs.amplitude_p[0], p_closed, rtol=1e-10, atol=1e-12 * p_closed.max())

@@ -132,11 +132,43 @@ def read_run(out, height=None):
         onset.observe(mesh.centers, _slipping(data), time_value, step)
     dd = np.asarray(data["dd"], dtype=float)[:, :mesh.dim]
     # orient each rebuilt normal so that DD.n is the stored opening (the + face convention)
-    flip = np.sum(dd * mesh.normals, axis=1) * np.asarray(data["opening"], dtype=float) < 0.0
+    # (a safeguard: the writer keeps the orientation; closed elements, whose opening is
+    # round-off, decide nothing)
+    stored = np.asarray(data["opening"], dtype=float)
+    along = np.sum(dd * mesh.normals, axis=1)
+    flip = (along * stored < 0.0) & (np.abs(stored) > 1e-6 * np.linalg.norm(dd, axis=1))
     if np.any(flip):
         mesh = _flipped(mesh, flip)
     state = np.asarray(data.get("state", np.zeros(mesh.n_elements)), dtype=np.int64)
     return RunState(mesh=mesh, dd=dd, state=state, time=float(time_value), step=step, onset=onset,
+                    height=float(height))
+
+
+def _slip_magnitude(mesh, dd):
+    dd = np.asarray(dd, dtype=float).reshape(mesh.n_elements, mesh.dim)
+    normal_part = np.sum(dd * mesh.normals, axis=1)
+    return np.linalg.norm(dd - normal_part[:, None] * mesh.normals, axis=1)
+
+
+def onset_recorder(onset):
+    """A ``callback(simulation, record)`` for :meth:`hmatddm.Simulation.run` that feeds
+    :class:`SlipOnset` ``onset`` from ``simulation.view()`` after every step (the onset of
+    each event to the step, where a run folder's .vtu series has ``output.every``)."""
+    def record(simulation, step_record):
+        mesh, dd, _, state = simulation.view()
+        onset.tolerance = 1e-6 * float(np.max(mesh.radii))
+        slipping = (state == FAILED_NATURAL) & (_slip_magnitude(mesh, dd) > 0.0)
+        onset.observe(mesh.centers, slipping, step_record["time"], step_record["step"])
+    return record
+
+
+def run_state_from_simulation(simulation, onset=None, height=1.0):
+    """The :class:`RunState` of a :class:`hmatddm.Simulation` after (part of) its run;
+    ``onset`` as filled by :func:`onset_recorder` (None: every event at the last step)."""
+    mesh, dd, _, state = simulation.view()
+    return RunState(mesh=mesh, dd=np.asarray(dd, dtype=float).reshape(mesh.n_elements, mesh.dim),
+                    state=np.asarray(state, dtype=np.int64), time=float(simulation.state.time),
+                    step=int(simulation.state.step), onset=SlipOnset() if onset is None else onset,
                     height=float(height))
 
 

@@ -40,19 +40,32 @@ def azimuth_difference(a, b):
     return np.minimum(difference, 180.0 - difference)
 
 
-def fit_traces(positions, eps=3.0, min_samples=3):
-    """Cluster located events (E, 2 or 3) in plan view with DBSCAN (``eps`` m,
-    ``min_samples``) and fit one trace per cluster by PCA; noise points are left out."""
+def neighbour_distance(plan, min_samples):
+    """Data-driven DBSCAN radius: twice the median distance of an event to its
+    ``min_samples - 1``-th nearest neighbour (the knee heuristic of Ester et al. 1996, in
+    its simplest form), so that the radius follows the scatter the noise adds."""
+    from scipy.spatial import cKDTree
+
+    distance, _ = cKDTree(plan).query(plan, k=int(min_samples))
+    return 2.0 * float(np.median(distance[:, -1]))
+
+
+def fit_traces(positions, eps=None, min_samples=3):
+    """Cluster located events (E, 2 or 3) in plan view with DBSCAN (radius ``eps`` m,
+    default :func:`neighbour_distance`; ``min_samples``) and fit one trace per cluster by
+    PCA; noise points are left out."""
     from sklearn.cluster import DBSCAN
     from sklearn.decomposition import PCA
 
-    if not np.isfinite(eps) or eps <= 0.0:
-        raise InputError(f"eps must be > 0 m, got {eps!r}")
     if isinstance(min_samples, bool) or int(min_samples) < 2:
         raise InputError(f"min_samples must be an integer >= 2, got {min_samples!r}")
     plan = np.atleast_2d(np.asarray(positions, dtype=float))[:, :2]
     if len(plan) < min_samples:
         return []
+    if eps is None:
+        eps = max(neighbour_distance(plan, min_samples), 1e-12)
+    if not np.isfinite(eps) or eps <= 0.0:
+        raise InputError(f"eps must be > 0 m, got {eps!r}")
     labels = DBSCAN(eps=eps, min_samples=int(min_samples)).fit_predict(plan)
     traces = []
     for label in np.unique(labels[labels >= 0]):
