@@ -142,6 +142,23 @@ The format, annotated (``=`` values are the defaults unless marked REQUIRED)::
     [[natural_fracture]]           # explicit natural fractures: plan-view segments
     p0 = [5.0, -10.0]              # m
     p1 = [5.0, 10.0]               # m
+
+    [microseismic]                 # synthetic monitoring (ref. Ch. 7): DIR/events.csv and
+                                   # DIR/microseismic_map.png (hmatddm.microseismic)
+    wells = [[50.0, 50.0]]         # REQUIRED, plan positions [x, y] of vertical observation wells, m
+    receiver_top = 20.0            # m, receivers from receiver_bottom to receiver_top
+    receiver_bottom = -20.0        # m
+    receiver_spacing = 5.0         # m, > 0
+    p_wave_speed = 4000.0          # m/s (ref. Table 7.1; the dynamic moduli follow)
+    s_wave_speed = 2350.0          # m/s, < sqrt(3)/2 p_wave_speed
+    density = 3000.0               # kg/m^3
+    shear_ratio = 2.0              # events: |slip| >= shear_ratio |opening| (ref. Eq. 7.29)
+    rotation_noise_deg = 0.0       # standard deviations of the noise (ref. Table 7.2): horizontal
+    travel_time_noise = 0.0        #   rotation of the direction cosines (deg), S-P time (s) and
+    amplitude_noise = 0.0          #   amplitude, a share of the largest one (ref. Table 7.5)
+    seed = 0                       # of the noise
+    merge = false                  # one event per element (the reference), or merge neighbours
+                                   # that fail in the same step
 '''
 import difflib
 import tomllib
