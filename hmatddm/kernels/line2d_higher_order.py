@@ -308,7 +308,12 @@ def traction_matrix(data, out):
 @njit(cache=True)
 def edge_distance(data, i, j):
     """Distance from the collocation nodes of element ``i`` to the nearer end of element ``j``."""
-    centers, frames, half_length, nodes = data[0], data[1], data[2], data[7]
+    return nodes_edge_distance(data[0], data[1], data[2], data[7], i, j)
+
+
+@njit(cache=True)
+def nodes_edge_distance(centers, frames, half_length, nodes, i, j):
+    """:func:`edge_distance` on the arrays themselves (any data layout)."""
     point = np.empty(2)
     best = np.inf
     for r in range(nodes.shape[0]):
