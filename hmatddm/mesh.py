@@ -19,7 +19,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ._validation import finite_array, positive_int, positive_scalar
+from ._validation import finite_array, finite_scalar, positive_int, positive_scalar
 from .errors import InputError, MeshQualityWarning
 
 _ORTHONORMAL_TOL = 1e-6
@@ -211,8 +211,8 @@ class Mesh3D:
             raise InputError("centers must hold at least one rectangle, got 0")
         e1 = np.broadcast_to(finite_array("e1", e1), (n, 3)) if np.ndim(e1) == 1 else finite_array("e1", e1, (n, 3))
         e2 = np.broadcast_to(finite_array("e2", e2), (n, 3)) if np.ndim(e2) == 1 else finite_array("e2", e2, (n, 3))
-        half_a = np.broadcast_to(finite_array("half_a", half_a), (n,)).astype(float)
-        half_b = np.broadcast_to(finite_array("half_b", half_b), (n,)).astype(float)
+        half_a, half_b = (np.full(n, float(finite_scalar(name, h))) if np.ndim(h) == 0 else finite_array(name, h, (n,))
+                          for name, h in (("half_a", half_a), ("half_b", half_b)))
         for name, h in (("half_a", half_a), ("half_b", half_b)):
             bad = np.flatnonzero(h <= 0.0)
             if bad.size:
@@ -520,6 +520,29 @@ def _overlap(mesh, i, j):
                    + mesh.half_b[j] * np.abs(np.einsum("kd,kd->k", mesh.frames[j, 1], u)))
         overlap &= np.abs(np.einsum("kd,kd->k", d, u)) < (half[i] + reach_j) * margin
     return overlap
+
+
+def check_mesh(mesh, name="mesh"):
+    """InputError unless ``mesh`` holds at least one element with finite geometry and
+    positive half sizes: arrays of a built mesh can be changed in place (NaN put into
+    ``centers``), which would otherwise reach numpy or scipy errors far from the cause.
+    The message names the array and the first bad element."""
+    if mesh.n_elements == 0:
+        raise InputError(f"{name} has no elements; build it with hd.mesh.rectangle, penny, line or "
+                         "Mesh3D.from_rectangles / Mesh2D.from_segments")
+    sizes = ("half_length",) if mesh.dim == 2 else ("half_a", "half_b")
+    for field in ("centers", "frames", *sizes):
+        values = np.asarray(getattr(mesh, field))
+        finite = np.isfinite(values.reshape(len(values), -1)).all(axis=1)
+        if not finite.all():
+            index = int(np.flatnonzero(~finite)[0])
+            raise InputError(f"{name}.{field}[{index}] must be finite, got {values[index].tolist()}")
+    for field in sizes:
+        values = getattr(mesh, field)
+        if np.any(values <= 0.0):
+            index = int(np.flatnonzero(values <= 0.0)[0])
+            raise InputError(f"{name}.{field}[{index}] must be > 0 m, got {values[index]}")
+    return mesh
 
 
 def check_parallel_spacing(mesh, stacklevel=2):

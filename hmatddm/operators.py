@@ -23,7 +23,7 @@ from .errors import InputError
 from .kernels import element_data, kernel_module
 from .layered.medium import LayeredMedium
 from .material import Elastic
-from .mesh import Mesh2D, Mesh3D, check_parallel_spacing
+from .mesh import Mesh2D, Mesh3D, check_mesh, check_parallel_spacing
 
 from .options import BACKENDS, DEFAULT_EPS, DEFAULT_ETA, DEFAULT_LEAF_SIZE, SINGULAR_CORRECTIONS  # noqa: F401
 _AVERAGE_SHIFT = 1e-3  # fraction of the element half size used by the NaN averaging
@@ -110,6 +110,7 @@ class ElasticityOperator(LinearOperator):
             if alpha < 1.0:
                 raise InputError(f"alpha must be >= 1 (or None for no scaling), got {alpha}")
 
+        check_mesh(mesh)
         _refuse_coincident(mesh)
         check_parallel_spacing(mesh, stacklevel=2)
         self.mesh = mesh

@@ -25,7 +25,7 @@ from .kernels.rectangle3d import on_edge as _on_edge
 from .kernels.rectangle3d import g_derivatives as _g_derivatives
 from .layered.medium import LayeredMedium
 from .material import Elastic
-from .mesh import Mesh2D, Mesh3D
+from .mesh import Mesh2D, Mesh3D, check_mesh
 
 
 def _as_element_major(name, values, n_elements, dof):
@@ -127,6 +127,7 @@ def slip(mesh, dd):
 
 
 def _check_points(mesh, points):
+    check_mesh(mesh)
     return np.ascontiguousarray(finite_array("points", points, (None, mesh.dim)))
 
 

@@ -100,3 +100,59 @@ def test_checkpoints_and_scenes_are_read_without_executing_code(tmp_path):
         pass  # refused: object arrays need pickle
     else:
         raise AssertionError("a pickled checkpoint array was loaded")
+
+
+def test_api_meshes_are_checked_where_they_are_used():
+    """Empty meshes, mismatched array lengths and NaN put into a built mesh are named,
+    not left to numpy or scipy (issue 19 item 9)."""
+    import pytest
+
+    mat = hd.Elastic(10e9, 0.25)
+    empty = hd.Mesh3D(np.zeros((0, 3)), np.zeros((0, 3, 3)), np.zeros(0), np.zeros(0), np.zeros(0, np.int64))
+    with pytest.raises(InputError, match="mesh has no elements"):
+        hd.ElasticityOperator(empty, mat)
+    centers = np.array([[0.0, 0, 0], [3.0, 0, 0], [6.0, 0, 0]])
+    with pytest.raises(InputError, match=r"half_a must have shape \(3\), got \(2,\)"):
+        hd.Mesh3D.from_rectangles(centers, [1.0, 0, 0], [0, 1.0, 0], np.ones(2), 1.0)
+    with pytest.raises(InputError, match=r"half_b must be a finite number, got nan"):
+        hd.Mesh3D.from_rectangles(centers, [1.0, 0, 0], [0, 1.0, 0], 1.0, math.nan)
+    mesh = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 3, 3, 3, 3)
+    mesh.centers[4, 1] = np.nan
+    for backend in ("dense", "hmatrix"):
+        with pytest.raises(InputError, match=r"mesh.centers\[4\] must be finite, got \[0.0, nan, 0.0\]"):
+            hd.ElasticityOperator(mesh, mat, backend=backend)
+    with pytest.raises(InputError, match=r"mesh.centers\[4\] must be finite"):
+        hd.stress_at(mesh, mat, np.zeros((9, 3)), np.ones((1, 3)))
+    line = hd.mesh.line([0.0, 0.0], [3.0, 0.0], 3)
+    line.half_length[0] = -1.0
+    with pytest.raises(InputError, match=r"mesh.half_length\[0\] must be > 0 m, got -1.0"):
+        hd.Simulation(line, mat, hd.Fluid(1e-3), [hd.Cluster((1.5, 0.0), rate=1e-3)], -np.eye(2) * 1e6, 1.0)
+
+
+def test_zero_injection_warns():
+    import pytest
+
+    from hmatddm.errors import NoInjectionWarning
+
+    mesh = hd.mesh.line([0.0, 0.0], [3.0, 0.0], 3)
+    with pytest.warns(NoInjectionWarning, match="every cluster injects at rate 0"):
+        hd.Simulation(mesh, hd.Elastic(10e9, 0.25), hd.Fluid(1e-3), [hd.Cluster((1.5, 0.0), rate=0.0)],
+                      -np.eye(2) * 1e6, 1.0)
+
+
+def test_sweep_refuses_bad_values_before_starting_dask(capsys, monkeypatch):
+    import dask.distributed
+
+    from hmatddm import cli
+
+    def no_cluster(*args, **kwargs):
+        raise AssertionError("a Dask cluster was started for a refused grid")
+
+    monkeypatch.setattr(dask.distributed, "LocalCluster", no_cluster)
+    monkeypatch.setattr(dask.distributed, "Client", no_cluster)
+    for argv, message in ((["--density", "-1"], "density must be > 0, got -1.0"),
+                          (["--length-exponent", "0.5"], "length_exponent"),
+                          (["--realizations", "0"], "realizations must be an integer >= 1, got 0")):
+        assert cli.main(["sweep", *argv]) == cli.EXIT_BAD_INPUT
+        err = capsys.readouterr().err
+        assert message in err and len(err.strip().splitlines()) == 1 and "Traceback" not in err

@@ -30,7 +30,7 @@ from ..flow import Cluster, Fluid, LeakOff, LubricationModel, fracture_complianc
 from ..fracture import Propagation, evaluate_tips, new_elements
 from ..fracture.crossing import NaturalFractureProperties
 from ..material import Elastic
-from ..mesh import Mesh2D, Mesh3D, concatenate
+from ..mesh import Mesh2D, Mesh3D, check_mesh, concatenate
 from ..extended_operator import ExtendedElasticityOperator
 from ..operators import BACKENDS, DEFAULT_EPS, DEFAULT_ETA, DEFAULT_LEAF_SIZE, ElasticityOperator
 from . import checkpoint
@@ -176,6 +176,7 @@ class Simulation:
                  natural_fractures=None, natural=None, remote_failure=True, contact="natural", max_elements=None):
         if not isinstance(mesh, (Mesh2D, Mesh3D)):
             raise InputError(f"mesh must be a Mesh2D or Mesh3D, got {type(mesh).__name__}")
+        check_mesh(mesh)
         if not isinstance(material, Elastic):
             raise InputError(f"material must be an hmatddm.Elastic, got {type(material).__name__}")
         if not isinstance(fluid, Fluid):
@@ -223,6 +224,7 @@ class Simulation:
             if type(natural_fractures) is not type(mesh):
                 raise InputError(f"natural_fractures must be a {type(mesh).__name__} like mesh, "
                                  f"got {type(natural_fractures).__name__}")
+            check_mesh(natural_fractures, "natural_fractures")
             natural = NaturalFractureProperties() if natural is None else natural
             if not isinstance(natural, NaturalFractureProperties):
                 raise InputError("natural must be an hmatddm.NaturalFractureProperties or None")
