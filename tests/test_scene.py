@@ -320,3 +320,18 @@ def test_relaxation_growth_reaches_the_scheme_settings():
     default = scheme_settings(validate(raw()))
     assert default.relaxation_growth == (2.0 if default.scheme in ("krylov", "fully-coupled") else 1.0)
     assert scheme_settings(validate(set_key(raw(), "numerics.relaxation_growth", 1.5))).relaxation_growth == 1.5
+
+
+def test_scenes_with_natural_fractures_close_every_element_by_default():
+    """issue 19 item 5: numerics.contact defaults to "all" with natural fractures (a hydraulic
+    element squeezed in a network otherwise opens negatively), "natural" without; a scene
+    that says otherwise keeps its choice, and the echo validates to itself."""
+    from scene_texts import KGD_2D_HEAD
+
+    plain = KGD_2D_HEAD + "end_time = 1.0\n"
+    natural = plain + "[[natural_fracture]]\np0 = [2.0, -1.0]\np1 = [2.0, 1.0]\n"
+    assert hs.parse_scene(plain).numerics["contact"] == "natural"
+    echo = hs.parse_scene(natural).data
+    assert echo["numerics"]["contact"] == "all" and validate(copy.deepcopy(echo)) == echo
+    assert hs.parse_scene(natural, overrides=['numerics.contact="natural"']).numerics["contact"] == "natural"
+    assert hs.load_scene("crossing").numerics["contact"] == "all"

@@ -103,6 +103,12 @@ The format, annotated (``=`` values are the defaults unless marked REQUIRED)::
     singular_correction = "none"   # "none" or "average"
     # alpha = 10.0                 # >= 1, influence scaling of ref. Eq. 6.11 (default off)
     keep_checkpoints = 3           # newest checkpoints kept, >= 1
+    # contact = "natural"          # elements that close (open / stick / Coulomb slip): "natural",
+                                   # "all" or "none"; default "all" when the scene has natural
+                                   # fractures (hydraulic elements close too), else "natural"
+    max_elements = 200000          # more elements (at the start, or by growth) stop the run with
+                                   # exit code 2 and a resumable checkpoint; `--check` prints
+                                   # the estimate (elements, memory, time)
 
     [output]
     every = 1                      # write a .vtu every k steps (the last one always), >= 1

@@ -286,7 +286,8 @@ NUMERICS = {
     "singular_correction": Key("choice", "none", choices=SINGULAR_CORRECTIONS),
     "alpha": Key("number", low=1.0),
     "contact": Key("choice", "natural", choices=CONTACT_MODES,
-                   doc="elements that close with contact and Coulomb friction: natural, all, none"),
+                   doc="elements that close with contact and Coulomb friction: natural, all, none "
+                       "(default: all in a scene with natural fractures, natural otherwise)"),
     "keep_checkpoints": Key("integer", 3, low=1),
     "max_elements": Key("integer", 200_000, low=1,
                         doc="refuse a scene (or stop a run, resumably) with more elements than this"),
@@ -661,6 +662,10 @@ def validate(raw, name=None):
                              f"got {show(fracture['p0'])}")
     if "reference" in scene:
         _check_reference(scene)
+    if has_natural_fractures(scene) and "contact" not in raw["numerics"]:
+        # a hydraulic element squeezed between natural fractures can open negatively and stall
+        # the Picard iteration with contact = "natural": in a network every element closes
+        numerics["contact"] = "all"
     return scene
 
 
