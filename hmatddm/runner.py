@@ -12,7 +12,7 @@ The folder (``--out DIR``) holds::
     vtu/step-NNNNNN.vtu cell data: opening (m), slip (vector, m), pressure (Pa),
                         net_pressure (Pa, pressure minus the compressive normal far-field
                         stress), fracture_id, state (0 hydraulic, 1 intact natural,
-                        2 failed natural), dd (vector, m)
+                        2 activated or failed natural), dd (vector, m)
     checkpoints/        the simulation's atomic checkpoints (one per step, newest kept)
     snapshots/step-NNNNNN_plan.png, _oblique.png   views of the last state (plan
                         only in 2D; the plan view of vertical 3D fractures shows their
@@ -148,11 +148,20 @@ def snapshot_views(mesh):
     return ("plan", "oblique")
 
 
+def snapshot_title(name, time_value, mesh, state=None):
+    """The title of a snapshot: the run's element count (``n_elements`` of its record:
+    hydraulic and activated or failed natural elements, the unknowns), and apart from it
+    the intact natural elements drawn as stress targets."""
+    intact = 0 if state is None else int(np.count_nonzero(np.asarray(state) == 1))
+    text = f"{name}: t = {time_value:g} s, {mesh.n_elements - intact} elements"
+    return text + (f" (+ {intact} intact natural)" if intact else "")
+
+
 def write_snapshots(out, mesh, fields, step, time_value, title_prefix):
     """``snapshots/step-NNNNNN_{plan,oblique}.png`` of one state; returns the paths."""
     from .render import snapshot
 
-    title = f"{title_prefix}: t = {time_value:g} s, {mesh.n_elements} elements"
+    title = snapshot_title(title_prefix, time_value, mesh, fields.get("state"))
     slip_vectors = _visible_slip(mesh, fields["slip"], fields["opening"])
     return [snapshot(mesh, Path(out) / SNAPSHOT_DIR / f"step-{step:06d}_{view}.png", opening=fields["opening"],
                      state=fields.get("state"), slip=slip_vectors, view=view, title=title)

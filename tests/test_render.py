@@ -228,3 +228,66 @@ def test_plot_history_bad_inputs_raise_input_error(tmp_path, records, reference,
     with pytest.raises(hd.InputError, match=message):
         plot_history(records, tmp_path / "history.png", reference=reference)
     assert not list(tmp_path.iterdir())
+
+
+# -- pictures that tell the truth (issue 19 item 7) -------------------------------------
+
+def test_plan_frame_puts_the_fractures_left_of_the_colour_bar_and_above_the_legend():
+    from hmatddm.render.snapshots import PLAN_BOX, plan_frame
+
+    for extent, window in (((-50.0, 50.0, -1.0, 1.0), (1200, 900)), ((0.0, 1.0, -30.0, 10.0), (400, 300))):
+        centre_x, centre_y, scale, box = plan_frame(extent, window)
+        aspect = window[0] / window[1]
+        fx = [0.5 + (x - centre_x) / (2 * scale * aspect) for x in extent[:2]]
+        fy = [0.5 + (y - centre_y) / (2 * scale) for y in extent[2:]]
+        assert box == PLAN_BOX
+        assert PLAN_BOX[0] - 1e-9 <= fx[0] < fx[1] <= PLAN_BOX[1] + 1e-9
+        assert PLAN_BOX[2] - 1e-9 <= fy[0] < fy[1] <= PLAN_BOX[3] + 1e-9
+        assert max(fx[1] - fx[0] - (PLAN_BOX[1] - PLAN_BOX[0]), fy[1] - fy[0] - (PLAN_BOX[3] - PLAN_BOX[2])) > -1e-9
+
+
+def test_a_long_2d_crack_ends_left_of_the_colour_bar(tmp_path):
+    """The kgd picture: the right tip was hidden under the colour bar."""
+    from hmatddm.render.snapshots import BAR_LEFT
+
+    mesh = hd.mesh.line([-60.0, 0.0], [60.0, 0.0], 120)
+    opening = 1e-3 * np.sqrt(np.clip(1 - (mesh.centers[:, 0] / 60.0) ** 2, 1e-4, None))
+    path = snapshot(mesh, tmp_path / "kgd.png", opening=opening, title="kgd", window_size=WINDOW)
+    coloured = _coloured_pixels(_image(path))
+    _, columns = np.nonzero(coloured[:, :int(BAR_LEFT * WINDOW[0]) - 1])
+    assert columns.max() < 0.84 * WINDOW[0] and columns.max() > 0.75 * WINDOW[0]
+    assert columns.min() < 0.1 * WINDOW[0]
+    gap = coloured[:, int(0.835 * WINDOW[0]):int(BAR_LEFT * WINDOW[0]) - 1]
+    assert not gap.any(), "something coloured between the crack and the colour bar"
+
+
+def test_negative_openings_are_drawn_as_zero_and_said_so(tmp_path, scene2d):
+    from hmatddm.render.snapshots import opening_colour_range
+
+    clim, title = opening_colour_range(np.array([-1.4e-2, 0.0, 0.5]))
+    assert clim == [0.0, 0.5] and "< 0 drawn as 0" in title and "-0.014" in title
+    clim, title = opening_colour_range(np.array([0.1, 0.5]))
+    assert clim == [0.0, 0.5] and title == "opening (mm)"
+    mesh, fields = scene2d
+    closed = dict(fields, opening=fields["opening"] - 2e-5)  # some elements pressed shut
+    _assert_picture(snapshot(mesh, tmp_path / "closed.png", window_size=WINDOW, **closed), WINDOW)
+
+
+def test_legend_names_activated_natural_elements_and_the_slip_arrows():
+    from hmatddm.render.snapshots import legend_labels
+
+    state = np.array([HYDRAULIC, INTACT_NATURAL, FAILED_NATURAL])
+    assert [text for text, _ in legend_labels(state, slip_shown=True)] == [
+        "natural fracture, intact", "natural fracture, activated or failed", "slip (arrow length ~ slip)"]
+    assert legend_labels(np.zeros(3, int)) == []
+
+
+def test_plan_views_carry_a_round_length_scale(tmp_path, scene3d):
+    from hmatddm.render.snapshots import scale_bar_length
+
+    assert [scale_bar_length(span) for span in (120.0, 3.0, 0.75, 40.0)] == [20.0, 0.5, 0.1, 5.0]
+    mesh, fields = scene3d
+    path = snapshot(mesh, tmp_path / "plan.png", view="plan", window_size=WINDOW, **fields)
+    image = _image(path)
+    black = (image.max(axis=2) < 0.15)[int(0.88 * WINDOW[1]):, :int(0.3 * WINDOW[0])]  # lower left corner
+    assert black.sum() > 10, "no length scale in the lower left corner"

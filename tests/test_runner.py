@@ -194,3 +194,17 @@ def test_progress_lines():
     progress.update(record)
     progress.note("a message")
     assert terminal.getvalue().startswith("\rstep    1") and terminal.getvalue().endswith("\na message\n")
+
+
+def test_snapshot_titles_count_the_elements_of_the_record(tmp_path):
+    """The title gives the run's element count (its record's n_elements) and the intact
+    natural elements apart (issue 19 item 7: crossing said 21 for 15)."""
+    text = TINY_2D.replace("end_time = 6.0", "end_time = 2.0") + (
+        "[[natural_fracture]]\np0 = [2.0, -1.0]\np1 = [2.0, 1.0]\n")
+    run = runner.SceneRun(hs.parse_scene(text), tmp_path, quiet=True)
+    run.execute()
+    mesh, _, _, state = run.simulation.view()
+    title = runner.snapshot_title("tiny", 2.0, mesh, state)
+    intact = int(np.count_nonzero(state == 1))
+    assert intact > 0 and mesh.n_elements > run.last_record["n_elements"]
+    assert title == f"tiny: t = 2 s, {run.last_record['n_elements']} elements (+ {intact} intact natural)"

@@ -10,6 +10,11 @@
   every element border on small meshes);
 * with ``slip`` vectors: arrows at the elements that slip (magnitude above
   ``1e-3`` of the largest), their length proportional to the slip;
+* a legend at the bottom names the natural-fracture states and the slip arrows; the
+  opening colour bar runs from 0 (negative openings of closed elements are drawn as 0,
+  and the bar's title says so with the smallest value, :func:`opening_colour_range`);
+* a plan view frames the fractures left of the colour bar, under the title and above
+  the legend (:func:`plan_frame`), with a round length scale in the lower left corner;
 * ``view="plan"`` looks down ``-z`` (map view, parallel projection),
   ``view="oblique"`` is an isometric perspective. A :class:`~hmatddm.mesh.Mesh2D` is
   always drawn as lines in the ``xy``-plane seen from ``+z``.
@@ -48,6 +53,15 @@ MAX_SLIP_ARROWS = 400  # more slipping elements than this: every k-th gets an ar
 VERTICAL_NORMAL_Z = 0.05  # an element is vertical when |n_z| <= this (within ~2.9 degrees)
 MOSTLY_VERTICAL_AREA = 0.5  # plan view as traces when vertical elements hold this share of the area
 PLAN_STYLES = ("auto", "traces", "surfaces")
+# layout of a picture, in fractions of its width and height: the colour bar stands at
+# x in [BAR_LEFT, BAR_LEFT + 0.08]; a plan view puts the fractures inside PLAN_BOX
+# (left, right, bottom, top), left of the bar, above the legend and the length scale
+# (SCALE_Y) and below the title
+BAR_LEFT = 0.86
+PLAN_BOX = (0.04, 0.82, 0.16, 0.90)
+PLAN_BOX_WITHOUT_BAR_RIGHT = 0.96
+PLAN_BOX_WITHOUT_TITLE_TOP = 0.96
+SCALE_Y = 0.07
 # a column of elements shows its highest-ranked state: failed > hydraulic > intact
 _RANK_OF_STATE = np.array([1, 0, 2])                     # indexed by state code 0, 1, 2
 _STATE_OF_RANK = np.array([INTACT_NATURAL, HYDRAULIC, FAILED_NATURAL])
@@ -180,12 +194,19 @@ def _diagonal(mesh):
 # Layers
 # ---------------------------------------------------------------------------------
 
-def _opening_range_mm(opening_mm):
-    low = min(0.0, float(np.min(opening_mm)))
-    high = float(np.max(opening_mm))
-    if high - low <= 1e-12 * max(1.0, abs(high)):
-        high = low + max(1e-9, abs(low) * 1e-3)
-    return [low, high]
+def opening_colour_range(opening_mm):
+    """``(clim, bar_title)`` of the opening colour bar: from 0 to the largest opening
+    (mm). Negative openings (closed elements pressed a little into each other, or the
+    round-off of contact) are drawn in the colour of 0 and the bar title says so,
+    with the smallest value, instead of stretching the scale below zero."""
+    low = float(np.min(opening_mm))
+    high = max(float(np.max(opening_mm)), 0.0)
+    if high <= 1e-12:
+        high = 1e-9
+    title = "opening (mm)"
+    if low < 0.0:
+        title = f"opening (mm)\n< 0 drawn as 0\n(min {low:.2g})"
+    return [0.0, high], title
 
 
 def _line_width(coloured=True):
@@ -195,7 +216,7 @@ def _line_width(coloured=True):
 
 def _add_coloured(plotter, mesh, indices, opening, lift=0.0, clim=None):
     """Hydraulic and failed elements: coloured by opening (mm; colour range ``clim``,
-    default that of these elements) or a plain colour."""
+    default that of these elements, :func:`opening_colour_range`) or a plain colour."""
     if indices.size == 0:
         return
     part = _part(mesh, indices, lift)
@@ -207,10 +228,12 @@ def _add_coloured(plotter, mesh, indices, opening, lift=0.0, clim=None):
         return
     opening_mm = 1e3 * opening
     part.cell_data["opening (mm)"] = opening_mm[indices]
-    clim = _opening_range_mm(opening_mm[indices]) if clim is None else clim
-    plotter.add_mesh(part, scalars="opening (mm)", cmap=OPENING_COLORMAP, clim=clim,
-                     scalar_bar_args=dict(title="opening (mm)", vertical=True, fmt="%.3g",
-                                          position_x=0.86, position_y=0.15, height=0.7, width=0.08),
+    if clim is None:
+        clim = opening_colour_range(opening_mm[indices])
+    limits, title = clim
+    plotter.add_mesh(part, scalars="opening (mm)", cmap=OPENING_COLORMAP, clim=limits,
+                     scalar_bar_args=dict(title=title, vertical=True, fmt="%.3g", position_x=BAR_LEFT,
+                                          position_y=0.15, height=0.7, width=0.08),
                      **style)
 
 
@@ -288,25 +311,107 @@ def _add_slip_arrows(plotter, mesh, slip, lift=0.0):
     plotter.add_mesh(arrows, color=SLIP_ARROW_COLOR)
 
 
-def _add_legend(plotter, state):
+def legend_labels(state, slip_shown=False):
+    """``[[text, colour], ...]`` of the legend: the natural-fracture states present and
+    the slip arrows when drawn."""
     labels = []
-    if np.any(state == INTACT_NATURAL):
+    if state is not None and np.any(state == INTACT_NATURAL):
         labels.append(["natural fracture, intact", INTACT_COLOR])
-    if np.any(state == FAILED_NATURAL):
-        labels.append(["natural fracture, failed", FAILED_COLOR])
+    if state is not None and np.any(state == FAILED_NATURAL):
+        labels.append(["natural fracture, activated or failed", FAILED_COLOR])
+    if slip_shown:
+        labels.append(["slip (arrow length ~ slip)", SLIP_ARROW_COLOR])
+    return labels
+
+
+def _add_legend(plotter, state, slip_shown=False):
+    """The legend at the bottom, between the length scale and the colour bar, below the
+    fractures in a plan view (:func:`plan_frame`)."""
+    labels = legend_labels(state, slip_shown)
     if labels:
-        plotter.add_legend(labels=labels, bcolor="white", face="rectangle", loc="lower center", size=(0.3, 0.08))
+        plotter.add_legend(labels=labels, bcolor="white", face="rectangle", loc="lower center",
+                           size=(0.42, 0.035 * len(labels) + 0.02))
+
+
+def _slip_shown(slip):
+    return slip is not None and bool(np.any(slip))
 
 
 def _set_view(plotter, mesh, view):
-    """Plan: look down ``-z`` with a parallel projection. Oblique: isometric. Both
-    frame every actor. A 2D mesh is always seen from ``+z``."""
-    if view == "plan" or isinstance(mesh, Mesh2D):
-        plotter.view_xy()
-        plotter.enable_parallel_projection()
-    else:
-        plotter.view_isometric()
+    """Oblique: isometric, framing every actor (plan views: :func:`_frame_plan`)."""
+    plotter.view_isometric()
     plotter.reset_camera()
+
+
+def _plan_extent(mesh):
+    """``(x_min, x_max, y_min, y_max)`` of the elements seen from above (their corners, or
+    segment ends)."""
+    if isinstance(mesh, Mesh2D):
+        points = np.concatenate(mesh.endpoints)
+    else:
+        points = mesh.corners().reshape(-1, 3)[:, :2]
+    low, high = points.min(axis=0), points.max(axis=0)
+    pad = 0.02 * max(float(np.max(high - low)), float(np.max(mesh.radii)))  # room for tubes and arrows
+    return low[0] - pad, high[0] + pad, low[1] - pad, high[1] + pad
+
+
+def plan_frame(extent, window_size, colour_bar=True, title=True):
+    """The camera of a plan view: ``(centre_x, centre_y, parallel_scale, box)`` so that
+    ``extent`` (x_min, x_max, y_min, y_max, m) fills ``box`` (fractions of the window,
+    :data:`PLAN_BOX`; wider without a colour bar, taller without a title) at the same
+    scale in x and y -- never under the colour bar, the legend or the title."""
+    left, right, bottom, top = PLAN_BOX
+    right = right if colour_bar else PLAN_BOX_WITHOUT_BAR_RIGHT
+    top = top if title else PLAN_BOX_WITHOUT_TITLE_TOP
+    width, height = window_size
+    aspect = width / height
+    x_min, x_max, y_min, y_max = extent
+    span_x = max(x_max - x_min, 1e-12 * max(1.0, abs(x_max)))
+    span_y = max(y_max - y_min, 1e-12 * max(1.0, abs(y_max)))
+    scale = max(span_x / (2.0 * aspect * (right - left)), span_y / (2.0 * (top - bottom)))
+    centre_x = 0.5 * (x_min + x_max) - (0.5 * (left + right) - 0.5) * 2.0 * scale * aspect
+    centre_y = 0.5 * (y_min + y_max) - (0.5 * (bottom + top) - 0.5) * 2.0 * scale
+    return centre_x, centre_y, scale, (left, right, bottom, top)
+
+
+def scale_bar_length(span):
+    """A round length (1, 2 or 5 x 10^k m) of about a fifth of ``span`` (m, > 0)."""
+    target = 0.2 * float(span)
+    power = 10.0 ** np.floor(np.log10(target))
+    return float(max(m * power for m in (1.0, 2.0, 5.0) if m * power <= target))
+
+
+def _length_text(length):
+    return f"{length * 1e3:g} mm" if length < 1e-2 else (f"{length:g} m" if length < 1e3 else f"{length / 1e3:g} km")
+
+
+def _frame_plan(plotter, mesh, window_size, colour_bar, title):
+    """Look down ``-z`` (parallel projection) with the fractures inside :data:`PLAN_BOX`,
+    and draw a length scale under them."""
+    pyvista = _pyvista()
+    extent = _plan_extent(mesh)
+    centre_x, centre_y, scale, box = plan_frame(extent, window_size, colour_bar, title)
+    aspect = window_size[0] / window_size[1]
+    z_top = float(np.max(mesh.corners()[..., 2])) if isinstance(mesh, Mesh3D) else 0.0
+    z_bottom = float(np.min(mesh.corners()[..., 2])) if isinstance(mesh, Mesh3D) else 0.0
+    diagonal = _diagonal(mesh)
+    # the length scale: a black bar from the left edge of the box, at SCALE_Y
+    length = scale_bar_length(extent[1] - extent[0])
+    x0 = centre_x + (box[0] - 0.5) * 2.0 * scale * aspect
+    y0 = centre_y + (SCALE_Y - 0.5) * 2.0 * scale
+    lift = z_top + 0.5 * diagonal
+    plotter.add_mesh(pyvista.Line((x0, y0, lift), (x0 + length, y0, lift)), color="black", line_width=4)
+    right_end = box[0] + length / (2.0 * scale * aspect)
+    plotter.add_text(_length_text(length), position=(int((right_end + 0.01) * window_size[0]),
+                                                     int((SCALE_Y - 0.02) * window_size[1])),
+                     font_size=10, color="black")
+    camera = plotter.camera
+    camera.parallel_projection = True
+    camera.focal_point = (centre_x, centre_y, z_bottom)
+    camera.position = (centre_x, centre_y, z_top + 2.0 * diagonal + 1.0)
+    camera.up = (0.0, 1.0, 0.0)
+    camera.parallel_scale = scale
+    plotter.reset_camera_clipping_range()
 
 
 def _draw(plotter, mesh, opening, state, slip):
@@ -317,7 +422,7 @@ def _draw(plotter, mesh, opening, state, slip):
         _add_coloured(plotter, mesh, every[state != INTACT_NATURAL], opening)
         _add_intact(plotter, mesh, every[state == INTACT_NATURAL])
         _add_failed_outline(plotter, mesh, every[state == FAILED_NATURAL])
-        _add_legend(plotter, state)
+    _add_legend(plotter, state, _slip_shown(slip))
     if slip is not None:
         _add_slip_arrows(plotter, mesh, slip)
 
@@ -410,7 +515,7 @@ def _draw_plan_traces(plotter, mesh, opening, state, slip):
     coloured = every_state != INTACT_NATURAL
     clim = None
     if opening is not None and np.any(coloured):
-        clim = _opening_range_mm(1e3 * opening[coloured])
+        clim = opening_colour_range(1e3 * opening[coloured])
     # surfaces of the non-vertical elements at their own height ...
     if others.size:
         if state is None:
@@ -431,7 +536,7 @@ def _draw_plan_traces(plotter, mesh, opening, state, slip):
         _add_coloured(plotter, traces, lines[line_state != INTACT_NATURAL], line_opening, lift=lift, clim=clim)
         _add_intact(plotter, traces, lines[line_state == INTACT_NATURAL], lift=lift)
         _add_failed_outline(plotter, traces, lines[line_state == FAILED_NATURAL], lift=lift)
-        _add_legend(plotter, state)
+    _add_legend(plotter, state, _slip_shown(line_slip) or (slip is not None and _slip_shown(slip[others])))
     if line_slip is not None and np.any(line_slip):
         _add_slip_arrows(plotter, traces, line_slip, lift=lift)
 
@@ -528,9 +633,12 @@ def snapshot(mesh, path, opening=None, state=None, slip=None, view="oblique", ti
             _draw(plotter, mesh, opening, state, slip)
         if title is not None:
             plotter.add_text(str(title), position="upper_edge", font_size=12)
-        if isinstance(mesh, Mesh3D):
-            plotter.add_axes()
-        _set_view(plotter, mesh, view)
+        if view == "oblique" and isinstance(mesh, Mesh3D):
+            plotter.add_axes()  # a plan view has x to the right and y up, and a length scale instead
+        if view == "plan" or isinstance(mesh, Mesh2D):
+            _frame_plan(plotter, mesh, window_size, colour_bar=opening is not None, title=title is not None)
+        else:
+            _set_view(plotter, mesh, view)
         image = _screenshot(plotter, window_size)
     finally:
         plotter.close()
