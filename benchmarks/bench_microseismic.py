@@ -44,7 +44,7 @@ sys.path.insert(0, HERE)
 from _common import machine, markdown_table  # noqa: E402
 
 from hmatddm import microseismic as ms  # noqa: E402
-from hmatddm.microseismic.inversion import invert_source, orientation_error  # noqa: E402
+from hmatddm.microseismic.inversion import invert_source_draws  # noqa: E402
 
 MEDIUM = ms.Medium(4000.0, 2350.0, 3000.0)  # ref. Table 7.1
 WELLS = {1: [ms.Well(50.0, 50.0)], 2: [ms.Well(50.0, 50.0), ms.Well(50.0, -50.0)]}  # ref. Sec. 7.4.2
@@ -261,23 +261,18 @@ def inversion_study(draws, seed=10):
         clean = ms.observe(events, receivers, MEDIUM, well)
         for constraint in ("general", "double-couple"):
             for name, levels in AMPLITUDE_NOISE.items():
-                angle, ratio, misfit = [], [], []
                 with Clock() as clock:
-                    for draw in range(5 if levels.is_zero else draws):
-                        noisy = ms.add_noise(clean, levels, seed + draw) if not levels.is_zero else clean
-                        solution = invert_source([0, 0, 0], receivers, noisy.amplitude_p[0], noisy.amplitude_s[0],
-                                                 MEDIUM, seed=seed + draw, constraint=constraint)
-                        angle.append(orientation_error(solution.normal, solution.slip_direction, TABLE_NORMAL,
-                                                       TABLE_SLIP))
-                        ratio.append(solution.potency / TABLE_POTENCY)
-                        misfit.append(solution.relative_misfit)
-                angle, ratio = np.array(angle), np.array(ratio)
+                    spread = invert_source_draws(clean, MEDIUM, levels, 5 if levels.is_zero else draws, seed=seed,
+                                                 constraint=constraint)
+                angle = spread.orientation_errors(TABLE_NORMAL, TABLE_SLIP)
+                ratio = spread.potency / TABLE_POTENCY
                 samples[(count, constraint, name)] = (angle, ratio)
                 rows.append(dict(wells=count, constraint=constraint, noise=name, draws=len(angle),
                                  angle_median=float(np.median(angle)), angle_p90=float(np.percentile(angle, 90)),
                                  within_5deg=float(np.mean(angle < 5.0)),
                                  potency_median=float(np.median(ratio)), potency_p5=float(np.percentile(ratio, 5)),
-                                 potency_p95=float(np.percentile(ratio, 95)), misfit_median=float(np.median(misfit)),
+                                 potency_p95=float(np.percentile(ratio, 95)),
+                                 misfit_median=float(np.median(spread.relative_misfit)),
                                  wall=clock.wall / len(angle), cpu=clock.cpu / len(angle)))
                 print(f"  inversion {count} well(s) {constraint:13s} noise {name:4s}: median angle "
                       f"{rows[-1]['angle_median']:.2f} deg, potency {rows[-1]['potency_median']:.3f} "

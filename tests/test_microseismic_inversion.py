@@ -164,3 +164,20 @@ def test_noise_is_seeded_and_of_the_requested_size():
     error_one = location_error(locate(add_noise(one, levels, 1), MEDIUM), events.position)
     error_two = location_error(locate(add_noise(obs, levels, 1), MEDIUM), events.position)
     assert 0.0 < error_two < error_one
+
+
+def test_spread_over_noise_draws_is_seeded_and_noise_free_draws_are_exact():
+    from hmatddm.microseismic.inversion import invert_source_draws
+
+    _, _, obs = _table_source(TWO_WELLS)
+    exact = invert_source_draws(obs, MEDIUM, NoiseLevels(), draws=1, seed=3)
+    assert exact.orientation_errors(NORMAL, SLIP)[0] < 0.1 and exact.potency[0] == pytest.approx(POTENCY, rel=1e-6)
+    noisy = NoiseLevels(amplitude_share=0.05)
+    quick = dict(constraint="double-couple", restarts=1, popsize=10)
+    first = invert_source_draws(obs, MEDIUM, noisy, draws=2, seed=3, **quick)
+    again = invert_source_draws(obs, MEDIUM, noisy, draws=2, seed=3, **quick)
+    np.testing.assert_array_equal(first.potency, again.potency)
+    assert first.potency[0] != first.potency[1]  # two different draws
+    assert np.all(np.abs(first.potency / POTENCY - 1) < 0.1)
+    with pytest.raises(InputError, match="draws"):
+        invert_source_draws(obs, MEDIUM, noisy, draws=0)

@@ -17,9 +17,9 @@ from .catalogue import (Catalogue, MonitoringSettings, catalogue_for_folder, eve
                         onset_recorder, read_events_csv, read_run, run_state_from_simulation,
                         settings_from_section, write_catalogue, write_events_csv)
 from .forward import Observations, Well, observe, radiation_factors, receivers_of, wells_from_positions
-from .inversion import (RMS_FACTOR_P, RMS_FACTOR_S, SourceSolution, brune_moment, dislocation_from_moment_tensor,
-                        dislocation_twins, invert_source, locate, location_error, orientation_error,
-                        unresolved_direction)
+from .inversion import (RMS_FACTOR_P, RMS_FACTOR_S, SourceSolution, SourceSpread, brune_moment,
+                        dislocation_from_moment_tensor, dislocation_twins, invert_source, invert_source_draws, locate,
+                        location_error, orientation_error, unresolved_direction)
 from .noise import (LARGE_AMPLITUDE_NOISE, LARGE_LOCATION_NOISE, NO_NOISE, SMALL_AMPLITUDE_NOISE,
                     SMALL_LOCATION_NOISE, NoiseLevels, add_noise)
 from .planes import fit_traces, strike_errors, true_trace_azimuths
@@ -30,7 +30,8 @@ __all__ = ["Catalogue", "MonitoringSettings", "catalogue_for_folder", "events_fr
            "onset_recorder", "read_events_csv", "read_run", "run_state_from_simulation", "settings_from_section",
            "write_catalogue", "write_events_csv", "Observations", "Well", "observe", "radiation_factors",
            "receivers_of", "wells_from_positions", "RMS_FACTOR_P", "RMS_FACTOR_S", "SourceSolution",
-           "brune_moment", "dislocation_from_moment_tensor", "dislocation_twins", "invert_source", "locate",
+           "SourceSpread", "invert_source_draws", "brune_moment", "dislocation_from_moment_tensor",
+           "dislocation_twins", "invert_source", "locate",
            "location_error", "orientation_error", "unresolved_direction", "LARGE_AMPLITUDE_NOISE",
            "LARGE_LOCATION_NOISE", "NO_NOISE", "SMALL_AMPLITUDE_NOISE", "SMALL_LOCATION_NOISE", "NoiseLevels",
            "add_noise", "fit_traces", "strike_errors", "true_trace_azimuths", "Events", "Medium", "SlipOnset",

@@ -270,6 +270,54 @@ def invert_source(position, receivers, amplitude_p, amplitude_s, medium, seed=0,
                           evaluations=counter[0], constraint=constraint)
 
 
+@dataclass
+class SourceSpread:
+    """Solutions of :func:`invert_source_draws`, one row per noise draw: ``normal`` and
+    ``slip_direction`` (D, 3), ``potency`` (D,) m^3, ``relative_misfit`` (D,)."""
+
+    normal: np.ndarray
+    slip_direction: np.ndarray
+    potency: np.ndarray
+    relative_misfit: np.ndarray
+
+    def orientation_errors(self, true_normal, true_slip_direction):
+        """:func:`orientation_error` of every draw (deg)."""
+        return np.array([orientation_error(n, s, true_normal, true_slip_direction)
+                         for n, s in zip(self.normal, self.slip_direction)])
+
+    def potency_percentiles(self, percentiles=(5, 50, 95)):
+        return np.percentile(self.potency, percentiles)
+
+
+def invert_source_draws(observations, medium, levels, draws, seed=0, constraint="general", event=0, **options):
+    """The source of event ``event`` of ``observations`` inverted for ``draws`` noise
+    draws of ``levels`` (:class:`~hmatddm.microseismic.noise.NoiseLevels`), the draws and
+    the optimiser seeded from ``seed``: the spread of the answers, not one answer."""
+    from .noise import add_noise
+
+    if isinstance(draws, bool) or int(draws) < 1:
+        raise InputError(f"draws must be an integer >= 1, got {draws!r}")
+    single = observations if len(observations.distance) == 1 else _one_event(observations, event)
+    position = single.receivers[0] - single.distance[0, 0] * single.direction[0, 0]
+    rows = []
+    for draw in range(int(draws)):
+        noisy = single if levels.is_zero else add_noise(single, levels, [seed, draw])
+        rows.append(invert_source(position, single.receivers, noisy.amplitude_p[0], noisy.amplitude_s[0], medium,
+                                  seed=[seed, draw], constraint=constraint, **options))
+    return SourceSpread(normal=np.array([r.normal for r in rows]),
+                        slip_direction=np.array([r.slip_direction for r in rows]),
+                        potency=np.array([r.potency for r in rows]),
+                        relative_misfit=np.array([r.relative_misfit for r in rows]))
+
+
+def _one_event(observations, event):
+    from dataclasses import replace
+
+    fields = ("distance", "direction", "travel_time_p", "travel_time_s", "amplitude_p", "amplitude_s", "factor_p",
+              "factor_s")
+    return replace(observations, **{name: getattr(observations, name)[event:event + 1] for name in fields})
+
+
 def _line_angle(a, b):
     """Angle (deg) between the lines along unit vectors a and b (sign-free)."""
     return np.degrees(np.arccos(np.clip(abs(float(np.dot(a, b))), 0.0, 1.0)))
