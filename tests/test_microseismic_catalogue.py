@@ -153,3 +153,35 @@ def test_events_of_a_simulation_object_match_those_of_its_run_folder(run_folder)
     np.testing.assert_allclose(direct.moment_tensor, from_folder.moment_tensor, rtol=1e-6,
                                atol=1e-6 * np.abs(direct.moment_tensor).max())
     np.testing.assert_array_equal(direct.time, from_folder.time)
+
+
+def test_a_3d_run_folder_gives_the_events_of_its_elements(tmp_path):
+    """The .vtu path in 3D (quads rebuilt into rectangles): two saved states, the second
+    with one more slipping element, give the onsets and the moment tensors of the DDs."""
+    import hmatddm as hd
+    from hmatddm.io import write_pvd, write_vtu
+    from hmatddm.microseismic import events_from_run, read_run
+    from hmatddm.microseismic.sources import Medium, moment_tensor
+    from hmatddm.runner import cell_fields
+
+    mesh = hd.mesh.rectangle([0, 0, 0], [1, 1, 0], [0, 0, 1], 4.0, 2.0, 4, 2, fracture_id=3)
+    tangent = mesh.frames[:, 0, :]
+    dd = 1e-3 * tangent + 1e-4 * mesh.normals  # slip with a small opening: passes Eq. 7.29
+    state = np.full(mesh.n_elements, 2)
+    first = np.where(np.arange(mesh.n_elements) < 3, 1.0, 0.0)[:, None]
+    stress = np.zeros((3, 3))
+    write_vtu(tmp_path / "vtu/step-000001.vtu", mesh, cell_fields(mesh, dd * first, np.zeros(mesh.n_elements),
+                                                                    stress, np.where(first[:, 0] > 0, 2, 1)))
+    write_vtu(tmp_path / "vtu/step-000002.vtu", mesh, cell_fields(mesh, dd, np.zeros(mesh.n_elements), stress, state))
+    write_pvd(tmp_path / "fractures.pvd", [(1.0, "vtu/step-000001.vtu"), (2.0, "vtu/step-000002.vtu")])
+    medium = Medium()
+    events = events_from_run(read_run(tmp_path), medium)
+    assert len(events) == mesh.n_elements
+    order = np.lexsort(events.position.T[::-1])
+    expected_order = np.lexsort(mesh.centers.T[::-1])
+    np.testing.assert_allclose(events.position[order], mesh.centers[expected_order], atol=1e-12)
+    np.testing.assert_allclose(events.moment_tensor[order],
+                               moment_tensor(dd, mesh.normals, mesh.areas, medium)[expected_order], rtol=1e-9,
+                               atol=1e-9 * medium.shear_modulus * 1e-3)
+    assert np.all(events.decomposition()[0] > 0)  # the opening part: positive ISO
+    np.testing.assert_array_equal(np.sort(events.time), [1.0] * 3 + [2.0] * (mesh.n_elements - 3))
