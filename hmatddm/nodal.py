@@ -72,9 +72,10 @@ def stress_at(mesh, material, dd, points, singular_correction="none", method="au
     ``method`` may be ``"auto"`` or ``"direct"``; the compressed sum exists for
     constant elements only)."""
     from .kernels import line2d_higher_order
+    from .layered.medium import LayeredMedium
 
-    if not isinstance(material, Elastic):
-        raise InputError(f"material must be an hmatddm.Elastic, got {type(material).__name__}")
+    if not isinstance(material, (Elastic, LayeredMedium)):
+        raise InputError(f"material must be an hmatddm.Elastic or LayeredMedium, got {type(material).__name__}")
     if singular_correction not in ("none", "average"):
         raise InputError(f"singular_correction must be one of ('none', 'average'), got {singular_correction!r}")
     if method not in ("auto", "direct"):
@@ -83,6 +84,10 @@ def stress_at(mesh, material, dd, points, singular_correction="none", method="au
     near_fraction = finite_scalar("near_fraction", near_fraction)
     if not 0.0 <= near_fraction < 1.0:
         raise InputError(f"near_fraction must be in [0, 1), got {near_fraction}")
+    if isinstance(material, LayeredMedium):  # closed form + image terms (ref. Ch. 3)
+        from .layered_higher_order import stress_at as layered_stress_at
+
+        return layered_stress_at(mesh, material, dd, points, singular_correction, near_fraction)
     dd = np.ascontiguousarray(nodal_array("dd", dd, mesh))
     points = np.ascontiguousarray(finite_array("points", points, (None, 2)))
     params = np.array([material.shear_modulus, material.poisson_ratio,
