@@ -37,15 +37,16 @@ _EXPORTS = {
     "NaturalFractureProperties": ".fracture", "Propagation": ".fracture", "Elastic": ".material",
     "Mesh2D": ".mesh", "Mesh3D": ".mesh", "ElasticityOperator": ".operators", "CheckpointError": ".simulation",
     "Simulation": ".simulation", "mean_stress_at": ".solve", "opening": ".solve", "slip": ".solve",
-    "solve": ".solve", "stress_at": ".solve",
+    "solve": ".solve", "stress_at": ".solve", "opening_at": ".nodal", "LayeredMedium": ".layered",
 }
 _SUBMODULES = ("analytical", "kernels", "mesh", "network", "topology", "simulation", "scene", "render", "io",
                "hmatrix", "coupled", "flow", "fracture", "operators", "runner", "errors", "material",
-               "ensemble", "validate", "extended_operator", "cli", "bench_cli")
+               "ensemble", "validate", "extended_operator", "cli", "bench_cli", "nodal", "shape_functions", "layered")
 __getattr__, __dir__ = attach(__name__, _EXPORTS, _SUBMODULES)
 
 __all__ = [
-    "Elastic", "Mesh2D", "Mesh3D", "ElasticityOperator", "solve", "opening", "slip", "stress_at",
+    "Elastic", "Mesh2D", "Mesh3D", "ElasticityOperator", "solve", "opening", "opening_at", "slip", "stress_at",
     "mean_stress_at", "mesh", "analytical", "kernels", "topology", "HmatddmError", "InputError", "ConvergenceError", "OutputError",
     "Fluid", "LeakOff", "Cluster", "Propagation", "NaturalFractureProperties", "network", "SchemeSettings", "Simulation", "CheckpointError",
+    "LayeredMedium", "layered",
 ]
