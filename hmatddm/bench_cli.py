@@ -59,25 +59,32 @@ def run_bench(quick=False, eps=DEFAULT_EPS, stream=None):
     ``relative_error`` is ``||H x - D x|| / ||D x||`` on the smooth field (None for
     the dense rows). ``stream``: where to print one progress line per operator.
     """
+    from .progress import TaskProgress
+
     material = Elastic(shear_modulus=10e9, poisson_ratio=0.25)
+    sides = QUICK_SIDES if quick else FULL_SIDES
+    progress = TaskProgress(1 + 2 * len(sides), stream=stream, enabled=stream is not None)
+    progress.start("compiling the numba kernels (cached after the first run)")
     warm = planar_crack(4)  # compile the numba kernels before timing anything
     for backend in ("dense", "hmatrix"):
         ElasticityOperator(warm, material, backend=backend, eps=eps).matvec(smooth_field(warm))
+    progress.done()
     rows = []
-    for side in QUICK_SIDES if quick else FULL_SIDES:
+    for side in sides:
         mesh = planar_crack(side)
         x = smooth_field(mesh)
-        if stream is not None:
-            print(f"bench: {side * side} elements, dense ...", file=stream, flush=True)
+        progress.start(f"{side * side} elements, dense")
         dense = ElasticityOperator(mesh, material, backend="dense")
         reference = dense.matvec(x)
         rows.append(_row(side, "dense", dense, _matvec_seconds(dense, x), None))
         del dense
-        if stream is not None:
-            print(f"bench: {side * side} elements, hmatrix (eps {eps:g}) ...", file=stream, flush=True)
+        progress.done(f"build {rows[-1]['build_seconds']:.2f} s")
+        progress.start(f"{side * side} elements, hmatrix (eps {eps:g})")
         hmatrix = ElasticityOperator(mesh, material, backend="hmatrix", eps=eps)
         error = float(np.linalg.norm(hmatrix.matvec(x) - reference) / np.linalg.norm(reference))
         rows.append(_row(side, "hmatrix", hmatrix, _matvec_seconds(hmatrix, x), error))
+        progress.done(f"build {rows[-1]['build_seconds']:.2f} s, error {error:.1e}")
+    progress.finish()
     return rows
 
 

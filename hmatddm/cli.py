@@ -37,7 +37,7 @@ def _say(args, text, stream=None):
 def _validate(args):
     from .validate import format_table, run_checks
 
-    rows = run_checks()
+    rows = run_checks(stream=None if args.quiet else sys.stderr)
     if args.json:
         print(json.dumps(rows, indent=2))
     else:
@@ -287,10 +287,11 @@ def build_parser():
 
     validate = sub.add_parser("validate", help="closed-form checks (Griffith, Sneddon) as a table")
     validate.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    validate.add_argument("--quiet", action="store_true", help="no progress lines (on stderr)")
     validate.set_defaults(handler=_validate)
 
     bench = sub.add_parser("bench", help="H-matrix against dense: build time, memory, matvec time, error")
-    bench.add_argument("--quick", action="store_true", help="small sizes only (about 20 s)")
+    bench.add_argument("--quick", action="store_true", help="small sizes only (about 11 s of CPU time)")
     bench.add_argument("--json", action="store_true", help="print JSON instead of a table")
     bench.add_argument("--quiet", action="store_true", help="no progress")
     bench.set_defaults(handler=_bench)

@@ -56,14 +56,25 @@ def checks():
     ]
 
 
-def run_checks():
-    """Run every check; a list of dicts with name, error, tolerance, passed, seconds."""
+def run_checks(stream=None):
+    """Run every check; a list of dicts with name, error, tolerance, passed, seconds.
+
+    ``stream``: where to print a progress line per check (``[k/n] name ... error PASS
+    (seconds)``; the first includes the numba compilation) and a last line with the
+    wall and CPU time of all of them."""
+    from .progress import TaskProgress
+
+    listed = checks()
+    progress = TaskProgress(len(listed), stream=stream, enabled=stream is not None)
     rows = []
-    for name, function, tolerance in checks():
+    for name, function, tolerance in listed:
+        progress.start(name)
         t0 = time.perf_counter()
         error = function()
         rows.append(dict(name=name, error=error, tolerance=tolerance, passed=bool(error <= tolerance),
                          seconds=time.perf_counter() - t0))
+        progress.done(f"error {error:.2e} {'PASS' if error <= tolerance else 'FAIL'}")
+    progress.finish()
     return rows
 
 

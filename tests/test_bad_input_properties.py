@@ -156,3 +156,91 @@ def test_sweep_refuses_bad_values_before_starting_dask(capsys, monkeypatch):
         assert cli.main(["sweep", *argv]) == cli.EXIT_BAD_INPUT
         err = capsys.readouterr().err
         assert message in err and len(err.strip().splitlines()) == 1 and "Traceback" not in err
+
+
+# -- every key of every embedded scene, through the command line (issue 19 item 6) ---------
+
+def _scene_keys():
+    """``(scene, key)`` for every key of every embedded scene as `--set` writes it
+    (``numerics.end_time``, ``cluster[1].rate``, ``dimension``), read from the scenes at run
+    time, so that sections other sessions add are fuzzed too."""
+    import tomllib
+
+    keys = []
+    for name in hs.embedded_names():
+        raw = tomllib.loads(hs.embedded_text(name))
+        for key, value in raw.items():
+            if isinstance(value, dict):
+                keys += [(name, f"{key}.{leaf}") for leaf in value]
+            elif isinstance(value, list) and value and all(isinstance(v, dict) for v in value):
+                keys += [(name, f"{key}[{i}].{leaf}") for i, table in enumerate(value) for leaf in table]
+            else:
+                keys.append((name, key))
+    return keys
+
+
+SCENE_KEYS = _scene_keys()
+# TOML literals: wrong types, non-finite, negative, huge and empty values
+FUZZ_VALUES = ('"text"', "true", "[]", "{}", '""', "nan", "inf", "-inf", "-1", "-1e300", "1e300", "0",
+               "123456789012345678901", '[1.0, "a"]', "[[1.0]]", "-0.5")
+
+
+class _WouldRun(Exception):
+    """Raised instead of running a scene that passed every check."""
+
+
+def _run_mutated(scene, path, value):
+    """``(exit code or None when the scene would run, stderr, files left in the working folder)``."""
+    import contextlib
+    import io
+    import os
+    import tempfile
+    from unittest import mock
+
+    from hmatddm import cli, runner
+
+    with tempfile.TemporaryDirectory() as folder, contextlib.ExitStack() as stack:
+        stack.enter_context(mock.patch.object(runner.SceneRun, "execute", side_effect=_WouldRun))
+        stack.enter_context(mock.patch("hmatddm.operators.ElasticityOperator.__init__",
+                                       side_effect=AssertionError("an operator was built")))
+        err = stack.enter_context(contextlib.redirect_stderr(io.StringIO()))
+        stack.enter_context(contextlib.redirect_stdout(io.StringIO()))
+        cwd = os.getcwd()
+        os.chdir(folder)
+        try:
+            code = cli.main(["run", scene, "--out", "out", "--set", f"{path}={value}"])
+        except _WouldRun:
+            code = None
+        finally:
+            os.chdir(cwd)
+        return code, err.getvalue().strip(), os.listdir(folder)
+
+
+@settings(max_examples=250, deadline=None)
+@given(st.sampled_from(SCENE_KEYS), st.sampled_from(FUZZ_VALUES))
+def test_fuzzed_scene_keys_are_refused_in_one_line_before_the_engine(key, value):
+    """Every mutation of an embedded scene either passes every check (and would run) or
+    is refused with exit code 2 and one line naming a scene key, without a traceback,
+    before any operator or simulation is built, writing nothing."""
+    import re
+
+    scene, path = key
+    code, message, leftovers = _run_mutated(scene, path, value)
+    assert leftovers == [], leftovers  # nothing written (the run itself is not started here)
+    if code is None:  # a valid scene: it reached the run
+        return
+    assert code == 2, (path, value, message)
+    assert "Traceback" not in message and "\n" not in message, (path, value, message)
+    assert message.startswith("hmatddm: error: "), message
+    named = re.findall(r"\b[a-z_]+(?:\[\d+\])?\.[a-z_0-9]+\b", message) or [
+        k for k in ("name", "description", "dimension", "height") if re.search(rf"\b{k}\b", message)]
+    assert named, (path, value, message)
+
+
+def test_every_scene_key_refuses_a_value_of_the_wrong_type_naming_itself():
+    """A list of lists fits no key of any scene: every key of every embedded scene is
+    refused with exit code 2 and one line naming that very key."""
+    for scene, path in SCENE_KEYS:
+        code, message, leftovers = _run_mutated(scene, path, "[[1.0]]")
+        assert code == 2 and "\n" not in message and leftovers == [], (scene, path, message)
+        assert path in message, (scene, path, message)

@@ -137,17 +137,23 @@ def test_bench_prints_a_table_or_json(capsys, monkeypatch):
     assert all(r["relative_error"] < 1e-3 for r in rows if r["backend"] == "hmatrix")
     assert all(r["build_seconds"] >= 0 and r["memory_mb"] > 0 and r["matvec_ms"] > 0 for r in rows)
     assert cli.main(["bench", "--quick", "--quiet"]) == cli.EXIT_OK
-    assert "error (smooth)" in capsys.readouterr().out
+    captured = capsys.readouterr()
+    assert "error (smooth)" in captured.out and captured.err == ""
+    assert cli.main(["bench", "--quick"]) == cli.EXIT_OK  # progress on stderr, one line per operator
+    lines = capsys.readouterr().err.splitlines()
+    assert lines[0].startswith("[1/5] compiling the numba kernels") and lines[-2].startswith(
+        "[5/5] 36 elements, hmatrix (eps 0.0001) ... build ")
+    assert " s wall, " in lines[-1] and lines[-1].endswith(" s CPU")
 
 
 def test_validate_keeps_its_exit_codes(capsys, monkeypatch):
     import hmatddm.validate as validate
 
     rows = [dict(name="check", error=1e-3, tolerance=1e-2, passed=True, seconds=0.1)]
-    monkeypatch.setattr(validate, "run_checks", lambda: rows)
+    monkeypatch.setattr(validate, "run_checks", lambda stream=None: rows)
     assert cli.main(["validate", "--json"]) == cli.EXIT_OK
     assert json.loads(capsys.readouterr().out) == rows
-    monkeypatch.setattr(validate, "run_checks", lambda: [dict(rows[0], passed=False)])
+    monkeypatch.setattr(validate, "run_checks", lambda stream=None: [dict(rows[0], passed=False)])
     assert cli.main(["validate"]) == cli.EXIT_FAILED
     assert "FAIL" in capsys.readouterr().out
 
@@ -206,7 +212,7 @@ def test_quick_answers_import_nothing_heavy_and_change_no_environment(tmp_path):
 import contextlib, io, os, sys
 import hmatddm, hmatddm.hmatrix
 assert "OMP_WAIT_POLICY" not in os.environ
-heavy = ("numba", "matplotlib", "pyvista", "hmatddm.hmatrix.hmatrix", "hmatddm.simulation.simulation",
+heavy = ("numba", "scipy", "matplotlib", "pyvista", "hmatddm.hmatrix.hmatrix", "hmatddm.simulation.simulation",
          )
 def loaded():
     return [m for m in heavy if m in sys.modules]
@@ -324,3 +330,50 @@ def test_growth_past_max_elements_stops_resumably(tiny, tmp_path, capsys):
     assert cli.main(["run", "--out", str(out), "--resume", "--quiet", "--set", "numerics.max_elements=100"]) == 0
     steps = json.loads((out / "summary.json").read_text())["steps"]
     assert [s["step"] for s in steps] == [1, 2, 3, 4] and steps[-1]["n_elements"] > 10
+
+
+def test_validate_prints_progress_per_check(capsys, monkeypatch):
+    import hmatddm.validate as validate
+
+    monkeypatch.setattr(validate, "checks", lambda: [("first", lambda: 1e-3, 1e-2), ("second", lambda: 0.5, 1e-2)])
+    assert cli.main(["validate"]) == cli.EXIT_FAILED
+    err = capsys.readouterr().err.splitlines()
+    assert err[0].startswith("[1/2] first ... error 1.00e-03 PASS (") and err[1].startswith("[2/2] second ... error")
+    assert "FAIL" in err[1] and err[2].startswith("2 task(s) in ") and err[2].endswith(" s CPU")
+    assert cli.main(["validate", "--quiet"]) == cli.EXIT_FAILED
+    assert capsys.readouterr().err == ""
+
+
+def test_interrupt_between_a_step_and_its_checkpoint_names_the_checkpointed_step(tiny, tmp_path, capsys,
+                                                                               monkeypatch):
+    """Ctrl-C after step 2 was computed but before its checkpoint was written: the message
+    names step 1, where a resume starts (issue 19 item 8: it said 'after step 24' with 23 on disk)."""
+    from hmatddm.simulation.simulation import Simulation
+
+    save = Simulation.save_checkpoint
+
+    def interrupted_save(simulation):
+        if simulation.state.step == 2:
+            raise KeyboardInterrupt
+        save(simulation)
+
+    monkeypatch.setattr(Simulation, "save_checkpoint", interrupted_save)
+    out = tmp_path / "out"
+    assert cli.main(["run", str(tiny), "--out", str(out), "--quiet"]) == cli.EXIT_INTERRUPTED
+    err = capsys.readouterr().err
+    assert "interrupted; the newest checkpoint is step 1 (t = 1 s)" in err
+
+
+def test_simulation_run_prints_progress_when_asked(tiny):
+    import io
+
+    import hmatddm.scene as hs
+
+    stream = io.StringIO()
+    simulation = hs.build_simulation(hs.load_scene(str(tiny)).data)
+    simulation.run(2.0, progress=stream)
+    lines = stream.getvalue().splitlines()
+    assert [line.split()[:2] for line in lines] == [["step", "1"], ["step", "2"]]  # not a terminal: plain lines
+    assert "t 2/2 s" in lines[-1] and "elements" in lines[-1]
+    quiet = hs.build_simulation(hs.load_scene(str(tiny)).data)
+    assert len(quiet.run(1.0)) == 1  # silent by default

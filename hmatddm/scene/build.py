@@ -9,7 +9,6 @@ import numpy as np
 from .. import mesh as meshes
 from ..errors import InputError
 from ..flow import Cluster, Fluid, LeakOff
-from ..fracture import Propagation
 from ..material import Elastic
 from .schema import SCHEME_KEYS, far_field_stress, has_natural_fractures, show
 
@@ -62,11 +61,11 @@ def _check_overlaps(scene, mesh):
     """Two initial fractures must not put collocation points on top of each other."""
     if len(scene["initial_fracture"]) < 2:
         return
-    from scipy.spatial import cKDTree
+    from ..neighbours import pairs_within  # numpy only: refusing a scene does not wait for scipy.spatial
 
-    pairs = cKDTree(mesh.centers).query_pairs(1e-6 * float(np.max(mesh.radii)), output_type="ndarray")
-    if len(pairs):
-        first, second = (int(i) for i in pairs[0])
+    sources, receivers = pairs_within(mesh.centers, 1e-6 * float(np.max(mesh.radii)))
+    if len(sources):
+        first, second = int(sources[0]), int(receivers[0])
         a, b = int(mesh.fracture_id[first]), int(mesh.fracture_id[second])
         raise InputError(f"initial_fracture[{a}] and initial_fracture[{b}] overlap: elements {first} and {second} "
                          f"share the centre {show(mesh.centers[first].tolist())}")
@@ -91,6 +90,8 @@ def propagation(scene):
     if settings is None:
         return None
     bounds = settings.get("bounds")
+    from ..fracture import Propagation  # scipy.spatial: loaded when a run is built
+
     return Propagation(toughness=settings["toughness"], criterion=settings["criterion"],
                        critical_energy_release_rate=settings.get("critical_energy_release_rate"),
                        correction=settings["correction"], turning=settings["turning"],

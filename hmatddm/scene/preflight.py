@@ -14,8 +14,8 @@ scene and starting the engine, so that every refusal comes within a second:
    element's edge when ``numerics.singular_correction = "none"`` -- the check the
    elasticity operator would otherwise make only once it is built (minutes later).
 
-Only numpy and scipy.spatial are used here; numba, the H-matrix engine, pyvista and
-matplotlib are not imported.
+Only numpy is used here (neighbours by :func:`hmatddm.neighbours.pairs_within`); scipy,
+numba, the H-matrix engine, pyvista and matplotlib are not imported.
 """
 import math
 import os
@@ -69,8 +69,9 @@ class Estimate:
         """The estimate as text, one line per quantity."""
         available = ("unknown" if self.available_bytes is None else _bytes(self.available_bytes))
         return [
-            f"elements: {self.elements:,} initial + {self.natural_elements:,} natural = {self.total_elements:,}"
-            f" (largest: {self.largest}); unknowns: {self.unknowns:,}",
+            f"elements: {_count_text(self.elements)} initial + {_count_text(self.natural_elements)} natural = "
+            f"{_count_text(self.total_elements)}"
+            f" (largest: {self.largest}); unknowns: {_count_text(self.unknowns)}",
             f"memory: dense {_bytes(self.dense_bytes)} (with its LU), H-matrix {_bytes(self.hmatrix_bytes)}; "
             f"this run ({self.backend}): ~{_bytes(self.memory_bytes)} of {available} available",
             f"time (rough, 2-core machine): operator build ~{_seconds(self.build_seconds)}, "
@@ -114,15 +115,27 @@ def available_memory():
         return None
 
 
+_COUNT_CAP = 1e30  # counts beyond this are only "too many" (and keep the arithmetic finite)
+
+
+def _capped(count):
+    return int(min(float(count), _COUNT_CAP))
+
+
+def _count_text(count):
+    return f"{count:,}" if count < 1e15 else f"{float(count):.3g}"
+
+
 def _fracture_elements(fracture):
     """Elements of one initial fracture, from its numbers (as the mesh would have them)."""
     size = fracture["element_size"]
     if fracture["shape"] == "rectangle":
-        return round(fracture["length"] / size) * round(fracture["height"] / size)
+        return _capped(min(round(fracture["length"] / size), _COUNT_CAP)
+                       * min(round(fracture["height"] / size), _COUNT_CAP))
     if fracture["shape"] == "penny":
-        return max(1, round(math.pi * (fracture["radius"] / size) ** 2))
+        return _capped(max(1.0, math.pi * min(fracture["radius"] / size, _COUNT_CAP) ** 2))
     length = math.dist(fracture["p0"], fracture["p1"])
-    return max(1, round(length / size))
+    return _capped(max(1, round(length / size)))
 
 
 def _mean_power_law_length(a, l_min, l_max):
@@ -147,10 +160,10 @@ def _natural_elements(scene):
     count = sum(max(1, round(math.dist(f["p0"], f["p1"]) / size)) for f in scene.get("natural_fracture", []))
     if "density" in network:
         x_min, x_max, y_min, y_max = network["region"]
-        fractures = round(network["density"] * (x_max - x_min) * (y_max - y_min))
+        fractures = min(network["density"] * (x_max - x_min) * (y_max - y_min), _COUNT_CAP)
         mean = _mean_power_law_length(network["length_exponent"], network["l_min"], network["l_max"])
-        count += fractures * max(1, round(mean / size))
-    return count * rows
+        count += round(fractures) * max(1, round(min(mean / size, _COUNT_CAP)))
+    return _capped(count * rows)
 
 
 def estimate(scene):
@@ -158,8 +171,8 @@ def estimate(scene):
     dim = scene["dimension"]
     counts = [_fracture_elements(f) for f in scene["initial_fracture"]]
     largest = int(np.argmax(counts))
-    elements, natural = int(sum(counts)), int(_natural_elements(scene))
-    n = max(1, elements + natural)
+    elements, natural = _capped(sum(counts)), _capped(_natural_elements(scene))
+    n = max(1, _capped(elements + natural))
     unknowns = (dim + 1) * n
     dense = 2.0 * 8.0 * float(n * dim) ** 2
     log_n = math.log2(max(n, 2))
@@ -180,7 +193,7 @@ def estimate(scene):
                     hmatrix_bytes=hmatrix, backend=backend, memory_bytes=_BASE_BYTES + 1.15 * memory,
                     available_bytes=available_memory(), build_seconds=build,
                     step_seconds=_MATVECS_PER_STEP * matvec, steps=steps,
-                    largest=f"initial_fracture[{largest}] ({counts[largest]:,} elements)")
+                    largest=f"initial_fracture[{largest}] ({_count_text(counts[largest])} elements)")
 
 
 def refuse_too_large(scene, size):
@@ -192,15 +205,15 @@ def refuse_too_large(scene, size):
            f"{', network.element_size' if size.natural_elements else ''})")
     if size.total_elements > cap:
         raise InputError(
-            f"the scene needs about {size.total_elements:,} elements ({size.largest}"
-            f"{f', {size.natural_elements:,} natural' if size.natural_elements else ''}), more than "
+            f"the scene needs about {_count_text(size.total_elements)} elements ({size.largest}"
+            f"{f', {_count_text(size.natural_elements)} natural' if size.natural_elements else ''}), more than "
             f"numerics.max_elements = {cap:,}; ~{_bytes(size.memory_bytes)} with the {size.backend} backend. "
             f"To run it, {fix}, or raise numerics.max_elements if the memory allows")
     if size.available_bytes is not None and size.memory_bytes > size.available_bytes:
         other = "hmatrix" if size.backend == "dense" else "dense"
         other_bytes = size.hmatrix_bytes if other == "hmatrix" else size.dense_bytes
         raise InputError(
-            f"the scene needs about {size.total_elements:,} elements ({size.largest}) and ~"
+            f"the scene needs about {_count_text(size.total_elements)} elements ({size.largest}) and ~"
             f"{_bytes(size.memory_bytes)} of memory with numerics.backend = {size.backend!r}, more than the "
             f"{_bytes(size.available_bytes)} available on this machine; {fix}"
             + (f", or numerics.backend = {other!r} (~{_bytes(_BASE_BYTES + 1.15 * other_bytes)})"
@@ -225,16 +238,11 @@ def near_edge_pairs(mesh, near_fraction=NEAR_SINGULAR_FRACTION):
     return NaN there), computed geometrically: the point in the source's frame, then its
     distance to the nearest point of the source's boundary.
     """
-    from scipy.spatial import cKDTree
+    from ..neighbours import pairs_within
 
     sizes = _half_sizes(mesh)
     reach = mesh.radii * (1.0 + 1e-9) + near_fraction * sizes
-    found = cKDTree(mesh.centers).query_ball_point(mesh.centers, reach)
-    counts = np.array([len(f) for f in found], dtype=np.int64)
-    sources = np.repeat(np.arange(mesh.n_elements, dtype=np.int64), counts)
-    receivers = np.fromiter((i for f in found for i in f), dtype=np.int64, count=int(counts.sum()))
-    keep = receivers != sources
-    receivers, sources = receivers[keep], sources[keep]
+    sources, receivers = pairs_within(mesh.centers, reach)
     local = np.einsum("kab,kb->ka", mesh.frames[sources], mesh.centers[receivers] - mesh.centers[sources])
     near = near_fraction * np.minimum(sizes[receivers], sizes[sources])
     if mesh.dim == 2:
@@ -288,10 +296,10 @@ def _check_collocation(scene, mesh, natural):
 def check_scene(scene):
     """Everything that can refuse a validated scene before the engine starts; returns its
     :class:`Estimate`. Raises InputError (one line, naming the key) on the first problem."""
-    from .build import _check_clusters, initial_mesh, natural_mesh
-
     size = estimate(scene)
     refuse_too_large(scene, size)
+    from .build import _check_clusters, initial_mesh, natural_mesh  # meshes: numpy and scipy.spatial
+
     mesh = initial_mesh(scene)       # each fracture meshable, no two sharing a collocation point
     _check_clusters(scene, mesh)     # every cluster on an initial fracture
     natural = natural_mesh(scene)    # the network generates and meshes
