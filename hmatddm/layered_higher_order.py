@@ -24,9 +24,8 @@ interfaces, shear_modulus, poisson_ratio, coefficients, nodes)`` with ``settings
 import numpy as np
 from numba import njit, prange
 
-from .kernels.correction import scale_to_self
-from .kernels.line2d_higher_order import (near_distance, node_point, nodes_edge_distance, stress_nodes,
-                                          traction_nodes)
+from .kernels.line2d_higher_order import (near_distance, node_point, nodes_edge_distance, set_node_rows,
+                                          store_block, stress_nodes, traction_nodes)
 from .layered.images2d import composite_rule, image_element_stress, subdivisions
 
 
@@ -67,11 +66,10 @@ def traction_block(data, rows, cols, out):
     alpha = params[3]
     near_fraction = params[4]
     n_nodes = nodes.shape[0]
-    dof = 2 * n_nodes
     work = np.empty((n_nodes, 2, 2, 2))
     pair = np.empty((n_nodes, 2, 2))
     image = np.empty((n_nodes, 2, 2, 2))
-    block = np.empty((dof, dof))
+    block = np.empty((2 * n_nodes, 2 * n_nodes))
     point = np.empty(2)
     for ia in range(rows.shape[0]):
         i = rows[ia]
@@ -94,15 +92,8 @@ def traction_block(data, rows, cols, out):
                         for p in range(2):
                             for q in range(2):
                                 pair[k, p, q] += image[k, q, p, 0] * normal[0] + image[k, q, p, 1] * normal[1]
-                for k in range(n_nodes):
-                    for p in range(2):
-                        for q in range(2):
-                            block[2 * r + p, 2 * k + q] = pair[k, p, q]
-            if alpha > 0.0 and i != j:
-                scale_to_self(block, alpha * self_max[j])
-            for p in range(dof):
-                for q in range(dof):
-                    out[dof * ia + p, dof * jb + q] = block[p, q]
+                set_node_rows(block, pair, r)
+            store_block(block, out, ia, jb, i, j, alpha, self_max)
 
 
 @njit(cache=True, parallel=True)

@@ -275,10 +275,9 @@ def traction_block(data, rows, cols, out):
     alpha = params[3]
     near_fraction = params[4]
     n_nodes = nodes.shape[0]
-    dof = 2 * n_nodes
     work = np.empty((n_nodes, 2, 2, 2))
     pair = np.empty((n_nodes, 2, 2))
-    block = np.empty((dof, dof))
+    block = np.empty((2 * n_nodes, 2 * n_nodes))
     point = np.empty(2)
     for ia in range(rows.shape[0]):
         i = rows[ia]
@@ -292,15 +291,30 @@ def traction_block(data, rows, cols, out):
                 node_point(centers[i], frames[i], half_length[i], nodes[r], point)
                 traction_nodes(point, normal, centers[j], frames[j], half_length[j], coefficients, g, nu, shift, pair,
                                work, near)
-                for k in range(n_nodes):
-                    for p in range(2):
-                        for q in range(2):
-                            block[2 * r + p, 2 * k + q] = pair[k, p, q]
-            if alpha > 0.0 and i != j:
-                scale_to_self(block, alpha * self_max[j])
-            for p in range(dof):
-                for q in range(dof):
-                    out[dof * ia + p, dof * jb + q] = block[p, q]
+                set_node_rows(block, pair, r)
+            store_block(block, out, ia, jb, i, j, alpha, self_max)
+
+
+@njit(cache=True)
+def set_node_rows(block, pair, r):
+    """The rows of receiver node ``r`` in an element block: ``block[2 r + p, 2 k + q] =
+    pair[k, p, q]`` (traction p for a unit DD q at source node k)."""
+    for k in range(pair.shape[0]):
+        for p in range(2):
+            for q in range(2):
+                block[2 * r + p, 2 * k + q] = pair[k, p, q]
+
+
+@njit(cache=True)
+def store_block(block, out, ia, jb, i, j, alpha, self_max):
+    """Scale an off-diagonal element block by ref. Eq. 6.11 (``alpha > 0``), then copy it
+    to its place ``(ia, jb)`` in ``out``."""
+    dof = block.shape[0]
+    if alpha > 0.0 and i != j:
+        scale_to_self(block, alpha * self_max[j])
+    for p in range(dof):
+        for q in range(dof):
+            out[dof * ia + p, dof * jb + q] = block[p, q]
 
 
 @njit(cache=True, parallel=True)
