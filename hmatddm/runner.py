@@ -468,7 +468,8 @@ def latest_state(out):
         mesh = _mesh_from_checkpoint(arrays)
         if stress is None:
             stress = np.zeros((mesh.dim, mesh.dim))
-        fields = cell_fields(mesh, arrays["dd"], arrays["pressure"], stress)
+        state = np.where(arrays["origin"] >= 1, 2, 0).astype(np.int64) if "origin" in arrays else None
+        fields = cell_fields(mesh, arrays["dd"], arrays["pressure"], stress, state)
         return mesh, fields, int(metadata["step"]), float(metadata["time"])
     steps = _vtu_steps(out)
     if not steps:

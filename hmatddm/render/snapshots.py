@@ -58,7 +58,7 @@ PLAN_STYLES = ("auto", "traces", "surfaces")
 # (left, right, bottom, top), left of the bar, above the legend and the length scale
 # (SCALE_Y) and below the title
 BAR_LEFT = 0.86
-PLAN_BOX = (0.04, 0.82, 0.16, 0.90)
+PLAN_BOX = (0.04, 0.82, 0.19, 0.90)
 PLAN_BOX_WITHOUT_BAR_RIGHT = 0.96
 PLAN_BOX_WITHOUT_TITLE_TOP = 0.96
 SCALE_Y = 0.07
@@ -330,7 +330,7 @@ def _add_legend(plotter, state, slip_shown=False):
     labels = legend_labels(state, slip_shown)
     if labels:
         plotter.add_legend(labels=labels, bcolor="white", face="rectangle", loc="lower center",
-                           size=(0.42, 0.035 * len(labels) + 0.02))
+                           size=(0.4, 0.028 * len(labels) + 0.008))
 
 
 def _slip_shown(slip):
