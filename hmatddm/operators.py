@@ -298,6 +298,8 @@ def singular_pairs(mesh, kernels, data):
 
     near_fraction = float(data[4][4])
     reach = mesh.radii * (1.0 + 1e-9) + near_fraction * element_sizes(mesh)
+    if mesh.n_nodes > 1:  # collocation nodes of linear / quadratic elements lie off the centre
+        reach = reach + np.max(mesh.radii)
     tree = cKDTree(mesh.centers)
     found = tree.query_ball_point(mesh.centers, reach)
     counts = np.array([len(f) for f in found], dtype=np.int64)
@@ -328,10 +330,11 @@ def refuse_singular(mesh=None, kernels=None, data=None):
             i, j = int(receivers[0]), int(sources[0])
             gap = float(kernels.edge_distance(data, i, j))
             size = float(min(element_sizes(mesh)[i], element_sizes(mesh)[j]))
+            point = "centre" if mesh.n_nodes == 1 else "collocation node"
             where = ("on an edge" if gap <= 1e-9 * size else
                      f"{gap:.3g} m ({gap / size:.2g} of the smaller half size) from an edge")
             raise InputError(
                 f"{len(receivers)} collocation point(s) lie on or near another element's edge: element {i} "
-                f"(fracture {int(mesh.fracture_id[i])}) has its centre {where} of element {j} (fracture "
+                f"(fracture {int(mesh.fracture_id[i])}) has its {point} {where} of element {j} (fracture "
                 f"{int(mesh.fracture_id[j])}); {what}. To fix it, {fix}")
     raise InputError(f"the mesh has collocation points on or near element edges; {what}. To fix it, {fix}")

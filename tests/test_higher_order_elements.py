@@ -139,6 +139,24 @@ def test_unknowns_are_element_major_then_node_then_component():
     assert np.allclose(column.reshape(9, 2), traction, rtol=0.0, atol=1e-12 * np.abs(column).max())
 
 
+@pytest.mark.parametrize("order", [1, 2])
+def test_a_branch_ending_on_a_collocation_node_is_refused_or_averaged(order):
+    """T-junction: a branch whose end lies on a node of the main crack (ref. Sec. 6.2.3)."""
+    main = hd.mesh.line([-1.0, 0.0], [1.0, 0.0], 4, element_order=order, fracture_id=0)
+    node = main.collocation_points[order + 2]  # node 1 of element 1
+    branch = hd.mesh.line(node + [0.0, 1.0], node, 4, element_order=order, fracture_id=1)
+    mesh = hd.mesh.concatenate([main, branch])
+    with pytest.raises(hd.InputError, match=r"element 1 \(fracture 0\) has its collocation node on an edge of "
+                                            r"element 7 \(fracture 1\)"):
+        hd.ElasticityOperator(mesh, MATERIAL)
+    dense = hd.ElasticityOperator(mesh, MATERIAL, singular_correction="average", alpha=1.0)
+    compressed = hd.ElasticityOperator(mesh, MATERIAL, singular_correction="average", alpha=1.0,
+                                       backend="hmatrix", leaf_size=2, eps=1e-8)
+    assert np.all(np.isfinite(dense.to_dense()))
+    assert np.allclose(compressed.to_dense(), dense.to_dense(), rtol=0.0, atol=1e-8 * np.abs(dense.to_dense()).max())
+    assert np.all(np.isfinite(hd.solve(dense, -1e-3 * mesh.normals)))
+
+
 def test_opening_along_elements_interpolates_the_nodes():
     mesh = hd.mesh.line([-1.0, 0.0], [1.0, 0.0], 4, element_order=1)
     dd = np.random.default_rng(1).normal(size=(4, 2, 2))
