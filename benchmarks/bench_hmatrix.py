@@ -102,7 +102,9 @@ def run_case(geometry, n, eps, dense_limit, solve_limit, check_blocks, rtol=1e-8
     mesh = (planar if geometry == "planar" else cloud)(n)
     material = hd.Elastic(shear_modulus=10e9, poisson_ratio=0.25)
     row = dict(geometry=geometry, n=mesh.n_elements, eps=eps, rtol=rtol)
+    c0 = time.process_time()
     op = hd.ElasticityOperator(mesh, material, backend="hmatrix", eps=eps)
+    row["build_cpu_s"] = time.process_time() - c0
     stats = op.stats
     row.update(build_s=stats["build_seconds"], memory_mb=stats["memory_bytes"] / 2**20,
                dense_mb=stats["dense_bytes"] / 2**20, compression=stats["compression"],
@@ -122,6 +124,7 @@ def run_case(geometry, n, eps, dense_limit, solve_limit, check_blocks, rtol=1e-8
     t0 = time.perf_counter()
     dd, info = hd.solve(op, traction, rtol=rtol, return_info=True)
     row.update(gmres_s=time.perf_counter() - t0 + 0.0, gmres_iterations=info["iterations"])
+    row["preconditioners"] = compare_preconditioners(op, traction.ravel(), rtol)
     if check_blocks:
         row["worst_block_error"] = float(op.check_against_dense(n_samples=200))
     row["peak_rss_mb"] = peak_rss_bytes() / 2**20  # the H-matrix run only, before any dense work
@@ -139,6 +142,35 @@ def run_case(geometry, n, eps, dense_limit, solve_limit, check_blocks, rtol=1e-8
         row["smooth_error"] = float(np.linalg.norm(y_smooth[index] - exact) / np.linalg.norm(exact))
         row["smooth_error_sampled"] = True
     return row
+
+
+def compare_preconditioners(op, b, rtol):
+    """Setup (wall and CPU), memory, GMRES iterations and time of the near-field block
+    ILU and of the two-level preconditioner built on it, for the same right-hand side."""
+    from hmatddm.hmatrix import gmres, near_field_block_ilu, two_level
+    from hmatddm.hmatrix.preconditioners import DEFAULT_ILU
+
+    out = {}
+    t0, c0 = time.perf_counter(), time.process_time()
+    ilu = near_field_block_ilu(op.hmatrix, **DEFAULT_ILU)
+    ilu_setup, ilu_cpu = time.perf_counter() - t0, time.process_time() - c0
+    t0, c0 = time.perf_counter(), time.process_time()
+    both = two_level(op.hmatrix, smoother=ilu)
+    setup, cpu = time.perf_counter() - t0, time.process_time() - c0
+    solutions = {}
+    for name, M, setup_s, setup_cpu, extra in (("block_ilu", ilu, ilu_setup, ilu_cpu, ilu.nbytes),
+                                                ("two_level", both, ilu_setup + setup, ilu_cpu + cpu,
+                                                 ilu.nbytes + both.coarse["coarse_bytes"])):
+        t0, c0 = time.perf_counter(), time.process_time()
+        x, info = gmres(op, b, M=M, rtol=rtol, restart=100, maxiter=20)
+        out[name] = dict(setup_s=setup_s, setup_cpu_s=setup_cpu, gmres_s=time.perf_counter() - t0,
+                         gmres_cpu_s=time.process_time() - c0, iterations=info["iterations"],
+                         memory_mb=extra / 2**20)
+        solutions[name] = x
+    out["two_level"]["coarse_size"] = both.coarse["coarse_size"]
+    out["two_level"]["difference"] = float(np.linalg.norm(solutions["two_level"] - solutions["block_ilu"])
+                                           / np.linalg.norm(solutions["block_ilu"]))
+    return out
 
 
 def dense_reference(mesh, material, x_smooth, x_random, traction, op, solve_limit):

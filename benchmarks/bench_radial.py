@@ -373,6 +373,10 @@ def main():
     sys.path.insert(0, HERE)
     if args.case:
         spec = json.loads(args.case)
+        if "two_level_from" in spec:  # elements from which the H-matrix runs use the two-level preconditioner
+            import hmatddm.hmatrix.preconditioners as preconditioners
+
+            preconditioners.TWO_LEVEL_MIN_ELEMENTS = int(spec["two_level_from"])
         print(json.dumps(run_case(spec["case"], float(spec["h"]), spec["backend"], float(spec.get("t_end", 50.0)),
                                   spec.get("scheme", "krylov"))))
         return

@@ -1,5 +1,5 @@
 """Generic hierarchical-matrix engine: cluster tree, block tree, whole-element ACA,
-flat storage with a parallel matvec, near-field preconditioners and GMRES.
+flat storage with a parallel matvec, near-field and two-level preconditioners and GMRES.
 
 Knows nothing about elasticity: it compresses the matrix of any
 :class:`BlockGenerator` (a numba kernel filling d x d element blocks).
@@ -10,6 +10,7 @@ _EXPORTS = {
     "BlockGenerator": ".generator", "HMatrix": ".hmatrix", "block_jacobi": ".preconditioners",
     "default_preconditioner": ".preconditioners", "near_field_block_ilu": ".preconditioners",
     "near_field_ilu": ".preconditioners", "near_field_lu": ".preconditioners", "gmres": ".solvers",
+    "two_level": ".preconditioners",
 }
 __getattr__, __dir__ = attach(__name__, _EXPORTS)
 
@@ -22,4 +23,5 @@ __all__ = [
     "near_field_block_ilu",
     "near_field_ilu",
     "near_field_lu",
+    "two_level",
 ]

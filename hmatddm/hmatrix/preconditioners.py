@@ -33,6 +33,13 @@ logger = logging.getLogger(__name__)
 # 10k with twice the memory and setup.
 DEFAULT_ILU = {"threshold": 3e-3}
 
+# Settings of the two-level preconditioner (two_level): aggregates of at most 256
+# elements (a balanced tree gives 128-256), constant + 2 linear functions per aggregate
+# and component; default_preconditioner uses it from TWO_LEVEL_MIN_ELEMENTS elements
+# on (measured in benchmarks/RESULTS.md, section "Two-level preconditioner").
+TWO_LEVEL = {"aggregate_size": 256, "n_functions": 3}
+TWO_LEVEL_MIN_ELEMENTS = 4000
+
 
 def _check_hmatrix(hmatrix):
     from .hmatrix import HMatrix
@@ -123,11 +130,41 @@ def near_field_block_ilu(hmatrix, threshold=0.0, part="near"):
         return np.column_stack([block_ilu_solve(indptr, indices, values, inverse_diagonal, diagonal_position,
                                                 np.ascontiguousarray(column)) for column in x.reshape(n, -1).T])
 
-    return spla.LinearOperator(hmatrix.shape, matvec=apply, matmat=apply, dtype=np.float64)
+    operator = spla.LinearOperator(hmatrix.shape, matvec=apply, matmat=apply, dtype=np.float64)
+    operator.nbytes = int(values.nbytes + inverse_diagonal.nbytes + indices.nbytes + indptr.nbytes)
+    return operator
+
+
+def two_level(hmatrix, smoother=None, aggregate_size=None, n_functions=None, multiplicative=True):
+    """Near-field block ILU plus a Galerkin coarse correction built from the H-matrix
+    (:mod:`hmatddm.hmatrix.coarse_space`): GMRES iterations that do not grow with N.
+
+    ``smoother``: the fine-level preconditioner (default: the thresholded block ILU of
+    :func:`default_preconditioner`'s near field). ``aggregate_size`` (default
+    ``TWO_LEVEL["aggregate_size"]``): largest cluster forming one coarse aggregate;
+    ``n_functions`` (1, 2 or 3; default ``TWO_LEVEL["n_functions"]``): constant, plus
+    linear functions along the aggregate's principal axes. ``multiplicative=True``
+    costs one extra H-matvec per application and halves the iterations against the
+    additive form. Setup: one pass over the stored blocks and a dense LU of the coarse
+    matrix (n_aggregates * n_functions * d square). The returned operator has a
+    ``coarse`` attribute (sizes, bytes).
+    """
+    from .coarse_space import two_level_preconditioner
+
+    _check_hmatrix(hmatrix)
+    if smoother is None:
+        smoother = near_field_block_ilu(hmatrix, **DEFAULT_ILU)
+    return two_level_preconditioner(
+        hmatrix, smoother,
+        aggregate_size=TWO_LEVEL["aggregate_size"] if aggregate_size is None else aggregate_size,
+        n_functions=TWO_LEVEL["n_functions"] if n_functions is None else n_functions,
+        multiplicative=multiplicative)
 
 
 def default_preconditioner(hmatrix):
-    """Thresholded near-field block ILU (``DEFAULT_ILU``), checked on one product.
+    """The two-level preconditioner (:func:`two_level`) from ``TWO_LEVEL_MIN_ELEMENTS``
+    elements on, else the thresholded near-field block ILU (``DEFAULT_ILU``); checked
+    on one product.
 
     Falls back, with a logged warning, to :func:`block_jacobi` when the incomplete
     factorisation fails (singular pivot block) or gives non-finite values.
@@ -135,7 +172,17 @@ def default_preconditioner(hmatrix):
     _check_hmatrix(hmatrix)
     try:
         preconditioner = near_field_block_ilu(hmatrix, **DEFAULT_ILU)
-        probe = preconditioner @ (hmatrix @ np.ones(hmatrix.shape[0]))
+        probe_rhs = hmatrix @ np.ones(hmatrix.shape[0])
+        if hmatrix.n_elements >= TWO_LEVEL_MIN_ELEMENTS:
+            try:
+                combined = two_level(hmatrix, smoother=preconditioner)
+                if np.all(np.isfinite(combined @ probe_rhs)):
+                    return combined
+                reason = "non-finite values"
+            except (np.linalg.LinAlgError, ValueError) as error:
+                reason = str(error)
+            logger.warning("two-level coarse correction failed (%s); using the near-field block ILU alone", reason)
+        probe = preconditioner @ probe_rhs
         if np.all(np.isfinite(probe)):
             return preconditioner
         reason = "non-finite values"
