@@ -86,3 +86,24 @@ def test_two_level_bad_input(crack):
         two_level(op.hmatrix, n_functions=4)
     with pytest.raises(InputError, match="hmatrix"):
         two_level(np.eye(3))
+
+
+def test_grown_mesh_with_a_two_level_base_matches_dense(monkeypatch):
+    """The block lower-triangular preconditioner of a grown mesh applies the base
+    operator's default preconditioner, here the two-level one."""
+    import hmatddm.hmatrix.preconditioners as preconditioners
+    from hmatddm.coupled import ElasticSolver
+    from hmatddm.extended_operator import ExtendedElasticityOperator
+
+    monkeypatch.setattr(preconditioners, "TWO_LEVEL_MIN_ELEMENTS", 0)
+    full = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 16.0, 16.0, 16, 16)
+    order = np.argsort(np.max(np.abs(full.centers), axis=1), kind="stable")  # inner square first
+    mesh = full.subset(order)
+    base = hd.ElasticityOperator(mesh.subset(np.arange(196)), MATERIAL, backend="hmatrix", eps=1e-8, leaf_size=16)
+    assert hasattr(base.preconditioner(), "coarse")
+    extended = ExtendedElasticityOperator(base, mesh)
+    dense = hd.ElasticityOperator(mesh, MATERIAL)
+    load = -1e6 * mesh.normals.ravel()
+    x, iterations = ElasticSolver(extended, rtol=1e-10).solve(load)
+    np.testing.assert_allclose(x, hd.solve(dense, load).ravel(), atol=1e-6 * np.abs(x).max())
+    assert 0 < iterations < 60
