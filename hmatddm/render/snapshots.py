@@ -268,7 +268,8 @@ def _add_failed_outline(plotter, mesh, indices, lift=0.0):
         return
     if isinstance(mesh, Mesh2D):
         part = _part(mesh, indices, lift - 0.1 * _diagonal(mesh))
-        plotter.add_mesh(part, color=FAILED_COLOR, line_width=2 * _line_width(), render_lines_as_tubes=True)
+        # flat and unlit: the visible rim of a lit tube is shaded to dark red
+        plotter.add_mesh(part, color=FAILED_COLOR, line_width=2 * _line_width(), lighting=False)
         return
     if mesh.n_elements <= MAX_ELEMENTS_WITH_EDGES:
         plotter.add_mesh(_part(mesh, indices), style="wireframe", color=FAILED_COLOR, line_width=1)
@@ -393,7 +394,6 @@ def _frame_plan(plotter, mesh, window_size, colour_bar, title):
     centre_x, centre_y, scale, box = plan_frame(extent, window_size, colour_bar, title)
     aspect = window_size[0] / window_size[1]
     z_top = float(np.max(mesh.corners()[..., 2])) if isinstance(mesh, Mesh3D) else 0.0
-    z_bottom = float(np.min(mesh.corners()[..., 2])) if isinstance(mesh, Mesh3D) else 0.0
     diagonal = _diagonal(mesh)
     # the length scale: a black bar from the left edge of the box, at SCALE_Y
     length = scale_bar_length(extent[1] - extent[0])
@@ -405,11 +405,13 @@ def _frame_plan(plotter, mesh, window_size, colour_bar, title):
     plotter.add_text(_length_text(length), position=(int((right_end + 0.01) * window_size[0]),
                                                      int((SCALE_Y - 0.02) * window_size[1])),
                      font_size=10, color="black")
+    plotter.view_xy()  # the camera pyvista frames (its distance keeps the lighting), moved over the box
+    plotter.enable_parallel_projection()
+    plotter.reset_camera()
     camera = plotter.camera
-    camera.parallel_projection = True
-    camera.focal_point = (centre_x, centre_y, z_bottom)
-    camera.position = (centre_x, centre_y, z_top + 2.0 * diagonal + 1.0)
-    camera.up = (0.0, 1.0, 0.0)
+    focal, position = camera.focal_point, camera.position
+    camera.focal_point = (centre_x, centre_y, focal[2])
+    camera.position = (centre_x, centre_y, position[2])
     camera.parallel_scale = scale
     plotter.reset_camera_clipping_range()
 
