@@ -1,5 +1,9 @@
 """The ``hmatddm`` command line.
 
+Every scene is checked whole (values, meshes, clusters, collocation points on edges, size)
+before numba or the engine load, so refusals come within a second. The command sets
+``OMP_WAIT_POLICY=PASSIVE`` (unless set) before numba starts its threads.
+
     hmatddm run [SCENE] [--out DIR]   run a scene (embedded name or .toml file; default: "default")
     hmatddm scenes [NAME]             list the embedded scenes, or print one as TOML
     hmatddm validate [--json]         closed-form checks as a table of error and time
@@ -8,7 +12,9 @@
     hmatddm sweep [--realizations N]  natural-fracture network ensembles on Dask (ref. Fig. 6.9)
     hmatddm microseismic DIR          event catalogue (events.csv) and map of a finished run (ref. Ch. 7)
 
-Exit codes: 0 ok, 1 a check failed (validate), 2 bad input, 3 did not converge,
+Exit codes: 0 ok, 1 a check failed (validate), 2 bad input (also a scene over
+numerics.max_elements or the memory available, and a run whose growth would pass
+numerics.max_elements: it stops with the last step checkpointed), 3 did not converge,
 4 an output could not be written (the disk is full or the folder is not writable; every
 finished step is checkpointed, so free space and continue with --resume),
 130 interrupted (Ctrl-C; a run can be continued with --resume).
@@ -262,7 +268,10 @@ def build_parser():
                                      "default: the embedded 'default') and write DIR/summary.json, "
                                      "DIR/fractures.pvd with DIR/vtu/*.vtu, DIR/checkpoints, "
                                      "DIR/snapshots/*.png and DIR/history.png.",
-                         epilog="Exit codes: 0 done, 2 bad input, 3 did not converge (the outputs of the last "
+                         epilog="Exit codes: 0 done, 2 bad input (a scene over numerics.max_elements or the "
+                                "memory refused; a run growing past it stops with its last step checkpointed: "
+                                "continue with --resume --set numerics.max_elements=...), "
+                                "3 did not converge (the outputs of the last "
                                 "converged step are written), 4 an output could not be written (disk full or "
                                 "folder not writable: every finished step is checkpointed; free space and "
                                 "continue with --resume), 130 interrupted (continue with --resume).")
@@ -276,7 +285,8 @@ def build_parser():
     run.add_argument("--set", action="append", metavar="KEY=VALUE",
                      help="override a scene value, e.g. --set numerics.end_time=10 (repeatable)")
     run.add_argument("--check", action="store_true",
-                     help="validate the scene, print it as JSON (every default filled in) and stop")
+                     help="check the scene, print it as JSON (every default filled in) and its size estimate "
+                          "(elements, unknowns, memory, rough time; on stderr), and stop")
     run.add_argument("--quiet", action="store_true", help="no progress and no messages (errors still print)")
     run.set_defaults(handler=_run)
 
