@@ -302,7 +302,7 @@ def test_check_prints_the_size_estimate_and_a_huge_scene_is_refused(tiny, tmp_pa
     captured = capsys.readouterr()
     assert json.loads(captured.out)["numerics"]["max_elements"] == 200_000
     assert "hmatddm: estimate: elements: 3 initial + 0 natural = 3" in captured.err
-    assert "memory: dense" in captured.err and "per step" in captured.err
+    assert "memory at the start: dense" in captured.err and "per step" in captured.err
     out = tmp_path / "huge"
     assert cli.main(["run", str(tiny), "--out", str(out), "--set", "initial_fracture[0].element_size=7.5e-7"]) == 2
     err = capsys.readouterr().err.strip()

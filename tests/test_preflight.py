@@ -71,7 +71,7 @@ def test_estimate_counts_elements_from_the_numbers():
     built = hd.mesh.penny([0, 0, 0], [0, 0, 1], 5.0, 1.0)
     assert abs(preflight.estimate(penny).elements - built.n_elements) <= 0.1 * built.n_elements
     text = "\n".join(preflight.estimate(penny).lines())
-    assert "elements:" in text and "memory: dense" in text and "per step" in text
+    assert "elements:" in text and "memory at the start: dense" in text and "per step" in text
 
 
 def test_a_huge_scene_is_refused_naming_the_estimate_and_the_setting():
@@ -87,3 +87,14 @@ def test_a_huge_scene_is_refused_naming_the_estimate_and_the_setting():
         with pytest.raises(InputError, match=r"about 1,000,000 elements .* more than the .* available on this "
                                              r"machine; use a larger element_size \(initial_fracture\[0\]"):
             preflight.refuse_too_large(two_d, size)
+
+
+def test_natural_elements_count_towards_the_limit_not_the_starting_operator():
+    network = KGD + "[network]\nelement_size = 0.5\n[[natural_fracture]]\np0 = [2.0, -5.0]\np1 = [2.0, 5.0]\n"
+    size = preflight.estimate(_scene(network))
+    assert size.elements == 3 and size.natural_elements == 20 and size.total_elements == 23
+    assert size.dense_bytes == 2 * 8.0 * 6 ** 2 and size.joined_bytes > size.memory_bytes
+    assert "if every natural element joined the operator" in "\n".join(size.lines())
+    with pytest.raises(InputError, match=r"about 23 elements .*3 elements\), 20 natural\), more than "
+                                         r"numerics.max_elements = 10.*network.element_size"):
+        preflight.check_scene(_scene(network, "numerics.max_elements=10"))

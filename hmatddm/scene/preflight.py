@@ -42,22 +42,24 @@ _DENSE_PAIRS_PER_SECOND = 7e6
 _FLOPS = 1e10
 _BASE_BYTES = 250e6  # the interpreter, numpy, scipy, numba and the engine
 _MATVECS_PER_STEP = 60  # nonlinear x linear iterations of a typical step (RESULTS: 20-200)
+_STEP_SECONDS = 0.2     # flow, growth and bookkeeping of a step on a small mesh (default scene: ~0.7 s/step)
 
 
 @dataclass(frozen=True)
 class Estimate:
     """What a scene will need, roughly (see :func:`estimate`)."""
 
-    elements: int            # initial hydraulic elements
-    natural_elements: int    # natural-fracture elements (stress targets; they join when reached)
-    unknowns: int            # DD components and pressures of all of them, (d + 1) (elements + natural)
-    dense_bytes: float       # the dense operator of all elements, with its LU
-    hmatrix_bytes: float     # the H-matrix operator of all elements
+    elements: int            # initial hydraulic elements: the operator at the start (growth adds more)
+    natural_elements: int    # natural-fracture elements (stress targets; they join the operator when reached)
+    unknowns: int            # DD components and pressures at the start, (d + 1) elements
+    dense_bytes: float       # the dense operator at the start, with its LU
+    hmatrix_bytes: float     # the H-matrix operator at the start
     backend: str
-    memory_bytes: float      # of the scene's backend, plus the process itself
+    memory_bytes: float      # of the scene's backend at the start, plus the process itself
     available_bytes: float   # what this machine has available now (None if unknown)
-    build_seconds: float     # one operator build, all elements, the scene's backend
+    build_seconds: float     # one operator build at the start, the scene's backend
     step_seconds: float      # one time step at that size
+    joined_bytes: float      # the scene's operator if every natural element joined it (0 without)
     steps: int
     largest: str             # the scene key of the fracture with the most elements
 
@@ -72,11 +74,13 @@ class Estimate:
             f"elements: {_count_text(self.elements)} initial + {_count_text(self.natural_elements)} natural = "
             f"{_count_text(self.total_elements)}"
             f" (largest: {self.largest}); unknowns: {_count_text(self.unknowns)}",
-            f"memory: dense {_bytes(self.dense_bytes)} (with its LU), H-matrix {_bytes(self.hmatrix_bytes)}; "
-            f"this run ({self.backend}): ~{_bytes(self.memory_bytes)} of {available} available",
+            f"memory at the start: dense {_bytes(self.dense_bytes)} (with its LU), H-matrix "
+            f"{_bytes(self.hmatrix_bytes)}; this run ({self.backend}): ~{_bytes(self.memory_bytes)} of {available} "
+            "available" + (f"; ~{_bytes(self.joined_bytes)} if every natural element joined the operator"
+                           if self.natural_elements else ""),
             f"time (rough, 2-core machine): operator build ~{_seconds(self.build_seconds)}, "
             f"~{_seconds(self.step_seconds)} per step, {self.steps} steps ~{_seconds(self.steps * self.step_seconds)}"
-            " before growth (growing fractures take longer)",
+            " before growth (growing fractures take longer; a first run also compiles for ~10-60 s)",
         ]
 
     def to_dict(self):
@@ -166,20 +170,28 @@ def _natural_elements(scene):
     return _capped(count * rows)
 
 
+def _operator_bytes(n, dim):
+    """``(dense with its LU, H-matrix)`` bytes of the operator of ``n`` elements."""
+    dense = 2.0 * 8.0 * float(n * dim) ** 2
+    return dense, min(dense / 2.0, _H_BYTES * 8.0 * dim * dim * n * math.log2(max(n, 2)))
+
+
 def estimate(scene):
     """An :class:`Estimate` of a validated scene, from its numbers (nothing is built)."""
     dim = scene["dimension"]
     counts = [_fracture_elements(f) for f in scene["initial_fracture"]]
     largest = int(np.argmax(counts))
     elements, natural = _capped(sum(counts)), _capped(_natural_elements(scene))
-    n = max(1, _capped(elements + natural))
+    n = max(1, elements)
     unknowns = (dim + 1) * n
-    dense = 2.0 * 8.0 * float(n * dim) ** 2
-    log_n = math.log2(max(n, 2))
-    scale = (dim / 3.0) ** 2
-    hmatrix = min(dense / 2.0, _H_BYTES * 8.0 * dim * dim * n * log_n)
     numerics = scene["numerics"]
     backend = numerics["backend"]
+    dense, hmatrix = _operator_bytes(n, dim)
+    joined = 0.0
+    if natural:
+        joined = _BASE_BYTES + 1.15 * _operator_bytes(_capped(n + natural), dim)[0 if backend == "dense" else 1]
+    log_n = math.log2(max(n, 2))
+    scale = (dim / 3.0) ** 2
     if backend == "dense":
         memory = dense
         build = float(n) ** 2 / _DENSE_PAIRS_PER_SECOND + float(n * dim) ** 3 / 3.0 / _FLOPS
@@ -192,7 +204,7 @@ def estimate(scene):
     return Estimate(elements=elements, natural_elements=natural, unknowns=unknowns, dense_bytes=dense,
                     hmatrix_bytes=hmatrix, backend=backend, memory_bytes=_BASE_BYTES + 1.15 * memory,
                     available_bytes=available_memory(), build_seconds=build,
-                    step_seconds=_MATVECS_PER_STEP * matvec, steps=steps,
+                    step_seconds=_STEP_SECONDS + _MATVECS_PER_STEP * matvec, steps=steps, joined_bytes=joined,
                     largest=f"initial_fracture[{largest}] ({_count_text(counts[largest])} elements)")
 
 
