@@ -28,7 +28,9 @@ Studies, each with wall and CPU time:
    wells at the amplitude noise of ref. Table 7.5 (0, 5 %, 20 % of the largest
    amplitude), ``--draws`` draws each, general and double-couple sources.
 
-PNGs go next to this script (``microseismic_*.png``), numbers to ``--out``/microseismic.json.
+PNGs go next to this script (``microseismic_*.png``; with ``--quick`` into ``--out``), numbers
+to ``--out``/microseismic.json. ``--reuse`` reads the finished 2D run in ``--out`` and the
+cached 3D state instead of running them again.
 """
 import argparse
 import json
@@ -106,26 +108,54 @@ def forward_speed(count, stations=100, seed=0):
 # the runs
 # ---------------------------------------------------------------------------------
 
-def run_2d(out, quick=False):
-    from hmatddm.runner import SceneRun
+def run_2d(out, quick=False, reuse=False):
+    """The dfn-3cluster run in ``out`` (``reuse``: a finished run there is read, not redone;
+    its wall time is the one its summary.json recorded, its CPU time unknown: nan)."""
+    from hmatddm.runner import SceneRun, read_summary
     from hmatddm.scene import load_scene
 
     overrides = ["output.every=1", "output.snapshots=false"] + (["numerics.end_time=30"] if quick else [])
     scene = load_scene("dfn-3cluster", overrides=overrides)
+    summary = read_summary(out) if reuse and os.path.isdir(out) else None
+    end = scene.numerics["end_time"]
+    if summary and summary.get("steps") and summary["steps"][-1]["time"] >= end - 1e-9:
+        clock = Clock()
+        clock.wall, clock.cpu = float(summary["wall_seconds"]), float("nan")
+        return ms.read_run(out), clock
     with Clock() as clock:
         SceneRun(scene, out, overwrite=True, quiet=True).execute()
     return ms.read_run(out), clock
 
 
-def run_3d(quick=False):
+def run_3d(quick=False, cache=None, reuse=False):
+    """The bench_dfn run with onsets recorded every step; its last state and onsets are
+    saved to ``cache`` (.npz), which ``reuse`` reads instead of running again."""
     import bench_dfn
 
+    from hmatddm.mesh import Mesh3D
+
+    if reuse and cache is not None and os.path.isfile(cache):
+        data = np.load(cache)
+        mesh = Mesh3D(data["centers"], data["frames"], data["half_a"], data["half_b"], data["fracture_id"])
+        onset = ms.SlipOnset(float(data["tolerance"]))
+        onset.centers, onset.time, onset.step = data["onset_centers"], data["onset_time"], data["onset_step"]
+        clock = Clock()
+        clock.wall, clock.cpu = float(data["wall"]), float(data["cpu"])
+        return ms.catalogue.RunState(mesh=mesh, dd=data["dd"], state=data["state"], time=float(data["time"]),
+                                     step=int(data["step"]), onset=onset, height=1.0), clock
     scene = bench_dfn.FULL if not quick else bench_dfn.REDUCED
     simulation = bench_dfn.build_simulation(scene, "hmatrix")
     onset = ms.SlipOnset()
     with Clock() as clock:
         simulation.run(scene.end_time, callback=ms.onset_recorder(onset))
-    return ms.run_state_from_simulation(simulation, onset), clock
+    run = ms.run_state_from_simulation(simulation, onset)
+    if cache is not None:
+        mesh = run.mesh
+        np.savez(cache, centers=mesh.centers, frames=mesh.frames, half_a=mesh.half_a, half_b=mesh.half_b,
+                 fracture_id=mesh.fracture_id, dd=run.dd, state=run.state, time=run.time, step=run.step,
+                 tolerance=onset.tolerance, onset_centers=onset.centers, onset_time=onset.time,
+                 onset_step=onset.step, wall=clock.wall, cpu=clock.cpu)
+    return run, clock
 
 
 # ---------------------------------------------------------------------------------
@@ -314,9 +344,12 @@ def main(argv=None):
     parser.add_argument("--draws", type=int, default=50)
     parser.add_argument("--quick", action="store_true", help="small sizes (smoke test)")
     parser.add_argument("--skip-inversion", action="store_true")
+    parser.add_argument("--reuse", action="store_true",
+                        help="read the 2D run in OUT and the cached 3D state instead of running them again")
     parser.add_argument("--out", default=os.path.join(HERE, "out"))
     args = parser.parse_args(argv)
     os.makedirs(args.out, exist_ok=True)
+    figures = args.out if args.quick else HERE  # a smoke test leaves the recorded pictures alone
     print(machine(), f"load at start {_load():.2f}", flush=True)
     results = dict(machine=machine(), load_start=_load())
 
@@ -330,9 +363,11 @@ def main(argv=None):
 
     runs = {}
     if args.runs in ("2d", "both"):
-        runs["2D dfn-3cluster"] = run_2d(os.path.join(args.out, "microseismic-dfn-3cluster"), args.quick)
+        runs["2D dfn-3cluster"] = run_2d(os.path.join(args.out, "microseismic-dfn-3cluster"), args.quick,
+                                         args.reuse)
     if args.runs in ("3d", "both"):
-        runs["3D bench_dfn"] = run_3d(args.quick)
+        cache = os.path.join(args.out, f"microseismic-3d-state{'-quick' if args.quick else ''}.npz")
+        runs["3D bench_dfn"] = run_3d(args.quick, cache, args.reuse)
     studies, run_rows = {}, []
     for label, (run, clock) in runs.items():
         tag = "2d" if label.startswith("2D") else "3d"
@@ -347,9 +382,9 @@ def main(argv=None):
         run_rows.append([label, f"{clock.wall:.0f} / {clock.cpu:.0f}", failed, len(events),
                          f"{events.moment_magnitude.min():.2f} to {events.moment_magnitude.max():.2f}",
                          f"{np.median(dc):.2f}", f"{np.unique(events.time).size}"])
-        plot_maps(run, events, os.path.join(HERE, f"microseismic_maps_{tag}.png"),
+        plot_maps(run, events, os.path.join(figures, f"microseismic_maps_{tag}.png"),
                   f"{label}: {len(events)} events located from S-P time and direction (ref. Figs 7.6, 7.9, 7.10)")
-        results[f"brune_{tag}"] = plot_brune(events, os.path.join(HERE, f"microseismic_brune_{tag}.png"),
+        results[f"brune_{tag}"] = plot_brune(events, os.path.join(figures, f"microseismic_brune_{tag}.png"),
                                              f"{label}: Brune's equation, one well (ref. Figs 7.7-7.8)")
         studies[label] = location_study(run, events, 5 if args.quick else args.draws)
         results[f"location_{tag}"] = studies[label]
@@ -365,7 +400,7 @@ def main(argv=None):
         print(markdown_table(["run", "wall / CPU (s)", "failed natural elements", "shear events", "Mw",
                               "median DC share", "distinct onset times"], run_rows))
     if studies:
-        plot_location_errors(studies, os.path.join(HERE, "microseismic_location_error.png"))
+        plot_location_errors(studies, os.path.join(figures, "microseismic_location_error.png"))
 
     if not args.skip_inversion:
         rows, samples = inversion_study(3 if args.quick else args.draws)
@@ -376,9 +411,13 @@ def main(argv=None):
                                f"{r['angle_median']:.2f} / {r['angle_p90']:.2f}", f"{100 * r['within_5deg']:.0f}%",
                                f"{r['potency_median']:.3f} [{r['potency_p5']:.3f}, {r['potency_p95']:.3f}]",
                                f"{r['wall']:.2f} / {r['cpu']:.2f}"] for r in rows]))
-        plot_inversion(samples, os.path.join(HERE, "microseismic_source_inversion.png"))
+        plot_inversion(samples, os.path.join(figures, "microseismic_source_inversion.png"))
     results["load_end"] = _load()
-    with open(os.path.join(args.out, "microseismic.json"), "w") as handle:
+    path = os.path.join(args.out, "microseismic.json")
+    if args.reuse and os.path.isfile(path):  # keep the parts this run did not redo
+        with open(path) as handle:
+            results = {**json.load(handle), **results}
+    with open(path, "w") as handle:
         json.dump(results, handle, indent=1, default=float)
     print(f"load at end {_load():.2f}")
 

@@ -127,7 +127,8 @@ def read_run(out, height=None):
     for time_value, name in entries:
         points, cells, data = read_vtu(out / name)
         mesh = mesh_from_vtu(points, cells, data)
-        step = int(Path(name).stem.split("-")[-1]) if Path(name).stem.split("-")[-1].isdigit() else 0
+        suffix = Path(name).stem.rsplit("-", 1)[-1]  # vtu/step-NNNNNN.vtu
+        step = int(suffix) if suffix.isdigit() else 0
         onset.tolerance = 1e-6 * float(np.max(mesh.radii))
         onset.observe(mesh.centers, _slipping(data), time_value, step)
     dd = np.asarray(data["dd"], dtype=float)[:, :mesh.dim]
