@@ -92,7 +92,17 @@ class BlockStorage:
 
     def matmat_permuted(self, x):
         """y = A x for x of shape (nrhs, N*d) (transposed!) in the permuted ordering;
-        returns y of shape (nrhs, N*d). Parallel and race-free."""
+        returns y of shape (nrhs, N*d). Parallel and race-free; on one thread below
+        ``SERIAL_MATVEC_ENTRIES`` stored entries x right-hand sides and on the cores
+        other processes leave free (:func:`~hmatddm.hmatrix._threads.threads_for`;
+        the same result whatever the count)."""
+        from ._threads import SERIAL_MATVEC_ENTRIES, threads_for
+
+        entries = self.dense_values.size + self.u_values.size + self.v_values.size
+        with threads_for(entries * x.shape[0], SERIAL_MATVEC_ENTRIES):
+            return self._matmat_permuted(x)
+
+    def _matmat_permuted(self, x):
         return _matmat_permuted(
             self.dof,
             self.dense_col_start,
