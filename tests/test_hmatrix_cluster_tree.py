@@ -149,3 +149,23 @@ def test_block_tree_refuses_bad_eta():
     for bad in (0.0, -1.0, np.inf, np.nan):
         with pytest.raises(InputError, match="eta"):
             block_tree(tree, bad)
+
+
+def test_group_split_keeps_each_group_whole_until_a_cluster_holds_one_group():
+    """Three parallel strips (groups) close together: every cluster holds either whole
+    groups or part of a single group, and the tree still partitions the elements."""
+    rng = np.random.default_rng(0)
+    strips = [np.column_stack([rng.uniform(0, 10, 300), np.full(300, 0.3 * k), rng.uniform(0, 1, 300)])
+              for k in range(3)]
+    points = np.concatenate(strips)
+    groups = np.repeat(np.arange(3), 300)
+    tree = cluster_tree(points, 0.01, leaf_size=32, groups=groups)
+    assert np.array_equal(np.sort(tree.permutation), np.arange(900))
+    counts = np.bincount(groups)
+    for c in range(tree.n_clusters):
+        members = groups[tree.permutation[tree.start[c]:tree.stop[c]]]
+        present = np.unique(members)
+        if present.size > 1:  # several groups: only whole ones
+            assert all(np.count_nonzero(members == g) == counts[g] for g in present)
+    with pytest.raises(InputError, match="groups"):
+        cluster_tree(points, 0.01, leaf_size=32, groups=groups[:10])

@@ -91,13 +91,40 @@ def _principal_split(points):
     return order[:half], order[half:]
 
 
-def cluster_tree(points, radii, leaf_size=64):
+def _group_split(points, groups):
+    """Split whole groups (e.g. fractures): order the groups by the projection of
+    their centroids on the principal axis of the points and cut where the element
+    count is closest to half (at least one group on each side). None when all
+    points are in one group."""
+    labels, inverse, counts = np.unique(groups, return_inverse=True, return_counts=True)
+    if labels.size < 2:
+        return None
+    centred = points - points.mean(axis=0)
+    _, vectors = np.linalg.eigh(centred.T @ centred)
+    projection = centred @ vectors[:, -1]
+    centroid = np.bincount(inverse, weights=projection, minlength=labels.size) / counts
+    order = np.argsort(centroid, kind="stable")
+    cumulative = np.cumsum(counts[order])
+    cut = int(np.clip(np.argmin(np.abs(cumulative - 0.5 * points.shape[0])) + 1, 1, labels.size - 1))
+    left = np.zeros(labels.size, dtype=bool)
+    left[order[:cut]] = True
+    first = np.flatnonzero(left[inverse])
+    second = np.flatnonzero(~left[inverse])
+    return first, second
+
+
+def cluster_tree(points, radii, leaf_size=64, groups=None):
     """Build the cluster tree of element centres ``points`` (N, dim).
 
     Each cluster with more than ``leaf_size`` elements is bisected at the median of
     the projections of its centres on their principal axis (largest eigenvector of
     the covariance), which follows tilted planar fractures. Balanced by
     construction: depth ceil(log2(N / leaf_size)). Cost O(N log N).
+
+    ``groups`` (N,) int, optional (e.g. the fracture of each element): a cluster that
+    holds several groups is split between whole groups (:func:`_group_split`), so
+    that every cluster below the group level lies on one fracture, whose blocks have
+    the low ranks of a planar crack; the tree is then only roughly balanced.
     """
     points = np.ascontiguousarray(points, dtype=np.float64)
     if points.ndim != 2 or points.shape[0] < 1:
@@ -106,6 +133,10 @@ def cluster_tree(points, radii, leaf_size=64):
     radii = np.broadcast_to(np.asarray(radii, dtype=np.float64), (n,))
     if isinstance(leaf_size, bool) or not isinstance(leaf_size, (int, np.integer)) or leaf_size < 1:
         raise InputError(f"leaf_size must be an integer >= 1, got {leaf_size!r}")
+    if groups is not None:
+        groups = np.asarray(groups)
+        if groups.shape != (n,) or not np.issubdtype(groups.dtype, np.integer):
+            raise InputError(f"groups must be an integer array of shape ({n},), got {groups.dtype} {groups.shape}")
 
     permutation = np.arange(n, dtype=np.int64)
     # Clusters are appended breadth-first, so numbering goes level by level.
@@ -115,7 +146,8 @@ def cluster_tree(points, radii, leaf_size=64):
         lo, hi = start[current], stop[current]
         if hi - lo > leaf_size:
             members = permutation[lo:hi]
-            first, second = _principal_split(points[members])
+            split = None if groups is None else _group_split(points[members], groups[members])
+            first, second = _principal_split(points[members]) if split is None else split
             mid = lo + first.size
             permutation[lo:hi] = np.concatenate((members[first], members[second]))
             left.append(len(start))

@@ -73,7 +73,7 @@ class HMatrix(LinearOperator):
 
     # ------------------------------------------------------------------ construction
     @classmethod
-    def build(cls, generator, eps=1e-4, eta=3.0, leaf_size=64, factor_dtype=None, check_finite=False):
+    def build(cls, generator, eps=1e-4, eta=3.0, leaf_size=64, factor_dtype=None, check_finite=False, groups=None):
         """Cluster, partition and compress the matrix of ``generator``.
 
         Parameters
@@ -95,6 +95,9 @@ class HMatrix(LinearOperator):
             entry once, ~0.3% of the build time). Off by default so that callers can
             give their own, domain-specific message (see :meth:`is_finite`). A NaN met
             by the ACA in a far-field block always raises InputError.
+        groups : (N,) int array, optional
+            Group of each element (e.g. its fracture): clusters are split between
+            whole groups first (see :func:`~hmatddm.hmatrix.cluster_tree.cluster_tree`).
 
         Cost: O(N log N) for the trees, kernel evaluations of the near field plus
         O((m + n) k) per far block, run on numba's thread count.
@@ -104,7 +107,7 @@ class HMatrix(LinearOperator):
         _check_parameters(eps, eta, leaf_size)
         dtype = _factor_dtype(factor_dtype, eps)
         started = time.perf_counter()
-        tree = cluster_tree(generator.points, generator.radii, int(leaf_size))
+        tree = cluster_tree(generator.points, generator.radii, int(leaf_size), groups=groups)
         blocks = block_tree(tree, float(eta))
         try:
             storage = assemble(generator, tree, blocks, float(eps), factor_dtype=dtype)
