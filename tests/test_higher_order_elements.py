@@ -127,6 +127,23 @@ def test_stress_at_collocation_points_gives_the_operator_traction(order):
     assert np.allclose(mean, 1.25 * (stress[:, 0, 0] + stress[:, 1, 1]) / 3.0, rtol=1e-14, atol=0.0)
 
 
+@pytest.mark.parametrize("order", [1, 2])
+def test_stress_on_an_element_is_the_mean_of_its_faces(order):
+    """A varying DD makes s_tt jump across its element; on the element (a tilted one far
+    from the origin, so that its nodes are off its line by round-off) stress_at returns
+    the mean of the two faces, whatever the sign of the round-off."""
+    angle, centre = 0.37, np.array([3.1, -2.3])
+    tangent = np.array([np.cos(angle), np.sin(angle)])
+    mesh = hd.Mesh2D.from_segments([centre - 0.3 * tangent], [centre + 0.3 * tangent], element_order=order)
+    dd = np.outer(np.linspace(-1.0, 2.0, order + 1), tangent + 0.5 * mesh.normals[0])[None]
+    normal = mesh.normals[0]
+    on = hd.stress_at(mesh, MATERIAL, dd, mesh.collocation_points)
+    above = hd.stress_at(mesh, MATERIAL, dd, mesh.collocation_points + 1e-7 * normal)
+    below = hd.stress_at(mesh, MATERIAL, dd, mesh.collocation_points - 1e-7 * normal)
+    assert np.max(np.abs(above - below)) > 0.1 * np.max(np.abs(on))  # the faces differ
+    assert np.allclose(on, 0.5 * (above + below), rtol=0.0, atol=1e-5 * np.max(np.abs(on)))
+
+
 def test_unknowns_are_element_major_then_node_then_component():
     mesh = hd.mesh.line([0.0, 0.0], [3.0, 1.0], 3, element_order=2)
     matrix = hd.ElasticityOperator(mesh, MATERIAL).to_dense()

@@ -21,7 +21,7 @@ are elementary (derived by parts, checked by differentiation):
 
 and ``int (s/a)^m F(x - s) ds`` follows from ``s = x - X`` by the binomial expansion. The
 jump of ``T`` across the element (``[T] = +-pi`` inside it) is the jump of ``s_xx``
-that a varying DD carries; exactly on the element (``y = 0``) the mean of the two faces
+that a varying DD carries; on the element (``|y| <= 1e-12 a``) the mean of the two faces
 is returned (``[T] = 0``). The traction on the element's line is continuous.
 
 Far from the element (``x^2 + y^2 > FAR_RATIO^2 a^2``) the closed form loses digits to
@@ -98,7 +98,7 @@ def monomial_integrals(x, y, a, out):
     # [L] and [T] between the ends X1 = x - a and X2 = x + a
     dlog = 0.5 * math.log(r2 / r1)
     dangle = 0.0
-    if y != 0.0:
+    if abs(y) > 1e-12 * a:  # on the element's line to round-off: the mean of both faces
         dangle = math.atan2(y * (x2 - x1), ysq + x1 * x2)
     moments = np.empty((4, 3))
     for d in range(4):
