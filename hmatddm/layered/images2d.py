@@ -137,7 +137,6 @@ def trace(t, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, p
     q_eps = np.empty(cap + 2)
     q_coef = np.zeros((cap + 2, 2, 2, n_orders))
     q_dcoef = np.zeros((cap + 2, 2, 2, n_orders))
-    q_out = np.full(cap + 2, -1, dtype=np.int64)
     g_s = shear_modulus[source_layer]
     delta_s = 1.0 / (3.0 - 4.0 * poisson_ratio[source_layer])
     k_2d = _INV_4PI / (g_s * (1.0 + delta_s))
@@ -264,12 +263,23 @@ def pair_stress_gradient(r1, r3, eps, coef, dcoef, n_orders, delta, shear_modulu
     the stress component ``c`` (0: xx, 1: xy, 2: yy) at a receiver ``(r1, r3)`` from the
     point the pair emanates from, for a unit force along ``f``. ``delta``, shear modulus
     and Lame constant are the receiver layer's; ``eps = dz/dt``."""
+    work = Workspace(n_orders)
+    _pair_stress_gradient(r1, r3, eps, coef, dcoef, n_orders, delta, shear_modulus, lame, out, work)
+
+
+@njit(cache=True)
+def Workspace(n_orders):
+    """Scratch arrays of :func:`_pair_stress_gradient` (allocated once per caller)."""
+    return (np.empty(n_orders + 6, dtype=np.complex128), np.zeros((5, n_orders + 5)), np.empty((2, 5, 5)),
+            np.empty((2, 5, 5)), np.empty(4))
+
+
+@njit(cache=True)
+def _pair_stress_gradient(r1, r3, eps, coef, dcoef, n_orders, delta, shear_modulus, lame, out, work):
+    gk, beta, table, dtable, grad = work
     w = complex(r1, r3)
     inv = 1.0 / w
-    kmax = 4 + n_orders
-    gk = np.empty(kmax + 1, dtype=np.complex128)
-    gk[0] = 0.0
-    gk[1] = 0.0
+    kmax = 3 + n_orders  # a + b <= 4 in the tables, plus D^(n_orders - 1)
     gk[2] = inv
     power = inv
     fact = 1.0
@@ -277,15 +287,11 @@ def pair_stress_gradient(r1, r3, eps, coef, dcoef, n_orders, delta, shear_modulu
         power = power * inv
         fact *= (k - 2)
         gk[k] = fact * power if k % 2 == 0 else -fact * power
-    table = np.empty((2, 5, 5))
-    dtable = np.empty((2, 5, 5))
-    beta = np.zeros((5, 5 + n_orders))
-    grad = np.empty(4)
     for f in range(2):
         for a in range(5):
             ib = complex(1.0, 0.0)
-            for b in range(5 + n_orders):
-                if 2 <= a + b <= kmax:
+            for b in range(kmax + 1 - a):
+                if a + b >= 2:
                     v = ib * gk[a + b]
                     beta[a, b] = -v.real if f == 0 else -v.imag
                 ib = ib * 1j
@@ -340,19 +346,20 @@ def _contract(gradient, normal, shear_modulus, lame, weight, out):
 
 @njit(cache=True)
 def _complementary_gradient(y1, y3, receiver_layer, x1, n_pairs, source_layer, t, pair_layer, pair_z, pair_eps,
-                            pair_coef, pair_dcoef, shear_modulus, poisson_ratio, gradient):
+                            pair_coef, pair_dcoef, shear_modulus, poisson_ratio, gradient, work, work1):
     """``gradient[f, q, c]`` of the complementary field (see the module docstring) at a
-    receiver from the traced pairs of a source point ``(x1, t)``."""
+    receiver from the traced pairs of a source point ``(x1, t)``; ``work``: a
+    :func:`Workspace` of the pairs' order, ``work1`` one of order 1."""
     gradient[:] = 0.0
-    n_orders = pair_coef.shape[3]
+    n_orders = pair_coef.shape[-1]
     g_r = shear_modulus[receiver_layer]
     nu_r = poisson_ratio[receiver_layer]
     delta_r = 1.0 / (3.0 - 4.0 * nu_r)
     lame_r = _lame(g_r, nu_r)
     for k in range(n_pairs):
         if pair_layer[k] == receiver_layer:
-            pair_stress_gradient(y1 - x1, y3 - pair_z[k], pair_eps[k], pair_coef[k], pair_dcoef[k], n_orders,
-                                 delta_r, g_r, lame_r, gradient)
+            _pair_stress_gradient(y1 - x1, y3 - pair_z[k], pair_eps[k], pair_coef[k], pair_dcoef[k], n_orders,
+                                  delta_r, g_r, lame_r, gradient, work)
     if receiver_layer != source_layer:
         # minus the whole-plane field of the source's material (added in closed form)
         g_s = shear_modulus[source_layer]
@@ -365,7 +372,7 @@ def _complementary_gradient(y1, y3, receiver_layer, x1, n_pairs, source_layer, t
         coef[1, 0, 0] = -k_2d
         coef[1, 1, 0] = -k_2d
         dcoef = np.zeros((2, 2, 1))
-        pair_stress_gradient(y1 - x1, y3 - t, 1.0, coef, dcoef, 1, delta_s, g_s, _lame(g_s, nu_s), gradient)
+        _pair_stress_gradient(y1 - x1, y3 - t, 1.0, coef, dcoef, 1, delta_s, g_s, _lame(g_s, nu_s), gradient, work1)
 
 
 @njit(cache=True)
@@ -410,10 +417,53 @@ def image_point_stress(y1, y3, receiver_layer, x1, x3, source_layer, normal, int
                     pair_eps, pair_coef, pair_dcoef)
     gradient = np.empty((2, 2, 3))
     _complementary_gradient(y1, y3, receiver_layer, x1, n_pairs, source_layer, x3, pair_layer, pair_z, pair_eps,
-                            pair_coef, pair_dcoef, shear_modulus, poisson_ratio, gradient)
+                            pair_coef, pair_dcoef, shear_modulus, poisson_ratio, gradient, Workspace(n_orders),
+                            Workspace(1))
     out[:] = 0.0
     g_s = shear_modulus[source_layer]
     _contract(gradient, normal, g_s, _lame(g_s, poisson_ratio[source_layer]), 1.0, out)
+
+
+@njit(cache=True)
+def trace_points(p0, p1, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, xi):
+    """The image pairs of the source points ``x(xi)`` of the element ``p0 -> p1``:
+    ``(n_pairs (G,), layer (G, P), z (G, P), eps (G, P), coef (G, P, 2, 2, O), dcoef)``."""
+    cap, n_orders = trace_capacity(source_layer, shear_modulus, n_images)
+    n_points = xi.shape[0]
+    n_pairs = np.empty(n_points, dtype=np.int64)
+    layer = np.empty((n_points, cap), dtype=np.int64)
+    z = np.empty((n_points, cap))
+    eps = np.empty((n_points, cap))
+    coef = np.zeros((n_points, cap, 2, 2, n_orders))
+    dcoef = np.zeros((n_points, cap, 2, 2, n_orders))
+    for g in range(n_points):
+        x3 = 0.5 * (p0[1] + p1[1]) + 0.5 * xi[g] * (p1[1] - p0[1])
+        n_pairs[g] = trace(x3, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, layer[g], z[g],
+                           eps[g], coef[g], dcoef[g])
+    return n_pairs, layer, z, eps, coef, dcoef
+
+
+@njit(cache=True)
+def _integrate(y1, y3, receiver_layer, p0, p1, source_layer, shear_modulus, poisson_ratio, xi, weights, shape,
+               traced, offset, out, gradient, work, work1):
+    """``out += `` the Gauss sum of :func:`image_element_stress` with the pairs traced
+    at the points ``offset ... offset + len(xi)`` of ``traced`` (:func:`trace_points`)."""
+    n_pairs, layer, z, eps, coef, dcoef = traced
+    tx = p1[0] - p0[0]
+    ty = p1[1] - p0[1]
+    length = math.sqrt(tx * tx + ty * ty)
+    normal = np.array([-ty / length, tx / length])
+    jac = 0.5 * length
+    g_s = shear_modulus[source_layer]
+    lame_s = _lame(g_s, poisson_ratio[source_layer])
+    for g in range(xi.shape[0]):
+        x1 = 0.5 * (p0[0] + p1[0]) + 0.5 * xi[g] * tx
+        x3 = 0.5 * (p0[1] + p1[1]) + 0.5 * xi[g] * ty
+        k = offset + g
+        _complementary_gradient(y1, y3, receiver_layer, x1, n_pairs[k], source_layer, x3, layer[k], z[k], eps[k],
+                                coef[k], dcoef[k], shear_modulus, poisson_ratio, gradient, work, work1)
+        for m in range(shape.shape[1]):
+            _contract(gradient, normal, g_s, lame_s, weights[g] * jac * shape[g, m], out[m])
 
 
 @njit(cache=True)
@@ -426,32 +476,10 @@ def image_element_stress(y1, y3, receiver_layer, p0, p1, source_layer, interface
     ``x(xi) = (p0 + p1)/2 + xi (p1 - p0)/2`` and ``J = |p1 - p0|/2``; ``xi`` in [-1, 1].
     Constant elements: ``shape = ones((n_gauss, 1))``.
     """
-    tx = p1[0] - p0[0]
-    ty = p1[1] - p0[1]
-    length = math.sqrt(tx * tx + ty * ty)
-    normal = np.array([-ty / length, tx / length])
-    jac = 0.5 * length
-    cap, n_orders = trace_capacity(source_layer, shear_modulus, n_images)
-    pair_layer = np.empty(cap, dtype=np.int64)
-    pair_z = np.empty(cap)
-    pair_eps = np.empty(cap)
-    pair_coef = np.zeros((cap, 2, 2, n_orders))
-    pair_dcoef = np.zeros((cap, 2, 2, n_orders))
-    gradient = np.empty((2, 2, 3))
-    g_s = shear_modulus[source_layer]
-    lame_s = _lame(g_s, poisson_ratio[source_layer])
+    traced = trace_points(p0, p1, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, xi)
     out[:] = 0.0
-    for g in range(xi.shape[0]):
-        x1 = 0.5 * (p0[0] + p1[0]) + 0.5 * xi[g] * tx
-        x3 = 0.5 * (p0[1] + p1[1]) + 0.5 * xi[g] * ty
-        pair_coef[:] = 0.0
-        pair_dcoef[:] = 0.0
-        n_pairs = trace(x3, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, pair_layer, pair_z,
-                        pair_eps, pair_coef, pair_dcoef)
-        _complementary_gradient(y1, y3, receiver_layer, x1, n_pairs, source_layer, x3, pair_layer, pair_z, pair_eps,
-                                pair_coef, pair_dcoef, shear_modulus, poisson_ratio, gradient)
-        for m in range(shape.shape[1]):
-            _contract(gradient, normal, g_s, lame_s, weights[g] * jac * shape[g, m], out[m])
+    _integrate(y1, y3, receiver_layer, p0, p1, source_layer, shear_modulus, poisson_ratio, xi, weights, shape, traced,
+               0, out, np.empty((2, 2, 3)), Workspace(traced[4].shape[-1]), Workspace(1))
 
 
 # -- quadrature ----------------------------------------------------------------------------
@@ -529,37 +557,84 @@ def subdivisions(y1, y3, receiver_layer, p0, p1, source_layer, interfaces, max_s
 
 
 # -- block generator for constant elements -------------------------------------------------
+#: Sub-segment levels (2^level sub-segments) whose traced pairs a source keeps.
+_CACHED_LEVELS = 4
+
+
 @njit(cache=True)
-def _pair(i, j, centers, frames, half_length, layer, params, settings, interfaces, shear_modulus, poisson_ratio,
-          out, work, image):
-    """Global traction ``out[p, q]`` at element i's collocation point for a unit global
-    DD ``q`` of constant element j: closed form (source layer's material) + images."""
+def _level_rule(n_gauss, max_level):
+    """Composite rules of 2^level sub-segments, levels 0..max_level, stacked:
+    ``(xi, w, start)`` with level l at ``start[l]:start[l + 1]``."""
+    start = np.zeros(max_level + 2, dtype=np.int64)
+    for level in range(max_level + 1):
+        start[level + 1] = start[level] + n_gauss * 2 ** level
+    xi = np.empty(start[-1])
+    w = np.empty(start[-1])
+    for level in range(max_level + 1):
+        x, wt = composite_rule(n_gauss, 2 ** level)
+        xi[start[level]:start[level + 1]] = x
+        w[start[level]:start[level + 1]] = wt
+    return xi, w, start
+
+
+@njit(cache=True)
+def _source_block(j, rows, centers, frames, half_length, layer, params, settings, interfaces, shear_modulus,
+                  poisson_ratio, alpha, self_max, out, column):
+    """Traction ``out[2 ia + p, column + q]`` at the collocation points of ``rows`` for a
+    unit global DD ``q`` of constant element ``j``: closed form (source layer's material)
+    plus images, the source's traced pairs reused across receivers."""
     shift = params[2]
     near_fraction = params[4]
     n_images = int(settings[0])
     n_gauss = int(settings[1])
     max_sub = int(settings[2])
     ls = layer[j]
-    lr = layer[i]
-    point = centers[i]
-    normal = frames[i, 1]
-    near = 0.0
-    if i != j:
-        near = near_fraction * min(half_length[i], half_length[j])
-    line2d.traction_pair(point, normal, centers[j], frames[j], half_length[j], shear_modulus[ls], poisson_ratio[ls],
-                         shift, out, work, near)
-    if interfaces.shape[0] == 0:
-        return
+    work = np.empty((2, 2, 2))
+    pair = np.empty((2, 2))
+    image = np.zeros((1, 2, 2, 2))
+    gradient = np.empty((2, 2, 3))
     p0 = centers[j] - half_length[j] * frames[j, 0]
     p1 = centers[j] + half_length[j] * frames[j, 0]
-    n_sub = subdivisions(point[0], point[1], lr, p0, p1, ls, interfaces, max_sub)
-    xi, wt = composite_rule(n_gauss, n_sub)
-    shape = np.ones((xi.shape[0], 1))
-    image_element_stress(point[0], point[1], lr, p0, p1, ls, interfaces, shear_modulus, poisson_ratio, n_images, xi,
-                         wt, shape, image)
-    for p in range(2):
-        for q in range(2):
-            out[p, q] += image[0, q, p, 0] * normal[0] + image[0, q, p, 1] * normal[1]
+    layered = interfaces.shape[0] > 0
+    max_level = _CACHED_LEVELS - 1
+    xi, wt, start = _level_rule(n_gauss, max_level)
+    traced = trace_points(p0, p1, ls, interfaces, shear_modulus, poisson_ratio, n_images, xi[:0])
+    if layered:
+        traced = trace_points(p0, p1, ls, interfaces, shear_modulus, poisson_ratio, n_images, xi)
+    ws = Workspace(traced[4].shape[-1])
+    ws1 = Workspace(1)
+    for ia in range(rows.shape[0]):
+        i = rows[ia]
+        point = centers[i]
+        normal = frames[i, 1]
+        near = 0.0
+        if i != j:
+            near = near_fraction * min(half_length[i], half_length[j])
+        line2d.traction_pair(point, normal, centers[j], frames[j], half_length[j], shear_modulus[ls],
+                             poisson_ratio[ls], shift, pair, work, near)
+        if layered:
+            lr = layer[i]
+            n_sub = subdivisions(point[0], point[1], lr, p0, p1, ls, interfaces, max_sub)
+            level = 0
+            while 2 ** level < n_sub:
+                level += 1
+            image[:] = 0.0
+            if level <= max_level:
+                a, b = start[level], start[level + 1]
+                _integrate(point[0], point[1], lr, p0, p1, ls, shear_modulus, poisson_ratio, xi[a:b], wt[a:b],
+                           np.ones((b - a, 1)), traced, a, image, gradient, ws, ws1)
+            else:
+                x, w = composite_rule(n_gauss, 2 ** level)
+                image_element_stress(point[0], point[1], lr, p0, p1, ls, interfaces, shear_modulus, poisson_ratio,
+                                     n_images, x, w, np.ones((x.shape[0], 1)), image)
+            for p in range(2):
+                for q in range(2):
+                    pair[p, q] += image[0, q, p, 0] * normal[0] + image[0, q, p, 1] * normal[1]
+        if alpha > 0.0 and i != j:
+            scale_to_self(pair, alpha * self_max[j])
+        for p in range(2):
+            for q in range(2):
+                out[2 * ia + p, column + q] = pair[p, q]
 
 
 @njit(cache=True)
@@ -568,32 +643,23 @@ def traction_block(data, rows, cols, out):
     of constant elements in a layered medium. ``data = (centers, frames, half_length,
     half_length, params, self_max, layer, settings, interfaces, shear_modulus,
     poisson_ratio)`` with ``params = [0, 0, singular_shift, alpha, near_fraction]``,
-    ``settings = [n_images, gauss_points, max_subdivisions]``."""
+    ``settings = [n_images, gauss_points, max_subdivisions]``. Sub-segments come in
+    powers of two (:func:`subdivisions` rounded up)."""
     centers, frames, half_length, _unused, params, self_max, layer, settings, interfaces, g, nu = data
-    alpha = params[3]
-    work = np.empty((2, 2, 2))
-    image = np.empty((1, 2, 2, 2))
-    pair = np.empty((2, 2))
-    for ia in range(rows.shape[0]):
-        i = rows[ia]
-        for jb in range(cols.shape[0]):
-            j = cols[jb]
-            _pair(i, j, centers, frames, half_length, layer, params, settings, interfaces, g, nu, pair, work, image)
-            if alpha > 0.0 and i != j:
-                scale_to_self(pair, alpha * self_max[j])
-            for p in range(2):
-                for q in range(2):
-                    out[2 * ia + p, 2 * jb + q] = pair[p, q]
+    for jb in range(cols.shape[0]):
+        _source_block(cols[jb], rows, centers, frames, half_length, layer, params, settings, interfaces, g, nu,
+                      params[3], self_max, out, 2 * jb)
 
 
 @njit(cache=True, parallel=True)
 def traction_matrix(data, out):
-    """Dense assembly, parallel over row elements."""
+    """Dense assembly, parallel over source elements (their traced pairs are reused)."""
     n = data[0].shape[0]
-    cols = np.arange(n)
-    for i in prange(n):
-        rows = np.array([i])
-        traction_block(data, rows, cols, out[2 * i:2 * i + 2, :])
+    rows = np.arange(n)
+    centers, frames, half_length, _unused, params, self_max, layer, settings, interfaces, g, nu = data
+    for j in prange(n):
+        _source_block(j, rows, centers, frames, half_length, layer, params, settings, interfaces, g, nu, params[3],
+                      self_max, out, 2 * j)
 
 
 @njit(cache=True)
@@ -636,7 +702,10 @@ def stress_at_points(points, point_layer, centers, frames, half_length, layer, p
                     p0 = centers[j] - half_length[j] * frames[j, 0]
                     p1 = centers[j] + half_length[j] * frames[j, 0]
                     n_sub = subdivisions(points[m, 0], points[m, 1], lr, p0, p1, ls, interfaces, max_sub)
-                    xi, wt = composite_rule(n_gauss, n_sub)
+                    level = 0
+                    while 2 ** level < n_sub:  # as the block generator
+                        level += 1
+                    xi, wt = composite_rule(n_gauss, 2 ** level)
                     shape = np.ones((xi.shape[0], 1))
                     image_element_stress(points[m, 0], points[m, 1], lr, p0, p1, ls, interfaces, shear_modulus,
                                          poisson_ratio, n_images, xi, wt, shape, image)

@@ -56,7 +56,7 @@ class LayeredMedium:
     in_situ_stress: object = None
     toughness: object = None
     images: object = "auto"
-    image_tol: float = 1e-6
+    image_tol: float = 1e-4
     gauss_points: int = 4
 
     def __post_init__(self):

@@ -16,8 +16,30 @@ _CROSSING_NAMES = {"mohr-coulomb": "mohr-coulomb", "energy-release-rate": "energ
 
 
 def material(scene):
+    """The :class:`Elastic` of ``[material]``, or a :class:`LayeredMedium` of the
+    ``[[layer]]`` tables (2D, y up; per-layer s_hmin and toughness where given)."""
+    if "layer" in scene:
+        return layered_medium(scene)
     return Elastic(shear_modulus=scene["material"]["shear_modulus"],
                    poisson_ratio=scene["material"]["poisson_ratio"])
+
+
+def layered_medium(scene):
+    from ..layered import LayeredMedium
+
+    layers = scene["layer"]
+    stress = None
+    if any("s_hmin" in layer for layer in layers):
+        base = far_field_stress(scene)
+        stress = np.repeat(base[None], len(layers), axis=0)
+        for k, layer in enumerate(layers):
+            if "s_hmin" in layer:
+                stress[k, 0, 0] = -layer["s_hmin"]
+    toughness = None
+    if any("toughness" in layer for layer in layers):
+        toughness = [layer.get("toughness", scene["propagation"]["toughness"]) for layer in layers]
+    return LayeredMedium([layer["bottom"] for layer in layers[:-1]], [layer["shear_modulus"] for layer in layers],
+                         [layer["poisson_ratio"] for layer in layers], in_situ_stress=stress, toughness=toughness)
 
 
 def fluid(scene):
@@ -123,10 +145,15 @@ def build_simulation(scene, checkpoint_dir=None):
 
     mesh = initial_mesh(scene)
     _check_clusters(scene, mesh)
+    rock = material(scene)
+    if "layer" in scene:  # initial elements end on the interfaces
+        from ..layered import split_at_interfaces
+
+        mesh = split_at_interfaces(mesh, rock)[0]
     numerics = scene["numerics"]
     growing = scene.get("propagation", {}).get("growing_fractures")
     return Simulation(
-        mesh, material(scene), fluid(scene), clusters(scene), far_field_stress(scene), numerics["time_step"],
+        mesh, rock, fluid(scene), clusters(scene), far_field_stress(scene), numerics["time_step"],
         propagation=propagation(scene), leak_off=leak_off(scene), initial_pressure=numerics["initial_pressure"],
         initial_opening=numerics["initial_opening"], minimum_width=numerics.get("minimum_width"),
         height=scene.get("height", 1.0), backend=numerics["backend"], eps=numerics["eps"], eta=numerics["eta"],

@@ -355,6 +355,15 @@ MICROSEISMIC = {  # synthetic monitoring of the run (ref. Ch. 7): hmatddm.micros
     "merge": Key("boolean", False, doc="merge neighbouring elements failing in the same step"),
 }
 
+LAYER = {  # 2D vertical cross-section, y up; tables listed top down (ref. Ch. 3, hmatddm.LayeredMedium)
+    "bottom": Key("number", unit="m", doc="height of the interface below this layer; omit for the last layer"),
+    "shear_modulus": Key("number", REQUIRED, low=0.0, unit="Pa", doc="0: void (a free surface), top or bottom only"),
+    "poisson_ratio": Key("number", REQUIRED, low=0.0, high=0.5, high_open=True),
+    "s_hmin": Key("number", unit="Pa", doc="compressive stress along x in this layer (default: the [stress] one)"),
+    "toughness": Key("number", low=0.0, low_open=True, unit="Pa m^0.5",
+                     doc="K_Ic of this layer (default: propagation.toughness)"),
+}
+
 # name -> (keys, array of tables?, required?)
 SECTIONS = {
     "material": (MATERIAL, False, True),
@@ -370,6 +379,7 @@ SECTIONS = {
     "network": (NETWORK, False, False),
     "natural_fracture": (NATURAL_FRACTURE, True, False),
     "microseismic": (MICROSEISMIC, False, False),
+    "layer": (LAYER, True, False),
 }
 FILLED_WHEN_ABSENT = ("leak_off", "output")  # optional sections echoed with their defaults
 
@@ -613,7 +623,7 @@ def validate(raw, name=None):
 
     for section, (keys, is_array, required) in SECTIONS.items():
         if section not in raw:
-            if required:
+            if required and not (section == "material" and "layer" in raw):  # layers give the moduli
                 header = f"[[{section}]]" if is_array else f"[{section}]"
                 raise InputError(f"the scene needs a {header} section")
             if section in FILLED_WHEN_ABSENT:
@@ -660,6 +670,8 @@ def validate(raw, name=None):
         if fracture["p0"] == fracture["p1"]:
             raise InputError(f"natural_fracture[{i}].p0 and natural_fracture[{i}].p1 must differ, "
                              f"got {show(fracture['p0'])}")
+    if "layer" in scene:
+        _check_layers(scene)
     if "reference" in scene:
         _check_reference(scene)
     if has_natural_fractures(scene) and "contact" not in raw["numerics"]:
@@ -667,6 +679,26 @@ def validate(raw, name=None):
         # the Picard iteration with contact = "natural": in a network every element closes
         numerics["contact"] = "all"
     return scene
+
+
+def _check_layers(scene):
+    layers = scene["layer"]
+    if scene["dimension"] != 2:
+        raise InputError("[[layer]] tables need dimension = 2 (a vertical cross-section, y up)")
+    for i, layer in enumerate(layers):
+        last = i == len(layers) - 1
+        if not last and "bottom" not in layer:
+            raise InputError(f"layer[{i}].bottom is required (the height of the interface below it); only the last "
+                             "layer extends downwards without one")
+        if last and "bottom" in layer:
+            raise InputError(f"layer[{i}].bottom must be omitted: the last layer extends downwards to infinity")
+        if i > 0 and not last and layer["bottom"] >= layers[i - 1]["bottom"]:
+            raise InputError(f"layer[{i}].bottom must be below layer[{i - 1}].bottom = {show(layers[i - 1]['bottom'])} "
+                             f"(layers are listed top down), got {show(layer['bottom'])}")
+        if layer["shear_modulus"] == 0.0 and 0 < i < len(layers) - 1:
+            raise InputError(f"layer[{i}].shear_modulus = 0 (void) is allowed only for the top or bottom layer")
+    if "toughness" in [k for layer in layers for k in layer] and "propagation" not in scene:
+        raise InputError("layer toughness needs a [propagation] section")
 
 
 def has_natural_fractures(scene):

@@ -29,6 +29,7 @@ from ..errors import InputError, MeshQualityWarning, NoInjectionWarning, SizeLim
 from ..flow import Cluster, Fluid, LeakOff, LubricationModel, fracture_compliance
 from ..fracture import Propagation, evaluate_tips, new_elements
 from ..fracture.crossing import NaturalFractureProperties
+from ..layered.medium import LayeredMedium
 from ..material import Elastic
 from ..mesh import Mesh2D, Mesh3D, check_mesh, concatenate
 from ..extended_operator import ExtendedElasticityOperator
@@ -65,7 +66,7 @@ class State:
     failure_pressure: np.ndarray = None  # (N,) pore pressure of remotely failed elements (NaN otherwise)
     front_distance: np.ndarray = None  # (N,) asymptotic front: ribbon distance to the front (NaN elsewhere)
     front_velocity: np.ndarray = None  # (N,) asymptotic front: ribbon front velocity (NaN elsewhere)
-    front_class: np.ndarray = None     # (N,) asymptotic front: 0 channel, 1 tip, 2 empty (hmatddm.fracture.front)
+    front_class: np.ndarray = None     # (N,) asymptotic front: channel, tip, empty, filled (hmatddm.fracture.front)
 
     def __post_init__(self):
         n, d = self.dd.shape
@@ -114,7 +115,11 @@ class Simulation:
     ----------
     mesh : Mesh2D or Mesh3D
         The initial fracture(s).
-    material : Elastic
+    material : Elastic or LayeredMedium
+        A :class:`hmatddm.LayeredMedium` (2D vertical cross-section, constant elements):
+        the operator adds the layers' image terms (ref. Ch. 3), tips use their layer's
+        moduli and toughness (if given), elements their layer's in-situ stress (if given,
+        else ``far_field_stress``), and new tip elements are cut at the interfaces.
     fluid : Fluid
     clusters : list of Cluster
         Injection points; each feeds the element nearest its position.
@@ -177,8 +182,17 @@ class Simulation:
         if not isinstance(mesh, (Mesh2D, Mesh3D)):
             raise InputError(f"mesh must be a Mesh2D or Mesh3D, got {type(mesh).__name__}")
         check_mesh(mesh)
-        if not isinstance(material, Elastic):
-            raise InputError(f"material must be an hmatddm.Elastic, got {type(material).__name__}")
+        if mesh.element_order != 0:  # flow, tips and growth work on constant elements
+            raise InputError(f"mesh.element_order must be 0 for a Simulation (linear and quadratic elements are "
+                             f"for static solves: hd.ElasticityOperator, hd.solve), got {mesh.element_order}")
+        self.medium = material if isinstance(material, LayeredMedium) else None  # layered rock, ref. Ch. 3
+        if self.medium is not None:
+            from ..layered import engine as layered_engine
+
+            layered_engine.check_simulation(mesh, material, natural_fractures, propagation)
+        elif not isinstance(material, Elastic):
+            raise InputError(f"material must be an hmatddm.Elastic or hmatddm.LayeredMedium, got "
+                             f"{type(material).__name__}")
         if not isinstance(fluid, Fluid):
             raise InputError(f"fluid must be an hmatddm.Fluid, got {type(fluid).__name__}")
         clusters = list(clusters)
@@ -333,7 +347,23 @@ class Simulation:
 
     def far_field_traction(self, mesh):
         """f = -sigma_0 . n at every element (ref. Eq. 4.4, our sign), flat."""
+        if self.medium is not None:  # the in-situ stress of each element's layer, if given
+            from ..layered import engine as layered_engine
+
+            return layered_engine.far_field_traction(mesh, self.medium, self.far_field_stress)
         return -(mesh.normals @ self.far_field_stress.T).ravel()
+
+    def elastic_constants(self, mesh, elements=None):
+        """The material (an :class:`Elastic`), or in a layered medium the moduli of each
+        element (of ``elements``, if given) as arrays with the same attribute names."""
+        if self.medium is None:
+            return self.material
+        from ..layered import engine as layered_engine
+
+        materials = layered_engine.element_materials(mesh, self.medium)
+        if elements is None:
+            return materials
+        return layered_engine.ElementMaterials(materials.shear_modulus[elements], materials.poisson_ratio[elements])
 
     def flow_model(self, mesh, faces):
         areas = mesh.areas * (self.height if mesh.dim == 2 else 1.0)
@@ -389,7 +419,7 @@ class Simulation:
             p_guess = np.where(drained, failure_pressure, p_guess)
         problem = StepProblem(elastic=elastic, normals=mesh.normals,
                               far_field=self.far_field_traction(mesh), flow=flow,
-                              compliance=fracture_compliance(mesh, self.material), dt=t_new - t_old,
+                              compliance=fracture_compliance(mesh, self.elastic_constants(mesh)), dt=t_new - t_old,
                               width_old=dd_old_width, pressure_old=p_old,
                               leak_off_rate=flow.leak_off_rate(creation_time, t_old, t_new),
                               contact=contact, fixed_pressure=fixed_pressure)
@@ -545,11 +575,19 @@ class Simulation:
             element, edge = element[keep], edge[keep]
         if element.size == 0:
             return None
-        tips = evaluate_tips(mesh, edges, element, edge, dd, self.material, self.propagation)
+        tips = evaluate_tips(mesh, edges, element, edge, dd, self.elastic_constants(mesh, element), self.propagation)
+        if self.medium is not None:  # per-layer toughness; new elements end on interfaces
+            from ..layered import engine as layered_engine
+
+            tips = layered_engine.tip_criterion(tips, self.elastic_constants(mesh, element),
+                                                layered_engine.layers_ahead(edges, element, edge, self.medium),
+                                                self.medium, self.propagation)
         result = new_elements(mesh, edges, tips, self.propagation, return_tips=True)
         if result is None:
             return None
         grown, parent, rows = result
+        if self.medium is not None and not layered_engine.uniform(self.medium):
+            grown, parent, rows = layered_engine.split_new_elements(grown, parent, rows, self.medium)
         grown, parent, rows, junctions = self._junctions(mesh, edges, tips, grown, parent, rows, origin)
         if grown is None:
             return None, np.zeros(0, np.int64), np.zeros(0, np.int64), junctions, np.zeros(0, np.int64), np.zeros(0)
