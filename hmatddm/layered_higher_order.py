@@ -24,7 +24,7 @@ interfaces, shear_modulus, poisson_ratio, coefficients, nodes)`` with ``settings
 import numpy as np
 from numba import njit, prange
 
-from .kernels.line2d_higher_order import (near_distance, node_point, nodes_edge_distance, set_node_rows,
+from .kernels.line2d_higher_order import (edge_distance, near_distance, node_point, set_node_rows,
                                           store_block, stress_nodes, traction_nodes)
 from .layered.images2d import composite_rule, image_element_stress, subdivisions
 
@@ -100,7 +100,7 @@ def traction_block(data, rows, cols, out):
 def traction_matrix(data, out):
     """Dense assembly, parallel over row elements."""
     n = data[0].shape[0]
-    dof = 2 * data[12].shape[0]
+    dof = 2 * data[-1].shape[0]
     cols = np.arange(n)
     for i in prange(n):
         rows = np.array([i])
@@ -108,15 +108,9 @@ def traction_matrix(data, out):
 
 
 @njit(cache=True)
-def edge_distance(data, i, j):
-    """Distance from the collocation nodes of element ``i`` to the nearer end of element ``j``."""
-    return nodes_edge_distance(data[0], data[1], data[2], data[12], i, j)
-
-
-@njit(cache=True)
 def singular_pairs(data, rows, cols, out):
     """``out[k]`` = True when the block of receiver ``rows[k]`` and source ``cols[k]`` is not finite."""
-    dof = 2 * data[12].shape[0]
+    dof = 2 * data[-1].shape[0]
     block = np.empty((dof, dof))
     for k in range(rows.shape[0]):
         traction_block(data, rows[k:k + 1], cols[k:k + 1], block)
@@ -157,21 +151,30 @@ def stress_at_points(points, point_layer, data, dd, out):
         out[m] = acc
 
 
+def _constant_data(mesh, medium, singular_shift, near_fraction, n_images, gauss_points, max_subdivisions):
+    """The data of :func:`hmatddm.layered.influence2d.influence_data` (no Eq. 6.11
+    scaling), with the image quadrature's Gauss points and largest number of
+    sub-segments replaced where given."""
+    from .layered import influence2d
+
+    data = influence2d.influence_data(mesh, medium, singular_shift, 0.0, near_fraction, n_images)
+    if gauss_points is not None:
+        data[7][1] = float(gauss_points)
+    if max_subdivisions is not None:
+        data[7][2] = float(max_subdivisions)
+    return data
+
+
 def influence_data(mesh, medium, singular_shift, alpha, near_fraction, n_images, gauss_points=None,
                    max_subdivisions=None):
     """The data tuple of :func:`traction_block` for a linear or quadratic 2D ``mesh`` in
     ``medium``; ``gauss_points`` (default ``medium.gauss_points``) and
     ``max_subdivisions`` (default that of :mod:`hmatddm.layered.influence2d`) set the
     image quadrature; ``alpha > 0`` fills ``self_max`` for ref. Eq. 6.11."""
-    from .layered import influence2d
     from .shape_functions import coefficients, nodes
 
-    data = influence2d.influence_data(mesh, medium, singular_shift, 0.0, near_fraction, n_images)
+    data = _constant_data(mesh, medium, singular_shift, near_fraction, n_images, gauss_points, max_subdivisions)
     data[4][3] = float(alpha)
-    if gauss_points is not None:
-        data[7][1] = float(gauss_points)
-    if max_subdivisions is not None:
-        data[7][2] = float(max_subdivisions)
     data = data + (coefficients(mesh.element_order), nodes(mesh.element_order))
     if alpha > 0.0:
         self_max = data[5]
@@ -226,15 +229,11 @@ def dense_matrix(mesh, medium, n_images, gauss_points=None, max_subdivisions=Non
     """The dense traction matrix of a 2D mesh of any element order in ``medium`` with a
     given number of images and image quadrature (``max_subdivisions = 1``: the plain
     ``gauss_points``-point rule of ref. Table 3.2), for studies of those settings."""
-    from .layered import images2d, influence2d
+    from .layered import images2d
     from .operators import NEAR_SINGULAR_FRACTION
 
     if mesh.element_order == 0:
-        data = influence2d.influence_data(mesh, medium, 0.0, 0.0, NEAR_SINGULAR_FRACTION, n_images)
-        if gauss_points is not None:
-            data[7][1] = float(gauss_points)
-        if max_subdivisions is not None:
-            data[7][2] = float(max_subdivisions)
+        data = _constant_data(mesh, medium, 0.0, NEAR_SINGULAR_FRACTION, n_images, gauss_points, max_subdivisions)
         assemble = images2d.traction_matrix
     else:
         data = influence_data(mesh, medium, 0.0, 0.0, NEAR_SINGULAR_FRACTION, n_images, gauss_points,
@@ -246,5 +245,5 @@ def dense_matrix(mesh, medium, n_images, gauss_points=None, max_subdivisions=Non
     return out
 
 
-__all__ = ["traction_block", "traction_matrix", "stress_at_points", "influence_data", "image_count", "stress_at",
-           "image_nodes", "dense_matrix"]
+__all__ = ["traction_block", "traction_matrix", "edge_distance", "singular_pairs", "stress_at_points", "influence_data",
+           "image_count", "stress_at", "image_nodes", "dense_matrix"]

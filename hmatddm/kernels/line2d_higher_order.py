@@ -321,7 +321,7 @@ def store_block(block, out, ia, jb, i, j, alpha, self_max):
 def traction_matrix(data, out):
     """Dense assembly of the whole traction matrix, parallel over row elements."""
     centers = data[0]
-    dof = 2 * data[7].shape[0]
+    dof = 2 * data[-1].shape[0]
     n = centers.shape[0]
     cols = np.arange(n)
     for i in prange(n):
@@ -331,13 +331,10 @@ def traction_matrix(data, out):
 
 @njit(cache=True)
 def edge_distance(data, i, j):
-    """Distance from the collocation nodes of element ``i`` to the nearer end of element ``j``."""
-    return nodes_edge_distance(data[0], data[1], data[2], data[7], i, j)
-
-
-@njit(cache=True)
-def nodes_edge_distance(centers, frames, half_length, nodes, i, j):
-    """:func:`edge_distance` on the arrays themselves (any data layout)."""
+    """Distance from the collocation nodes of element ``i`` to the nearer end of element
+    ``j`` (any data tuple that starts with centres, frames, half lengths and ends with
+    the nodes, as the layered one of :mod:`hmatddm.layered_higher_order`)."""
+    centers, frames, half_length, nodes = data[0], data[1], data[2], data[-1]
     point = np.empty(2)
     best = np.inf
     for r in range(nodes.shape[0]):
@@ -351,7 +348,7 @@ def nodes_edge_distance(centers, frames, half_length, nodes, i, j):
 def singular_pairs(data, rows, cols, out):
     """``out[k]`` = True when the influence block of receiver ``rows[k]`` and source
     ``cols[k]`` (from :func:`traction_block`) is not finite: a singular pair."""
-    dof = 2 * data[7].shape[0]
+    dof = 2 * data[-1].shape[0]
     block = np.empty((dof, dof))
     for k in range(rows.shape[0]):
         traction_block(data, rows[k:k + 1], cols[k:k + 1], block)
