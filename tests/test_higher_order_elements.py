@@ -210,6 +210,10 @@ def test_bad_element_order_is_refused_by_name():
         hd.stress_at(mesh, MATERIAL, np.zeros((4, 3, 2)), [[0.5, 1.0]], method="tree")
     with pytest.raises(hd.InputError, match="lies on an element end"):
         hd.stress_at(mesh, MATERIAL, np.ones((4, 3, 2)), [[0.25, 0.0]])
+    with pytest.raises(hd.InputError, match="element_order must be 0 for a Simulation"):
+        hd.Simulation(mesh, MATERIAL, hd.Fluid(viscosity=1e-3, compressibility=4.4e-10),
+                      [hd.Cluster((0.5, 0.0), rate=0.01, wellbore_volume=0.005)], far_field_stress=-np.eye(2),
+                      time_step=1.0, propagation=hd.Propagation(toughness=1.0), initial_pressure=2.0)
 
 
 # -- layered media (ref. Ch. 3): closed form in the source's layer + Gauss-integrated images --
