@@ -67,7 +67,8 @@ def run(order, nodes, backend):
     exact = griffith_opening(x, 1.0, PRESSURE, MATERIAL)
     error = np.abs(hd.opening(mesh, dd).reshape(-1) - exact) / exact
     volume_exact = np.pi * 2.0 * (1.0 - MATERIAL.poisson_ratio) * PRESSURE / MATERIAL.shear_modulus / 2.0
-    return dict(order=order, nodes=nodes, elements=mesh.n_elements, backend=backend,
+    compression = operator.stats["compression"]
+    return dict(order=order, nodes=nodes, elements=mesh.n_elements, backend=backend, compression=compression,
                 half=float(error[np.abs(x) < 0.5].max()), inner=float(error[np.abs(x) < 0.8].max()),
                 volume=abs(crack_volume(mesh, dd) / volume_exact - 1.0), wall=wall, cpu=cpu)
 
@@ -99,10 +100,11 @@ def main():
         ref = constant[(r["nodes"], r["backend"])]
         table.append([r["nodes"], 2 * r["nodes"], names[r["order"]], r["elements"], r["backend"], f"{r['half']:.2e}",
                       f"{ref['half'] / r['half']:.1f}", f"{r['inner']:.2e}", f"{r['volume']:.1e}",
-                      f"{r['wall']:.3f}", f"{r['cpu']:.3f}"])
+                      f"{r['wall']:.3f}", f"{r['cpu']:.3f}", f"{r['compression']:.2f}"])
     print(f"\nMachine: {machine()}; calibration (LU of a 1500x1500 matrix, best of 3): {calib:.3f} s")
-    print(markdown_table(["nodes", "unknowns", "element type", "elements", "backend", "max rel. error |x|<a/2",
-                          "gain vs constant", "max rel. error |x|<0.8a", "volume error", "wall s", "CPU s"],
+    print(markdown_table(["nodes", "unknowns", "element type", "elements", "backend", "max rel. error \\|x\\|<a/2",
+                          "gain vs constant", "max rel. error \\|x\\|<0.8a", "volume error", "wall s", "CPU s",
+                          "compression (dense bytes / stored)"],
                          table))
     if args.plot:
         import matplotlib
