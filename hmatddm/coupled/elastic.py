@@ -1,7 +1,9 @@
 """Solves with the elasticity block ``A`` of the coupled system, for either backend.
 
 * ``dense``: LU factors, computed once per mesh and reused for every solve.
-* ``hmatrix``: GMRES preconditioned by the near field (ILU), warm-started.
+* ``hmatrix``: GMRES preconditioned by the operator's default preconditioner (near-field
+  block ILU; from 4000 elements plus the two-level coarse correction of
+  :mod:`hmatddm.hmatrix.coarse_space`), built once per operator, warm-started.
 * an :class:`~hmatddm.extended_operator.ExtendedElasticityOperator` (a grown mesh):
   GMRES preconditioned by its block-triangular near-field solve.
 
@@ -13,7 +15,8 @@ Every method takes optional contact ``rows`` (:class:`~hmatddm.coupled.contact.C
 the operator is then ``S A + D`` (closed elements, see :mod:`hmatddm.coupled.contact`),
 and the factorisations are those of ``S A + D`` (dense LU), of ``S A_near + D``
 (near-field ILU) or the block-triangular one with modified blocks (grown mesh); they
-are cached for the last set of statuses.
+are cached for the last set of statuses. Contact rows fall back to this scalar ILU of
+``S A_near + D``: the two-level correction is not built for modified rows.
 """
 import numpy as np
 import scipy.linalg
