@@ -3,6 +3,7 @@
     python benchmarks/bench_hmatrix.py                 # full study (about an hour on 2 cores)
     python benchmarks/bench_hmatrix.py --quick         # N = 1k, 4k only, short eps sweep
     python benchmarks/bench_hmatrix.py --case planar --n 10000 --eps 1e-4   # one case, JSON
+    python benchmarks/bench_hmatrix.py --tree-study 4000   # cloud: principal-axis vs fractures-first tree
 
 Three studies, each printed as a markdown table and saved (JSON + PNG) in benchmarks/out/:
 
@@ -173,6 +174,37 @@ def compare_preconditioners(op, b, rtol):
     return out
 
 
+def tree_study(n, leaf_size=32):
+    """Cloud of N elements: H-matrix with the principal-axis cluster tree against one split
+    between whole fractures first (``groups=fracture_id``); build wall and CPU, memory,
+    near field, ranks and the sampled smooth-field error. Returns a list of dicts."""
+    import hmatddm as hd
+    from hmatddm.hmatrix import BlockGenerator, HMatrix
+    from hmatddm.operators import influence_data
+
+    mesh = cloud(n)
+    kernels, data = influence_data(mesh, hd.Elastic(shear_modulus=10e9, poisson_ratio=0.25))
+    generator = BlockGenerator(kernel=kernels.traction_block, data=data, points=mesh.centers, radii=mesh.radii, dof=3)
+    x = smooth_field(mesh)
+    rows = np.sort(np.random.default_rng(2).choice(mesh.n_elements, 300, replace=False))
+    exact_rows = np.empty((3 * rows.size, 3 * mesh.n_elements))
+    kernels.traction_block(data, rows, np.arange(mesh.n_elements), exact_rows)
+    exact = exact_rows @ x
+    index = (3 * rows[:, None] + np.arange(3)).ravel()
+    out = []
+    for tree, groups in (("principal axis", None), ("fractures first", mesh.fracture_id)):
+        t0, c0 = time.perf_counter(), time.process_time()
+        h = HMatrix.build(generator, eps=1e-4, eta=3.0, leaf_size=leaf_size, groups=groups)
+        wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+        st = h.stats
+        error = float(np.linalg.norm((h @ x)[index] - exact) / np.linalg.norm(exact))
+        out.append(dict(n=mesh.n_elements, tree=tree, build_s=wall, build_cpu_s=cpu, memory_mb=st["memory_bytes"] / 2**20,
+                        near_mb=st["near_field_bytes"] / 2**20, max_rank=st["max_rank"], mean_rank=st["mean_rank"],
+                        smooth_error=error))
+        print(json.dumps(out[-1]), flush=True)
+    return out
+
+
 def dense_reference(mesh, material, x_smooth, x_random, traction, op, solve_limit):
     """Dense products and solution, cached in benchmarks/out/ (the eps sweep reuses them)."""
     import hmatddm as hd
@@ -327,8 +359,13 @@ def main():
     parser.add_argument("--sizes", default=None, help="comma-separated N (default 1000,4000,10000,40000,100000)")
     parser.add_argument("--skip-sweep", action="store_true")
     parser.add_argument("--geometries", default="planar,cloud", help="comma-separated: planar, cloud")
+    parser.add_argument("--tree-study", type=int, default=None, metavar="N",
+                        help="cloud of N elements: principal-axis tree against fractures-first tree, then exit")
     args = parser.parse_args()
     sys.path.insert(0, HERE)
+    if args.tree_study:
+        tree_study(args.tree_study)
+        return
     if args.case:
         print(json.dumps(run_case(args.case, args.n, args.eps, args.dense_limit, args.solve_limit,
                                   args.check_blocks, args.rtol)))
