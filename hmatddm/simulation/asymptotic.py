@@ -1,0 +1,288 @@
+"""Time steps of a planar fracture whose front lies inside the tip elements
+(``Propagation(front="asymptotic")``; implicit level set, Peirce and Detournay 2008).
+
+Elements are *channel* (fully fractured, the plain fluid-loaded elasticity rows),
+*tip* (crossed by the front: their opening is prescribed, the universal asymptote
+averaged over the element, :func:`hmatddm.fracture.front.fill`) or *empty* (reached by
+no front yet: opening 0). Every element keeps its flow row, so a tip element holds the
+fluid volume of its partial opening and its pressure is the one its fluxes need. Per
+time step, with the ribbon elements (channel elements next to the front) fixed:
+
+1. from the trial distances ``s_r`` of the ribbon centres to the front, the front
+   (:class:`~hmatddm.fracture.front.FrontField`), the tip elements and their openings;
+   elements the front reaches for the first time join the mesh (the operator grows by
+   border blocks, :meth:`Simulation.operator`);
+2. the coupled step (:func:`hmatddm.coupled.solve_step`, any scheme) with the tip rows
+   ``DD_i = w_i n_i``;
+3. the ribbon openings give new ``s_r`` by inverting the asymptote with ``V = (s_r -
+   s_r^n) / dt`` (:meth:`~hmatddm.fracture.tip_asymptote.TipAsymptote.front_distance`);
+
+until no ``s_r`` changes by more than ``front_tolerance`` element sizes.
+"""
+import logging
+import time
+
+import numpy as np
+
+from .. import topology
+from ..coupled import ElasticSolver, StepProblem, solve_step
+from ..coupled.contact import ContactRows
+from ..errors import ConvergenceError, InputError, SizeLimitError
+from ..flow import fracture_compliance
+from ..fracture.front import CHANNEL, EMPTY, FILLED, TIP, FrontField, PlanarGrid, fill, front_radii, level_set
+from ..fracture.tip_asymptote import TipAsymptote
+from ..mesh import concatenate
+
+logger = logging.getLogger(__name__)
+# sample points per element side for the filled fraction and mean opening of tip elements
+# (2D: a segment, fine and cheap; 3D: 8 x 8, the fraction of the front's many tip elements
+# averages out)
+SUB_SAMPLES = {1: 256, 2: 8}
+
+
+class PrescribedOpening:
+    """Elasticity rows ``k DD_i = k w_i n_i`` of the prescribed (tip, empty) elements, as
+    block-diagonal rows (the ``contact`` interface of :class:`~hmatddm.coupled.StepProblem`,
+    :class:`~hmatddm.coupled.contact.ContactRows`); ``k`` the element's own stiffness."""
+
+    frozen = 0
+
+    def __init__(self, prescribed, width, normals, stiffness):
+        n, d = normals.shape
+        select = np.repeat(np.eye(d)[None], n, axis=0)
+        select[prescribed] = 0.0
+        direct = np.zeros((n, d, d))
+        direct[prescribed] = stiffness[prescribed, None, None] * np.eye(d)
+        rhs = np.zeros((n, d))
+        rhs[prescribed] = (stiffness * width)[prescribed, None] * normals[prescribed]
+        self._rows = ContactRows(select, direct, rhs, hash((n, np.asarray(prescribed, bool).tobytes())))
+
+    def rows(self):
+        return self._rows
+
+    def reset(self):
+        pass
+
+    def update(self, dd, traction):
+        return 0
+
+
+class AsymptoticFront:
+    """The asymptotic front of one :class:`~hmatddm.Simulation` (checks its setup)."""
+
+    def __init__(self, simulation):
+        sim = simulation
+        prop = sim.propagation
+        unsupported = []
+        if sim.network is not None:
+            unsupported.append("natural fractures")
+        if sim.leak_off.coefficient != 0.0:
+            unsupported.append("leak-off (leak_off.coefficient > 0)")
+        if prop.bounds is not None:
+            unsupported.append("propagation.bounds")
+        if sim.contact == "all":
+            unsupported.append("contact = 'all'")
+        if unsupported:
+            raise InputError("propagation.front = 'asymptotic' supports one planar fracture without "
+                             + ", ".join(unsupported) + "; use propagation.front = 'element'")
+        self.grid = PlanarGrid(sim.mesh0)
+        if sim.growing_fractures is not None and int(sim.mesh0.fracture_id[0]) not in sim.growing_fractures:
+            raise InputError("propagation.front = 'asymptotic': the fracture is not among growing_fractures")
+        self.asymptote = TipAsymptote(sim.material.plane_strain_modulus, prop.toughness, sim.fluid.viscosity_prime)
+        self._solver = None
+
+    # -- the front at t = 0 -------------------------------------------------------------
+    def initial(self, mesh):
+        """``(front_distance, front_velocity, front_class)`` of the initial elements: every
+        element is a circle reaching the boundary of the initial rectangle of cells."""
+        grid = self.grid
+        cells = grid.cells(mesh.centers)
+        lo, hi = cells.min(axis=0) - 0.5, cells.max(axis=0) + 0.5
+        if int(np.prod(hi - lo).round()) != mesh.n_elements or np.unique(grid.key(cells)).size != mesh.n_elements:
+            raise InputError("propagation.front = 'asymptotic' needs an initial fracture that fills a rectangle "
+                             "(3D) or a segment (2D) of elements")
+        distance = grid.h * np.min(np.minimum(cells - lo, hi - cells), axis=1)
+        velocity = np.zeros(mesh.n_elements)
+        field = self.field(cells, distance, velocity, cells)
+        fraction, _, full = fill(cells, field, self.asymptote, SUB_SAMPLES[self.grid.k])
+        front_class = np.where(full, CHANNEL, np.where(fraction > 0.0, TIP, EMPTY)).astype(np.int64)
+        return distance, velocity, front_class
+
+    def field(self, cells, distance, velocity, channel):
+        """The :class:`~hmatddm.fracture.front.FrontField` of ribbon ``cells`` at ``distance``."""
+        margin = int(np.ceil(np.max(distance) / self.grid.h)) + 3
+        return FrontField(cells, distance, velocity, channel, self.grid.h, margin)
+
+    # -- one step ------------------------------------------------------------------------
+    def _solve(self, sim, mesh, prescribed, width, width_old, p_old, creation, dd, p, t_old, t_new, relaxation):
+        edges = topology.element_edges(mesh, sim.height)
+        faces = topology.element_faces(mesh, edges)
+        flow = sim.flow_model(mesh, faces)
+        op = sim.operator(mesh)
+        if self._solver is None or self._solver.operator is not op:
+            self._solver = ElasticSolver(op, rtol=sim.settings.linear_rtol)
+        rows = PrescribedOpening(prescribed, width, mesh.normals, self._solver.normal_stiffness(mesh.normals))
+        problem = StepProblem(elastic=self._solver, normals=mesh.normals, far_field=sim.far_field_traction(mesh),
+                              flow=flow, compliance=fracture_compliance(mesh, sim.material), dt=t_new - t_old,
+                              width_old=width_old, pressure_old=p_old,
+                              leak_off_rate=flow.leak_off_rate(creation, t_old, t_new), contact=rows)
+        guess = dd.copy()
+        guess[prescribed] = width[prescribed, None] * mesh.normals[prescribed]
+        dd, p, info = solve_step(problem, sim.settings, guess.ravel(), p, relaxation)
+        return dd.reshape(mesh.n_elements, mesh.dim), p, info, flow
+
+    def _candidates(self, cells, channel, field):
+        """Cells the front may cross: cells of the field's box within half a diagonal of the
+        front, not channel, plus every element of the mesh that is not channel (M, k)."""
+        grid = self.grid
+        k, h = grid.k, grid.h
+        box = np.stack(np.meshgrid(*[np.arange(n) for n in field.phi.shape], indexing="ij"), axis=-1)
+        box = box.reshape(-1, k) + field.low
+        near = box[field.at_cells(box) < 0.5 * np.sqrt(k) * h + 1e-9 * h]
+        own = cells[~channel]
+        both = np.unique(np.concatenate([near, own]), axis=0)
+        return both[~np.isin(grid.key(both), grid.key(cells[channel]))]
+
+    def step(self, sim, end_time=None):
+        start = time.perf_counter()
+        s = sim.state
+        prop = sim.propagation
+        grid, h = self.grid, self.grid.h
+        t_old, t_new = s.time, s.time + sim.time_step
+        if end_time is not None and t_new >= end_time - 1e-9 * sim.time_step:
+            t_new = float(end_time)
+        dt = t_new - t_old
+        mesh = s.mesh
+        width_old = np.sum(s.dd * mesh.normals, axis=1)
+        p_old, creation = s.pressure.copy(), s.creation_time.copy()
+        dd, p = s.dd.copy(), s.pressure.copy()
+        front_class = s.front_class.copy()
+        builds = sim.operator_builds
+
+        # the front at t_old
+        circle = np.isfinite(s.front_distance)
+        # the ribbon: channel elements with an edge neighbour that is not channel
+        cells = grid.cells(mesh.centers)
+        channel = (front_class == CHANNEL) | (front_class == FILLED)
+        channel_keys = grid.key(cells[channel])
+        around = grid.key(grid.neighbours(cells[channel]).reshape(-1, grid.k)).reshape(int(channel.sum()), -1)
+        ribbon = np.flatnonzero(channel)[~np.all(np.isin(around, channel_keys), axis=1)]
+        # (the field of the old ribbon: inward through the cells that were channel before it)
+        old = self.field(cells[circle], s.front_distance[circle], s.front_velocity[circle],
+                         cells[front_class == CHANNEL])
+        distance_old = np.maximum(-old.at_cells(cells[ribbon]), 0.0)
+        velocity = old.velocity(cells[ribbon] * h)
+        distance = distance_old + velocity * dt
+
+        totals = dict(nonlinear_iterations=0, linear_iterations=0, restarts=0, contact_changes=0)
+        relaxation = s.relaxation
+        added, change, iterations, last_change, weight = 0, np.inf, 0, np.inf, 1.0
+        for iterations in range(1, prop.front_iterations + 1):
+            field = self.field(cells[ribbon], distance, velocity, cells[channel])
+            candidates = self._candidates(cells, channel, field)
+            fraction, mean_width, full = fill(candidates, field, self.asymptote, SUB_SAMPLES[self.grid.k])
+            index = {key: i for i, key in enumerate(grid.key(cells).tolist())}
+            where = np.array([index.get(key, -1) for key in grid.key(candidates).tolist()], np.int64)
+            new = (where < 0) & (fraction > 0.0)
+            if np.any(new):
+                grown = grid.elements(candidates[new], mesh)
+                m = grown.n_elements
+                if sim.max_elements is not None and mesh.n_elements + m > sim.max_elements:
+                    raise SizeLimitError(
+                        f"growth in step {s.step + 1} (t = {t_new:g} s) would take the mesh to "
+                        f"{mesh.n_elements + m} elements, more than max_elements = {sim.max_elements}",
+                        elements=mesh.n_elements + m, limit=sim.max_elements)
+                _, parent = level_set(grid.plane(grown.centers), grid.plane(mesh.centers[channel]),
+                                      np.zeros(int(channel.sum())))
+                parent = np.flatnonzero(channel)[parent]
+                where[new] = mesh.n_elements + np.arange(m)
+                mesh = concatenate([mesh, grown])
+                cells = np.concatenate([cells, candidates[new]])
+                width_old = np.concatenate([width_old, np.zeros(m)])
+                p_old = np.concatenate([p_old, p_old[parent]])
+                p = np.concatenate([p, p[parent]])
+                creation = np.concatenate([creation, np.full(m, t_old)])
+                dd = np.concatenate([dd, np.zeros((m, mesh.dim))])
+                channel = np.concatenate([channel, np.zeros(m, bool)])
+                added += m
+            kept = where >= 0
+            state = np.full(mesh.n_elements, CHANNEL, np.int64)
+            width = np.zeros(mesh.n_elements)
+            state[where[kept]] = np.where(full[kept], FILLED, np.where(fraction[kept] > 0.0, TIP, EMPTY))
+            state[channel] = CHANNEL
+            width[where[kept]] = mean_width[kept]
+            prescribed = (state == TIP) | (state == EMPTY)
+            dd, p, info, flow = self._solve(sim, mesh, prescribed, width, width_old, p_old, creation, dd, p, t_old,
+                                            t_new, relaxation)
+            relaxation = info["relaxation"]
+            for key in totals:
+                totals[key] += info.get(key, 0)
+            ribbon_width = np.sum(dd[ribbon] * mesh.normals[ribbon], axis=1)
+            new_distance, _ = self.asymptote.front_distance(ribbon_width, distance_old, dt)
+            # at most one element per iteration: far from the fixed point the ribbon takes the
+            # volume the trial front leaves out, and the asymptote answers with a far front
+            new_distance = np.maximum(np.clip(new_distance, distance - h, distance + h), distance_old)
+            change = float(np.max(np.abs(new_distance - distance))) / h
+            if change > 0.5 * last_change:  # damp a fixed point that oscillates or stalls
+                weight = max(0.5 * weight, 0.125)
+            last_change = change
+            distance = distance + weight * (new_distance - distance)
+            velocity = (distance - distance_old) / dt
+            logger.debug("front iteration %d: %d elements, %d ribbon, %d tip, %d empty, change %.3g elements",
+                         iterations, mesh.n_elements, len(ribbon), np.count_nonzero(state == TIP),
+                         np.count_nonzero(state == EMPTY), change)
+            if change < prop.front_tolerance:
+                break
+        if not np.isfinite(change) or change > 0.05:
+            raise ConvergenceError(f"the asymptotic front did not converge in step {s.step + 1} (t = {t_new:g} s): "
+                                   f"the ribbon distances still moved by {change:.3g} elements after "
+                                   f"{prop.front_iterations} iterations")
+
+        n = mesh.n_elements
+        front_distance = np.full(n, np.nan)
+        front_velocity = np.full(n, np.nan)
+        front_distance[ribbon], front_velocity[ribbon] = distance, velocity
+        width = np.sum(dd * mesh.normals, axis=1)
+        leak = np.zeros(n)
+        injected = s.injected_volume + dt * sum(c.rate for c in sim.clusters)
+        next_relaxation = relaxation
+        if totals["restarts"] == 0:
+            next_relaxation = min(sim.settings.relaxation, relaxation * sim.settings.relaxation_growth)
+        sim.state = type(s)(mesh, dd, p, creation, t_new, s.step + 1, next_relaxation, injected,
+                            s.leaked_volume + float(np.sum(leak)) * dt, origin=np.zeros(n, np.int64),
+                            natural_index=-np.ones(n, np.int64), intact=s.intact, failed=s.failed,
+                            extra_faces=s.extra_faces, front_distance=front_distance, front_velocity=front_velocity,
+                            front_class=state)
+        sim._events = dict(natural_crossed=0, natural_deflected=0, natural_newly_failed=0, contact_frozen=0,
+                           junctions=0)
+        record = sim._record(flow, width, totals, added, iterations, relaxation, time.perf_counter() - start,
+                             sim.operator_builds - builds)
+        record.update(self.measures(sim.state, sim))
+        record["front_iterations"] = int(iterations)
+        sim.records.append(record)
+        return record
+
+    def measures(self, state, sim):
+        """Front measures of a state: the fractured area (channel elements plus the filled
+        fractions of the tip elements), the radius sqrt(A/pi) (3D) or half-length (2D),
+        and in 3D the smallest and largest front distance from the first injection point."""
+        grid, h = self.grid, self.grid.h
+        mesh = state.mesh
+        circle = np.isfinite(state.front_distance)
+        cells = grid.cells(mesh.centers)
+        tip = state.front_class == TIP
+        field = self.field(cells[circle], state.front_distance[circle], state.front_velocity[circle],
+                           cells[state.front_class == CHANNEL])  # the ribbon's inside
+        fraction, _, _ = fill(cells[tip], field, self.asymptote, SUB_SAMPLES[self.grid.k])
+        filled = float(np.count_nonzero((state.front_class == CHANNEL) | (state.front_class == FILLED)))
+        filled += float(np.sum(fraction))
+        out = {}
+        if grid.k == 2:
+            area = filled * h * h
+            well = grid.plane(mesh.centers[sim.injection_elements[0]])
+            radii = front_radii(well, field)
+            out.update(fracture_area=area, radius=float(np.sqrt(area / np.pi)), front_radius_min=float(radii.min()),
+                       front_radius_max=float(radii.max()), front_circularity=float(radii.max() / radii.min()))
+        else:
+            out.update(fracture_area=filled * h * sim.height, half_length=0.5 * filled * h)
+        return out
