@@ -83,6 +83,22 @@ def coarse_functions(points_permuted, boundaries, n_functions):
 
 
 @njit(cache=True)
+def _project_factor(d, n_f, agg, phi, values, offset, k, start, stop):
+    """P^T F restricted to the aggregates of tree positions [start, stop), for a low-rank
+    factor F (d (stop - start) x k) stored column by column at ``values[offset:]``."""
+    first = agg[start]
+    m = d * (stop - start)
+    out = np.zeros(((agg[stop - 1] - first + 1) * n_f * d, k))
+    for q in range(k):
+        for i in range(m):
+            element = start + i // d
+            value = values[offset + q * m + i]
+            for f in range(n_f):
+                out[((agg[element] - first) * n_f + f) * d + i % d, q] += phi[element, f] * value
+    return out
+
+
+@njit(cache=True)
 def _galerkin(d, n_f, agg, phi, n_coarse, dense_row_start, dense_row_stop, dense_col_start, dense_col_stop,
               dense_offset, dense_values, lowrank_row_start, lowrank_row_stop, lowrank_col_start,
               lowrank_col_stop, lowrank_rank, u_offset, v_offset, u_values, v_values):
@@ -118,24 +134,10 @@ def _galerkin(d, n_f, agg, phi, n_coarse, dense_row_start, dense_row_stop, dense
         k = lowrank_rank[b]
         r0, r1 = lowrank_row_start[b], lowrank_row_stop[b]
         c0, c1 = lowrank_col_start[b], lowrank_col_stop[b]
-        m = d * (r1 - r0)
-        n = d * (c1 - c0)
         ar, ac = agg[r0], agg[c0]
-        nr = (agg[r1 - 1] - ar + 1) * n_f * d
-        ncc = (agg[c1 - 1] - ac + 1) * n_f * d
-        pu = np.zeros((nr, k))
-        pv = np.zeros((ncc, k))
-        for q in range(k):
-            for i in range(m):
-                element = r0 + i // d
-                value = u_values[u_offset[b] + q * m + i]
-                for f in range(n_f):
-                    pu[((agg[element] - ar) * n_f + f) * d + i % d, q] += phi[element, f] * value
-            for j in range(n):
-                element = c0 + j // d
-                value = v_values[v_offset[b] + q * n + j]
-                for g in range(n_f):
-                    pv[((agg[element] - ac) * n_f + g) * d + j % d, q] += phi[element, g] * value
+        pu = _project_factor(d, n_f, agg, phi, u_values, u_offset[b], k, r0, r1)
+        pv = _project_factor(d, n_f, agg, phi, v_values, v_offset[b], k, c0, c1)
+        nr, ncc = pu.shape[0], pv.shape[0]
         row0 = ar * n_f * d
         col0 = ac * n_f * d
         for i in range(nr):
@@ -148,28 +150,20 @@ def _galerkin(d, n_f, agg, phi, n_coarse, dense_row_start, dense_row_stop, dense
 
 
 @njit(cache=True)
-def _restrict(d, n_f, agg, phi, element_order, r, n_coarse):
-    out = np.zeros(n_coarse)
+def _transfer(d, n_f, agg, phi, element_order, source, n_out, restrict):
+    """P^T source (``restrict``, fine -> coarse) or P source (coarse -> fine); fine
+    vectors in the original ordering."""
+    out = np.zeros(n_out)
     for k in range(agg.shape[0]):
         e = element_order[k]
         for f in range(n_f):
             weight = phi[k, f]
             base = (agg[k] * n_f + f) * d
             for p in range(d):
-                out[base + p] += weight * r[d * e + p]
-    return out
-
-
-@njit(cache=True)
-def _prolong(d, n_f, agg, phi, element_order, c):
-    out = np.zeros(agg.shape[0] * d)
-    for k in range(agg.shape[0]):
-        e = element_order[k]
-        for f in range(n_f):
-            weight = phi[k, f]
-            base = (agg[k] * n_f + f) * d
-            for p in range(d):
-                out[d * e + p] += weight * c[base + p]
+                if restrict:
+                    out[base + p] += weight * source[d * e + p]
+                else:
+                    out[d * e + p] += weight * source[base + p]
     return out
 
 
@@ -210,12 +204,13 @@ class TwoLevel:
 
     def restrict(self, r):
         """P^T r for r in the original ordering."""
-        return _restrict(self.d, self.n_f, self.of_position, self.phi, self.element_order,
-                         np.ascontiguousarray(r, dtype=np.float64), self.coarse_size)
+        return _transfer(self.d, self.n_f, self.of_position, self.phi, self.element_order,
+                         np.ascontiguousarray(r, dtype=np.float64), self.coarse_size, True)
 
     def prolong(self, c):
         """P c in the original ordering."""
-        return _prolong(self.d, self.n_f, self.of_position, self.phi, self.element_order, c)
+        return _transfer(self.d, self.n_f, self.of_position, self.phi, self.element_order, c,
+                         self.of_position.size * self.d, False)
 
     def coarse_correction(self, r):
         """Q r = P A_c^{-1} P^T r."""
