@@ -218,7 +218,8 @@ def plot_maps(run, events, path, title, seed=1):
             error = ms.location_error(located, events.position)
             scatter = draw_map(axes[row, column], traces, [[w.x, w.y] for w in wells], located, magnitude,
                                magnitude_range=(low, high),
-                               title=f"{count} well(s), {name} noise: error {error:.2f} m")
+                               title=f"{count} well(s), {'no' if levels.is_zero else name} noise: "
+                                     f"location error {error:.2f} m")
             axes[row, column].set_xlim(-60, 60)
             axes[row, column].set_ylim(-110, 110)
     figure.colorbar(scatter, ax=axes, label="moment magnitude Mw", shrink=0.6)

@@ -39,3 +39,5 @@ def test_bad_settings_are_refused():
     with pytest.raises(InputError, match="min_samples"):
         fit_traces(np.zeros((5, 2)), min_samples=1)
     assert fit_traces(np.zeros((2, 2)), min_samples=3) == []
+    column = np.array([[3.0, 4.0, z] for z in range(6)]) + 1e-15 * np.arange(18).reshape(6, 3)
+    assert fit_traces(column, eps=1.0) == []  # events stacked in one vertical column: no trace

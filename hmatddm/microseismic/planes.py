@@ -55,7 +55,8 @@ def neighbour_distance(plan, min_samples):
 def fit_traces(positions, eps=None, min_samples=3):
     """Cluster located events (E, 2 or 3) in plan view with DBSCAN (radius ``eps`` m,
     default :func:`neighbour_distance`; ``min_samples``) and fit one trace per cluster by
-    PCA; noise points are left out."""
+    PCA; noise points are left out, and so are clusters at a single plan position (the
+    events of one vertical column of elements), whose azimuth would be round-off."""
     from sklearn.cluster import DBSCAN
     from sklearn.decomposition import PCA
 
@@ -75,6 +76,8 @@ def fit_traces(positions, eps=None, min_samples=3):
         points = plan[members]
         pca = PCA(n_components=2).fit(points)
         spread = np.sqrt(np.maximum(pca.explained_variance_, 0.0))
+        if spread[0] <= 1e-9 * max(1.0, float(np.max(np.abs(points)))):
+            continue  # one plan position (a vertical column of events): no trace to fit
         along = (points - pca.mean_) @ pca.components_[0]
         traces.append(Trace(azimuth_deg=float(trace_azimuth(pca.components_[0])), centroid=pca.mean_.copy(),
                             members=members, linearity=float(1.0 - spread[1] / max(spread[0], 1e-300)),
