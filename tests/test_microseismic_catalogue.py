@@ -109,7 +109,7 @@ def test_microseismic_command_on_a_finished_run(run_folder, capsys):
     on_source = folder / "on_source.toml"
     on_source.write_text(SLIP_SCENE + f"[microseismic]\nwells = [[{x!r}, {y!r}]]\n")
     assert cli.main(["microseismic", str(out), "--scene", str(on_source)]) == cli.EXIT_BAD_INPUT
-    assert "wells: receiver" in capsys.readouterr().err
+    assert "microseismic.wells: receiver" in capsys.readouterr().err
     # a scene without the section
     assert cli.main(["microseismic", str(out), "--scene", "kgd"]) == cli.EXIT_BAD_INPUT
     assert "has no [microseismic] section" in capsys.readouterr().err

@@ -214,14 +214,15 @@ class Catalogue:
     brune_s: np.ndarray
 
 
-def monitor(events, wells, medium, noise=None, seed=0):
+def monitor(events, wells, medium, noise=None, seed=0, field="wells"):
     """Record ``events`` at the receivers of ``wells``, add ``noise`` (seeded) and invert
-    for the location and the Brune moments (RMS factors)."""
+    for the location and the Brune moments (RMS factors). ``field`` names the wells in the
+    message refusing a receiver on an event."""
     receivers, well = receivers_of(list(wells))
     if len(events) == 0:
         empty = np.zeros(0)
         return Catalogue(events, None, np.zeros((0, 3)), empty, empty)
-    observations = observe(events, receivers, medium, well)
+    observations = observe(events, receivers, medium, well, field=field)
     if noise is not None and not noise.is_zero:
         observations = add_noise(observations, noise, seed)
     return Catalogue(events, observations, locate(observations, medium),
@@ -277,7 +278,8 @@ def write_catalogue(out, section, name=None, height=None):
     settings = settings_from_section(section)
     run = read_run(out, height=height)
     events = events_from_run(run, settings.medium, settings.shear_ratio, settings.merge)
-    catalogue = monitor(events, settings.wells, settings.medium, settings.noise, settings.seed)
+    catalogue = monitor(events, settings.wells, settings.medium, settings.noise, settings.seed,
+                        field="microseismic.wells")
     out = Path(out)
     csv_path = write_events_csv(out / EVENTS_CSV, catalogue)
     wells = np.array([[w.x, w.y] for w in settings.wells])

@@ -139,12 +139,13 @@ def radiation_factors(moment_tensors, direction, seismic_moment, shear_modulus):
     return p_part * scale, s_part * scale
 
 
-def observe(events, receivers, medium, well=None, minimum_distance=1e-6):
+def observe(events, receivers, medium, well=None, minimum_distance=1e-6, field="wells"):
     """Noise-free observations of ``events`` (:class:`~hmatddm.microseismic.sources.Events`)
     at ``receivers`` (R, 3) in ``medium`` (ref. Sec. 7.2.2). ``well`` (R,) labels the
-    receivers by well (default 0). Refuses a receiver on an event."""
+    receivers by well (default 0). Refuses a receiver on an event (the message names
+    ``field``)."""
     receivers = finite_array("receivers", np.atleast_2d(receivers), shape=(None, 3))
-    check_receivers(events.position, receivers, minimum_distance, name="wells")
+    check_receivers(events.position, receivers, minimum_distance, name=field)
     count, stations = len(events), len(receivers)
     fields = {name: np.empty((count, stations)) for name in
               ("distance", "travel_time_p", "travel_time_s", "amplitude_p", "amplitude_s", "factor_p", "factor_s")}
