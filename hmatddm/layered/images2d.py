@@ -562,6 +562,15 @@ _CACHED_LEVELS = 4
 
 
 @njit(cache=True)
+def _level(n_sub):
+    """The smallest level with 2^level >= n_sub sub-segments."""
+    level = 0
+    while 2 ** level < n_sub:
+        level += 1
+    return level
+
+
+@njit(cache=True)
 def _level_rule(n_gauss, max_level):
     """Composite rules of 2^level sub-segments, levels 0..max_level, stacked:
     ``(xi, w, start)`` with level l at ``start[l]:start[l + 1]``."""
@@ -614,10 +623,7 @@ def _source_block(j, rows, centers, frames, half_length, layer, params, settings
                              poisson_ratio[ls], shift, pair, work, near)
         if layered:
             lr = layer[i]
-            n_sub = subdivisions(point[0], point[1], lr, p0, p1, ls, interfaces, max_sub)
-            level = 0
-            while 2 ** level < n_sub:
-                level += 1
+            level = _level(subdivisions(point[0], point[1], lr, p0, p1, ls, interfaces, max_sub))
             image[:] = 0.0
             if level <= max_level:
                 a, b = start[level], start[level + 1]
@@ -701,11 +707,8 @@ def stress_at_points(points, point_layer, centers, frames, half_length, layer, p
                 if interfaces.shape[0] > 0:
                     p0 = centers[j] - half_length[j] * frames[j, 0]
                     p1 = centers[j] + half_length[j] * frames[j, 0]
-                    n_sub = subdivisions(points[m, 0], points[m, 1], lr, p0, p1, ls, interfaces, max_sub)
-                    level = 0
-                    while 2 ** level < n_sub:  # as the block generator
-                        level += 1
-                    xi, wt = composite_rule(n_gauss, 2 ** level)
+                    level = _level(subdivisions(points[m, 0], points[m, 1], lr, p0, p1, ls, interfaces, max_sub))
+                    xi, wt = composite_rule(n_gauss, 2 ** level)  # as the block generator
                     shape = np.ones((xi.shape[0], 1))
                     image_element_stress(points[m, 0], points[m, 1], lr, p0, p1, ls, interfaces, shear_modulus,
                                          poisson_ratio, n_images, xi, wt, shape, image)
