@@ -80,7 +80,7 @@ def closed_form(case, t, h):
     return radius, width, pressure, "K-vertex"
 
 
-def run_case(case, h, backend, t_end, scheme="krylov"):
+def run_case(case, h, backend, t_end, scheme="krylov", front="element"):
     """One simulation; returns a dict with the per-step history and the final errors."""
     import hmatddm as hd
     from _common import peak_rss_bytes
@@ -91,7 +91,7 @@ def run_case(case, h, backend, t_end, scheme="krylov"):
     mesh = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 3 * h, 3 * h, 3, 3)
     sim = hd.Simulation(mesh, material, hd.Fluid(params["viscosity"], COMPRESSIBILITY),
                         [hd.Cluster((0, 0, 0), RATE, WELLBORE)], far_field_stress=np.diag([0, 0, -S_HMIN]),
-                        time_step=1.0, propagation=hd.Propagation(toughness=params["toughness"]),
+                        time_step=1.0, propagation=hd.Propagation(toughness=params["toughness"], front=front),
                         initial_pressure=INITIAL_PRESSURE, initial_opening=params["initial_opening"],
                         backend=backend, scheme=scheme)
     failure = None
@@ -106,8 +106,9 @@ def run_case(case, h, backend, t_end, scheme="krylov"):
     keys = ("time", "n_elements", "radius", "max_opening", "nonlinear_iterations", "linear_iterations",
             "solve_seconds", "operator_builds")
     history = {k: [r[k] for r in records] for k in keys}
+    history["front_circularity"] = [r.get("front_circularity") for r in records]
     history["net_pressure"] = [r["wellbore_pressure"][0] - S_HMIN for r in records]
-    row = dict(case=case, h=h, backend=backend, scheme=scheme, t_end=t_end, wall_s=wall,
+    row = dict(case=case, h=h, backend=backend, scheme=scheme, front=front, t_end=t_end, wall_s=wall,
                peak_rss_mb=peak_rss_bytes() / 2**20, history=history, failure=failure,
                centre_width=float(width[injection]), final_elements=int(state.mesh.n_elements),
                operator_builds=int(sim.operator_builds))
@@ -165,8 +166,8 @@ def measured_run(cmd, threads=None, timeout=1800):
     return row
 
 
-def spawn(case, h, backend, t_end, scheme="krylov", threads=None, timeout=1800):
-    spec = dict(case=case, h=h, backend=backend, t_end=t_end, scheme=scheme)
+def spawn(case, h, backend, t_end, scheme="krylov", threads=None, timeout=1800, front="element"):
+    spec = dict(case=case, h=h, backend=backend, t_end=t_end, scheme=scheme, front=front)
     print(f"  running {spec}" + (f", {threads} thread(s)" if threads else ""), flush=True)
     row = measured_run([sys.executable, os.path.abspath(__file__), "--case", json.dumps(spec)], threads, timeout)
     if "history" not in row:
@@ -354,6 +355,73 @@ def plot_cost(rows, path):
     plt.close(fig)
 
 
+FRONT_RUNS = [  # (case, h, backend, front, t_end), cheapest first
+    ("M", 2.0, "hmatrix", "element", 50.0), ("M", 2.0, "hmatrix", "asymptotic", 50.0),
+    ("M", 2.0, "dense", "asymptotic", 50.0), ("M", 1.0, "hmatrix", "element", 50.0),
+    ("M", 1.0, "hmatrix", "asymptotic", 50.0), ("K", 1.0, "hmatrix", "asymptotic", 50.0),
+    ("K-vertex", 1.0, "hmatrix", "asymptotic", 50.0), ("M", 0.5, "hmatrix", "asymptotic", 12.0),
+]
+
+
+def run_front_study(threads):
+    """Every FRONT_RUNS row in its own process; the JSON is rewritten after each row."""
+    rows = []
+    for case, h, backend, front, t_end in FRONT_RUNS:
+        rows.append(spawn(case, h, backend, t_end, threads=threads, front=front, timeout=3600))
+        with open(os.path.join(OUT, "radial_front_partial.json"), "w") as f:
+            json.dump(rows, f)
+    return rows
+
+
+def front_table(rows):
+    from _common import markdown_table
+
+    out = []
+    for r in rows:
+        if "history" not in r:
+            out.append([r.get("case"), r.get("front"), r.get("h"), r.get("backend"), r.get("t_end"),
+                        f"failed: {r.get('failure')}"] + [""] * 9)
+            continue
+        rms = rms_errors(r)
+        circ = [c for c, t in zip(r["history"]["front_circularity"], r["history"]["time"]) if c and t >= 10.0]
+        out.append([r["case"], r["front"], f"{r['h']:g}", r["backend"], f"{r['t_end']:g}", r["final_elements"],
+                    f"{r['wall_s']:.0f}", f"{r.get('process_cpu_s', float('nan')):.0f}",
+                    f"{r.get('background_cores', float('nan')):.2f}", pct(r["error"]["radius"]),
+                    pct(r["error"]["centre_width"]), pct(r["error"]["net_pressure"]),
+                    " / ".join("-" if v is None else f"{100 * v:.1f}%" for v in rms.values()),
+                    f"{100 * (max(circ) - 1):.1f}%" if circ else "-",
+                    r.get("failure") or ""])
+    return markdown_table(["case", "front", "h (m)", "backend", "t_end (s)", "elements", "wall (s)", "CPU (s)",
+                           "background (cores)", "R error", "centre w error", "p_net error",
+                           "RMS 10 s-t_end (R / w_max / p_net)", "worst circularity 10 s-t_end", "note"], out)
+
+
+def plot_front(rows, path):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+    for r in rows:
+        if "history" not in r or r["case"] != "M" or r["backend"] != "hmatrix" or r["t_end"] < 50:
+            continue
+        marker = "o" if r["front"] == "asymptotic" else "s"
+        label = f"{r['front']}, h = {r['h']:g} m"
+        axes[0].loglog(r["wall_s"], abs(r["error"]["radius"]) * 100, marker, ms=8, label=label)
+        axes[1].loglog(r["wall_s"], abs(r["error"]["centre_width"]) * 100, marker, ms=8, label=label)
+    for ax, name in zip(axes, ("radius", "centre opening")):
+        ax.loglog([121.0], [1.1 if name == "radius" else 0.7], "k*", ms=12, label="planar-3D level-set peer")
+        ax.set_xlabel("wall time (s), one thread")
+        ax.set_ylabel(f"|{name} error| at 50 s (%)")
+        ax.set_title(f"radial M-vertex (ref. Table 4.1 M): {name}")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="h = 2, 1.5 m to 20 s (about 1-2 min)")
@@ -363,7 +431,7 @@ def main():
                                                       "(default 2,1.5,1,0.75,0.5)")
     parser.add_argument("--dense-limit", type=int, default=2500,
                         help="dense backend only for meshes expected below this many elements at t_end")
-    parser.add_argument("--skip", default="", help="comma-separated studies to skip: table41, cost, threads")
+    parser.add_argument("--skip", default="", help="comma-separated studies to skip: table41, cost, front, threads")
     parser.add_argument("--report", action="store_true",
                         help="print the tables and redraw the plots from the JSON of the last run (no runs)")
     parser.add_argument("--threads", type=int, default=1,
@@ -378,7 +446,7 @@ def main():
 
             preconditioners.TWO_LEVEL_MIN_ELEMENTS = int(spec["two_level_from"])
         print(json.dumps(run_case(spec["case"], float(spec["h"]), spec["backend"], float(spec.get("t_end", 50.0)),
-                                  spec.get("scheme", "krylov"))))
+                                  spec.get("scheme", "krylov"), spec.get("front", "element"))))
         return
     from _common import machine, markdown_table
 
@@ -449,6 +517,12 @@ def main():
         print()
         print(cost_table(rows))
         plot_cost(rows, os.path.join(plots, "radial_accuracy_cost.png"))
+
+    if "front" not in skip:
+        rows_f = study("front", lambda: run_front_study(args.threads))
+        print("\n## Front models: element switch against the asymptotic front (radial, hmatrix unless said)\n")
+        print(front_table(rows_f))
+        plot_front(rows_f, os.path.join(plots, "radial_front_accuracy_cost.png"))
 
     if "threads" not in skip:
         h_threads = 2.0 if args.quick else 1.0

@@ -3,6 +3,7 @@
 Each check returns its error against a closed form and the tolerance it must meet;
 ``hmatddm validate`` prints them (``--json`` for scripts).
 """
+import functools
 import time
 
 import numpy as np
@@ -45,6 +46,29 @@ def _penny_axis(material):
     return float(max(np.max(np.abs(stress[:, 2, 2] - sigma_z)), np.max(np.abs(mean - sigma_mean))) / PRESSURE)
 
 
+@functools.lru_cache(maxsize=1)
+def _radial_m_asymptotic(h=1.0, end_time=6.0):
+    """Ref. Table 4.1 M case with the asymptotic front (issue 16), h = 1 m, to 6 s (R ~ 8 h):
+    relative errors of the radius, the centre opening (M-vertex) and the circularity."""
+    from .flow import Cluster, Fluid
+    from .fracture import Propagation
+    from .mesh import rectangle
+    from .simulation import Simulation
+
+    material = Elastic(shear_modulus=24e9, poisson_ratio=0.25)
+    mesh = rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 3 * h, 3 * h, 3, 3)
+    sim = Simulation(mesh, material, Fluid(1e-3, 4.4e-10), [Cluster((0, 0, 0), 0.01, 0.005)],
+                     far_field_stress=np.diag([0, 0, -8e6]), time_step=1.0,
+                     propagation=Propagation(toughness=1e6, front="asymptotic"), initial_pressure=10e6,
+                     initial_opening=4e-6)
+    record = sim.run(end_time)[-1]
+    radius, width = analytical.radial_m_vertex(end_time, 0.01, 1e-3, material)
+    i = sim.injection_elements[0]
+    centre = float(sim.state.dd[i] @ sim.state.mesh.normals[i])
+    return dict(radius=abs(record["radius"] / radius - 1.0), width=abs(centre / width - 1.0),
+                circularity=record["front_circularity"] - 1.0)
+
+
 def checks():
     """(name, function, tolerance) of every check, cheapest first."""
     material = Elastic(shear_modulus=SHEAR_MODULUS, poisson_ratio=POISSON_RATIO)
@@ -53,6 +77,9 @@ def checks():
         ("Griffith slip, remote shear (dense)", lambda: _griffith(material, "dense", "shear"), 0.01),
         ("Sneddon volume, staircase h=c/20 (dense)", lambda: _penny_volume(material, "dense"), 0.05),
         ("Sneddon on-axis stress, z/c>=0.2, /p (dense)", lambda: _penny_axis(material), 0.01),
+        ("radial M-vertex radius, asymptotic front, h=1 m, 6 s", lambda: _radial_m_asymptotic()["radius"], 0.05),
+        ("radial M-vertex centre opening, same run", lambda: _radial_m_asymptotic()["width"], 0.07),
+        ("radial front circularity max/min - 1, same run", lambda: _radial_m_asymptotic()["circularity"], 0.05),
     ]
 
 

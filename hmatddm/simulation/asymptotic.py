@@ -148,9 +148,7 @@ class AsymptoticFront:
         s = sim.state
         prop = sim.propagation
         grid, h = self.grid, self.grid.h
-        t_old, t_new = s.time, s.time + sim.time_step
-        if end_time is not None and t_new >= end_time - 1e-9 * sim.time_step:
-            t_new = float(end_time)
+        t_old, t_new = sim.step_times(end_time)
         dt = t_new - t_old
         mesh = s.mesh
         width_old = np.sum(s.dd * mesh.normals, axis=1)

@@ -445,9 +445,7 @@ class Simulation:
             return self.front.step(self, end_time)
         start = time.perf_counter()
         s = self.state
-        t_old, t_new = s.time, s.time + self.time_step
-        if end_time is not None and t_new >= end_time - 1e-9 * self.time_step:
-            t_new = float(end_time)
+        t_old, t_new = self.step_times(end_time)
         dt = t_new - t_old
         mesh = s.mesh
         width_old = np.sum(s.dd * mesh.normals, axis=1)
@@ -538,6 +536,15 @@ class Simulation:
                               self.operator_builds - builds)
         self.records.append(record)
         return record
+
+    def step_times(self, end_time=None):
+        """``(t_old, t_new)`` of the next step: one ``time_step``, shortened to end exactly at
+        ``end_time`` when it would reach or pass it (within 1e-9 of a step)."""
+        t_old = self.state.time
+        t_new = t_old + self.time_step
+        if end_time is not None and t_new >= end_time - 1e-9 * self.time_step:
+            t_new = float(end_time)
+        return t_old, t_new
 
     def _remote_failures(self, mesh, dd, intact):
         """Intact natural elements that fail (ref. Sec. 5.3) as new elements to join the

@@ -1,0 +1,86 @@
+"""Simulations with the asymptotic front (Propagation(front="asymptotic")): radial and KGD
+fractures against the closed-form vertex solutions, a round front, both backends, resume
+from a checkpoint, and the setups it refuses."""
+import numpy as np
+import pytest
+
+import hmatddm as hd
+from hmatddm.errors import InputError
+
+MATERIAL = hd.Elastic(24e9, 0.25)
+
+
+def radial(h=1.0, backend="hmatrix", toughness=1e6, viscosity=1e-3, opening=4e-6, **kwargs):
+    """Ref. Table 4.1 (M case by default) with 3 x 3 initial elements of side h."""
+    mesh = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 3 * h, 3 * h, 3, 3)
+    return hd.Simulation(mesh, MATERIAL, hd.Fluid(viscosity, 4.4e-10), [hd.Cluster((0, 0, 0), 0.01, 0.005)],
+                         far_field_stress=np.diag([0, 0, -8e6]), time_step=1.0,
+                         propagation=hd.Propagation(toughness=toughness, front="asymptotic"),
+                         initial_pressure=10e6, initial_opening=opening, backend=backend, **kwargs)
+
+
+def test_radial_m_vertex_early_growth_is_round_and_conserves_volume():
+    sim = radial()
+    records = sim.run(6.0)
+    radius, width = hd.analytical.radial_m_vertex(6.0, 0.01, 1e-3, MATERIAL)
+    last = records[-1]
+    injection = sim.injection_elements[0]
+    centre = float(sim.state.dd[injection] @ sim.state.mesh.normals[injection])
+    # R ~ 8 elements at 6 s: a few % (the h = 1 m run reaches -0.5% / +1% at 50 s, see
+    # benchmarks/RESULTS.md); the element switch gives +7% here
+    assert abs(last["radius"] / radius - 1.0) < 0.05
+    assert abs(centre / width - 1.0) < 0.07
+    assert last["front_circularity"] < 1.05
+    assert last["fracture_volume"] == pytest.approx(last["injected_volume"], rel=0.01)
+    assert np.all(np.isfinite(sim.state.front_distance[np.isfinite(sim.state.front_distance)]))
+
+
+def test_dense_and_hmatrix_runs_agree():
+    runs = [radial(h=2.0, backend=backend).run(3.0) for backend in ("dense", "hmatrix")]
+    for dense, hmatrix in zip(*runs):
+        assert dense["n_elements"] == hmatrix["n_elements"]
+        assert hmatrix["radius"] == pytest.approx(dense["radius"], rel=1e-6)
+        assert hmatrix["wellbore_pressure"][0] == pytest.approx(dense["wellbore_pressure"][0], rel=1e-6)
+
+
+def test_resume_from_checkpoint_gives_the_same_run(tmp_path):
+    whole = radial(h=2.0).run(3.0)
+    first = radial(h=2.0, checkpoint_dir=tmp_path)
+    first.run(2.0)
+    resumed = radial(h=2.0, checkpoint_dir=tmp_path)
+    records = resumed.run(3.0, resume=True)
+    assert records[-1]["radius"] == pytest.approx(whole[-1]["radius"], rel=1e-9)
+    assert records[-1]["n_elements"] == whole[-1]["n_elements"]
+
+
+def test_kgd_toughness_vertex():
+    # ref. Table 4.2 setup with K_Ic 5 MPa m^1/2 (K_m = 4.9: K-vertex), 1 m segments
+    material = hd.Elastic(10e9, 0.25)
+    sim = hd.Simulation(hd.mesh.line([-1.5, 0.0], [1.5, 0.0], 3), material, hd.Fluid(1e-3, 4.5e-10),
+                        [hd.Cluster((0.0, 0.0), 5e-4, 0.5)], far_field_stress=np.diag([-1e6, -0.5e6]), time_step=2.0,
+                        propagation=hd.Propagation(toughness=5e6, front="asymptotic"), initial_pressure=1e6,
+                        initial_opening=1e-4)
+    records = sim.run(24.0)
+    half_length, width, _ = hd.analytical.kgd_k_vertex(24.0, 5e-4, 5e6, material)
+    assert abs(records[-1]["half_length"] / half_length - 1.0) < 0.04
+    assert abs(records[-1]["max_opening"] / width - 1.0) < 0.06
+
+
+def test_unsupported_setups_are_refused():
+    with pytest.raises(InputError, match="front"):
+        hd.Propagation(toughness=1e6, front="level-set")
+    with pytest.raises(InputError, match="leak-off"):
+        radial(leak_off=hd.LeakOff(coefficient=1e-12))
+    with pytest.raises(InputError, match="contact"):
+        radial(contact="all")
+    mesh = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 3.0, 3.0, 3, 3)
+    other = hd.mesh.rectangle([0, 0, 5], [1, 0, 0], [0, 1, 0], 3.0, 3.0, 3, 3)
+    two = hd.mesh.concatenate([mesh, hd.Mesh3D(other.centers, other.frames, other.half_a, other.half_b,
+                                               np.ones(9, np.int64))])
+    with pytest.raises(InputError, match="one planar fracture"):
+        hd.Simulation(two, MATERIAL, hd.Fluid(1e-3), [hd.Cluster((0, 0, 0), 0.01)], np.diag([0, 0, -8e6]), 1.0,
+                      propagation=hd.Propagation(toughness=1e6, front="asymptotic"))
+    oblong = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 3.0, 3.0, 3, 6)
+    with pytest.raises(InputError, match="square"):
+        hd.Simulation(oblong, MATERIAL, hd.Fluid(1e-3), [hd.Cluster((0, 0, 0), 0.01)], np.diag([0, 0, -8e6]), 1.0,
+                      propagation=hd.Propagation(toughness=1e6, front="asymptotic"))
