@@ -73,6 +73,10 @@ def test_layered_simulation_refuses_what_it_does_not_support():
     mesh3d = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 1.0, 1.0, 1, 1)
     with pytest.raises(InputError, match="2D"):
         hd.Simulation(mesh3d, medium, hd.Fluid(1e-3), [hd.Cluster((0, 0, 0), 0.01)], np.zeros((3, 3)), 1.0)
+    stressed = LayeredMedium([0.0], [G, 2 * G], [NU, NU], in_situ_stress=np.zeros((2, 3, 3)))
+    with pytest.raises(InputError, match="in_situ_stress"):
+        hd.Simulation(hd.mesh.line([0.0, -1.0], [0.0, -0.5], 2), stressed, hd.Fluid(1e-3),
+                      [hd.Cluster((0.0, -0.75), 0.01)], np.zeros((2, 2)), 1.0)
 
 
 def test_layered_height_scene_builds_and_steps():

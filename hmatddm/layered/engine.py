@@ -33,6 +33,9 @@ def check_simulation(mesh, medium, natural_fractures, propagation):
         raise InputError("material: a LayeredMedium works with 2D meshes (a vertical cross-section) only, so far")
     if getattr(mesh, "element_order", 0) != 0:
         raise InputError("material: a LayeredMedium simulation needs constant elements (element_order 0)")
+    if medium.in_situ_stress is not None and medium.in_situ_stress.shape[1] != 2:
+        raise InputError(f"material.in_situ_stress must hold 2x2 tensors for a 2D run, got "
+                         f"{medium.in_situ_stress.shape[1]}x{medium.in_situ_stress.shape[2]}")
     if natural_fractures is not None:
         raise InputError("natural_fractures: not supported with a LayeredMedium yet")
     if propagation is not None and propagation.front != "element":
