@@ -36,7 +36,8 @@ class ExtendedElasticityOperator(LinearOperator):
         self.dof = d = base.dof
         self.n_base = n0
         super().__init__(dtype=np.float64, shape=(n * d, n * d))
-        kernels, data = influence_data(mesh, base.material, base.singular_correction, base.alpha)
+        kernels, data = influence_data(mesh, base.material, base.singular_correction, base.alpha,
+                                       n_images=base.stats.get("n_images"))  # layered: the base's images
         old = np.arange(n0, dtype=np.int64)
         new = np.arange(n0, n, dtype=np.int64)
         self.on = self._block(kernels, data, old, new)

@@ -249,13 +249,13 @@ def _refuse_coincident(mesh):
                              "system singular; remove one of them")
 
 
-def influence_data(mesh, material, singular_correction="none", alpha=None):
+def influence_data(mesh, material, singular_correction="none", alpha=None, n_images=None):
     """``(kernel_module, element_data)`` that fill exact influence blocks of ``mesh``
     with the same options (NaN averaging of singular and near-singular points,
     Eq. 6.11 scaling) as the operator uses."""
     shift = _AVERAGE_SHIFT if singular_correction == "average" else 0.0
     if isinstance(material, LayeredMedium):  # ref. Ch. 3: closed form + image terms
-        return _layered_influence_data(mesh, material, shift, alpha)
+        return _layered_influence_data(mesh, material, shift, alpha, n_images)
     kernels = kernel_module(mesh)
     self_max = None
     if alpha is not None:
@@ -270,17 +270,21 @@ def influence_data(mesh, material, singular_correction="none", alpha=None):
                                  near_fraction=NEAR_SINGULAR_FRACTION)
 
 
-def _layered_influence_data(mesh, medium, shift, alpha):
+def _layered_influence_data(mesh, medium, shift, alpha, n_images=None):
+    """Kernels and data of a layered medium; ``n_images`` None: the medium's choice (for
+    ``"auto"``, made on this mesh), else that number (an extended operator keeps its base's)."""
     from .layered import images2d, influence2d
 
     if mesh.dim == 2 and mesh.element_order > 0:  # linear / quadratic elements (ref. Sec. 3.5)
         from . import layered_higher_order
 
-        n_images = layered_higher_order.image_count(mesh, medium, shift)
+        if n_images is None:
+            n_images = layered_higher_order.image_count(mesh, medium, shift)
         return layered_higher_order, layered_higher_order.influence_data(mesh, medium, shift, alpha or 0.0,
                                                                          NEAR_SINGULAR_FRACTION, n_images)
-    data = influence2d.influence_data(mesh, medium, shift, 0.0, NEAR_SINGULAR_FRACTION, 0)
-    n_images = influence2d.choose_images(mesh, medium, data)
+    if n_images is None:
+        data = influence2d.influence_data(mesh, medium, shift, 0.0, NEAR_SINGULAR_FRACTION, 0)
+        n_images = influence2d.choose_images(mesh, medium, data)
     data = influence2d.influence_data(mesh, medium, shift, alpha or 0.0, NEAR_SINGULAR_FRACTION, n_images)
     return images2d, data
 

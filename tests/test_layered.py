@@ -267,3 +267,22 @@ def test_savin_pressurised_hole_near_a_free_surface():
     expected = p * (1.0 + 2.0 * (radius / a) ** 2 * np.sin(beta) ** 2)
     assert np.max(np.abs(hoop - expected) / expected) < 0.02
     assert abs(np.max(hoop) / p - (depth ** 2 + radius ** 2) / (depth ** 2 - radius ** 2)) < 0.02
+
+
+def test_grown_mesh_border_blocks_keep_the_base_images():
+    """A growing run's extended operator (hmatrix base + exact border blocks) uses the
+    base's number of images, and equals a fresh dense operator with that number."""
+    from hmatddm.extended_operator import ExtendedElasticityOperator
+
+    medium = LayeredMedium([0.5, -0.5], [2.0, 1.0, 2.0], [0.25, 0.25, 0.25])
+    full = split_at_interfaces(hd.mesh.line([0.0, -1.5], [0.0, 1.5], 24), medium)[0]
+    inner = np.flatnonzero(np.abs(full.centers[:, 1]) < 1.0)
+    outer = np.flatnonzero(np.abs(full.centers[:, 1]) >= 1.0)
+    base_mesh, grown = full.subset(inner), full.subset(np.concatenate([inner, outer]))
+    base = hd.ElasticityOperator(base_mesh, medium, backend="hmatrix", eps=1e-10, leaf_size=4)
+    extended = ExtendedElasticityOperator(base, grown)
+    fixed = LayeredMedium(medium.interfaces, medium.shear_modulus, medium.poisson_ratio,
+                          images=base.stats["n_images"])
+    dense = hd.ElasticityOperator(grown, fixed).to_dense()
+    x = np.random.default_rng(2).standard_normal(dense.shape[0])
+    assert np.linalg.norm(extended @ x - dense @ x) <= 1e-8 * np.linalg.norm(dense @ x)
