@@ -32,6 +32,14 @@ Two studies, printed as markdown tables and saved (JSON in benchmarks/out/, PNG 
 
 3. threads: the K-vertex at h = 1 m with 1 and 2 numba threads, alternating.
 
+4. front: the two front models (``Propagation(front="element" | "asymptotic")``, issue 16)
+   on the M case (h = 2 and 1 m to 50 s, h = 0.5 m to 12 s; dense twin of the asymptotic
+   front at h = 2 m) and the K and K-vertex cases (h = 1 m): errors at t_end, RMS over 10 s
+   to t_end, the worst front circularity (largest / smallest front distance from the well,
+   minus 1) over the same times, wall and process CPU time. Plot:
+   radial_front_accuracy_cost.png (M-vertex errors against wall time, with the planar-3D
+   level-set simulator's 1.1% / 0.7% in ~121 s). ``--skip table41,cost,threads`` runs it alone.
+
 Every run is a separate process (clean timings and peak RSS), with one numba/BLAS thread
 unless --threads says otherwise; each row records the background load (cores kept busy by
 other processes during the run), because other jobs share the machine.

@@ -175,6 +175,7 @@ class AsymptoticFront:
         totals = dict(nonlinear_iterations=0, linear_iterations=0, restarts=0, contact_changes=0)
         relaxation = s.relaxation
         added, change, iterations, last_change, weight = 0, np.inf, 0, np.inf, 1.0
+        filled = np.zeros(mesh.n_elements, bool)  # filled once in this step: stays filled (no tip/filled cycling)
         for iterations in range(1, prop.front_iterations + 1):
             field = self.field(cells[ribbon], distance, velocity, cells[channel])
             candidates = self._candidates(cells, channel, field)
@@ -202,11 +203,14 @@ class AsymptoticFront:
                 creation = np.concatenate([creation, np.full(m, t_old)])
                 dd = np.concatenate([dd, np.zeros((m, mesh.dim))])
                 channel = np.concatenate([channel, np.zeros(m, bool)])
+                filled = np.concatenate([filled, np.zeros(m, bool)])
                 added += m
             kept = where >= 0
             state = np.full(mesh.n_elements, CHANNEL, np.int64)
             width = np.zeros(mesh.n_elements)
             state[where[kept]] = np.where(full[kept], FILLED, np.where(fraction[kept] > 0.0, TIP, EMPTY))
+            filled |= state == FILLED
+            state[filled] = FILLED
             state[channel] = CHANNEL
             width[where[kept]] = mean_width[kept]
             prescribed = (state == TIP) | (state == EMPTY)
