@@ -230,17 +230,22 @@ def trace(t, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, p
 @njit(cache=True)
 def _potential_table(coef, dcoef, beta, n_orders, table, dtable):
     """``table[j, a, b] = sum_n coef[j, n] beta[a, b + n]`` (derivative d1^a d3^b of
-    potential j), ``a + b <= 4``; ``dtable`` the same with ``dcoef``."""
+    potential j) for ``a + b`` = 3, 4, and ``dtable`` the same with ``dcoef`` for
+    ``a + b`` = 2, 3: the entries :func:`_pair_stress_gradient` reads."""
     for j in range(2):
         for a in range(5):
-            for b in range(5 - a):
-                s = 0.0
-                ds = 0.0
-                for n in range(n_orders):
-                    s += coef[j, n] * beta[a, b + n]
-                    ds += dcoef[j, n] * beta[a, b + n]
-                table[j, a, b] = s
-                dtable[j, a, b] = ds
+            for b in range(max(0, 2 - a), 5 - a):
+                order = a + b
+                if order >= 3:
+                    s = 0.0
+                    for n in range(n_orders):
+                        s += coef[j, n] * beta[a, b + n]
+                    table[j, a, b] = s
+                if order <= 3:
+                    ds = 0.0
+                    for n in range(n_orders):
+                        ds += dcoef[j, n] * beta[a, b + n]
+                    dtable[j, a, b] = ds
 
 
 @njit(cache=True)
@@ -277,6 +282,15 @@ def Workspace(n_orders):
 @njit(cache=True)
 def _pair_stress_gradient(r1, r3, eps, coef, dcoef, n_orders, delta, shear_modulus, lame, out, work):
     gk, beta, table, dtable, grad = work
+    # highest order of D with a non-zero coefficient (most pairs stop well below n_orders)
+    used = 1
+    for f in range(2):
+        for j in range(2):
+            for n in range(n_orders - 1, used - 1, -1):
+                if coef[f, j, n] != 0.0 or dcoef[f, j, n] != 0.0:
+                    used = n + 1
+                    break
+    n_orders = used
     w = complex(r1, r3)
     inv = 1.0 / w
     kmax = 3 + n_orders  # a + b <= 4 in the tables, plus D^(n_orders - 1)
