@@ -169,8 +169,8 @@ def test_image_quadrature_converges_with_gauss_points():
 
 def test_hmatrix_equals_dense_on_a_layered_mesh():
     medium = LayeredMedium([0.0, -1.0], [0.5, 1.0, 3.0], [0.2, 0.25, 0.3])
-    mesh = hd.mesh.concatenate([hd.mesh.line([-3, -0.5], [3, -0.5], 40, fracture_id=0),
-                                hd.mesh.line([-2.0, -0.9], [-2.0, 0.9], 12, fracture_id=1)])
+    mesh = hd.mesh.concatenate([hd.mesh.line([-3, -0.5], [3, -0.5], 24, fracture_id=0),
+                                hd.mesh.line([-2.0, -0.9], [-2.0, 0.9], 8, fracture_id=1)])
     mesh = split_at_interfaces(mesh, medium)[0]
     dense = hd.ElasticityOperator(mesh, medium, backend="dense")
     hmat = hd.ElasticityOperator(mesh, medium, backend="hmatrix", eps=1e-8, leaf_size=8)
