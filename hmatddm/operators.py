@@ -209,7 +209,7 @@ class ElasticityOperator(LinearOperator):
 
     def preconditioner(self):
         """:func:`hmatddm.hmatrix.default_preconditioner` of the ``hmatrix`` backend (near-field
-        block ILU, two-level from 4000 elements; built once and cached)."""
+        block ILU, two-level from 20 000 elements; built once and cached)."""
         if self._hmatrix is None:
             return None
         if self._preconditioner is None:

@@ -2,7 +2,7 @@
 
 * ``dense``: LU factors, computed once per mesh and reused for every solve.
 * ``hmatrix``: GMRES preconditioned by the operator's default preconditioner (near-field
-  block ILU; from 4000 elements plus the two-level coarse correction of
+  block ILU; from 20 000 elements plus the two-level coarse correction of
   :mod:`hmatddm.hmatrix.coarse_space`), built once per operator, warm-started.
 * an :class:`~hmatddm.extended_operator.ExtendedElasticityOperator` (a grown mesh):
   GMRES preconditioned by its block-triangular near-field solve.
