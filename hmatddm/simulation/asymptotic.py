@@ -174,7 +174,8 @@ class AsymptoticFront:
 
         totals = dict(nonlinear_iterations=0, linear_iterations=0, restarts=0, contact_changes=0)
         relaxation = s.relaxation
-        added, change, iterations, last_change, weight = 0, np.inf, 0, np.inf, 1.0
+        added, change, iterations, weight = 0, np.inf, 0, 1.0
+        last_update = np.zeros(len(ribbon))
         filled = np.zeros(mesh.n_elements, bool)  # filled once in this step: stays filled (no tip/filled cycling)
         for iterations in range(1, prop.front_iterations + 1):
             field = self.field(cells[ribbon], distance, velocity, cells[channel])
@@ -224,11 +225,13 @@ class AsymptoticFront:
             # at most one element per iteration: far from the fixed point the ribbon takes the
             # volume the trial front leaves out, and the asymptote answers with a far front
             new_distance = np.maximum(np.clip(new_distance, distance - h, distance + h), distance_old)
-            change = float(np.max(np.abs(new_distance - distance))) / h
-            if change > 0.5 * last_change:  # damp a fixed point that oscillates or stalls
-                weight = max(0.5 * weight, 0.125)
-            last_change = change
-            distance = distance + weight * (new_distance - distance)
+            update = new_distance - distance
+            change = float(np.max(np.abs(update))) / h
+            # relax an iteration that oscillates (the update turned back), speed up one
+            # that creeps in one direction
+            weight = max(0.5 * weight, 0.125) if np.dot(update, last_update) < 0.0 else min(1.5 * weight, 1.0)
+            last_update = update
+            distance = distance + weight * update
             velocity = (distance - distance_old) / dt
             logger.debug("front iteration %d: %d elements, %d ribbon, %d tip, %d empty, change %.3g elements",
                          iterations, mesh.n_elements, len(ribbon), np.count_nonzero(state == TIP),
