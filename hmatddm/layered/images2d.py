@@ -439,22 +439,29 @@ def image_point_stress(y1, y3, receiver_layer, x1, x3, source_layer, normal, int
 
 
 @njit(cache=True)
-def trace_points(p0, p1, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, xi):
+def trace_points(p0, p1, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, xi, untraced=False):
     """The image pairs of the source points ``x(xi)`` of the element ``p0 -> p1``:
-    ``(n_pairs (G,), layer (G, P), z (G, P), eps (G, P), coef (G, P, 2, 2, O), dcoef)``."""
+    ``(n_pairs (G,), layer (G, P), z (G, P), eps (G, P), coef (G, P, 2, 2, O), dcoef)``.
+    ``untraced``: only allocate (fill ranges later with :func:`_trace_range`)."""
     cap, n_orders = trace_capacity(source_layer, shear_modulus, n_images)
     n_points = xi.shape[0]
-    n_pairs = np.empty(n_points, dtype=np.int64)
-    layer = np.empty((n_points, cap), dtype=np.int64)
-    z = np.empty((n_points, cap))
-    eps = np.empty((n_points, cap))
-    coef = np.zeros((n_points, cap, 2, 2, n_orders))
-    dcoef = np.zeros((n_points, cap, 2, 2, n_orders))
-    for g in range(n_points):
+    traced = (np.zeros(n_points, dtype=np.int64), np.empty((n_points, cap), dtype=np.int64),
+              np.empty((n_points, cap)), np.empty((n_points, cap)), np.zeros((n_points, cap, 2, 2, n_orders)),
+              np.zeros((n_points, cap, 2, 2, n_orders)))
+    if not untraced:
+        _trace_range(p0, p1, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, xi, 0, n_points,
+                     traced)
+    return traced
+
+
+@njit(cache=True)
+def _trace_range(p0, p1, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, xi, start, stop, traced):
+    """Trace the points ``start:stop`` of ``xi`` into ``traced`` (see :func:`trace_points`)."""
+    n_pairs, layer, z, eps, coef, dcoef = traced
+    for g in range(start, stop):
         x3 = 0.5 * (p0[1] + p1[1]) + 0.5 * xi[g] * (p1[1] - p0[1])
         n_pairs[g] = trace(x3, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, layer[g], z[g],
                            eps[g], coef[g], dcoef[g])
-    return n_pairs, layer, z, eps, coef, dcoef
 
 
 @njit(cache=True)
@@ -621,9 +628,9 @@ def _source_block(j, rows, centers, frames, half_length, layer, params, settings
     layered = interfaces.shape[0] > 0
     max_level = _CACHED_LEVELS - 1
     xi, wt, start = _level_rule(n_gauss, max_level)
-    traced = trace_points(p0, p1, ls, interfaces, shear_modulus, poisson_ratio, n_images, xi[:0])
-    if layered:
-        traced = trace_points(p0, p1, ls, interfaces, shear_modulus, poisson_ratio, n_images, xi)
+    # each level is traced when a receiver first needs it (a lone receiver: one level)
+    traced = trace_points(p0, p1, ls, interfaces, shear_modulus, poisson_ratio, n_images, xi, True)
+    is_traced = np.zeros(max_level + 1, dtype=np.bool_)
     ws = Workspace(traced[4].shape[-1])
     ws1 = Workspace(1)
     for ia in range(rows.shape[0]):
@@ -641,6 +648,9 @@ def _source_block(j, rows, centers, frames, half_length, layer, params, settings
             image[:] = 0.0
             if level <= max_level:
                 a, b = start[level], start[level + 1]
+                if not is_traced[level]:
+                    _trace_range(p0, p1, ls, interfaces, shear_modulus, poisson_ratio, n_images, xi, a, b, traced)
+                    is_traced[level] = True
                 _integrate(point[0], point[1], lr, p0, p1, ls, shear_modulus, poisson_ratio, xi[a:b], wt[a:b],
                            np.ones((b - a, 1)), traced, a, image, gradient, ws, ws1)
             else:
