@@ -286,3 +286,29 @@ def test_grown_mesh_border_blocks_keep_the_base_images():
     dense = hd.ElasticityOperator(grown, fixed).to_dense()
     x = np.random.default_rng(2).standard_normal(dense.shape[0])
     assert np.linalg.norm(extended @ x - dense @ x) <= 1e-8 * np.linalg.norm(dense @ x)
+
+
+def test_reference_three_layer_conclusions():
+    """Ref. Sec. 3.5.1 (Table 3.2; gamma = G_outer/G_middle, crack length = middle-layer
+    height, nu = 0.2, 20 constant elements): the vertical crack needs fewer images than the
+    horizontal one, and gamma = 5 more than gamma = 2 (crack volume against 16 images)."""
+    h = 1.0
+    meshes = {"horizontal": hd.mesh.line([-h / 2, 0.0], [h / 2, 0.0], 20),
+              "vertical": hd.mesh.line([0.0, -h / 2], [0.0, h / 2], 20)}
+
+    def volume(mesh, gamma, images):
+        medium = LayeredMedium([h / 2, -h / 2], [gamma, 1.0, gamma], [0.2, 0.2, 0.2], images=images,
+                               gauss_points=3)
+        dd = hd.solve(hd.ElasticityOperator(mesh, medium), -1e-3 * mesh.normals)
+        return np.sum(hd.opening(mesh, dd) * mesh.areas)
+
+    error = {}
+    for gamma in (2.0, 5.0):
+        for name, mesh in meshes.items():
+            reference = volume(mesh, gamma, 16)
+            error[gamma, name] = abs(volume(mesh, gamma, 1) / reference - 1.0)
+    for gamma in (2.0, 5.0):
+        assert error[gamma, "vertical"] < 0.25 * error[gamma, "horizontal"]
+    for name in meshes:
+        assert error[5.0, name] > 2.0 * error[2.0, name]
+    assert error[2.0, "vertical"] < 0.01 < error[5.0, "horizontal"]  # one image: fine vs 10% off
