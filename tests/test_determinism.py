@@ -39,6 +39,10 @@ import sys
 
 import pytest
 
+#: Two fresh processes that compile and run a growing H-matrix simulation (~20 s warm,
+#: minutes on a cold numba cache): the slow set, run by .ci/run after the default set.
+pytestmark = pytest.mark.slow
+
 PROBE = r"""
 import json
 import numba
