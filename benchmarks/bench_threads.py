@@ -23,17 +23,12 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 
 
-def machine_busy_seconds():
-    """Busy CPU seconds of the whole machine so far (all processes, all cores)."""
-    with open("/proc/stat") as f:
-        fields = [int(v) for v in f.readline().split()[1:]]
-    return (sum(fields) - fields[3] - fields[4]) / os.sysconf("SC_CLK_TCK")
-
-
 def timed(function, threads, calls):
     """(mean wall, CPU per call, background cores) of ``calls`` calls on ``threads`` threads
     (the mean, not the median: a descheduled thread makes rare calls very slow)."""
     import numba
+
+    from hmatddm.hmatrix._threads import machine_busy_seconds
 
     numba.set_num_threads(threads)
     walls = []

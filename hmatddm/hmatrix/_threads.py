@@ -40,7 +40,7 @@ def single_threaded_blas():
     return _CONTROLLER[0].limit(limits=1, user_api="blas")
 
 
-def _machine_busy_seconds():
+def machine_busy_seconds():
     """Busy CPU seconds of the whole machine (Linux /proc/stat), None elsewhere."""
     try:
         with open("/proc/stat") as f:
@@ -58,7 +58,7 @@ def background_cores():
     state = _LOAD
     if state["time"] is not None and now - state["time"] < LOAD_WINDOW_SECONDS:
         return state["others"]
-    busy, cpu = _machine_busy_seconds(), time.process_time()
+    busy, cpu = machine_busy_seconds(), time.process_time()
     if busy is not None and state["busy"] is not None and now > state["time"]:
         state["others"] = max(0.0, (busy - state["busy"] - (cpu - state["cpu"])) / (now - state["time"]))
     state.update(time=now, busy=busy, cpu=cpu)
