@@ -287,8 +287,20 @@ def test_plan_views_carry_a_round_length_scale(tmp_path, scene3d):
     from hmatddm.render.snapshots import scale_bar_length
 
     assert [scale_bar_length(span) for span in (120.0, 3.0, 0.75, 40.0)] == [20.0, 0.5, 0.1, 5.0]
+
     mesh, fields = scene3d
     path = snapshot(mesh, tmp_path / "plan.png", view="plan", window_size=WINDOW, **fields)
     image = _image(path)
     black = (image.max(axis=2) < 0.15)[int(0.88 * WINDOW[1]):, :int(0.3 * WINDOW[0])]  # lower left corner
     assert black.sum() > 10, "no length scale in the lower left corner"
+
+
+def test_the_scale_bar_of_a_vertical_section_follows_the_shown_width():
+    """A vertical 2D section is ~0 wide in x; its bar is still a fifth of what the box shows."""
+    from hmatddm.render.snapshots import plan_frame, plan_scale_bar
+
+    extent, window = (-0.05, 0.05, -14.0, 14.0), (1200, 900)
+    _, _, scale, box = plan_frame(extent, window)
+    shown = 2.0 * scale * (window[0] / window[1]) * (box[1] - box[0])
+    assert 0.1 * shown <= plan_scale_bar(extent, window) <= 0.2 * shown
+    assert plan_scale_bar((-60.0, 60.0, -1.0, 1.0), window) == 20.0  # wide views: as before

@@ -382,6 +382,15 @@ def scale_bar_length(span):
     return float(max(m * power for m in (1.0, 2.0, 5.0) if m * power <= target))
 
 
+def plan_scale_bar(extent, window_size, colour_bar=True, title=True):
+    """The length scale of a plan view (m): a round length of about a fifth of the width
+    the plot box shows at :func:`plan_frame`'s scale -- not of the fractures' own x
+    extent, which is ~0 for a vertical 2D section (it made the bar a dot there)."""
+    _, _, scale, box = plan_frame(extent, window_size, colour_bar, title)
+    aspect = window_size[0] / window_size[1]
+    return scale_bar_length(2.0 * scale * aspect * (box[1] - box[0]))
+
+
 def _length_text(length):
     return f"{length * 1e3:g} mm" if length < 1e-2 else (f"{length:g} m" if length < 1e3 else f"{length / 1e3:g} km")
 
@@ -396,7 +405,7 @@ def _frame_plan(plotter, mesh, window_size, colour_bar, title):
     z_top = float(np.max(mesh.corners()[..., 2])) if isinstance(mesh, Mesh3D) else 0.0
     diagonal = _diagonal(mesh)
     # the length scale: a black bar from the left edge of the box, at SCALE_Y
-    length = scale_bar_length(extent[1] - extent[0])
+    length = plan_scale_bar(extent, window_size, colour_bar, title)
     x0 = centre_x + (box[0] - 0.5) * 2.0 * scale * aspect
     y0 = centre_y + (SCALE_Y - 0.5) * 2.0 * scale
     lift = z_top + 0.5 * diagonal
