@@ -157,14 +157,21 @@ def snapshot_title(name, time_value, mesh, state=None):
     return text + (f" (+ {intact} intact natural)" if intact else "")
 
 
-def write_snapshots(out, mesh, fields, step, time_value, title_prefix):
-    """``snapshots/step-NNNNNN_{plan,oblique}.png`` of one state; returns the paths."""
+def layer_interfaces(scene):
+    """Interface heights (m) of a scene's ``[[layer]]`` tables (validated data); () without layers."""
+    layers = (scene or {}).get("layer") or []
+    return tuple(float(layer["bottom"]) for layer in layers[:-1])
+
+
+def write_snapshots(out, mesh, fields, step, time_value, title_prefix, interfaces=()):
+    """``snapshots/step-NNNNNN_{plan,oblique}.png`` of one state; returns the paths.
+    ``interfaces``: layer interface heights, drawn across a 2D section."""
     from .render import snapshot
 
     title = snapshot_title(title_prefix, time_value, mesh, fields.get("state"))
     slip_vectors = _visible_slip(mesh, fields["slip"], fields["opening"])
     return [snapshot(mesh, Path(out) / SNAPSHOT_DIR / f"step-{step:06d}_{view}.png", opening=fields["opening"],
-                     state=fields.get("state"), slip=slip_vectors, view=view, title=title)
+                     state=fields.get("state"), slip=slip_vectors, view=view, title=title, interfaces=interfaces)
             for view in snapshot_views(mesh)]
 
 
@@ -396,7 +403,7 @@ class SceneRun:
             fields = cell_fields(mesh, dd, pressure, self._stress, codes)
             try:
                 self.written["snapshots"] = write_snapshots(self.out, mesh, fields, state.step, state.time,
-                                                            self.scene.name)
+                                                            self.scene.name, layer_interfaces(self.scene.data))
             except OutputError:
                 raise
             except HmatddmError as error:  # e.g. no offscreen OpenGL on this machine
@@ -504,7 +511,7 @@ def render_folder(out):
     summary = read_summary(out)
     scene = scene_from_dict(summary["scene"]).data if summary is not None and "scene" in summary else None
     name = scene["name"] if scene is not None else out.name
-    written = list(write_snapshots(out, mesh, fields, step, time_value, name))
+    written = list(write_snapshots(out, mesh, fields, step, time_value, name, layer_interfaces(scene)))
     if summary is not None and summary.get("steps"):
         written.append(write_history(out, summary["steps"], scene))
     return written

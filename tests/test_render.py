@@ -304,3 +304,23 @@ def test_the_scale_bar_of_a_vertical_section_follows_the_shown_width():
     shown = 2.0 * scale * (window[0] / window[1]) * (box[1] - box[0])
     assert 0.1 * shown <= plan_scale_bar(extent, window) <= 0.2 * shown
     assert plan_scale_bar((-60.0, 60.0, -1.0, 1.0), window) == 20.0  # wide views: as before
+
+
+def test_a_layered_section_draws_its_interfaces_across_the_picture(tmp_path):
+    """A vertical 2D crack from y = -3 to 3 m with interfaces at +-1 m: two grey rows
+    that span most of the picture's width; none without interfaces."""
+    mesh = hd.mesh.line([0.0, -3.0], [0.0, 3.0], 12)
+    opening = 1e-3 * np.sqrt(1 - np.linspace(-0.95, 0.95, 12) ** 2)
+
+    def grey_rows(path):
+        image = _image(path)
+        grey = (np.ptp(image, axis=2) < 0.05) & (image.mean(axis=2) > 0.3) & (image.mean(axis=2) < 0.7)
+        return np.flatnonzero(grey.sum(axis=1) > 0.5 * WINDOW[0])
+
+    plain = snapshot(mesh, tmp_path / "plain.png", opening=opening, window_size=WINDOW)
+    layered = snapshot(mesh, tmp_path / "layered.png", opening=opening, window_size=WINDOW, interfaces=(1.0, -1.0))
+    assert grey_rows(plain).size == 0
+    rows = grey_rows(layered)
+    assert rows.size >= 2 and np.ptp(rows) > 0.1 * WINDOW[1]  # two separate lines
+    with pytest.raises(hd.InputError, match="interfaces"):
+        snapshot(mesh, tmp_path / "bad.png", opening=opening, interfaces=(np.nan,))

@@ -208,3 +208,10 @@ def test_snapshot_titles_count_the_elements_of_the_record(tmp_path):
     intact = int(np.count_nonzero(state == 1))
     assert intact > 0 and mesh.n_elements > run.last_record["n_elements"]
     assert title == f"tiny: t = 2 s, {run.last_record['n_elements']} elements (+ {intact} intact natural)"
+
+
+def test_layer_interfaces_of_a_scene_are_what_its_snapshots_draw():
+    from hmatddm.runner import layer_interfaces
+
+    assert layer_interfaces(hs.load_scene("layered-height").data) == (3.0, -3.0)
+    assert layer_interfaces(hs.load_scene("kgd").data) == ()

@@ -395,15 +395,27 @@ def _length_text(length):
     return f"{length * 1e3:g} mm" if length < 1e-2 else (f"{length:g} m" if length < 1e3 else f"{length / 1e3:g} km")
 
 
-def _frame_plan(plotter, mesh, window_size, colour_bar, title):
+def _frame_plan(plotter, mesh, window_size, colour_bar, title, interfaces=()):
     """Look down ``-z`` (parallel projection) with the fractures inside :data:`PLAN_BOX`,
-    and draw a length scale under them."""
+    and draw a length scale under them (and, in a 2D section, the layer ``interfaces``
+    that cross the box as grey lines across it)."""
     pyvista = _pyvista()
     extent = _plan_extent(mesh)
     centre_x, centre_y, scale, box = plan_frame(extent, window_size, colour_bar, title)
     aspect = window_size[0] / window_size[1]
     z_top = float(np.max(mesh.corners()[..., 2])) if isinstance(mesh, Mesh3D) else 0.0
     diagonal = _diagonal(mesh)
+    x_left = centre_x + (box[0] - 0.5) * 2.0 * scale * aspect
+    x_right = centre_x + (box[1] - 0.5) * 2.0 * scale * aspect
+    y_low, y_high = (centre_y + (edge - 0.5) * 2.0 * scale for edge in (box[2], box[3]))
+    shown = [height for height in interfaces if y_low <= height <= y_high]
+    for height in shown:
+        plotter.add_mesh(pyvista.Line((x_left, height, -1e-3 * diagonal), (x_right, height, -1e-3 * diagonal)),
+                         color="grey", line_width=2)
+    if shown:
+        plotter.add_text("grey lines: layer interfaces", position=(int(0.3 * window_size[0]),
+                                                                    int((SCALE_Y - 0.02) * window_size[1])),
+                         font_size=10, color="grey")
     # the length scale: a black bar from the left edge of the box, at SCALE_Y
     length = plan_scale_bar(extent, window_size, colour_bar, title)
     x0 = centre_x + (box[0] - 0.5) * 2.0 * scale * aspect
@@ -577,7 +589,7 @@ def _screenshot(plotter, window_size):
 
 
 def snapshot(mesh, path, opening=None, state=None, slip=None, view="oblique", title=None,
-             window_size=(1200, 900), plan_style="auto"):
+             window_size=(1200, 900), plan_style="auto", interfaces=()):
     """Render one offscreen PNG of the fractures.
 
     Parameters
@@ -609,6 +621,10 @@ def snapshot(mesh, path, opening=None, state=None, slip=None, view="oblique", ti
         Text at the top of the image.
     window_size : (width, height)
         Image size in pixels.
+    interfaces : sequence of float, optional
+        Heights (m, the vertical second coordinate) of layer interfaces, drawn in a 2D
+        vertical section as grey lines across the picture (docs/conventions.md §3).
+        Ignored for a Mesh3D.
 
     Returns
     -------
@@ -630,6 +646,9 @@ def snapshot(mesh, path, opening=None, state=None, slip=None, view="oblique", ti
         raise InputError(f"plan_style must be one of {PLAN_STYLES}, got {plan_style!r}")
     window_size = _check_window_size(window_size)
     opening, state, slip = _check_fields(mesh, opening, state, slip)
+    interfaces = np.asarray(interfaces if interfaces is not None else (), dtype=float).ravel()
+    if not np.all(np.isfinite(interfaces)):
+        raise InputError("interfaces must be finite heights (m)")
     traces = view == "plan" and isinstance(mesh, Mesh3D) and (
         plan_style == "traces" or (plan_style == "auto" and is_mostly_vertical(mesh)))
     if traces and not np.any(vertical_elements(mesh)):
@@ -647,7 +666,8 @@ def snapshot(mesh, path, opening=None, state=None, slip=None, view="oblique", ti
         if view == "oblique" and isinstance(mesh, Mesh3D):
             plotter.add_axes()  # a plan view has x to the right and y up, and a length scale instead
         if view == "plan" or isinstance(mesh, Mesh2D):
-            _frame_plan(plotter, mesh, window_size, colour_bar=opening is not None, title=title is not None)
+            _frame_plan(plotter, mesh, window_size, colour_bar=opening is not None, title=title is not None,
+                        interfaces=interfaces if isinstance(mesh, Mesh2D) else ())
         else:
             _set_view(plotter, mesh, view)
         image = _screenshot(plotter, window_size)
