@@ -208,3 +208,30 @@ def test_farthest_unvisited_probe_order():
     visited[9] = True
     assert _farthest_unvisited(visited) == 5  # the middle of the largest gap
     assert _farthest_unvisited(np.ones(4, dtype=np.bool_)) == -1
+
+
+def test_the_production_build_loop_gives_the_factors_of_aca_tensor():
+    """HMatrix.build drives the ACA state machine from its own compiled loop
+    (hmatrix/storage.py, _build_blocks), not through aca_tensor. Every stored low-rank
+    block must be exactly what aca_tensor + recompress give on the same elements with
+    the tolerance the build uses, so the ACA tests above speak for production."""
+    from hmatddm.hmatrix import HMatrix
+    from hmatddm.hmatrix.aca import ACA_TOLERANCE_FACTOR
+    from hmatddm.hmatrix.example_kernels import tensor_generator, tensor_kernel
+
+    rng = np.random.default_rng(3)
+    points = rng.random((1200, 3)) * np.array([60.0, 4.0, 1.0])
+    generator = tensor_generator(points, coupling=0.7)
+    eps = 1e-7  # float64 factors: the comparison is to round-off
+    h = HMatrix.build(generator, eps=eps, eta=1.0, leaf_size=16)
+    s, permutation = h.storage, h.tree.permutation
+    assert s.lowrank_rank.size > 20
+    for b in range(s.lowrank_rank.size):
+        rows = permutation[s.lowrank_row_start[b]:s.lowrank_row_stop[b]].astype(np.int64)
+        cols = permutation[s.lowrank_col_start[b]:s.lowrank_col_stop[b]].astype(np.int64)
+        u, v, _ = aca_tensor(tensor_kernel, generator.data, rows, cols, generator.dof, ACA_TOLERANCE_FACTOR * eps)
+        u, v, rank = recompress(u, v, eps)
+        stored_u, stored_v = h._factors(b)
+        assert rank == s.lowrank_rank[b]
+        reference = u @ v.T
+        assert np.linalg.norm(stored_u @ stored_v.T - reference) <= 1e-12 * np.linalg.norm(reference)
