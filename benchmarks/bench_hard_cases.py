@@ -28,6 +28,7 @@ from _common import machine, markdown_table  # noqa: E402
 import hmatddm as hd  # noqa: E402
 from hmatddm import analytical as an  # noqa: E402
 from hmatddm import network as nw  # noqa: E402
+from hmatddm.cases import graded_line, mixed_scales  # noqa: E402
 from hmatddm.errors import ConvergenceError  # noqa: E402
 from hmatddm.hmatrix import gmres  # noqa: E402
 
@@ -222,19 +223,6 @@ def case_parallel():
 
 
 # ------------------------------------------------------ 3. thin and graded elements
-def graded_line(ratio, layout, coarse=0.1):
-    nodes, x = [-1.0], -1.0
-    count = int(round(2.0 / coarse))
-    for k in range(count):
-        refine = {"centre": k == count // 2, "tips": k in (0, count - 1), "alternating": k % 2 == 1}[layout]
-        nodes += list(np.linspace(x, x + coarse, ratio + 1)[1:]) if refine else [x + coarse]
-        x += coarse
-    nodes = np.array(nodes)
-    nodes[-1] = 1.0
-    zeros = np.zeros(len(nodes) - 1)
-    return hd.Mesh2D.from_segments(np.column_stack([nodes[:-1], zeros]), np.column_stack([nodes[1:], zeros]))
-
-
 def case_mesh_quality():
     print("3. thin and graded elements", flush=True)
     griffith_area = np.pi * (1 - MAT.poisson_ratio) * P / MAT.shear_modulus
@@ -316,25 +304,6 @@ def case_edge_extensions():
 
 
 # ------------------------------------------------------------- 5. scale separation
-def mixed_scales(dim, seed, small):
-    rng = np.random.default_rng(seed)
-    if dim == 2:
-        parts = [hd.mesh.line([-50, 0], [50, 0], 100)]
-    else:
-        parts = [hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 0, 1], 100.0, 10.0, 50, 5)]
-    for k in range(small):
-        offset = rng.choice([-1, 1]) * 10 ** rng.uniform(-1.3, 0.7)
-        strike = rng.uniform(0, np.pi)
-        tangent = np.array([np.cos(strike), np.sin(strike)])
-        if dim == 2:
-            centre = np.array([rng.uniform(-45, 45), offset])
-            parts.append(hd.mesh.line(centre - 0.05 * tangent, centre + 0.05 * tangent, 10, fracture_id=k + 1))
-        else:
-            centre = np.array([rng.uniform(-45, 45), offset, rng.uniform(-4, 4)])
-            parts.append(hd.mesh.rectangle(centre, [*tangent, 0], [0, 0, 1], 0.1, 0.1, 4, 4, fracture_id=k + 1))
-    return hd.mesh.concatenate(parts)
-
-
 def case_scales():
     print("5. scale separation", flush=True)
     # 2D with 5 small fractures: a block then holds few small-fracture rows/columns,

@@ -32,6 +32,7 @@ import scipy.sparse.linalg as spla
 import hmatddm as hd
 from hmatddm import analytical as an
 from hmatddm import network as nw
+from hmatddm.cases import graded_line, mixed_scales
 from hmatddm.kernels import rectangle3d
 
 P = 1e6          # net pressure, Pa
@@ -356,23 +357,6 @@ def test_parallel_pennies_3d_stress_shadow(material):
 
 
 # -------------------------------------------------------- 3. thin and graded elements
-def graded_line(ratio, layout, coarse=0.1):
-    """Nodes of a crack on [-1, 1] with coarse elements and fine blocks ``ratio`` times
-    smaller: at the centre ("centre"), at both tips ("tips") or every other coarse
-    element ("alternating"). Neighbouring sizes differ by ``ratio``."""
-    fine = lambda x0: list(np.linspace(x0, x0 + coarse, ratio + 1)[1:])  # noqa: E731
-    nodes, x, k = [-1.0], -1.0, 0
-    count = int(round(2.0 / coarse))
-    for k in range(count):
-        refine = {"centre": k == count // 2, "tips": k in (0, count - 1), "alternating": k % 2 == 1}[layout]
-        nodes += fine(x) if refine else [x + coarse]
-        x += coarse
-    nodes = np.array(nodes)
-    nodes[-1] = 1.0
-    zeros = np.zeros(len(nodes) - 1)
-    return hd.Mesh2D.from_segments(np.column_stack([nodes[:-1], zeros]), np.column_stack([nodes[1:], zeros]))
-
-
 @pytest.mark.parametrize("layout", ["centre", "tips", "alternating"])
 @pytest.mark.parametrize("ratio", [10, 50])
 def test_graded_2d_mesh_against_griffith(material, ratio, layout):
@@ -484,27 +468,6 @@ def test_collocation_points_on_segment_extensions_2d(material):
 
 
 # ---------------------------------------------------- 5. scale separation (0.1 m - 100 m)
-def mixed_scales(dim, seed=1, small=30):
-    """One 100 m fracture (1 m elements in 2D, 2 m in 3D) and ``small`` 0.1 m fractures
-    (10 elements / 4 x 4 elements) at 0.05 - 5 m from it, random strikes."""
-    rng = np.random.default_rng(seed)
-    if dim == 2:
-        parts = [hd.mesh.line([-50, 0], [50, 0], 100)]
-    else:
-        parts = [hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 0, 1], 100.0, 10.0, 50, 5)]
-    for k in range(small):
-        offset = rng.choice([-1, 1]) * 10 ** rng.uniform(-1.3, 0.7)
-        strike = rng.uniform(0, np.pi)
-        tangent = np.array([np.cos(strike), np.sin(strike)])
-        if dim == 2:
-            centre = np.array([rng.uniform(-45, 45), offset])
-            parts.append(hd.mesh.line(centre - 0.05 * tangent, centre + 0.05 * tangent, 10, fracture_id=k + 1))
-        else:
-            centre = np.array([rng.uniform(-45, 45), offset, rng.uniform(-4, 4)])
-            parts.append(hd.mesh.rectangle(centre, [*tangent, 0], [0, 0, 1], 0.1, 0.1, 4, 4, fracture_id=k + 1))
-    return hd.mesh.concatenate(parts)
-
-
 def per_fracture_error(mesh, dd, dd_h):
     return max(np.linalg.norm(dd_h[mesh.fracture_id == f] - dd[mesh.fracture_id == f])
                / np.linalg.norm(dd[mesh.fracture_id == f]) for f in np.unique(mesh.fracture_id))
