@@ -6,6 +6,7 @@ Every message names the field and the allowed range, e.g.
 import numpy as np
 
 from .errors import InputError
+from .settings import integer
 
 
 def finite_scalar(name, value):
@@ -27,11 +28,8 @@ def positive_scalar(name, value):
 
 
 def positive_int(name, value, minimum=1):
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise InputError(f"{name} must be an integer >= {minimum}, got {value!r}")
-    if value < minimum:
-        raise InputError(f"{name} must be an integer >= {minimum}, got {value}")
-    return int(value)
+    """``value`` as an int >= ``minimum``: the one integer check (:func:`hmatddm.settings.integer`)."""
+    return integer(name, value, minimum)
 
 
 def finite_array(name, value, shape=None, dtype=np.float64):

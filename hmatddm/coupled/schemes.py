@@ -37,11 +37,11 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from .._validation import finite_scalar, positive_int
-from ..errors import ConvergenceError, InputError
+from ..errors import ConvergenceError
 from ..hmatrix import gmres
 
 from ..options import SCHEME_DEFAULTS, SCHEMES  # noqa: E402,F401
+from ..settings import SCHEME  # noqa: E402  (ranges and units of the fields)
 COUPLED_SCHEMES = ("fully-coupled", "krylov")
 
 
@@ -80,26 +80,12 @@ class SchemeSettings:
     relaxation_growth: float = SCHEME_DEFAULTS["relaxation_growth"]
 
     def __post_init__(self):
-        if self.scheme not in SCHEMES:
-            raise InputError(f"scheme must be one of {SCHEMES}, got {self.scheme!r}")
+        object.__setattr__(self, "scheme", SCHEME["scheme"].value("scheme", self.scheme))
         if self.relaxation_growth is None:
             object.__setattr__(self, "relaxation_growth", 2.0 if self.scheme in COUPLED_SCHEMES else 1.0)
-        growth = finite_scalar("relaxation_growth", self.relaxation_growth)
-        if growth < 1.0:
-            raise InputError(f"relaxation_growth must be >= 1, got {growth}")
-        object.__setattr__(self, "relaxation_growth", growth)
-        for name, low, high in (("omega", 0.0, 1.0), ("relaxation", 1e-12, 1.0), ("min_relaxation", 1e-12, 1.0)):
-            value = finite_scalar(name, getattr(self, name))
-            if not low <= value <= high:
-                raise InputError(f"{name} must be in [{low:g}, {high:g}], got {value}")
-            object.__setattr__(self, name, value)
-        for name in ("tolerance_pressure", "tolerance_opening", "linear_rtol"):
-            value = finite_scalar(name, getattr(self, name))
-            if not 0.0 < value < 1.0:
-                raise InputError(f"{name} must be in (0, 1), got {value}")
-            object.__setattr__(self, name, value)
-        for name in ("max_iterations", "linear_restart", "linear_maxiter"):
-            object.__setattr__(self, name, positive_int(name, getattr(self, name)))
+        for name in ("relaxation_growth", "omega", "relaxation", "min_relaxation", "tolerance_pressure",
+                     "tolerance_opening", "linear_rtol", "max_iterations", "linear_restart", "linear_maxiter"):
+            object.__setattr__(self, name, SCHEME[name].value(name, getattr(self, name)))
 
 
 @dataclass

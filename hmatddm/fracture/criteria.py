@@ -8,7 +8,7 @@ mechanics gives ``DD_y = 8 (1 - nu^2) / E  K_I sqrt(r / 2 pi)`` and the same for
 """
 import numpy as np
 
-OLSON_CORRECTION = 0.806  # C_cor of ref. Eqs 4.18-4.19 (Olson 1991)
+from ..settings import OLSON_CORRECTION  # noqa: E402,F401  C_cor of ref. Eqs 4.18-4.19 (Olson 1991)
 
 
 def stress_intensity_factors(opening, slip_ahead, slip_along, half_width, material,

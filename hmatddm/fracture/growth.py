@@ -14,13 +14,14 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .._validation import finite_scalar, positive_int
+from .._validation import finite_scalar
 from ..errors import InputError
 from ..mesh import Mesh2D, Mesh3D
 from .criteria import (OLSON_CORRECTION, circumferential_stress_direction, energy_release_rate,
                        equivalent_mode_one, stress_intensity_factors)
 
 from ..options import CRITERIA, FRONTS, TURNING  # noqa: E402,F401
+from ..settings import PROPAGATION  # noqa: E402  (ranges, units and defaults of the fields)
 
 
 @dataclass(frozen=True)
@@ -79,37 +80,13 @@ class Propagation:
     front_tolerance: float = 1e-3
 
     def __post_init__(self):
-        toughness = finite_scalar("propagation.toughness", self.toughness)
-        if toughness <= 0.0:
-            raise InputError(f"propagation.toughness must be > 0 Pa m^0.5, got {toughness}")
-        object.__setattr__(self, "toughness", toughness)
-        if self.criterion not in CRITERIA:
-            raise InputError(f"propagation.criterion must be one of {CRITERIA}, got {self.criterion!r}")
-        if self.front not in FRONTS:
-            raise InputError(f"propagation.front must be one of {FRONTS}, got {self.front!r}")
-        object.__setattr__(self, "front_iterations",
-                           positive_int("propagation.front_iterations", self.front_iterations))
-        tolerance = finite_scalar("propagation.front_tolerance", self.front_tolerance)
-        if not 0.0 < tolerance < 1.0:
-            raise InputError(f"propagation.front_tolerance must be in (0, 1), got {tolerance}")
-        object.__setattr__(self, "front_tolerance", tolerance)
-        if self.turning not in TURNING:
-            raise InputError(f"propagation.turning must be one of {TURNING}, got {self.turning!r}")
-        if self.critical_energy_release_rate is not None:
-            g_c = finite_scalar("propagation.critical_energy_release_rate", self.critical_energy_release_rate)
-            if g_c <= 0.0:
-                raise InputError(f"propagation.critical_energy_release_rate must be > 0 J/m^2, got {g_c}")
-            object.__setattr__(self, "critical_energy_release_rate", g_c)
-        correction = finite_scalar("propagation.correction", self.correction)
-        if not 0.0 < correction <= 2.0:
-            raise InputError(f"propagation.correction must be in (0, 2], got {correction}")
-        object.__setattr__(self, "correction", correction)
-        angle = finite_scalar("propagation.min_turn_angle", self.min_turn_angle)
+        for name in ("toughness", "criterion", "front", "front_iterations", "front_tolerance", "turning",
+                     "critical_energy_release_rate", "correction", "max_growth_passes"):
+            object.__setattr__(self, name, PROPAGATION[name].value(f"propagation.{name}", getattr(self, name)))
+        angle = finite_scalar("propagation.min_turn_angle", self.min_turn_angle)  # radians here, degrees in a scene
         if not 0.0 <= angle < np.pi / 2:
             raise InputError(f"propagation.min_turn_angle must be in [0, pi/2) rad, got {angle}")
         object.__setattr__(self, "min_turn_angle", angle)
-        object.__setattr__(self, "max_growth_passes",
-                           positive_int("propagation.max_growth_passes", self.max_growth_passes, minimum=0))
         if self.bounds is not None:
             try:
                 bounds = tuple((float(lo), float(hi)) for lo, hi in self.bounds)

@@ -25,6 +25,7 @@ import scipy.sparse.linalg as spla
 from scipy.linalg import get_lapack_funcs
 
 from hmatddm.errors import ConvergenceError, InputError
+from hmatddm.settings import integer
 
 from ._threads import single_threaded_blas
 
@@ -39,9 +40,7 @@ MAX_BASIS_BYTES = 1 << 30
 
 
 def _positive_integer(name, value):
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
-        raise InputError(f"{name} must be an integer >= 1, got {value!r}")
-    return int(value)
+    return integer(name, value, 1)
 
 
 def _default_max_restart(restart, n):

@@ -21,164 +21,14 @@ import math
 import numpy as np
 
 from ..errors import InputError
-from ..fracture.criteria import OLSON_CORRECTION
-from ..options import (BACKENDS, CONTACT_MODES, CRITERIA, DEFAULT_EPS, DEFAULT_ETA, DEFAULT_LEAF_SIZE, FRONTS,
-                       SCHEME_DEFAULTS, SCHEMES, SINGULAR_CORRECTIONS, TURNING)
-
-REQUIRED = object()  # marker: the key has no default
-ABSENT = object()    # marker: optional key without a default (left out of the echo when not given)
+from ..options import BACKENDS, CONTACT_MODES, DEFAULT_EPS, DEFAULT_ETA, DEFAULT_LEAF_SIZE, SINGULAR_CORRECTIONS
+from ..settings import ABSENT, PROPAGATION, REQUIRED, SCHEME, show
+from ..settings import Setting as Key  # a key of a scene section is one setting
 
 REFERENCE_KINDS = ("radial-k", "radial-m", "kgd-k", "kgd-m")
 SHAPES = {2: ("line",), 3: ("rectangle", "penny")}
 CROSSING_CRITERIA = ("mohr-coulomb", "energy-release-rate", "stress-intensity")
 NETWORK_BOUNDARY = ("resample", "clip")
-
-
-def show(value):
-    """A value as error messages print it (numbers with up to 12 significant digits)."""
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, float):
-        return f"{value:.12g}"
-    if isinstance(value, (list, tuple)):
-        return "[" + ", ".join(show(v) for v in value) + "]"
-    if isinstance(value, dict):
-        return "a table"
-    return repr(value)
-
-
-class Key:
-    """One key of a section: its kind, default, range and unit.
-
-    kind: ``number``, ``integer``, ``boolean``, ``string``, ``choice`` (one of ``choices``),
-    ``point`` (``length`` numbers; ``length="dim"`` is the scene dimension),
-    ``numbers`` (a non-empty list of numbers, or one number), ``integers`` (a list of
-    integers >= 0), ``matrix`` (dim x dim numbers), ``pairs`` (a list of [low, high]).
-    ``low``/``high`` bound numbers (and every entry of a list), open when
-    ``low_open``/``high_open``.
-    """
-
-    def __init__(self, kind, default=ABSENT, *, low=None, high=None, low_open=False, high_open=False,
-                 choices=None, length=None, unit="", doc=""):
-        self.kind, self.default = kind, default
-        self.low, self.high, self.low_open, self.high_open = low, high, low_open, high_open
-        self.choices, self.length, self.unit, self.doc = choices, length, unit, doc
-
-    # -- ranges --------------------------------------------------------------------
-    def range_text(self):
-        unit = f" {self.unit}" if self.unit else ""
-        low, high = self.low, self.high
-        if low is not None and high is not None:
-            return (f"in {'(' if self.low_open else '['}{show(float(low))}, {show(float(high))}"
-                    f"{')' if self.high_open else ']'}{unit}")
-        if low is not None:
-            return f"{'>' if self.low_open else '>='} {show(float(low))}{unit}"
-        if high is not None:
-            return f"{'<' if self.high_open else '<='} {show(float(high))}{unit}"
-        return f"a finite number{unit}"
-
-    def in_range(self, value):
-        if self.low is not None and (value <= self.low if self.low_open else value < self.low):
-            return False
-        if self.high is not None and (value >= self.high if self.high_open else value > self.high):
-            return False
-        return True
-
-    # -- checks -----------------------------------------------------------------------
-    def _number(self, path, value, what=None):
-        what = what or path
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise InputError(f"{what} must be a number ({self.range_text()}), got {show(value)}")
-        number = float(value)
-        if not math.isfinite(number):
-            raise InputError(f"{what} must be finite ({self.range_text()}), got {show(number)}")
-        if not self.in_range(number):
-            raise InputError(f"{what} must be {self.range_text()}, got {show(value)}")
-        return number
-
-    def _list(self, path, value, length, item_text):
-        if not isinstance(value, list):
-            raise InputError(f"{path} must be a list of {item_text}, got {show(value)}")
-        if length is not None and len(value) != length:
-            raise InputError(f"{path} must be a list of {length} {item_text}, got {len(value)}: {show(value)}")
-        return value
-
-    def check(self, path, value, dim):
-        kind = self.kind
-        if kind == "number":
-            return self._number(path, value)
-        if kind == "integer":
-            if isinstance(value, bool) or not isinstance(value, int):
-                allowed = f"one of {show(list(self.choices))}" if self.choices else self.range_text()
-                raise InputError(f"{path} must be an integer ({allowed}), got {show(value)}")
-            if self.choices is not None and value not in self.choices:
-                raise InputError(f"{path} must be one of {show(list(self.choices))}, got {show(value)}")
-            if not self.in_range(value):
-                raise InputError(f"{path} must be an integer {self.range_text()}, got {show(value)}")
-            return int(value)
-        if kind == "boolean":
-            if not isinstance(value, bool):
-                raise InputError(f"{path} must be true or false, got {show(value)}")
-            return value
-        if kind == "string":
-            if not isinstance(value, str):
-                raise InputError(f"{path} must be a string, got {show(value)}")
-            return value
-        if kind == "choice":
-            if not isinstance(value, str) or value not in self.choices:
-                hint = ""
-                if isinstance(value, str):
-                    close = difflib.get_close_matches(value, self.choices, n=1)
-                    hint = f"; did you mean {close[0]!r}?" if close else ""
-                raise InputError(f"{path} must be one of {', '.join(map(repr, self.choices))}, "
-                                 f"got {show(value)}{hint}")
-            return value
-        if kind == "point":
-            length = dim if self.length == "dim" else self.length
-            self._list(path, value, length, f"coordinates{f' ({self.unit})' if self.unit else ''}")
-            return [self._number(path, v, f"{path}[{i}]") for i, v in enumerate(value)]
-        if kind == "numbers":
-            if isinstance(value, (int, float)) and not isinstance(value, bool):
-                value = [value]
-            self._list(path, value, None, "numbers")
-            if not value:
-                raise InputError(f"{path} must be a non-empty list of numbers, got []")
-            return [self._number(path, v, f"{path}[{i}]") for i, v in enumerate(value)]
-        if kind == "integers":
-            self._list(path, value, None, "integers")
-            for i, v in enumerate(value):
-                if isinstance(v, bool) or not isinstance(v, int) or v < 0:
-                    raise InputError(f"{path}[{i}] must be an integer >= 0, got {show(v)}")
-            return [int(v) for v in value]
-        if kind == "matrix":
-            self._list(path, value, dim, f"rows (a {dim} x {dim} tensor)")
-            rows = []
-            for i, row in enumerate(value):
-                self._list(f"{path}[{i}]", row, dim, "numbers")
-                rows.append([self._number(path, v, f"{path}[{i}][{j}]") for j, v in enumerate(row)])
-            return rows
-        if kind == "points":  # a list of points of `length` coordinates (e.g. well positions)
-            self._list(path, value, None, f"[{', '.join(['x', 'y', 'z'][:self.length])}] points")
-            return [Key("point", length=self.length, unit=self.unit).check(f"{path}[{i}]", v, dim)
-                    for i, v in enumerate(value)]
-        if kind == "pairs":
-            self._list(path, value, None, "[low, high] pairs")
-            pairs = []
-            for i, pair in enumerate(value):
-                if not isinstance(pair, list) or len(pair) != 2:
-                    raise InputError(f"{path}[{i}] must be a pair [low, high], got {show(pair)}")
-                low, high = (float(v) if isinstance(v, (int, float)) and not isinstance(v, bool) else None
-                             for v in pair)
-                if low is None or high is None or math.isnan(low) or math.isnan(high) or not low < high:
-                    raise InputError(f"{path}[{i}] must be numbers [low, high] with low < high "
-                                     f"(m; +-inf allowed), got {show(pair)}")
-                pairs.append([low, high])
-            return pairs
-        raise AssertionError(kind)  # pragma: no cover
-
-
-def _scheme_default(name):
-    return SCHEME_DEFAULTS[name]
 
 
 # ---------------------------------------------------------------------------------
@@ -240,20 +90,6 @@ SHAPE_KEYS = {  # key -> default (REQUIRED or a value) for each shape
     "line": {"p0": REQUIRED, "p1": REQUIRED, "element_size": REQUIRED},
 }
 
-PROPAGATION = {
-    "toughness": Key("number", REQUIRED, low=0.0, low_open=True, unit="Pa m^0.5"),
-    "criterion": Key("choice", "mcs", choices=CRITERIA),
-    "critical_energy_release_rate": Key("number", low=0.0, low_open=True, unit="J/m^2"),
-    "correction": Key("number", OLSON_CORRECTION, low=0.0, high=2.0, low_open=True),
-    "turning": Key("choice", "plan", choices=TURNING),
-    "min_turn_angle_deg": Key("number", 1.0, low=0.0, high=90.0, high_open=True, unit="deg"),
-    "max_growth_passes": Key("integer", 50, low=0),
-    "bounds": Key("pairs", unit="m"),
-    "growing_fractures": Key("integers"),
-    "front": Key("choice", "element", choices=FRONTS),
-    "front_iterations": Key("integer", 40, low=1),
-    "front_tolerance": Key("number", 1e-3, low=0.0, high=1.0, low_open=True, high_open=True),
-}
 
 LEAK_OFF = {
     "coefficient": Key("number", 0.0, low=0.0, unit="m/(s^0.5 Pa)"),
@@ -268,18 +104,17 @@ NUMERICS = {
     "eps": Key("number", DEFAULT_EPS, **_UNIT_INTERVAL),
     "eta": Key("number", DEFAULT_ETA, low=0.0, low_open=True),
     "leaf_size": Key("integer", DEFAULT_LEAF_SIZE, low=1),
-    "scheme": Key("choice", _scheme_default("scheme"), choices=SCHEMES),
-    "tolerance_pressure": Key("number", _scheme_default("tolerance_pressure"), **_UNIT_INTERVAL),
-    "tolerance_opening": Key("number", _scheme_default("tolerance_opening"), **_UNIT_INTERVAL),
-    "max_iterations": Key("integer", _scheme_default("max_iterations"), low=1),
-    "relaxation": Key("number", _scheme_default("relaxation"), low=0.0, high=1.0, low_open=True),
-    "min_relaxation": Key("number", _scheme_default("min_relaxation"), low=0.0, high=1.0, low_open=True),
-    "omega": Key("number", _scheme_default("omega"), low=0.0, high=1.0),
-    "relaxation_growth": Key("number", low=1.0,
-                             doc="factor raising alpha after a step without restart (default 2 coupled, 1 segregated)"),
-    "linear_rtol": Key("number", _scheme_default("linear_rtol"), **_UNIT_INTERVAL),
-    "linear_restart": Key("integer", _scheme_default("linear_restart"), low=1),
-    "linear_maxiter": Key("integer", _scheme_default("linear_maxiter"), low=1),
+    "scheme": SCHEME["scheme"],
+    "tolerance_pressure": SCHEME["tolerance_pressure"],
+    "tolerance_opening": SCHEME["tolerance_opening"],
+    "max_iterations": SCHEME["max_iterations"],
+    "relaxation": SCHEME["relaxation"],
+    "min_relaxation": SCHEME["min_relaxation"],
+    "omega": SCHEME["omega"],
+    "relaxation_growth": SCHEME["relaxation_growth"],
+    "linear_rtol": SCHEME["linear_rtol"],
+    "linear_restart": SCHEME["linear_restart"],
+    "linear_maxiter": SCHEME["linear_maxiter"],
     "initial_pressure": Key("number", 0.0, unit="Pa"),
     "initial_opening": Key("number", 1e-5, low=0.0, unit="m"),
     "minimum_width": Key("number", low=0.0, low_open=True, unit="m"),

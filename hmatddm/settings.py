@@ -1,0 +1,219 @@
+"""One declaration per setting: kind, default, range, unit and description.
+
+The scene schema (:mod:`hmatddm.scene.schema`) and the dataclasses the scene builds
+(:class:`hmatddm.Propagation`, :class:`hmatddm.SchemeSettings`, ...) read the same
+:class:`Setting` objects, so a range, a default or an error message is written once.
+Every message names the setting and its allowed range, e.g.
+``propagation.toughness must be > 0 Pa m^0.5, got 0``.
+
+This module imports neither numpy nor scipy nor numba: a refused scene answers within a
+second (issue 19).
+"""
+import difflib
+import math
+from numbers import Integral, Real
+
+from .errors import InputError
+from .options import CRITERIA, FRONTS, SCHEME_DEFAULTS, SCHEMES, TURNING
+
+REQUIRED = object()  # marker: the key has no default
+ABSENT = object()    # marker: optional key without a default (left out of the echo when not given)
+OLSON_CORRECTION = 0.806  # C_cor of ref. Eqs 4.18-4.19 (Olson 1991)
+
+
+def show(value):
+    """A value as error messages print it (numbers with up to 12 significant digits)."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        return f"{value:.12g}"
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(show(v) for v in value) + "]"
+    if isinstance(value, dict):
+        return "a table"
+    return repr(value)
+
+
+class Setting:
+    """One setting: its kind, default, range, unit and description (``doc``).
+
+    kind: ``number``, ``integer``, ``boolean``, ``string``, ``choice`` (one of ``choices``),
+    ``point`` (``length`` numbers; ``length="dim"`` is the scene dimension),
+    ``numbers`` (a non-empty list of numbers, or one number), ``integers`` (a list of
+    integers >= 0), ``matrix`` (dim x dim numbers), ``pairs`` (a list of [low, high]).
+    ``low``/``high`` bound numbers (and every entry of a list), open when
+    ``low_open``/``high_open``.
+    """
+
+    def __init__(self, kind, default=ABSENT, *, low=None, high=None, low_open=False, high_open=False,
+                 choices=None, length=None, unit="", doc=""):
+        self.kind, self.default = kind, default
+        self.low, self.high, self.low_open, self.high_open = low, high, low_open, high_open
+        self.choices, self.length, self.unit, self.doc = choices, length, unit, doc
+
+    # -- ranges --------------------------------------------------------------------
+    def range_text(self):
+        unit = f" {self.unit}" if self.unit else ""
+        low, high = self.low, self.high
+        if low is not None and high is not None:
+            return (f"in {'(' if self.low_open else '['}{show(float(low))}, {show(float(high))}"
+                    f"{')' if self.high_open else ']'}{unit}")
+        if low is not None:
+            return f"{'>' if self.low_open else '>='} {show(float(low))}{unit}"
+        if high is not None:
+            return f"{'<' if self.high_open else '<='} {show(float(high))}{unit}"
+        return f"a finite number{unit}"
+
+    def in_range(self, value):
+        if self.low is not None and (value <= self.low if self.low_open else value < self.low):
+            return False
+        if self.high is not None and (value >= self.high if self.high_open else value > self.high):
+            return False
+        return True
+
+    # -- checks -----------------------------------------------------------------------
+    def _number(self, path, value, what=None):
+        what = what or path
+        if isinstance(value, bool) or not isinstance(value, Real):
+            raise InputError(f"{what} must be a number ({self.range_text()}), got {show(value)}")
+        number = float(value)
+        if not math.isfinite(number):
+            raise InputError(f"{what} must be finite ({self.range_text()}), got {show(number)}")
+        if not self.in_range(number):
+            raise InputError(f"{what} must be {self.range_text()}, got {show(value)}")
+        return number
+
+    def _integer(self, path, value):
+        if isinstance(value, bool) or not isinstance(value, Integral):
+            allowed = f"one of {show(list(self.choices))}" if self.choices else self.range_text()
+            raise InputError(f"{path} must be an integer ({allowed}), got {show(value)}")
+        if self.choices is not None and value not in self.choices:
+            raise InputError(f"{path} must be one of {show(list(self.choices))}, got {show(value)}")
+        if not self.in_range(value):
+            raise InputError(f"{path} must be an integer {self.range_text()}, got {show(value)}")
+        return int(value)
+
+    def _list(self, path, value, length, item_text):
+        if not isinstance(value, list):
+            raise InputError(f"{path} must be a list of {item_text}, got {show(value)}")
+        if length is not None and len(value) != length:
+            raise InputError(f"{path} must be a list of {length} {item_text}, got {len(value)}: {show(value)}")
+        return value
+
+    def check(self, path, value, dim):
+        kind = self.kind
+        if kind == "number":
+            return self._number(path, value)
+        if kind == "integer":
+            return self._integer(path, value)
+        if kind == "boolean":
+            if not isinstance(value, bool):
+                raise InputError(f"{path} must be true or false, got {show(value)}")
+            return value
+        if kind == "string":
+            if not isinstance(value, str):
+                raise InputError(f"{path} must be a string, got {show(value)}")
+            return value
+        if kind == "choice":
+            if not isinstance(value, str) or value not in self.choices:
+                hint = ""
+                if isinstance(value, str):
+                    close = difflib.get_close_matches(value, self.choices, n=1)
+                    hint = f"; did you mean {close[0]!r}?" if close else ""
+                raise InputError(f"{path} must be one of {', '.join(map(repr, self.choices))}, "
+                                 f"got {show(value)}{hint}")
+            return value
+        if kind == "point":
+            length = dim if self.length == "dim" else self.length
+            self._list(path, value, length, f"coordinates{f' ({self.unit})' if self.unit else ''}")
+            return [self._number(path, v, f"{path}[{i}]") for i, v in enumerate(value)]
+        if kind == "numbers":
+            if isinstance(value, (int, float)) and not isinstance(value, bool):
+                value = [value]
+            self._list(path, value, None, "numbers")
+            if not value:
+                raise InputError(f"{path} must be a non-empty list of numbers, got []")
+            return [self._number(path, v, f"{path}[{i}]") for i, v in enumerate(value)]
+        if kind == "integers":
+            self._list(path, value, None, "integers")
+            for i, v in enumerate(value):
+                if isinstance(v, bool) or not isinstance(v, int) or v < 0:
+                    raise InputError(f"{path}[{i}] must be an integer >= 0, got {show(v)}")
+            return [int(v) for v in value]
+        if kind == "matrix":
+            self._list(path, value, dim, f"rows (a {dim} x {dim} tensor)")
+            rows = []
+            for i, row in enumerate(value):
+                self._list(f"{path}[{i}]", row, dim, "numbers")
+                rows.append([self._number(path, v, f"{path}[{i}][{j}]") for j, v in enumerate(row)])
+            return rows
+        if kind == "points":  # a list of points of `length` coordinates (e.g. well positions)
+            self._list(path, value, None, f"[{', '.join(['x', 'y', 'z'][:self.length])}] points")
+            return [Setting("point", length=self.length, unit=self.unit).check(f"{path}[{i}]", v, dim)
+                    for i, v in enumerate(value)]
+        if kind == "pairs":
+            self._list(path, value, None, "[low, high] pairs")
+            pairs = []
+            for i, pair in enumerate(value):
+                if not isinstance(pair, list) or len(pair) != 2:
+                    raise InputError(f"{path}[{i}] must be a pair [low, high], got {show(pair)}")
+                low, high = (float(v) if isinstance(v, (int, float)) and not isinstance(v, bool) else None
+                             for v in pair)
+                if low is None or high is None or math.isnan(low) or math.isnan(high) or not low < high:
+                    raise InputError(f"{path}[{i}] must be numbers [low, high] with low < high "
+                                     f"(m; +-inf allowed), got {show(pair)}")
+                pairs.append([low, high])
+            return pairs
+        raise AssertionError(kind)  # pragma: no cover
+
+    def value(self, name, value):
+        """``value`` checked against this setting outside a scene (a dataclass field):
+        ``name`` is how the message names it; ``None`` passes when the setting has no default."""
+        if value is None and self.default is ABSENT:
+            return None
+        return self.check(name, value, None)
+
+
+def integer(name, value, minimum=1):
+    """``value`` as an int >= ``minimum`` (Python or numpy integer; bools refused)."""
+    return Setting("integer", low=minimum).check(name, value, None)
+
+
+# ---------------------------------------------------------------------------------
+# Declarations shared by a scene section and the dataclass it builds
+# ---------------------------------------------------------------------------------
+
+_UNIT_INTERVAL = dict(low=0.0, high=1.0, low_open=True, high_open=True)
+
+PROPAGATION = {  # -> hmatddm.fracture.growth.Propagation (ref. Sec. 4.2.2)
+    "toughness": Setting("number", REQUIRED, low=0.0, low_open=True, unit="Pa m^0.5", doc="K_Ic"),
+    "criterion": Setting("choice", "mcs", choices=CRITERIA),
+    "critical_energy_release_rate": Setting("number", low=0.0, low_open=True, unit="J/m^2",
+                                            doc="G_c (default K_Ic^2 / E')"),
+    "correction": Setting("number", OLSON_CORRECTION, low=0.0, high=2.0, low_open=True,
+                          doc="C_cor of Olson's SIF estimate (ref. Eqs 4.18-4.19)"),
+    "turning": Setting("choice", "plan", choices=TURNING),
+    "min_turn_angle_deg": Setting("number", 1.0, low=0.0, high=90.0, high_open=True, unit="deg"),
+    "max_growth_passes": Setting("integer", 50, low=0),
+    "bounds": Setting("pairs", unit="m"),
+    "growing_fractures": Setting("integers"),
+    "front": Setting("choice", "element", choices=FRONTS),
+    "front_iterations": Setting("integer", 40, low=1),
+    "front_tolerance": Setting("number", 1e-3, **_UNIT_INTERVAL),
+}
+
+SCHEME = {  # -> hmatddm.coupled.schemes.SchemeSettings (ref. Sec. 4.5)
+    "scheme": Setting("choice", SCHEME_DEFAULTS["scheme"], choices=SCHEMES),
+    "tolerance_pressure": Setting("number", SCHEME_DEFAULTS["tolerance_pressure"], **_UNIT_INTERVAL),
+    "tolerance_opening": Setting("number", SCHEME_DEFAULTS["tolerance_opening"], **_UNIT_INTERVAL),
+    "max_iterations": Setting("integer", SCHEME_DEFAULTS["max_iterations"], low=1),
+    "relaxation": Setting("number", SCHEME_DEFAULTS["relaxation"], low=0.0, high=1.0, low_open=True),
+    "min_relaxation": Setting("number", SCHEME_DEFAULTS["min_relaxation"], low=0.0, high=1.0, low_open=True),
+    "omega": Setting("number", SCHEME_DEFAULTS["omega"], low=0.0, high=1.0),
+    "relaxation_growth": Setting("number", low=1.0,
+                                 doc="factor raising alpha after a step without restart (default 2 coupled, "
+                                     "1 segregated)"),
+    "linear_rtol": Setting("number", SCHEME_DEFAULTS["linear_rtol"], **_UNIT_INTERVAL),
+    "linear_restart": Setting("integer", SCHEME_DEFAULTS["linear_restart"], low=1),
+    "linear_maxiter": Setting("integer", SCHEME_DEFAULTS["linear_maxiter"], low=1),
+}
