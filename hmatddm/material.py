@@ -1,8 +1,7 @@
 """Linear isotropic elastic material (ref. Ch. 2, Eq. 2.1: Hooke's law)."""
 from dataclasses import dataclass, field
 
-from ._validation import finite_scalar
-from .errors import InputError
+from .settings import MATERIAL
 
 
 @dataclass(frozen=True)
@@ -29,12 +28,8 @@ class Elastic:
     bulk_modulus: float = field(init=False)
 
     def __post_init__(self):
-        g = finite_scalar("shear_modulus", self.shear_modulus)
-        nu = finite_scalar("poisson_ratio", self.poisson_ratio)
-        if g <= 0.0:
-            raise InputError(f"shear_modulus must be > 0 Pa, got {g}")
-        if not 0.0 <= nu < 0.5:
-            raise InputError(f"poisson_ratio must be in [0, 0.5), got {nu}")
+        g = MATERIAL["shear_modulus"].value("shear_modulus", self.shear_modulus)
+        nu = MATERIAL["poisson_ratio"].value("poisson_ratio", self.poisson_ratio)
         object.__setattr__(self, "shear_modulus", g)
         object.__setattr__(self, "poisson_ratio", nu)
         e = 2.0 * g * (1.0 + nu)

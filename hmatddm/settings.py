@@ -78,7 +78,7 @@ class Setting:
             raise InputError(f"{what} must be a number ({self.range_text()}), got {show(value)}")
         number = float(value)
         if not math.isfinite(number):
-            raise InputError(f"{what} must be finite ({self.range_text()}), got {show(number)}")
+            raise InputError(f"{what} must be a finite number ({self.range_text()}), got {show(number)}")
         if not self.in_range(number):
             raise InputError(f"{what} must be {self.range_text()}, got {show(value)}")
         return number
@@ -171,6 +171,11 @@ class Setting:
         ``name`` is how the message names it; ``None`` passes when the setting has no default."""
         if value is None and self.default is ABSENT:
             return None
+        if self.kind == "number" and (isinstance(value, bool) or not isinstance(value, Real)):
+            try:  # a 0-d array, or a string of a number, as hmatddm._validation.finite_scalar takes them
+                value = float(value)
+            except (TypeError, ValueError):
+                raise InputError(f"{name} must be a finite number ({self.range_text()}), got {show(value)}") from None
         return self.check(name, value, None)
 
 
@@ -216,4 +221,25 @@ SCHEME = {  # -> hmatddm.coupled.schemes.SchemeSettings (ref. Sec. 4.5)
     "linear_rtol": Setting("number", SCHEME_DEFAULTS["linear_rtol"], **_UNIT_INTERVAL),
     "linear_restart": Setting("integer", SCHEME_DEFAULTS["linear_restart"], low=1),
     "linear_maxiter": Setting("integer", SCHEME_DEFAULTS["linear_maxiter"], low=1),
+}
+
+MATERIAL = {  # -> hmatddm.material.Elastic
+    "shear_modulus": Setting("number", REQUIRED, low=0.0, low_open=True, unit="Pa"),
+    "poisson_ratio": Setting("number", REQUIRED, low=0.0, high=0.5, high_open=True),
+}
+
+FLUID = {  # -> hmatddm.flow.fluid.Fluid (ref. Eqs 4.22-4.24)
+    "viscosity": Setting("number", REQUIRED, low=0.0, low_open=True, unit="Pa s"),
+    "compressibility": Setting("number", 0.0, low=0.0, unit="1/Pa"),
+}
+
+CLUSTER = {  # -> hmatddm.flow.fluid.Cluster (ref. Eqs 4.34-4.35)
+    "position": Setting("point", REQUIRED, length="dim", unit="m"),
+    "rate": Setting("number", REQUIRED, low=0.0, unit="m^3/s"),
+    "wellbore_volume": Setting("number", 0.0, low=0.0, unit="m^3"),
+}
+
+LEAK_OFF = {  # -> hmatddm.flow.fluid.LeakOff (ref. Eqs 4.25-4.26)
+    "coefficient": Setting("number", 0.0, low=0.0, unit="m/(s^0.5 Pa)"),
+    "pore_pressure": Setting("number", 0.0, unit="Pa"),
 }

@@ -3,8 +3,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validation import finite_array, finite_scalar, positive_scalar
+from .._validation import finite_array
 from ..errors import InputError
+from ..settings import CLUSTER, FLUID, LEAK_OFF
 
 
 @dataclass(frozen=True)
@@ -24,11 +25,8 @@ class Fluid:
     compressibility: float = 0.0
 
     def __post_init__(self):
-        object.__setattr__(self, "viscosity", positive_scalar("viscosity", self.viscosity))
-        c = finite_scalar("compressibility", self.compressibility)
-        if c < 0.0:
-            raise InputError(f"compressibility must be >= 0 1/Pa, got {c}")
-        object.__setattr__(self, "compressibility", c)
+        for name in ("viscosity", "compressibility"):
+            object.__setattr__(self, name, FLUID[name].value(name, getattr(self, name)))
 
     @property
     def viscosity_prime(self):
@@ -52,11 +50,8 @@ class LeakOff:
     pore_pressure: float = 0.0
 
     def __post_init__(self):
-        c = finite_scalar("leak_off.coefficient", self.coefficient)
-        if c < 0.0:
-            raise InputError(f"leak_off.coefficient must be >= 0 m/(s^0.5 Pa), got {c}")
-        object.__setattr__(self, "coefficient", c)
-        object.__setattr__(self, "pore_pressure", finite_scalar("leak_off.pore_pressure", self.pore_pressure))
+        for name in ("coefficient", "pore_pressure"):
+            object.__setattr__(self, name, LEAK_OFF[name].value(f"leak_off.{name}", getattr(self, name)))
 
 
 @dataclass(frozen=True)
@@ -82,14 +77,8 @@ class Cluster:
         if position.ndim != 1 or position.size not in (2, 3):
             raise InputError(f"cluster.position must be a point with 2 or 3 coordinates, got shape {position.shape}")
         object.__setattr__(self, "position", tuple(float(v) for v in position))
-        rate = finite_scalar("cluster.rate", self.rate)
-        if rate < 0.0:
-            raise InputError(f"cluster.rate must be >= 0 m^3/s, got {rate}")
-        object.__setattr__(self, "rate", rate)
-        volume = finite_scalar("cluster.wellbore_volume", self.wellbore_volume)
-        if volume < 0.0:
-            raise InputError(f"cluster.wellbore_volume must be >= 0 m^3, got {volume}")
-        object.__setattr__(self, "wellbore_volume", volume)
+        for name in ("rate", "wellbore_volume"):
+            object.__setattr__(self, name, CLUSTER[name].value(f"cluster.{name}", getattr(self, name)))
 
     def nearest_element(self, mesh):
         position = np.asarray(self.position)

@@ -22,7 +22,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..options import BACKENDS, CONTACT_MODES, DEFAULT_EPS, DEFAULT_ETA, DEFAULT_LEAF_SIZE, SINGULAR_CORRECTIONS
-from ..settings import ABSENT, PROPAGATION, REQUIRED, SCHEME, show
+from ..settings import ABSENT, CLUSTER, FLUID, LEAK_OFF, MATERIAL, PROPAGATION, REQUIRED, SCHEME, show
 from ..settings import Setting as Key  # a key of a scene section is one setting
 
 REFERENCE_KINDS = ("radial-k", "radial-m", "kgd-k", "kgd-m")
@@ -43,16 +43,6 @@ TOP = {
                   doc="2D only: flow height of the plane-strain fractures (ref. Table 4.2)"),
 }
 
-MATERIAL = {
-    "shear_modulus": Key("number", REQUIRED, low=0.0, low_open=True, unit="Pa"),
-    "poisson_ratio": Key("number", REQUIRED, low=0.0, high=0.5, high_open=True),
-}
-
-FLUID = {
-    "viscosity": Key("number", REQUIRED, low=0.0, low_open=True, unit="Pa s"),
-    "compressibility": Key("number", 0.0, low=0.0, unit="1/Pa"),
-}
-
 STRESS = {
     "tensor": Key("matrix", unit="Pa", doc="full tensor, compressive positive, symmetric"),
     "s_hmin": Key("number", unit="Pa", doc="minimum horizontal stress, compressive positive"),
@@ -60,12 +50,6 @@ STRESS = {
     "s_v": Key("number", unit="Pa", doc="vertical stress (along z), compressive positive; 3D only"),
     "azimuth_deg": Key("number", low=-360.0, high=360.0, unit="deg",
                        doc="direction of s_hmax, degrees from +x counter-clockwise (default 0)"),
-}
-
-CLUSTER = {
-    "position": Key("point", REQUIRED, length="dim", unit="m"),
-    "rate": Key("number", REQUIRED, low=0.0, unit="m^3/s"),
-    "wellbore_volume": Key("number", 0.0, low=0.0, unit="m^3"),
 }
 
 _POSITIVE_LENGTH = dict(low=0.0, low_open=True, unit="m")
@@ -90,11 +74,6 @@ SHAPE_KEYS = {  # key -> default (REQUIRED or a value) for each shape
     "line": {"p0": REQUIRED, "p1": REQUIRED, "element_size": REQUIRED},
 }
 
-
-LEAK_OFF = {
-    "coefficient": Key("number", 0.0, low=0.0, unit="m/(s^0.5 Pa)"),
-    "pore_pressure": Key("number", 0.0, unit="Pa"),
-}
 
 _UNIT_INTERVAL = dict(low=0.0, high=1.0, low_open=True, high_open=True)
 NUMERICS = {
