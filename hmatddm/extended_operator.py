@@ -16,7 +16,8 @@ import numpy as np
 import scipy.linalg
 from scipy.sparse.linalg import LinearOperator
 
-from .operators import ElasticityOperator, influence_data, refuse_singular
+from .errors import InputError
+from .operators import ElasticityOperator, influence_data, refuse_singular, solve_with_inverse
 
 
 class ExtendedElasticityOperator(LinearOperator):
@@ -25,10 +26,11 @@ class ExtendedElasticityOperator(LinearOperator):
 
     def __init__(self, base, mesh):
         if not isinstance(base, ElasticityOperator):
-            raise TypeError("base must be an ElasticityOperator")
+            raise InputError(f"base must be an ElasticityOperator, got {type(base).__name__}")
         n0, n = base.mesh.n_elements, mesh.n_elements
         if n <= n0 or not np.array_equal(mesh.centers[:n0], base.mesh.centers):
-            raise ValueError("mesh must extend the base operator's mesh by appending elements")
+            raise InputError(f"mesh must extend the base operator's mesh ({n0} elements) by appending elements, "
+                             f"got {n} elements")
         self.base = base
         self.mesh = mesh
         self.material = base.material
@@ -68,19 +70,38 @@ class ExtendedElasticityOperator(LinearOperator):
             self._nn_lu = scipy.linalg.lu_factor(self.nn, check_finite=False)
         return self._nn_lu
 
+    #: The block-triangular inverse ignores ``A_on``: never exact, a solve iterates.
+    inverse_is_exact = False
+
     def approximate_inverse(self, r):
-        """Block lower-triangular solve: base preconditioner (or LU), then LU of ``A_nn``."""
+        """Block lower-triangular solve: the base's approximate inverse (LU or
+        preconditioner), then LU of ``A_nn``."""
+        return self._block_triangular(r, self.base.approximate_inverse, self.no, self._nn_factor())
+
+    def modified_inverse(self, rows):
+        """Approximate inverse (a callable) of ``S A + D`` for row operators ``rows``: the
+        block-triangular solve with the base's modified inverse and modified blocks."""
+        n0 = self.n_base
+        base_inverse = self.base.modified_inverse(rows.subset(0, n0))
+        no_rows = rows.modify_rows(self.no, n0)
+        nn_lu = scipy.linalg.lu_factor(rows.subset(n0, rows.n).modify_dense(self.nn), check_finite=False)
+        return lambda r: self._block_triangular(r, base_inverse, no_rows, nn_lu)
+
+    def _block_triangular(self, r, base_inverse, no, nn_lu):
         k = self.n_base * self.dof
         r = np.asarray(r, dtype=np.float64).ravel()
-        if self.base.backend == "dense":
-            x_old = scipy.linalg.lu_solve(self.base.lu(), r[:k], check_finite=False)
-        else:
-            x_old = self.base.preconditioner() @ r[:k]
-        x_new = scipy.linalg.lu_solve(self._nn_factor(), r[k:] - self.no @ x_old, check_finite=False)
+        x_old = base_inverse(r[:k])
+        x_new = scipy.linalg.lu_solve(nn_lu, r[k:] - no @ x_old, check_finite=False)
         return np.concatenate([x_old, x_new])
 
     def preconditioner(self):
         return LinearOperator(self.shape, matvec=self.approximate_inverse, dtype=np.float64)
+
+    def solve(self, rhs, x0=None, rtol=1e-9, restart=100, maxiter=20):
+        """``(x, info)``: GMRES preconditioned by :meth:`approximate_inverse`
+        (:func:`hmatddm.operators.solve_with_inverse`)."""
+        return solve_with_inverse(self, rhs, self.approximate_inverse, False, x0=x0, rtol=rtol, restart=restart,
+                                  maxiter=maxiter)
 
     def element_diagonal_blocks(self):
         """(N, d, d): the base operator's self blocks, then those of ``A_nn``."""

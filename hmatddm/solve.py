@@ -16,7 +16,7 @@ import numpy as np
 from numba import njit, prange
 
 from ._validation import finite_array, finite_scalar
-from .errors import ConvergenceError, InputError
+from .errors import InputError
 from .kernels import element_data
 from .kernels.line2d import stress_pair as _stress_pair2d
 from .kernels.rectangle3d import _INV_8PI, _r_plus
@@ -43,7 +43,8 @@ def solve(operator, traction, rtol=1e-10, maxiter=None, restart=100, x0=None, re
 
     Parameters
     ----------
-    operator : ElasticityOperator
+    operator : ElasticityOperator or ExtendedElasticityOperator
+        Solved by its own ``solve`` (dense: LU; otherwise preconditioned GMRES).
     traction : (N, d) or (N*d,) array
         Traction sigma.n at the collocation points, element-major, global frame
         (``-p * mesh.normals`` for a crack under net pressure ``p``). Linear and quadratic
@@ -63,38 +64,29 @@ def solve(operator, traction, rtol=1e-10, maxiter=None, restart=100, x0=None, re
     ConvergenceError
         GMRES stopped above ``rtol``; the message and ``.residual`` give what was reached.
     """
+    from .extended_operator import ExtendedElasticityOperator
     from .operators import ElasticityOperator
 
-    if not isinstance(operator, ElasticityOperator):
+    if not isinstance(operator, (ElasticityOperator, ExtendedElasticityOperator)):
         raise InputError(f"operator must be an ElasticityOperator, got {type(operator).__name__}")
     rtol = finite_scalar("rtol", rtol)
     if not 0.0 < rtol < 1.0:
         raise InputError(f"rtol must be in (0, 1), got {rtol}")
     n, d = operator.mesh.n_elements, operator.dof
+    guess = None
     if operator.mesh.n_nodes > 1:
         from .nodal import nodal_array
 
         b = nodal_array("traction", traction, operator.mesh, uniform=True).reshape(-1)
+        if x0 is not None:
+            guess = nodal_array("x0", x0, operator.mesh).reshape(-1)
     else:
         b = _as_element_major("traction", traction, n, d)
-    if operator.backend == "dense":
-        import scipy.linalg
-
-        x = scipy.linalg.lu_solve(operator.lu(), b, check_finite=False)
-        residual = float(np.linalg.norm(operator.matvec(x) - b) / max(np.linalg.norm(b), np.finfo(float).tiny))
-        info = dict(iterations=0, residual=residual)
-    else:
-        from .hmatrix import gmres
-
-        guess = None
-        if x0 is not None and operator.mesh.n_nodes > 1:
-            guess = nodal_array("x0", x0, operator.mesh).reshape(-1)
-        elif x0 is not None:
+        if x0 is not None:
             guess = _as_element_major("x0", x0, n, d)
-        x, info = gmres(operator, b, M=operator.preconditioner(), rtol=rtol, restart=restart,
-                        maxiter=maxiter if maxiter is not None else 20, x0=guess)
-    if not np.all(np.isfinite(x)):
-        raise ConvergenceError("the solution contains NaN or inf", residual=float("nan"))
+    x, info = operator.solve(b, x0=guess, rtol=rtol, restart=restart, maxiter=maxiter if maxiter is not None else 20)
+    if "residual" not in info:  # a direct solve: measure it
+        info["residual"] = float(np.linalg.norm(operator.matvec(x) - b) / max(np.linalg.norm(b), np.finfo(float).tiny))
     dd = x.reshape(n, d) if operator.mesh.n_nodes == 1 else x.reshape(n, operator.mesh.n_nodes, -1)
     return (dd, info) if return_info else dd
 

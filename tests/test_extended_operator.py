@@ -34,6 +34,32 @@ def test_solve_with_the_block_triangular_preconditioner_matches_dense(grown):
 
 
 def test_mesh_that_does_not_extend_the_base_is_refused(grown, material):
-    mesh, extended, _ = grown
-    with pytest.raises(ValueError, match="extend"):
+    mesh, extended, dense = grown
+    with pytest.raises(hd.InputError, match="extend"):
         ExtendedElasticityOperator(extended.base, mesh.subset(np.arange(50)))
+    with pytest.raises(hd.InputError, match="base"):
+        ExtendedElasticityOperator(dense.to_dense(), mesh)
+
+
+def test_every_operator_solves_through_the_same_methods(grown):
+    """Dense, H-matrix and extended operators answer solve / approximate_inverse alike;
+    hd.solve takes any of them and agrees with an independent dense LU."""
+    import scipy.linalg
+
+    mesh, extended, dense = grown
+    load = -1e6 * mesh.normals.ravel()
+    reference = scipy.linalg.solve(dense.to_dense(), load)
+    scale = np.abs(reference).max()
+    x, info = dense.solve(load)
+    assert info["iterations"] == 0 and dense.inverse_is_exact
+    np.testing.assert_allclose(x, reference, rtol=0, atol=1e-9 * scale)
+    np.testing.assert_array_equal(dense.approximate_inverse(load), x)
+    for operator in (extended, extended.base):
+        assert not operator.inverse_is_exact
+        rhs = load[:operator.shape[0]]
+        x, info = operator.solve(rhs, rtol=1e-10)
+        assert info["iterations"] > 0 and info["residual"] <= 1e-10
+        np.testing.assert_allclose(operator @ x, rhs, rtol=0, atol=1e-8 * np.abs(rhs).max())
+        assert np.linalg.norm(operator @ operator.approximate_inverse(rhs) - rhs) < 0.8 * np.linalg.norm(rhs)
+    dd, info = hd.solve(extended, load, return_info=True)
+    np.testing.assert_allclose(dd.ravel(), reference, rtol=0, atol=1e-6 * scale)
