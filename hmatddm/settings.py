@@ -243,3 +243,13 @@ LEAK_OFF = {  # -> hmatddm.flow.fluid.LeakOff (ref. Eqs 4.25-4.26)
     "coefficient": Setting("number", 0.0, low=0.0, unit="m/(s^0.5 Pa)"),
     "pore_pressure": Setting("number", 0.0, unit="Pa"),
 }
+
+NATURAL_FRACTURE = {  # network.* in a scene -> hmatddm.fracture.crossing.NaturalFractureProperties
+    "friction_coefficient": Setting("number", 0.25, low=0.0, doc="C (ref. Table 6.2)"),
+    "cohesion": Setting("number", 0.0, low=0.0, unit="Pa", doc="S_0"),
+    "tensile_strength": Setting("number", 0.0, low=0.0, unit="Pa", doc="T_0"),
+    "toughness": Setting("number", 0.5e6, low=0.0, low_open=True, unit="Pa m^0.5", doc="K_Ic of the natural fractures"),
+    "critical_radius": Setting("number", 0.005, low=0.0, low_open=True, unit="m",
+                               doc="r_c of the Mohr-Coulomb crossing criterion"),
+    "skempton": Setting("number", 0.0, low=0.0, high=1.0, doc="Skempton's B (ref. Eq. 5.18)"),
+}

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._validation import finite_scalar
+from ..settings import NATURAL_FRACTURE
 from ..errors import InputError
 from .criteria import equivalent_mode_one
 
@@ -58,21 +59,10 @@ class NaturalFractureProperties:
     skempton: float = 0.0
 
     def __post_init__(self):
-        for name in ("friction", "cohesion", "tensile_strength"):
-            value = finite_scalar(f"natural.{name}", getattr(self, name))
-            if value < 0.0:
-                raise InputError(f"natural.{name} must be >= 0, got {value}")
-            object.__setattr__(self, name, value)
-        for name in ("toughness", "critical_radius"):
-            value = finite_scalar(f"natural.{name}", getattr(self, name))
-            if value <= 0.0:
-                raise InputError(f"natural.{name} must be > 0, got {value}")
-            object.__setattr__(self, name, value)
+        for name in ("friction", "cohesion", "tensile_strength", "toughness", "critical_radius", "skempton"):
+            setting = NATURAL_FRACTURE["friction_coefficient" if name == "friction" else name]
+            object.__setattr__(self, name, setting.value(f"natural.{name}", getattr(self, name)))
         object.__setattr__(self, "pore_pressure", finite_scalar("natural.pore_pressure", self.pore_pressure))
-        skempton = finite_scalar("natural.skempton", self.skempton)
-        if not 0.0 <= skempton <= 1.0:
-            raise InputError(f"natural.skempton must be in [0, 1], got {skempton}")
-        object.__setattr__(self, "skempton", skempton)
         if self.crossing not in CROSSING_CRITERIA:
             raise InputError(f"natural.crossing must be one of {CROSSING_CRITERIA}, got {self.crossing!r}")
 

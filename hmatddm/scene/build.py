@@ -10,6 +10,7 @@ from .. import mesh as meshes
 from ..errors import InputError
 from ..flow import Cluster, Fluid, LeakOff
 from ..material import Elastic
+from ..settings import NATURAL_FRACTURE
 from .schema import SCHEME_KEYS, far_field_stress, has_natural_fractures, show
 
 _CROSSING_NAMES = {"mohr-coulomb": "mohr-coulomb", "energy-release-rate": "energy", "stress-intensity": "sif"}
@@ -206,10 +207,11 @@ def natural_properties(scene):
     if not has_natural_fractures(scene):
         return None
     settings = scene.get("network", {})
+    value = {key: settings.get(key, setting.default) for key, setting in NATURAL_FRACTURE.items()}
     return NaturalFractureProperties(
-        friction=settings.get("friction_coefficient", 0.25), cohesion=settings.get("cohesion", 0.0),
-        tensile_strength=settings.get("tensile_strength", 0.0), toughness=settings.get("toughness", 0.5e6),
-        critical_radius=settings.get("critical_radius", 0.005),
+        friction=value["friction_coefficient"], cohesion=value["cohesion"],
+        tensile_strength=value["tensile_strength"], toughness=value["toughness"],
+        critical_radius=value["critical_radius"],
         crossing=_CROSSING_NAMES[settings.get("crossing", "mohr-coulomb")],
         pore_pressure=scene["leak_off"]["pore_pressure"])
 

@@ -22,7 +22,8 @@ import numpy as np
 
 from ..errors import InputError
 from ..options import BACKENDS, CONTACT_MODES, DEFAULT_EPS, DEFAULT_ETA, DEFAULT_LEAF_SIZE, SINGULAR_CORRECTIONS
-from ..settings import ABSENT, CLUSTER, FLUID, LEAK_OFF, MATERIAL, PROPAGATION, REQUIRED, SCHEME, show
+from ..settings import (ABSENT, CLUSTER, FLUID, LEAK_OFF, MATERIAL, NATURAL_FRACTURE, PROPAGATION, REQUIRED,
+                        SCHEME, show)
 from ..settings import Setting as Key  # a key of a scene section is one setting
 
 REFERENCE_KINDS = ("radial-k", "radial-m", "kgd-k", "kgd-m")
@@ -123,11 +124,11 @@ REFERENCE = {
 }
 
 NETWORK_MECHANICS = {  # defaults: ref. Table 6.2 (natural-fracture properties)
-    "friction_coefficient": Key("number", 0.25, low=0.0),
-    "cohesion": Key("number", 0.0, low=0.0, unit="Pa"),
-    "tensile_strength": Key("number", 0.0, low=0.0, unit="Pa"),
-    "toughness": Key("number", 0.5e6, low=0.0, low_open=True, unit="Pa m^0.5"),
-    "critical_radius": Key("number", 0.005, **_POSITIVE_LENGTH),
+    "friction_coefficient": NATURAL_FRACTURE["friction_coefficient"],
+    "cohesion": NATURAL_FRACTURE["cohesion"],
+    "tensile_strength": NATURAL_FRACTURE["tensile_strength"],
+    "toughness": NATURAL_FRACTURE["toughness"],
+    "critical_radius": NATURAL_FRACTURE["critical_radius"],
     "crossing": Key("choice", "mohr-coulomb", choices=CROSSING_CRITERIA),
     "remote_failure": Key("boolean", True),
     "element_size": Key("number", 1.0, **_POSITIVE_LENGTH),
