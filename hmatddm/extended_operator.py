@@ -17,7 +17,8 @@ import scipy.linalg
 from scipy.sparse.linalg import LinearOperator
 
 from .errors import InputError
-from .operators import ElasticityOperator, influence_data, refuse_singular, solve_with_inverse
+from .operator_inverse import solve_with_inverse
+from .operators import ElasticityOperator, influence_data, refuse_singular
 
 
 class ExtendedElasticityOperator(LinearOperator):
@@ -99,7 +100,7 @@ class ExtendedElasticityOperator(LinearOperator):
 
     def solve(self, rhs, x0=None, rtol=1e-9, restart=100, maxiter=20):
         """``(x, info)``: GMRES preconditioned by :meth:`approximate_inverse`
-        (:func:`hmatddm.operators.solve_with_inverse`)."""
+        (:func:`hmatddm.operator_inverse.solve_with_inverse`)."""
         return solve_with_inverse(self, rhs, self.approximate_inverse, False, x0=x0, rtol=rtol, restart=restart,
                                   maxiter=maxiter)
 

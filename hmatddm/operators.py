@@ -24,6 +24,7 @@ from .kernels import element_data, kernel_module
 from .layered.medium import LayeredMedium
 from .material import Elastic
 from .mesh import Mesh2D, Mesh3D, check_mesh, check_parallel_spacing
+from .operator_inverse import modified_near_field_inverse, solve_with_inverse
 
 from .options import BACKENDS, DEFAULT_EPS, DEFAULT_ETA, DEFAULT_LEAF_SIZE, SINGULAR_CORRECTIONS  # noqa: F401
 _AVERAGE_SHIFT = 1e-3  # fraction of the element half size used by the NaN averaging
@@ -226,7 +227,7 @@ class ElasticityOperator(LinearOperator):
         index = np.arange(n)
         return np.ascontiguousarray(self._matrix.reshape(n, d, n, d)[index, :, index, :])
 
-    # -- solving (the same methods on every operator; see solve_with_inverse) --------
+    # -- solving (the same methods on every operator; hmatddm.operator_inverse) ---
     @property
     def inverse_is_exact(self):
         """True when :meth:`approximate_inverse` is exact (the dense LU), so a solve needs
@@ -257,7 +258,7 @@ class ElasticityOperator(LinearOperator):
         return lambda r: inverse @ np.asarray(r, dtype=np.float64).ravel()
 
     def solve(self, rhs, x0=None, rtol=1e-9, restart=100, maxiter=20):
-        """``(x, info)`` with ``A x = rhs`` (flat): see :func:`solve_with_inverse`."""
+        """``(x, info)`` with ``A x = rhs`` (flat): see :func:`hmatddm.operator_inverse.solve_with_inverse`."""
         return solve_with_inverse(self, rhs, self.approximate_inverse, self.inverse_is_exact, x0=x0, rtol=rtol,
                                   restart=restart, maxiter=maxiter)
 
@@ -274,58 +275,6 @@ class ElasticityOperator(LinearOperator):
     # -- helpers ------------------------------------------------------------------------
     def _refuse_singular(self):
         refuse_singular(self.mesh, self._kernels, self.data)
-
-
-def solve_with_inverse(operator, rhs, inverse, exact, x0=None, rtol=1e-9, restart=100, maxiter=20):
-    """``(x, info)`` solving ``operator x = rhs`` given an approximate inverse (a callable).
-
-    ``exact``: the inverse is exact (a direct factorisation): ``x = inverse(rhs)``, ``info``
-    ``{"iterations": 0}`` (no residual: it would cost a product). Otherwise GMRES
-    (:func:`hmatddm.hmatrix.gmres`, from ``x0``) preconditioned by ``inverse``; ``info`` is
-    its dict (``iterations``, ``residual``, ...). Raises ConvergenceError when GMRES stops
-    above ``rtol`` or ``x`` is not finite.
-    """
-    from .errors import ConvergenceError
-
-    rhs = np.asarray(rhs, dtype=np.float64).ravel()
-    if exact:
-        x, info = inverse(rhs), {"iterations": 0}
-    else:
-        from .hmatrix import gmres
-
-        preconditioner = LinearOperator(operator.shape, matvec=inverse, dtype=np.float64)
-        x, info = gmres(operator, rhs, M=preconditioner, rtol=rtol, restart=restart, maxiter=maxiter, x0=x0)
-    if not np.all(np.isfinite(x)):
-        raise ConvergenceError("the solution contains NaN or inf", residual=float("nan"))
-    return x, info
-
-
-# scalar ILU of the contact-modified near field (its rows mix element frames, so the
-# block ILU of the default preconditioner does not apply); the entries kept are those of
-# the default preconditioner's block threshold
-_CONTACT_ILU = {"drop_tol": 1e-3, "fill_factor": 5.0}
-
-
-def modified_near_field_inverse(operator, rows):
-    """ILU of ``S A_near + D`` (the default preconditioner's near field with contact rows),
-    falling back to block Jacobi of the modified diagonal blocks."""
-    import scipy.sparse.linalg as spla
-
-    from .hmatrix.preconditioners import DEFAULT_ILU
-
-    hmatrix = operator.hmatrix
-    matrix = rows.modify_sparse(hmatrix.near_field_csr(part="near", threshold=DEFAULT_ILU["threshold"]))
-    try:
-        factor = spla.spilu(matrix, drop_tol=_CONTACT_ILU["drop_tol"], fill_factor=_CONTACT_ILU["fill_factor"])
-        inverse = LinearOperator(operator.shape, matvec=factor.solve, dtype=np.float64)
-        if np.all(np.isfinite(inverse @ np.ones(operator.shape[0]))):
-            return inverse
-    except RuntimeError:
-        pass
-    blocks = np.linalg.pinv(rows.modify_blocks(operator.element_diagonal_blocks()))
-    n, d = blocks.shape[0], blocks.shape[1]
-    return LinearOperator(operator.shape, dtype=np.float64,
-                          matvec=lambda x: np.einsum("eij,ej->ei", blocks, np.reshape(x, (n, d))).ravel())
 
 
 def _refuse_coincident(mesh):

@@ -18,7 +18,7 @@ of ``S A_near + D``: the two-level correction is not built for modified rows.
 import numpy as np
 import scipy.sparse.linalg as spla
 
-from ..operators import solve_with_inverse
+from ..operator_inverse import solve_with_inverse
 
 
 class ElasticSolver:
