@@ -136,6 +136,13 @@ def stress_pair(point, center, frame, a, shear_modulus, poisson_ratio, singular_
     x = frame[0, 0] * dx + frame[0, 1] * dy
     y = frame[1, 0] * dx + frame[1, 1] * dy
     local_stress_corrected(x, y, a, shear_modulus, poisson_ratio, singular_shift, work, near)
+    rotate_to_global(frame, work, out)
+
+
+@njit(cache=True)
+def rotate_to_global(frame, local, out):
+    """``out[q, i, j]`` (global stress per unit global DD component q) from ``local[k, p, s]``
+    (local stress per unit local DD component k) and the element's ``frame`` rows."""
     for q in range(2):
         for i in range(2):
             for j in range(2):
@@ -143,7 +150,7 @@ def stress_pair(point, center, frame, a, shear_modulus, poisson_ratio, singular_
                 for k in range(2):
                     for p in range(2):
                         for s in range(2):
-                            acc += frame[k, q] * frame[p, i] * work[k, p, s] * frame[s, j]
+                            acc += frame[k, q] * frame[p, i] * local[k, p, s] * frame[s, j]
                 out[q, i, j] = acc
 
 

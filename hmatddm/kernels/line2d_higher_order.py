@@ -41,7 +41,7 @@ import numpy as np
 from numba import njit, prange
 
 from .correction import scale_to_self
-from .line2d import on_tip, tip_distance
+from .line2d import on_tip, rotate_to_global, tip_distance
 
 _INV_4PI = 1.0 / (4.0 * math.pi)
 
@@ -231,15 +231,7 @@ def stress_nodes(point, center, frame, a, coefficients, shear_modulus, poisson_r
     x, y = _local(point, center, frame)
     local_stress_nodes_corrected(x, y, a, coefficients, shear_modulus, poisson_ratio, singular_shift, work, near)
     for n in range(coefficients.shape[0]):
-        for q in range(2):
-            for i in range(2):
-                for j in range(2):
-                    acc = 0.0
-                    for k in range(2):
-                        for p in range(2):
-                            for s in range(2):
-                                acc += frame[k, q] * frame[p, i] * work[n, k, p, s] * frame[s, j]
-                    out[n, q, i, j] = acc
+        rotate_to_global(frame, work[n], out[n])
 
 
 @njit(cache=True)
