@@ -70,8 +70,8 @@ def test_per_layer_toughness_and_stress_contain_the_height():
 
 def test_layered_simulation_refuses_what_it_does_not_support():
     medium = LayeredMedium([0.0], [G, 2 * G], [NU, NU])
-    mesh3d = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 1.0, 1.0, 1, 1)
-    with pytest.raises(InputError, match="2D"):
+    mesh3d = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 0, 1], 1.0, 1.0, 1, 1)  # vertical, across z = 0
+    with pytest.raises(InputError, match="crosses the layer interface at z = 0"):
         hd.Simulation(mesh3d, medium, hd.Fluid(1e-3), [hd.Cluster((0, 0, 0), 0.01)], np.zeros((3, 3)), 1.0)
     stressed = LayeredMedium([0.0], [G, 2 * G], [NU, NU], in_situ_stress=np.zeros((2, 3, 3)))
     with pytest.raises(InputError, match="in_situ_stress"):

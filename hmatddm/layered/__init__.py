@@ -4,7 +4,8 @@
   optional per-layer in-situ stress and toughness.
 * :mod:`.images2d`: complementary (image) stress of DDs in 2D plane strain by the general
   image method (ref. Secs 3.2-3.3), numba; loaded on first use.
-* :func:`split_at_interfaces`: cut a 2D mesh's elements where they cross interfaces.
+* :func:`split_at_interfaces`: cut a mesh's elements where they cross interfaces (2D
+  segments; 3D rectangles with a horizontal edge).
 """
 import importlib
 
@@ -18,8 +19,12 @@ def __getattr__(name):
 
 
 def split_at_interfaces(mesh, medium):
-    """See :func:`hmatddm.layered.influence2d.split_at_interfaces`."""
-    from .influence2d import split_at_interfaces as split
+    """See :func:`hmatddm.layered.influence2d.split_at_interfaces` (2D) and
+    :func:`hmatddm.layered.engine.split_rectangles` (3D)."""
+    if mesh.dim == 3:
+        from .engine import split_rectangles as split
+    else:
+        from .influence2d import split_at_interfaces as split
 
     return split(mesh, medium)
 

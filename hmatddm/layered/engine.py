@@ -1,13 +1,24 @@
 """What the coupled flow/propagation engine (:class:`hmatddm.Simulation`) needs from a
-:class:`LayeredMedium` in a 2D vertical cross-section: per-element moduli (tip criteria,
-self compliance), per-element in-situ stress and toughness, and new tip elements cut at
-the interfaces, so that a fracture grows from one layer into the next."""
+:class:`LayeredMedium`, in a 2D vertical cross-section or in 3D: per-element moduli (tip
+criteria, self compliance), per-element in-situ stress and toughness, and new tip
+elements cut at the interfaces, so that a fracture grows from one layer into the next.
+
+The vertical axis is the last coordinate (``y`` in 2D, ``z`` in 3D; docs/conventions.md
+§3). In 3D a new rectangle that crosses an interface is cut along it into two
+rectangles, which needs one of its edges to be horizontal (vertical, horizontal and
+dipping elements whose strike edge is horizontal; ``propagation.turning`` "none" or
+"plan" keep it so); an element whose edges are all inclined is refused by name.
+"""
 from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ..errors import InputError
-from .influence2d import split_at_interfaces
+from ..mesh import Mesh3D
+
+#: Relative tolerance (of the element size) under which an element touching an
+#: interface does not count as crossing it.
+_CROSSING_TOL = 1e-9
 
 
 @dataclass(frozen=True)
@@ -29,17 +40,104 @@ class ElementMaterials:
 
 def check_simulation(mesh, medium, natural_fractures, propagation):
     """Refuse the engine settings the layered medium does not support (yet), by name."""
-    if mesh.dim != 2:
-        raise InputError("material: a LayeredMedium works with 2D meshes (a vertical cross-section) only, so far")
+    if mesh.dim not in (2, 3):
+        raise InputError(f"mesh: a LayeredMedium works with 2D or 3D meshes, got dimension {mesh.dim}")
     if getattr(mesh, "element_order", 0) != 0:
         raise InputError("material: a LayeredMedium simulation needs constant elements (element_order 0)")
-    if medium.in_situ_stress is not None and medium.in_situ_stress.shape[1] != 2:
-        raise InputError(f"material.in_situ_stress must hold 2x2 tensors for a 2D run, got "
-                         f"{medium.in_situ_stress.shape[1]}x{medium.in_situ_stress.shape[2]}")
+    if medium.in_situ_stress is not None and medium.in_situ_stress.shape[1] != mesh.dim:
+        raise InputError(f"material.in_situ_stress must hold {mesh.dim}x{mesh.dim} tensors for a {mesh.dim}D run, "
+                         f"got {medium.in_situ_stress.shape[1]}x{medium.in_situ_stress.shape[2]}")
     if natural_fractures is not None:
-        raise InputError("natural_fractures: not supported with a LayeredMedium yet")
+        raise InputError("natural_fractures: not supported with a LayeredMedium yet (remote failure and the "
+                         "crossing criterion evaluate stresses with a homogeneous material)")
     if propagation is not None and propagation.front != "element":
         raise InputError("propagation.front: a LayeredMedium supports front = 'element' only, so far")
+    if mesh.dim == 3:
+        crossing = crossed_interfaces(mesh, medium)
+        if crossing is not None:
+            element, height = crossing
+            raise InputError(f"mesh: element {element} crosses the layer interface at z = {height:g}; elements "
+                             f"must end on interfaces (docs/conventions.md §3): mesh each layer separately")
+        if propagation is not None and medium.n_layers > 1:
+            if propagation.turning == "any":
+                raise InputError("propagation.turning: 'any' may tilt new 3D elements so that an interface cuts "
+                                 "them obliquely; use 'plan' or 'none' with a LayeredMedium")
+            inclined = np.flatnonzero(~_has_horizontal_edge(mesh))
+            if inclined.size:
+                raise InputError(f"mesh: element {inclined[0]} has no horizontal edge, so new elements grown from "
+                                 f"it could not be cut along an interface into rectangles; with a LayeredMedium "
+                                 f"and propagation, give every 3D element a horizontal edge (e1 or e2 with z = 0)")
+
+
+def _has_horizontal_edge(mesh):
+    frames = mesh.frames
+    return (np.abs(frames[:, 0, 2]) <= 1e-9) | (np.abs(frames[:, 1, 2]) <= 1e-9)
+
+
+def _vertical_extent(mesh):
+    """Lowest and highest height of each 3D element."""
+    reach = mesh.half_a * np.abs(mesh.frames[:, 0, 2]) + mesh.half_b * np.abs(mesh.frames[:, 1, 2])
+    return mesh.centers[:, 2] - reach, mesh.centers[:, 2] + reach
+
+
+def crossed_interfaces(mesh, medium):
+    """``(element, height)`` of the first 3D element that crosses an interface, or None."""
+    if not medium.interfaces:
+        return None
+    low, high = _vertical_extent(mesh)
+    tol = _CROSSING_TOL * np.maximum(mesh.half_a, mesh.half_b)
+    for height in medium.interfaces:
+        bad = np.flatnonzero((low < height - tol) & (high > height + tol))
+        if bad.size:
+            return int(bad[0]), float(height)
+    return None
+
+
+def split_rectangles(mesh, medium):
+    """Cut the 3D elements of ``mesh`` that cross interfaces along them: ``(mesh, index)``
+    with ``index`` the original element of every piece (pieces in order along the cut
+    axis). The cut runs parallel to the element's horizontal edge, so every piece is a
+    rectangle with the parent's frame; InputError for an element without one."""
+    if not medium.interfaces:
+        return mesh, np.arange(mesh.n_elements)
+    heights = np.asarray(medium.interfaces)
+    centers, frames, half_a, half_b, index = [], [], [], [], []
+    for i in range(mesh.n_elements):
+        e1, e2 = mesh.frames[i, 0], mesh.frames[i, 1]
+        halves = [mesh.half_a[i], mesh.half_b[i]]
+        # the axis along which the height varies (the other edge is horizontal)
+        if abs(e1[2]) <= 1e-9:
+            axis = 1
+        elif abs(e2[2]) <= 1e-9:
+            axis = 0
+        else:
+            axis = -1
+        direction = mesh.frames[i, max(axis, 0)]
+        half = halves[max(axis, 0)]
+        cz, slope = mesh.centers[i, 2], direction[2]
+        tol = _CROSSING_TOL * max(halves)
+        inside = heights[(heights > cz - half * abs(slope) + tol) & (heights < cz + half * abs(slope) - tol)]
+        if inside.size == 0 or abs(slope) <= 1e-9:
+            cuts = []
+        elif axis < 0:
+            raise InputError(f"mesh: element {i} crosses the interface at z = {inside[0]:g} and has no horizontal "
+                             f"edge, so it cannot be cut into rectangles (use propagation.turning 'plan' or 'none')")
+        else:
+            cuts = sorted((inside - cz) / slope)
+        ends = [-half] + list(cuts) + [half]
+        for lo, hi in zip(ends[:-1], ends[1:]):
+            centers.append(mesh.centers[i] + 0.5 * (lo + hi) * direction)
+            frames.append(mesh.frames[i])
+            size = [mesh.half_a[i], mesh.half_b[i]]
+            size[max(axis, 0)] = 0.5 * (hi - lo)
+            half_a.append(size[0])
+            half_b.append(size[1])
+            index.append(i)
+    index = np.asarray(index, dtype=np.int64)
+    if index.size == mesh.n_elements:
+        return mesh, index
+    return Mesh3D(np.asarray(centers), np.ascontiguousarray(frames), np.asarray(half_a), np.asarray(half_b),
+                  mesh.fracture_id[index].copy()), index
 
 
 def uniform(medium):
@@ -51,7 +149,7 @@ def uniform(medium):
 
 def element_layers(mesh, medium):
     """Layer of each element (its midpoint's height)."""
-    return medium.layer_of(mesh.centers[:, 1]).astype(np.int64)
+    return medium.layer_of(mesh.centers[:, mesh.dim - 1]).astype(np.int64)
 
 
 def element_materials(mesh, medium):
@@ -72,7 +170,7 @@ def layers_ahead(edges, element, edge, medium):
     """Layer just ahead of each tip edge (the rock a tip on an interface grows into)."""
     mid = edges.midpoints[element, edge]
     step = 1e-6 * edges.half_width[element, edge]
-    return medium.layer_of(mid[:, 1] + step * edges.ahead[element, edge][:, 1]).astype(np.int64)
+    return medium.layer_of(mid[:, -1] + step * edges.ahead[element, edge][:, -1]).astype(np.int64)
 
 
 def tip_criterion(tips, tip_materials, layers, medium, propagation):
@@ -91,5 +189,10 @@ def tip_criterion(tips, tip_materials, layers, medium, propagation):
 
 def split_new_elements(grown, parent, rows, medium):
     """New tip elements cut where they cross interfaces (pieces keep the parent tip)."""
-    split, index = split_at_interfaces(grown, medium)
+    if grown.dim == 3:
+        split, index = split_rectangles(grown, medium)
+    else:
+        from .influence2d import split_at_interfaces
+
+        split, index = split_at_interfaces(grown, medium)
     return split, parent[index], rows[index]

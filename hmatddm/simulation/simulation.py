@@ -116,7 +116,7 @@ class Simulation:
     mesh : Mesh2D or Mesh3D
         The initial fracture(s).
     material : Elastic or LayeredMedium
-        A :class:`hmatddm.LayeredMedium` (2D vertical cross-section, constant elements):
+        A :class:`hmatddm.LayeredMedium` (2D vertical cross-section or 3D, constant elements):
         the operator adds the layers' image terms (ref. Ch. 3), tips use their layer's
         moduli and toughness (if given), elements their layer's in-situ stress (if given,
         else ``far_field_stress``), and new tip elements are cut at the interfaces.
