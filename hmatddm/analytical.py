@@ -15,6 +15,10 @@ Growing hydraulic fractures, zero leak-off (ref. Sec. 4.5):
   Detournay 2002), :func:`kgd_m_vertex` and :func:`kgd_m_vertex_profile` (Adachi and
   Detournay 2002);
 * which vertex applies: :func:`radial_regime`, :func:`kgd_regime` (dimensionless toughness).
+
+Comparing a discrete run with them:
+* :func:`well_element_radius`: the radius at which the pressure of a finite-volume injection
+  element on a square grid equals the radial (log) solution (Peaceman 1983).
 """
 import numpy as np
 from scipy import special
@@ -218,6 +222,22 @@ def radial_m_vertex_profile(rho, t, injection_rate, viscosity, material):
     e_prime, eps, length = _viscosity_scales(positive_scalar("t", t), injection_rate, viscosity,
                                              material, 1.0 / 9.0)
     return eps * length * _radial_m_width_scaled(rho), eps * e_prime * _radial_m_pressure_scaled(rho)
+
+
+def well_element_radius(element_size):
+    """Peaceman's equivalent radius ``r_eq = exp(-pi/2) h ~ 0.208 h`` of an injection element.
+
+    A point source in one cell of a square grid of side ``h``, with two-point fluxes between
+    edge neighbours (:class:`hmatddm.flow.LubricationModel`) and a locally uniform opening,
+    gives that cell the pressure of the radial flow ``p(r) = p_0 - q mu' ln(r) / (2 pi w^3)``
+    at ``r = r_eq`` (Peaceman 1983, SPE J. 23(3):531-543, the infinite-grid value; his
+    earlier numerical 0.2 h). The injection element's pressure of a simulation is therefore
+    the net pressure of a log-singular solution such as :func:`radial_m_vertex_pressure` at
+    ``rho = r_eq / R``, not at the radius ``h / sqrt(pi)`` of a disc of the element's area
+    (which reads the M-vertex about 10% lower at h = 1 m, 50 s of ref. Table 4.1).
+    ``tests/test_analytical.py`` checks it against the project's flow model.
+    """
+    return np.exp(-0.5 * np.pi) * positive_scalar("element_size", element_size)
 
 
 def radial_m_vertex_pressure(rho, t, injection_rate, viscosity, material):

@@ -314,3 +314,38 @@ def test_regime_numbers_compare_the_two_vertices():
 def test_m_vertex_input_validation_names_the_field(field, call):
     with pytest.raises(InputError, match=rf"^{field} must"):
         call()
+
+
+def test_well_element_radius_is_where_the_flow_model_reads_the_log_solution():
+    # steady radial flow from a point source in the centre cell of a square grid of the
+    # project's finite-volume model (uniform opening): cells beyond r_b hold the exact
+    # p(r) = -q mu' ln(r) / (2 pi w^3), the rest is solved; the source cell's pressure is
+    # the exact one at Peaceman's exp(-pi/2) h, not at the disc radius h / sqrt(pi)
+    from hmatddm import topology
+    from hmatddm.flow import LubricationModel
+
+    h, n, w, q = 1.0, 15, 1e-3, 1e-3
+    mesh = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], (2 * n + 1) * h, (2 * n + 1) * h, 2 * n + 1, 2 * n + 1)
+    fluid = hd.Fluid(1e-3, 0.0)
+    centre = int(np.argmin(np.linalg.norm(mesh.centers, axis=1)))
+    model = LubricationModel(areas=mesh.areas, normals=mesh.normals, faces=topology.element_faces(mesh),
+                             fluid=fluid, leak_off=hd.LeakOff(), injection_elements=np.array([centre]),
+                             injection_rates=np.array([q]), wellbore_volumes=np.array([0.0]), minimum_width=0.0)
+    width = np.full(mesh.n_elements, w)
+    matrix, _ = model.assemble(width, width, np.zeros(mesh.n_elements), 1e30, np.zeros(mesh.n_elements))
+    r = np.linalg.norm(mesh.centers, axis=1)
+    exact = lambda radius: -q * fluid.viscosity_prime * np.log(radius) / (2.0 * np.pi * w**3)  # noqa: E731
+    outer = r > (n - 2) * h
+    p = np.zeros(mesh.n_elements)
+    p[outer] = exact(r[outer])
+    inner = ~outer
+    rhs = model.injection()[inner] - matrix[inner][:, outer] @ p[outer]
+    from scipy.sparse.linalg import spsolve
+
+    p[inner] = spsolve(matrix[inner][:, inner].tocsc(), rhs)
+    r_eq = hd.analytical.well_element_radius(h)
+    assert r_eq == pytest.approx(0.2079, abs=1e-4)
+    # the radius at which the exact solution has the source cell's pressure: 0.199 h on this
+    # finite grid (Peaceman's own numerical value 0.198 h), against 0.564 h for the disc
+    implied = (n - 2) * h * np.exp(-(p[centre] - exact((n - 2) * h)) * 2.0 * np.pi * w**3 / (q * fluid.viscosity_prime))
+    assert implied == pytest.approx(r_eq, rel=0.06)
