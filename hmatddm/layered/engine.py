@@ -52,6 +52,10 @@ def check_simulation(mesh, medium, natural_fractures, propagation):
                          "crossing criterion evaluate stresses with a homogeneous material)")
     if propagation is not None and propagation.front != "element":
         raise InputError("propagation.front: a LayeredMedium supports front = 'element' only, so far")
+    void = np.flatnonzero(np.asarray(medium.shear_modulus)[element_layers(mesh, medium)] == 0.0)
+    if void.size:
+        raise InputError(f"mesh: element {void[0]} lies in a void layer (shear_modulus = 0, beyond the free "
+                         f"surface); fractures must lie in the rock")
     if mesh.dim == 3:
         crossing = crossed_interfaces(mesh, medium)
         if crossing is not None:
@@ -175,24 +179,31 @@ def layers_ahead(edges, element, edge, medium):
 
 def tip_criterion(tips, tip_materials, layers, medium, propagation):
     """``tips`` with ``grows`` re-evaluated against the toughness of the layer ahead of
-    each tip (``layers``; ref. Eqs 4.18-4.19); unchanged when the medium has no per-layer
-    toughness. The SIFs themselves use the moduli of the tip element's layer."""
-    if medium.toughness is None:
-        return tips
-    toughness = np.asarray(medium.toughness)[layers]
-    if propagation.criterion == "mcs":
-        grows = tips.k_bar >= toughness
-    else:
-        grows = tips.energy_release_rate >= toughness ** 2 / tip_materials.plane_strain_modulus
+    each tip (``layers``; ref. Eqs 4.18-4.19) where the medium gives per-layer toughness;
+    a tip never grows into a void layer (through a free surface). The SIFs themselves use
+    the moduli of the tip element's layer."""
+    grows = tips.grows
+    if medium.toughness is not None:
+        toughness = np.asarray(medium.toughness)[layers]
+        if propagation.criterion == "mcs":
+            grows = tips.k_bar >= toughness
+        else:
+            grows = tips.energy_release_rate >= toughness ** 2 / tip_materials.plane_strain_modulus
+    grows = grows & (np.asarray(medium.shear_modulus)[layers] > 0.0)
     return replace(tips, grows=grows)
 
 
 def split_new_elements(grown, parent, rows, medium):
-    """New tip elements cut where they cross interfaces (pieces keep the parent tip)."""
+    """New tip elements cut where they cross interfaces (pieces keep the parent tip);
+    pieces in a void layer (beyond a free surface) are dropped."""
     if grown.dim == 3:
         split, index = split_rectangles(grown, medium)
     else:
         from .influence2d import split_at_interfaces
 
         split, index = split_at_interfaces(grown, medium)
+    solid = np.asarray(medium.shear_modulus)[element_layers(split, medium)] > 0.0
+    if not np.all(solid) and np.any(solid):
+        keep = np.flatnonzero(solid)
+        split, index = split.subset(keep), index[keep]
     return split, parent[index], rows[index]
