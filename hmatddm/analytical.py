@@ -15,6 +15,8 @@ Growing hydraulic fractures, zero leak-off (ref. Sec. 4.5):
   Detournay 2002), :func:`kgd_m_vertex` and :func:`kgd_m_vertex_profile` (Adachi and
   Detournay 2002);
 * which vertex applies: :func:`radial_regime`, :func:`kgd_regime` (dimensionless toughness).
+* between the vertices (any ``K_m``): :func:`radial_transition` and
+  :func:`radial_transition_profile`, Dontsov's (2016) approximate solution without leak-off.
 
 Comparing a discrete run with them:
 * :func:`well_element_radius`: the radius at which the pressure of a finite-volume injection
@@ -341,8 +343,8 @@ def radial_regime(t, injection_rate, viscosity, fracture_toughness, material):
     ``mu' = 12 mu``. It grows as ``t^(1/9)``: a radial fracture starts viscosity dominated
     and ends toughness dominated. ``K_m <~ 1``: M-vertex (:func:`radial_m_vertex`,
     :func:`radial_m_vertex_profile`); ``K_m >~ 3.5``: K-vertex (:func:`radial_k_vertex`);
-    in between the fracture is in transition and neither vertex is exact (Dontsov 2016 gives
-    an approximate solution there). ``K_m = (t / t_mk)^(1/9)`` with Dontsov's transition time
+    in between the fracture is in transition and neither vertex is exact
+    (:func:`radial_transition`, Dontsov 2016). ``K_m = (t / t_mk)^(1/9)`` with Dontsov's transition time
     ``t_mk = (mu'^5 E'^13 Q^3 / K'^18)^(1/2)``. Returns an array like ``t``."""
     t = _positive_times(t)
     q = positive_scalar("injection_rate", injection_rate)
@@ -362,3 +364,100 @@ def kgd_regime(injection_rate, viscosity, fracture_toughness, material):
     k_prime = toughness_scale(positive_scalar("fracture_toughness", fracture_toughness))
     e_prime = material.plane_strain_modulus
     return k_prime / (e_prime**3 * mu_prime * q) ** 0.25
+
+
+# --- the K-M transition of a radial fracture (Dontsov 2016) ----------------------------------
+_LAMBDA_M, _LAMBDA_K = 0.487, 0.5  # exponents of (1 + rho) at the M and K vertices (Dontsov 2016)
+
+
+def _transition_shape(k_hat):
+    """Exponents ``(delta, lambda)`` of ``w = w_a (1 - rho)^delta ((1 + rho)/2)^lambda`` for the
+    tip-asymptote toughness ratio ``K^ = K' R^(1/2) / (E' w_a)`` (no leak-off): ``delta = (1 +
+    Delta)/2`` with the local exponent ``Delta = (1 - K^3)/3`` of the universal asymptote (Dontsov
+    and Peirce 2015), ``lambda = 0.487 (1 - K^4) + 0.5 K^4``."""
+    k_hat = np.clip(k_hat, 0.0, 1.0)
+    delta = 0.5 * (1.0 + (1.0 - k_hat**3) / 3.0)
+    return delta, _LAMBDA_M * (1.0 - k_hat**4) + _LAMBDA_K * k_hat**4
+
+
+def _transition_volume_factor(delta, lam):
+    """``int_0^1 rho (1 - rho)^delta ((1 + rho)/2)^lambda d rho`` in incomplete beta functions
+    (``u = (1 + rho)/2``): ``2^(1+delta) [B_(1/2)(lambda+2, delta+1) - B_(1/2)(lambda+1, delta+2)]``
+    with ``B_x(a, b) = int_x^1 u^(a-1) (1 - u)^(b-1) du``."""
+    def upper(a, b):
+        return special.beta(a, b) * (1.0 - special.betainc(a, b, 0.5))
+    return 2.0 ** (1.0 + delta) * (upper(lam + 2.0, delta + 1.0) - upper(lam + 1.0, delta + 2.0))
+
+
+def _transition_state(radius, t, alpha, q, asymptote):
+    """``(volume, w_a, delta, lambda)`` of the approximate solution of radius ``radius`` at ``t``
+    whose radius grows as ``t^alpha`` (front velocity ``alpha R / t``)."""
+    w_a = float(asymptote.width(radius, alpha * radius / t))
+    k_hat = asymptote.k_prime * np.sqrt(radius) / (asymptote.e_prime * w_a)
+    delta, lam = _transition_shape(k_hat)
+    return 2.0 * np.pi * radius**2 * w_a * _transition_volume_factor(delta, lam), w_a, delta, lam
+
+
+def _transition_radius(t, q, asymptote, alpha, bracket):
+    from scipy.optimize import brentq
+
+    def excess(log_radius):
+        return np.log(_transition_state(np.exp(log_radius), t, alpha, q, asymptote)[0] / (q * t))
+    return float(np.exp(brentq(excess, np.log(bracket[0]), np.log(bracket[1]), xtol=1e-12)))
+
+
+def radial_transition_profile(rho, t, injection_rate, viscosity, fracture_toughness, material):
+    """Opening of a radial hydraulic fracture at any dimensionless toughness, zero leak-off:
+    the approximate solution of Dontsov (2016, R. Soc. open sci. 3:160737), without leak-off.
+
+    The opening is the universal tip asymptote (Dontsov and Peirce 2015,
+    :class:`hmatddm.fracture.tip_asymptote.TipAsymptote`) evaluated at the distance ``R`` of the
+    well from the front, with the front velocity ``V = alpha R / t``, spread over the fracture as
+
+        w(rho) = w_a (1 - rho)^delta ((1 + rho)/2)^lambda,   w_a = w_asymptote(s = R, V),
+
+    with ``delta`` the local exponent of the asymptote (1/2 at K^ = K' R^(1/2)/(E' w_a) = 1,
+    2/3 at K^ = 0), ``lambda = 0.487 (1 - K^4) + 0.5 K^4``, and ``R`` such that the fracture
+    holds the injected volume ``Q t``; ``alpha = d ln R / d ln t`` (4/9 at the M-vertex, 2/5 at
+    the K-vertex) by a fixed point on the solution itself. The K-vertex is exact (Sneddon's
+    opening at toughness); the M-vertex gives Dontsov's ``R = 0.6944 L`` and ``w(0) = 1.1901 eps L``
+    of ref. Eqs 4.62-4.63 (see ``tests/test_analytical.py``; Dontsov quotes about 1% between
+    the vertices). The net pressure is not part of this approximation.
+
+    Returns ``(radius, width)``, ``width`` shaped like ``rho`` in ``[0, 1]``; ``t`` a scalar > 0.
+    """
+    rho = finite_array("rho", rho)
+    if np.any((rho < 0.0) | (rho > 1.0)):
+        raise InputError(f"rho must be in [0, 1] (r / R), got {rho[(rho < 0.0) | (rho > 1.0)].ravel()[0]}")
+    t = float(_positive_times(t).ravel()[0]) if np.size(t) == 1 else None
+    if t is None:
+        raise InputError("t must be a scalar > 0 for radial_transition_profile")
+    from .fracture.tip_asymptote import TipAsymptote
+
+    q = positive_scalar("injection_rate", injection_rate)
+    viscosity = positive_scalar("viscosity", viscosity)
+    toughness = positive_scalar("fracture_toughness", fracture_toughness)
+    asymptote = TipAsymptote(material.plane_strain_modulus, toughness, 12.0 * viscosity)
+    r_k = float(radial_k_vertex(t, q, toughness, material)[0])
+    r_m = float(radial_m_vertex(t, q, viscosity, material)[0])
+    bracket = (0.5 * min(r_k, r_m), 2.0 * max(r_k, r_m))
+    alpha, step = 4.0 / 9.0, 0.01
+    for _ in range(4):  # alpha from the radii a little before and after t
+        before = _transition_radius(t * np.exp(-step), q, asymptote, alpha, bracket)
+        after = _transition_radius(t * np.exp(step), q, asymptote, alpha, bracket)
+        alpha = float(np.clip(np.log(after / before) / (2.0 * step), 0.4, 4.0 / 9.0))
+    radius = _transition_radius(t, q, asymptote, alpha, bracket)
+    _, w_a, delta, lam = _transition_state(radius, t, alpha, q, asymptote)
+    return radius, w_a * (1.0 - rho) ** delta * (0.5 * (1.0 + rho)) ** lam
+
+
+def radial_transition(t, injection_rate, viscosity, fracture_toughness, material):
+    """Radius and opening at the well of a radial fracture at any dimensionless toughness
+    ``K_m`` (:func:`radial_regime`), zero leak-off: Dontsov's (2016) approximate solution, see
+    :func:`radial_transition_profile`. Returns ``(radius, max_width)``, arrays like ``t``."""
+    t = _positive_times(t)
+    out = [radial_transition_profile(0.0, ti, injection_rate, viscosity, fracture_toughness, material)
+           for ti in t.ravel()]
+    radius = np.array([r for r, _ in out]).reshape(t.shape)
+    width = np.array([float(np.ravel(w)[0]) for _, w in out]).reshape(t.shape)
+    return radius, width

@@ -349,3 +349,40 @@ def test_well_element_radius_is_where_the_flow_model_reads_the_log_solution():
     # finite grid (Peaceman's own numerical value 0.198 h), against 0.564 h for the disc
     implied = (n - 2) * h * np.exp(-(p[centre] - exact((n - 2) * h)) * 2.0 * np.pi * w**3 / (q * fluid.viscosity_prime))
     assert implied == pytest.approx(r_eq, rel=0.06)
+
+
+def test_radial_transition_reaches_both_vertices():
+    # Dontsov (2016) without leak-off: K_m ~ 0.005 is the M-vertex (his 0.6944 and 1.1901 of
+    # ref. Eqs 4.62-4.63), K_m ~ 100 the K-vertex (exact: Sneddon's crack at toughness)
+    t = np.array([10.0, 50.0])
+    radius, width = hd.analytical.radial_transition(t, Q_RADIAL, MU, 1e4, MAT)
+    r_m, w_m = hd.analytical.radial_m_vertex(t, Q_RADIAL, MU, MAT)
+    assert np.all(hd.analytical.radial_regime(t, Q_RADIAL, MU, 1e4, MAT) < 0.01)
+    np.testing.assert_allclose(radius, r_m, rtol=2e-4)
+    np.testing.assert_allclose(width, w_m, rtol=2e-4)
+    radius, width = hd.analytical.radial_transition(t, Q_RADIAL, 1e-9, 5e6, MAT)
+    r_k, w_k, _ = hd.analytical.radial_k_vertex(t, Q_RADIAL, 5e6, MAT)
+    np.testing.assert_allclose(radius, r_k, rtol=1e-6)
+    np.testing.assert_allclose(width, w_k, rtol=1e-6)
+    rho = np.linspace(0.0, 0.99, 7)
+    radius, profile = hd.analytical.radial_transition_profile(rho, 50.0, Q_RADIAL, 1e-9, 5e6, MAT)
+    _, _, pressure = hd.analytical.radial_k_vertex(50.0, Q_RADIAL, 5e6, MAT)
+    np.testing.assert_allclose(profile, hd.analytical.sneddon_opening(rho * radius, radius, pressure, MAT),
+                               rtol=1e-6)
+
+
+def test_radial_transition_lies_between_the_vertices_and_holds_the_volume():
+    # ref. Table 4.1 K case (K_m 2.4 - 2.8): both dissipations at once make the fracture
+    # smaller and wider than either vertex alone (the K-vertex is closer), and the profile
+    # integrates to Q t
+    t = 30.0
+    u = np.linspace(0.0, 1.0, 2001)  # rho = 1 - u^2: smooth at the front
+    radius, width = hd.analytical.radial_transition_profile(1.0 - u * u, t, Q_RADIAL, MU, 5e6, MAT)
+    r_m, w_m = hd.analytical.radial_m_vertex(t, Q_RADIAL, MU, MAT)
+    r_k, w_k, _ = hd.analytical.radial_k_vertex(t, Q_RADIAL, 5e6, MAT)
+    assert 0.95 * r_k < radius < r_k < r_m
+    assert w_m < w_k < width[-1] < 1.15 * w_k
+    volume = integrate.simpson(2.0 * np.pi * radius**2 * (1.0 - u * u) * width * 2.0 * u, x=u)
+    assert volume == pytest.approx(Q_RADIAL * t, rel=1e-5)
+    with pytest.raises(InputError, match="rho"):
+        hd.analytical.radial_transition_profile(1.5, t, Q_RADIAL, MU, 5e6, MAT)
