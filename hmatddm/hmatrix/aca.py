@@ -23,9 +23,11 @@ pivot has visited (the unvisited ones farthest, in cluster-tree order, from ever
 visited one) must be small; a probe that fails becomes the next pivot and the
 iteration goes on.
 
-Conventions: a block is given by its row elements (m_e of them) and column elements
-(n_e); it has m = d*m_e rows and n = d*n_e columns and is approximated by U V^T with
-U (m x k) and V (n x k). The ACA and the recompression work on the transposed
+Conventions: a block is given by its row elements (m_e of them, d_r unknowns each)
+and column elements (n_e, d_c unknowns each: a rectangular matrix, e.g. stress
+components at points x DD components of elements, has d_r != d_c; a square operator
+d_r = d_c = d); it has m = d_r*m_e rows and n = d_c*n_e columns and is approximated by
+U V^T with U (m x k) and V (n x k). A pivot is a d_r x d_c block. The ACA and the recompression work on the transposed
 factors (``ut`` k x m, ``vt`` k x n, one vector per contiguous row) so that every
 inner loop is contiguous.
 """
@@ -95,7 +97,8 @@ def _subtract_cols(residual, ut, vt, rank, first_col):
 
 @njit(cache=True, nogil=True)
 def _best_element(residual_rows, visited, d):
-    """Unvisited column element with the largest |entry| in a d x n residual row block.
+    """Unvisited column element (``d`` unknowns each) with the largest |entry| in a
+    d_r x n residual row block.
 
     Returns (element, largest |entry|); element = -1 when all are visited.
     """
@@ -118,7 +121,8 @@ def _best_element(residual_rows, visited, d):
 
 @njit(cache=True, nogil=True)
 def _best_row_element(residual_cols, visited, d):
-    """Unvisited row element with the largest squared norm in an m x d residual column block."""
+    """Unvisited row element (``d`` unknowns each) with the largest squared norm in an
+    m x d_c residual column block."""
     best = -1
     largest = -1.0
     for e in range(visited.shape[0]):
@@ -174,22 +178,23 @@ def _max_abs(array):
 def _add_cross(ut, vt, rank, residual_rows, residual_cols, first_col, threshold):
     """Append the cross C P^+ R of a whole-element pivot to the factors (vectors rank..).
 
-    residual_rows R (d x n), residual_cols C (m x d), pivot P = R[:, first_col:+d].
+    residual_rows R (d_r x n), residual_cols C (m x d_c), pivot P = R[:, first_col:+d_c].
     With P = W diag(s) Z^T the update is sum_k (C z_k / s_k)(R^T w_k)^T over the
-    numerical rank of P. The direction of the largest s_k is always kept; the others
+    numerical rank of P (at most min(d_r, d_c)). The direction of the largest s_k is always kept; the others
     only when ||C z_k / s_k|| ||R^T w_k|| > threshold (a weak direction stays in the
     residual and is picked up by a later pivot if it matters). Returns (added rank,
     squared Frobenius norm of the update, 2 * inner product of the update with the
     previous approximation). O((m+n) k d).
     """
     d = residual_rows.shape[0]
-    pivot = np.empty((d, d))
+    dc = residual_cols.shape[1]
+    pivot = np.empty((d, dc))
     for p in range(d):
-        for q in range(d):
+        for q in range(dc):
             pivot[p, q] = residual_rows[p, first_col + q]
     w, s, zh = np.linalg.svd(pivot)
     added = 0
-    for k in range(d):
+    for k in range(s.shape[0]):
         if s[k] > PIVOT_RTOL * s[0] and s[k] > 0.0:
             added += 1
     m = residual_cols.shape[0]
@@ -202,7 +207,7 @@ def _add_cross(ut, vt, rank, residual_rows, residual_cols, first_col, threshold)
         u_norm2 = 0.0
         for r in range(m):
             total = 0.0
-            for q in range(d):
+            for q in range(dc):
                 total += residual_cols[r, q] * zh[k, q]
             ut[vector, r] = total * inverse
             u_norm2 += ut[vector, r] ** 2
@@ -273,12 +278,13 @@ def _squared_norm(array):
 
 # The ACA is a resumable state machine (cached, kernel-independent): each call of
 # aca_advance consumes the rows or columns just evaluated and says what to evaluate
-# next. Only the small loop in aca_tensor / the storage driver calls the kernel, so
-# that only this loop is recompiled for every kernel (numba cannot cache functions
-# taking a dispatcher argument).
+# next. Only the small loop _aca_loop calls the kernel (aca_tensor for tests and
+# explicit blocks, aca_compressed for the H-matrix build); the build driver
+# (storage.build_driver) receives the kernel as a first-class function of a fixed
+# signature, so the driver with this loop in it is cached on disk per data type.
 REQUEST_DONE = 0
-REQUEST_ROW = 1  # evaluate the d rows of row element `index` into `rows` (d x n)
-REQUEST_COL = 2  # evaluate the d columns of column element `index` into `cols` (m x d)
+REQUEST_ROW = 1  # evaluate the d_r rows of row element `index` into `rows` (d_r x n)
+REQUEST_COL = 2  # evaluate the d_c columns of column element `index` into `cols` (m x d_c)
 
 # Slots of the integer state array.
 _PHASE, _RANK, _FAILURES, _PROBE, _ROW, _COL, _ROW_HOP, _COL_HOP, _CHECKS, _CHECK_INDEX = range(10)
@@ -321,7 +327,7 @@ _INTS = types.int64[::1]
 _FLOATS = types.float64[::1]
 ACA_START_SIGNATURE = types.Tuple(
     (_MATRIX, _MATRIX, _MATRIX, _MATRIX, _FLAGS, _FLAGS, _INTS, _FLOATS, types.int64, types.int64)
-)(types.int64, types.int64, types.int64, types.float64)
+)(types.int64, types.int64, types.int64, types.int64, types.float64)
 ACA_ADVANCE_SIGNATURE = types.Tuple((_MATRIX, _MATRIX, types.int64, types.int64))(
     _MATRIX, _MATRIX, _MATRIX, _MATRIX, _FLAGS, _FLAGS, _INTS, _FLOATS
 )
@@ -329,15 +335,16 @@ RECOMPRESS_STATE_SIGNATURE = types.Tuple((_MATRIX, _MATRIX, types.int64))(_MATRI
 
 
 @njit(ACA_START_SIGNATURE, cache=True, nogil=True)
-def aca_start(n_row_elements, n_col_elements, dof, eps):
-    """Allocate the ACA state of an (m_e x n_e)-element block; first request: row element 0.
+def aca_start(n_row_elements, n_col_elements, row_dof, col_dof, eps):
+    """Allocate the ACA state of an (m_e x n_e)-element block with ``row_dof`` unknowns
+    per row element and ``col_dof`` per column element; first request: row element 0.
 
     Returns (ut, vt, rows, cols, row_visited, col_visited, ints, floats, request, index)
     with the transposed factors ut (capacity x m), vt (capacity x n).
     """
-    d = dof
-    m = n_row_elements * d
-    n = n_col_elements * d
+    m = n_row_elements * row_dof
+    n = n_col_elements * col_dof
+    d = max(row_dof, col_dof)
     capacity = min(min(m, n) + d, 4 * d)
     ints = np.zeros(10, dtype=np.int64)
     ints[_ROW_HOP] = _coprime_hop(n_row_elements)
@@ -347,7 +354,7 @@ def aca_start(n_row_elements, n_col_elements, dof, eps):
     floats[_EPS] = eps
     row_visited = np.zeros(n_row_elements, dtype=np.bool_)
     row_visited[0] = True
-    return (np.zeros((capacity, m)), np.zeros((capacity, n)), np.empty((d, n)), np.empty((m, d)), row_visited,
+    return (np.zeros((capacity, m)), np.zeros((capacity, n)), np.empty((row_dof, n)), np.empty((m, col_dof)), row_visited,
             np.zeros(n_col_elements, dtype=np.bool_), ints, floats, REQUEST_ROW, 0)
 
 
@@ -365,7 +372,8 @@ def aca_advance(ut, vt, rows, cols, row_visited, col_visited, ints, floats):
     probe column with a large residual gives the next pivot row (its largest residual).
     Returns (ut, vt, request, index); ut, vt may have been reallocated to grow.
     """
-    d = rows.shape[0]
+    d = rows.shape[0]  # unknowns per row element
+    dc = cols.shape[1]  # unknowns per column element
     m = cols.shape[0]
     n = rows.shape[1]
     max_rank = min(m, n)
@@ -383,7 +391,7 @@ def aca_advance(ut, vt, rows, cols, row_visited, col_visited, ints, floats):
                 return ut, vt, request, index
             ints[_CHECKS] = 0  # the check failed: this row is the next pivot
             ints[_ROW] = row
-        col, largest = _best_element(rows, col_visited, d)
+        col, largest = _best_element(rows, col_visited, dc)
         if col < 0:
             return ut, vt, REQUEST_DONE, 0
         if largest > NEGLIGIBLE * floats[_SCALE]:
@@ -404,7 +412,7 @@ def aca_advance(ut, vt, rows, cols, row_visited, col_visited, ints, floats):
     floats[_SCALE] = max(floats[_SCALE], _max_abs(cols))
     if phase == _PHASE_CHECK_COL:
         probe = ints[_CHECK_INDEX]
-        _subtract_cols(cols, ut, vt, rank, probe * d)
+        _subtract_cols(cols, ut, vt, rank, probe * dc)
         limit = CHECK_FACTOR * floats[_EPS]
         if col_visited.shape[0] * _squared_norm(cols) <= limit * limit * floats[_NORM2]:
             col_visited[probe] = True
@@ -420,7 +428,7 @@ def aca_advance(ut, vt, rows, cols, row_visited, col_visited, ints, floats):
         return ut, vt, REQUEST_ROW, row
     if phase == _PHASE_PROBE_COL:
         probe = ints[_PROBE]
-        _subtract_cols(cols, ut, vt, rank, probe * d)
+        _subtract_cols(cols, ut, vt, rank, probe * dc)
         candidate, norm2 = _best_row_element(cols, row_visited, d)
         if candidate >= 0 and np.sqrt(norm2) > NEGLIGIBLE * floats[_SCALE]:
             row = candidate
@@ -435,13 +443,13 @@ def aca_advance(ut, vt, rows, cols, row_visited, col_visited, ints, floats):
         return ut, vt, REQUEST_ROW, row
     # phase == _PHASE_PIVOT_COL: add the cross of pivot (row, col).
     col = ints[_COL]
-    _subtract_cols(cols, ut, vt, rank, col * d)
-    if rank + d > ut.shape[0]:
-        capacity = min(max_rank + d, 2 * ut.shape[0])
+    _subtract_cols(cols, ut, vt, rank, col * dc)
+    if rank + min(d, dc) > ut.shape[0]:
+        capacity = min(max_rank + max(d, dc), 2 * ut.shape[0])
         ut = _grow(ut, capacity)
         vt = _grow(vt, capacity)
     threshold = floats[_EPS] * np.sqrt(floats[_NORM2])
-    added, update_norm2, cross = _add_cross(ut, vt, rank, rows, cols, col * d, threshold)
+    added, update_norm2, cross = _add_cross(ut, vt, rank, rows, cols, col * dc, threshold)
     rank += added
     ints[_RANK] = rank
     floats[_NORM2] = max(floats[_NORM2] + update_norm2 + cross, 0.0)
@@ -475,8 +483,9 @@ def aca_result(ut, vt, ints):
 
 
 @njit(nogil=True)
-def aca_tensor(kernel, data, row_elements, col_elements, dof, eps):
-    """Partial ACA with whole-element pivots of the block rows x cols (original indices).
+def aca_tensor(kernel, data, row_elements, col_elements, dof, eps, col_dof=0):
+    """Partial ACA with whole-element pivots of the block rows x cols (original indices),
+    ``dof`` unknowns per row element and ``col_dof`` per column element (0: ``dof``).
 
     Each step evaluates one row element (d rows) and one column element (d columns)
     of the residual: O((m + n) * d) kernel entries and O((m + n) * k * d) flops at
@@ -491,15 +500,35 @@ def aca_tensor(kernel, data, row_elements, col_elements, dof, eps):
 
     Returns (U, V, rank) with U (m x rank), V (n x rank); rank 0 for a zero block.
     """
+    ut, vt, ints = _aca_loop(kernel, data, row_elements, col_elements, dof, col_dof if col_dof > 0 else dof, eps)
+    return aca_result(ut, vt, ints)
+
+
+@njit(nogil=True)
+def _aca_loop(kernel, data, row_elements, col_elements, row_dof, col_dof, eps):
+    """Drive the ACA state machine (aca_start / aca_advance) to the end, evaluating the
+    requested row and column elements with ``kernel``; returns (ut, vt, ints)."""
     ut, vt, rows, cols, row_visited, col_visited, ints, floats, request, index = aca_start(
-        row_elements.shape[0], col_elements.shape[0], dof, eps)
+        row_elements.shape[0], col_elements.shape[0], row_dof, col_dof, eps)
     while request != REQUEST_DONE:
         if request == REQUEST_ROW:
             kernel(data, row_elements[index:index + 1], col_elements, rows)
         else:
             kernel(data, row_elements, col_elements[index:index + 1], cols)
         ut, vt, request, index = aca_advance(ut, vt, rows, cols, row_visited, col_visited, ints, floats)
-    return aca_result(ut, vt, ints)
+    return ut, vt, ints
+
+
+@njit(nogil=True)
+def aca_compressed(kernel, data, row_elements, col_elements, row_dof, col_dof, eps):
+    """What the H-matrix build stores for an admissible block: the ACA of
+    :func:`aca_tensor` at ``ACA_TOLERANCE_FACTOR * eps``, recompressed at ``eps``.
+
+    Returns the TRANSPOSED factors (U'^T, V'^T) with ``rank`` rows in use, and the rank
+    (the build driver, hmatrix/storage.py, calls exactly this function).
+    """
+    ut, vt, ints = _aca_loop(kernel, data, row_elements, col_elements, row_dof, col_dof, ACA_TOLERANCE_FACTOR * eps)
+    return recompress_transposed(ut, vt, ints[_RANK], eps)
 
 
 @njit(cache=True, nogil=True, fastmath=FAST)

@@ -23,18 +23,7 @@ import numba
 import numpy as np
 from numba import njit, prange, types
 
-from .aca import (
-    ACA_ADVANCE_SIGNATURE,
-    ACA_START_SIGNATURE,
-    ACA_TOLERANCE_FACTOR,
-    FAST,
-    RECOMPRESS_STATE_SIGNATURE,
-    REQUEST_DONE,
-    REQUEST_ROW,
-    aca_advance,
-    aca_start,
-    recompress_state,
-)
+from .aca import FAST, aca_compressed
 
 # Block kinds recorded for every admissible block.
 KIND_LOWRANK = 0
@@ -132,21 +121,21 @@ class BlockStorage:
 # ----------------------------------------------------------------------------- build
 
 
-def _build_blocks(kernel, data, permutation, dof, eps, row_start, row_stop, col_start, col_stop,
-                  admissible, dense_offset, dense_values, aca_start, aca_advance, recompress_state):
+def _build_blocks(kernel, data, row_permutation, col_permutation, row_dof, col_dof, eps, row_start, row_stop,
+                  col_start, col_stop, admissible, dense_offset, dense_values):
     """Assemble a batch of blocks (tree-position element ranges) sequentially.
 
-    Plain Python source, compiled once per kernel by :func:`build_driver` (the ACA
-    steps arrive as first-class function arguments).
+    Compiled per kernel data type by :func:`build_driver` (the kernel arrives as a
+    first-class function, so the compiled driver is cached on disk).
 
     Inadmissible blocks are filled by the kernel straight into
-    ``dense_values[dense_offset[b]:]`` (the final array). Admissible blocks get ACA
-    plus recompression; their factors (or, when the rank does not pay, their exact
+    ``dense_values[dense_offset[b]:]`` (the final array). Admissible blocks get
+    :func:`~hmatddm.hmatrix.aca.aca_compressed` (ACA plus recompression, the function
+    the ACA tests call); their factors (or, when the rank does not pay, their exact
     dense values) are appended to batch-local buffers returned at the end.
     Returns (rank per block, stored-dense flag per block, U values, V values, dense
     values of the far blocks stored dense), factors in batch order.
     """
-    d = dof
     count = row_start.shape[0]
     ranks = np.zeros(count, dtype=np.int64)
     stored_dense = np.zeros(count, dtype=np.bool_)
@@ -157,24 +146,15 @@ def _build_blocks(kernel, data, permutation, dof, eps, row_start, row_stop, col_
     v_used = 0
     far_used = 0
     for b in range(count):
-        rows = permutation[row_start[b]:row_stop[b]]
-        cols = permutation[col_start[b]:col_stop[b]]
-        m = d * rows.shape[0]
-        n = d * cols.shape[0]
+        rows = row_permutation[row_start[b]:row_stop[b]]
+        cols = col_permutation[col_start[b]:col_stop[b]]
+        m = row_dof * rows.shape[0]
+        n = col_dof * cols.shape[0]
         if not admissible[b]:
             target = dense_values[dense_offset[b]:dense_offset[b] + m * n].reshape((m, n))
             kernel(data, rows, cols, target)
             continue
-        # whole-element ACA: the same loop as aca.aca_tensor
-        ut, vt, row_buffer, col_buffer, row_visited, col_visited, ints, floats, request, index = aca_start(
-            rows.shape[0], cols.shape[0], d, ACA_TOLERANCE_FACTOR * eps)
-        while request != REQUEST_DONE:
-            if request == REQUEST_ROW:
-                kernel(data, rows[index:index + 1], cols, row_buffer)
-            else:
-                kernel(data, rows, cols[index:index + 1], col_buffer)
-            ut, vt, request, index = aca_advance(ut, vt, row_buffer, col_buffer, row_visited, col_visited, ints, floats)
-        ut, vt, rank = recompress_state(ut, vt, ints, eps)
+        ut, vt, rank = aca_compressed(kernel, data, rows, cols, row_dof, col_dof, eps)
         ranks[b] = rank
         if rank * (m + n) >= m * n:
             stored_dense[b] = True
@@ -195,26 +175,26 @@ def _build_blocks(kernel, data, permutation, dof, eps, row_start, row_stop, col_
 _DRIVERS = {}
 
 
-def build_driver(kernel, data):
-    """The compiled :func:`_build_blocks` for this kernel and data types (cached per process).
+def build_driver(data):
+    """The compiled :func:`_build_blocks` for kernel data of this type (cached on disk).
 
-    Compiled with an explicit signature so that aca_start / aca_advance /
-    recompress_state are first-class function arguments (called through pointers,
-    not linked in): about 0.3 s per kernel instead of ~2 s. Numba cannot cache it on
-    disk (it takes a dispatcher argument).
+    The kernel argument is typed as a first-class function ``none(data, int64[::1],
+    int64[::1], float64[:, ::1])`` rather than as its dispatcher, so the signature
+    holds no Python object and numba caches the compiled driver (``cache=True``): the
+    ~2 s compile is paid once per data type, not once per process. Call it with the
+    kernel dispatcher as first argument; numba compiles the kernel for that signature.
     """
     data_type = numba.typeof(data)
-    key = (kernel, data_type)
-    driver = _DRIVERS.get(key)
+    driver = _DRIVERS.get(data_type)
     if driver is None:
         index = types.int64[::1]
-        argument_types = (
-            numba.typeof(kernel), data_type, index, types.int64, types.float64, index, index, index, index,
-            types.boolean[::1], index, types.float64[::1], types.FunctionType(ACA_START_SIGNATURE),
-            types.FunctionType(ACA_ADVANCE_SIGNATURE), types.FunctionType(RECOMPRESS_STATE_SIGNATURE),
-        )
-        driver = njit(argument_types, nogil=True)(_build_blocks)
-        _DRIVERS[key] = driver
+        kernel_type = types.FunctionType(types.none(data_type, index, index, types.float64[:, ::1]))
+        outputs = types.Tuple((index, types.boolean[::1], types.float64[::1], types.float64[::1],
+                               types.float64[::1]))
+        signature = outputs(kernel_type, data_type, index, index, types.int64, types.int64, types.float64, index,
+                            index, index, index, types.boolean[::1], index, types.float64[::1])
+        driver = njit(signature, cache=True, nogil=True)(_build_blocks)
+        _DRIVERS[data_type] = driver
     return driver
 
 
@@ -326,13 +306,12 @@ def assemble(generator, tree, blocks, eps, n_threads=None, factor_dtype=np.float
     n_far = far_rows_start.size
     empty = np.empty(0)
     no_offsets = np.zeros(n_far, dtype=np.int64)
-    driver = build_driver(kernel, data)
-    steps = (aca_start, aca_advance, recompress_state)
+    driver = build_driver(data)
 
     def far_batch(ids):
-        return driver(kernel, data, permutation, d, float(eps), far_rows_start[ids], far_rows_stop[ids],
-                      far_cols_start[ids], far_cols_stop[ids], np.ones(ids.size, dtype=np.bool_),
-                      no_offsets[ids], empty, *steps)
+        return driver(kernel, data, permutation, permutation, d, d, float(eps), far_rows_start[ids],
+                      far_rows_stop[ids], far_cols_start[ids], far_cols_stop[ids], np.ones(ids.size, dtype=np.bool_),
+                      no_offsets[ids], empty)
 
     started = time.perf_counter()
     far_cost = (far_rows_stop - far_rows_start + far_cols_stop - far_cols_start).astype(np.float64)
@@ -386,9 +365,9 @@ def assemble(generator, tree, blocks, eps, n_threads=None, factor_dtype=np.float
     near_offset = dense_offset[far_dense.size:-1]
 
     def near_batch(ids):
-        return driver(kernel, data, permutation, d, float(eps), near_rows_start[ids], near_rows_stop[ids],
-                      near_cols_start[ids], near_cols_stop[ids], np.zeros(ids.size, dtype=np.bool_),
-                      near_offset[ids], dense_values, *steps)
+        return driver(kernel, data, permutation, permutation, d, d, float(eps), near_rows_start[ids],
+                      near_rows_stop[ids], near_cols_start[ids], near_cols_stop[ids],
+                      np.zeros(ids.size, dtype=np.bool_), near_offset[ids], dense_values)
 
     started = time.perf_counter()
     near_cost = dense_size[far_dense.size:].astype(np.float64)
