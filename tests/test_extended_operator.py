@@ -63,3 +63,31 @@ def test_every_operator_solves_through_the_same_methods(grown):
         assert np.linalg.norm(operator @ operator.approximate_inverse(rhs) - rhs) < 0.8 * np.linalg.norm(rhs)
     dd, info = hd.solve(extended, load, return_info=True)
     np.testing.assert_allclose(dd.ravel(), reference, rtol=0, atol=1e-6 * scale)
+
+
+def test_a_later_growth_pass_reuses_the_border_of_the_previous_one(grown, material):
+    """Passing the previous pass's operator copies the border entries of the elements it
+    shares and evaluates only the added ones: the blocks are exactly those of a fresh
+    evaluation; a changed element ends the shared run; another base shares nothing."""
+    mesh, extended, dense = grown
+    base = extended.base
+    first = ExtendedElasticityOperator(base, mesh.subset(np.arange(120)))
+    assert first.n_reused == 0
+    later = ExtendedElasticityOperator(base, mesh, previous=first)
+    assert later.n_reused == 20
+    for name in ("on", "no", "nn"):
+        np.testing.assert_array_equal(getattr(later, name), getattr(extended, name))
+    x = np.random.default_rng(2).normal(size=dense.shape[0])
+    np.testing.assert_allclose(later @ x, dense @ x, rtol=0, atol=1e-6 * np.abs(dense @ x).max())
+
+    order = np.concatenate([np.arange(110), np.arange(110, mesh.n_elements)[::-1]])  # elements 110.. changed
+    changed = mesh.subset(order)
+    partly = ExtendedElasticityOperator(base, changed, previous=first)
+    assert partly.n_reused == 10
+    fresh = ExtendedElasticityOperator(base, changed)
+    for name in ("on", "no", "nn"):
+        np.testing.assert_array_equal(getattr(partly, name), getattr(fresh, name))
+
+    other_base = hd.ElasticityOperator(mesh.subset(np.arange(100)), material, backend="hmatrix", eps=1e-8,
+                                       leaf_size=16)
+    assert ExtendedElasticityOperator(other_base, mesh, previous=first).n_reused == 0
