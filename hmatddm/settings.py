@@ -14,7 +14,8 @@ import math
 from numbers import Integral, Real
 
 from .errors import InputError
-from .options import CRITERIA, FRONTS, SCHEME_DEFAULTS, SCHEMES, TURNING
+from .options import (BACKENDS, CONTACT_MODES, CRITERIA, DEFAULT_EPS, DEFAULT_ETA, DEFAULT_LEAF_SIZE, FRONTS,
+                      SCHEME_DEFAULTS, SCHEMES, SINGULAR_CORRECTIONS, TURNING)
 
 REQUIRED = object()  # marker: the key has no default
 ABSENT = object()    # marker: optional key without a default (left out of the echo when not given)
@@ -179,9 +180,18 @@ class Setting:
         return self.check(name, value, None)
 
 
-def integer(name, value, minimum=1):
-    """``value`` as an int >= ``minimum`` (Python or numpy integer; bools refused)."""
-    return Setting("integer", low=minimum).check(name, value, None)
+def integer(name, value, minimum=1, maximum=None):
+    """``value`` as an int in [``minimum``, ``maximum``] (Python or numpy integer; bools
+    refused): the package's one integer check."""
+    return Setting("integer", low=minimum, high=maximum).check(name, value, None)
+
+
+def check_fields(instance, declarations, prefix=""):
+    """Check (and convert) the fields of a frozen dataclass ``instance`` that
+    ``declarations`` declares, in place; messages name ``prefix + field``."""
+    for name, setting in declarations.items():
+        if hasattr(instance, name):
+            object.__setattr__(instance, name, setting.value(prefix + name, getattr(instance, name)))
 
 
 # ---------------------------------------------------------------------------------
@@ -252,4 +262,85 @@ NATURAL_FRACTURE = {  # network.* in a scene -> hmatddm.fracture.crossing.Natura
     "critical_radius": Setting("number", 0.005, low=0.0, low_open=True, unit="m",
                                doc="r_c of the Mohr-Coulomb crossing criterion"),
     "skempton": Setting("number", 0.0, low=0.0, high=1.0, doc="Skempton's B (ref. Eq. 5.18)"),
+}
+
+_POSITIVE_LENGTH = dict(low=0.0, low_open=True, unit="m")
+
+OPERATOR = {  # -> hmatddm.operators.ElasticityOperator (the H-matrix options, ref. Ch. 5)
+    "backend": Setting("choice", "dense", choices=BACKENDS),
+    "eps": Setting("number", DEFAULT_EPS, **_UNIT_INTERVAL, doc="ACA tolerance of the admissible blocks"),
+    "eta": Setting("number", DEFAULT_ETA, low=0.0, low_open=True, doc="admissibility, min(diam) <= eta * dist"),
+    "leaf_size": Setting("integer", DEFAULT_LEAF_SIZE, low=1, doc="largest cluster that is not split"),
+    "singular_correction": Setting("choice", "none", choices=SINGULAR_CORRECTIONS),
+    "alpha": Setting("number", low=1.0, doc="scaling of the shear unknowns (None: no scaling)"),
+}
+
+NUMERICS = {  # [numerics] of a scene -> hmatddm.Simulation, its operator and its SchemeSettings
+    "time_step": Setting("number", 1.0, low=0.0, low_open=True, unit="s"),
+    "end_time": Setting("number", REQUIRED, low=0.0, low_open=True, unit="s"),
+    "backend": Setting("choice", "hmatrix", choices=BACKENDS),
+    **{key: OPERATOR[key] for key in ("eps", "eta", "leaf_size")},
+    **SCHEME,
+    "initial_pressure": Setting("number", 0.0, unit="Pa"),
+    "initial_opening": Setting("number", 1e-5, low=0.0, unit="m"),
+    "minimum_width": Setting("number", low=0.0, low_open=True, unit="m"),
+    "singular_correction": OPERATOR["singular_correction"],
+    "alpha": OPERATOR["alpha"],
+    "contact": Setting("choice", "natural", choices=CONTACT_MODES,
+                       doc="elements that close with contact and Coulomb friction: natural, all, none "
+                           "(default: all in a scene with natural fractures, natural otherwise)"),
+    "keep_checkpoints": Setting("integer", 3, low=1),
+    "max_elements": Setting("integer", 200_000, low=1,
+                            doc="refuse a scene (or stop a run, resumably) with more elements than this"),
+}
+
+LAYER = {  # a [[layer]] of a scene, and each entry of hmatddm.LayeredMedium's lists (ref. Ch. 3)
+    "bottom": Setting("number", unit="m", doc="height of the interface below this layer; omit for the last layer"),
+    "shear_modulus": Setting("number", REQUIRED, low=0.0, unit="Pa",
+                             doc="0: void (a free surface), top or bottom only"),
+    "poisson_ratio": Setting("number", REQUIRED, low=0.0, high=0.5, high_open=True),
+    "s_hmin": Setting("number", unit="Pa", doc="compressive stress along x in this layer (default: the [stress] one)"),
+    "toughness": Setting("number", low=0.0, low_open=True, unit="Pa m^0.5",
+                         doc="K_Ic of this layer (default: propagation.toughness); a void layer's is not used"),
+}
+
+LAYERED_MEDIUM = {  # the image-series options of hmatddm.LayeredMedium (ref. Fig. 3.4, Eqs 3.12-3.13)
+    "image_tol": Setting("number", 1e-4, **_UNIT_INTERVAL,
+                         doc="images='auto' stops when one more image changes a sampled block by less"),
+    "gauss_points": Setting("integer", 4, low=1, high=32, doc="Gauss points per sub-segment of the image terms"),
+}
+
+MICROSEISMIC = {  # [microseismic] of a scene (ref. Ch. 7) -> hmatddm.microseismic (Well, Medium, NoiseLevels)
+    "wells": Setting("points", REQUIRED, length=2, unit="m", doc="plan positions [x, y] of vertical observation wells"),
+    "receiver_top": Setting("number", 20.0, unit="m", doc="ref. Sec. 7.4.2: every 5 m from -20 to 20 m"),
+    "receiver_bottom": Setting("number", -20.0, unit="m"),
+    "receiver_spacing": Setting("number", 5.0, **_POSITIVE_LENGTH),
+    "p_wave_speed": Setting("number", 4000.0, low=0.0, low_open=True, unit="m/s", doc="ref. Table 7.1"),
+    "s_wave_speed": Setting("number", 2350.0, low=0.0, low_open=True, unit="m/s"),
+    "density": Setting("number", 3000.0, low=0.0, low_open=True, unit="kg/m^3"),
+    "shear_ratio": Setting("number", 2.0, low=0.0, doc="events: |slip| >= shear_ratio |opening| (ref. Eq. 7.29)"),
+    "rotation_noise_deg": Setting("number", 0.0, low=0.0, unit="deg",
+                                  doc="noise standard deviation of the direction (ref. Table 7.2)"),
+    "travel_time_noise": Setting("number", 0.0, low=0.0, unit="s", doc="noise standard deviation of t_S - t_P"),
+    "amplitude_noise": Setting("number", 0.0, low=0.0, doc="noise standard deviation, share of the largest amplitude"),
+    "seed": Setting("integer", 0, low=0),
+    "merge": Setting("boolean", False, doc="merge neighbouring elements failing in the same step"),
+}
+
+NETWORK_GENERATOR = {  # network.* of a scene -> hmatddm.network.NetworkSpec (ref. Sec. 6.2, Table 6.1)
+    "region": Setting("point", length=4, unit="m", doc="[x_min, x_max, y_min, y_max]"),
+    "density": Setting("number", low=0.0, low_open=True, unit="1/m^2", doc="rho_NF of ref. Eq. 6.12"),
+    "length_exponent": Setting("number", 2.0, low=1.0, doc="a of f(l) ~ l^-a (ref. Eq. 6.1; 1: log-uniform)"),
+    "l_min": Setting("number", 1.0, **_POSITIVE_LENGTH),
+    "l_max": Setting("number", 30.0, **_POSITIVE_LENGTH),
+    "mean_azimuths_deg": Setting("numbers", [45.0], unit="deg"),
+    "kappas": Setting("numbers", [5.0], low=0.0, doc="von Mises concentration of the doubled angle"),
+    "weights": Setting("numbers", low=0.0, doc="mixing factor of each set, summing to 1 (default: equal)"),
+    "seed": Setting("integer", 0, low=0),
+    "boundary": Setting("choice", "resample", choices=("resample", "clip")),
+}
+
+NETWORK_GEOMETRY = {  # network.* of a scene: the vertical extent of the natural fractures in 3D
+    "height": Setting("number", 1.0, **_POSITIVE_LENGTH),
+    "z_center": Setting("number", 0.0, unit="m"),
 }

@@ -18,7 +18,7 @@ import math
 import numpy as np
 
 from ._validation import finite_array
-from .errors import InputError
+from .settings import integer
 
 ELEMENT_ORDERS = (0, 1, 2)
 
@@ -40,12 +40,9 @@ _COEFFICIENTS = {
 
 
 def check_order(element_order):
-    """``element_order`` as an int in (0, 1, 2), or InputError naming it."""
-    if isinstance(element_order, bool) or not isinstance(element_order, (int, np.integer)) \
-            or int(element_order) not in ELEMENT_ORDERS:
-        raise InputError(f"element_order must be one of {ELEMENT_ORDERS} (0 constant, 1 linear, 2 quadratic "
-                         f"DD elements), got {element_order!r}")
-    return int(element_order)
+    """``element_order`` as an int in (0, 1, 2) (0 constant, 1 linear, 2 quadratic DD
+    elements), or InputError naming it."""
+    return integer("element_order", element_order, min(ELEMENT_ORDERS), max(ELEMENT_ORDERS))
 
 
 def nodes(element_order):

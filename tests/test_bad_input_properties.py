@@ -150,7 +150,7 @@ def test_sweep_refuses_bad_values_before_starting_dask(capsys, monkeypatch):
 
     monkeypatch.setattr(dask.distributed, "LocalCluster", no_cluster)
     monkeypatch.setattr(dask.distributed, "Client", no_cluster)
-    for argv, message in ((["--density", "-1"], "density must be > 0, got -1.0"),
+    for argv, message in ((["--density", "-1"], "density must be > 0 1/m^2, got -1"),
                           (["--length-exponent", "0.5"], "length_exponent"),
                           (["--realizations", "0"], "realizations must be an integer >= 1, got 0")):
         assert cli.main(["sweep", *argv]) == cli.EXIT_BAD_INPUT

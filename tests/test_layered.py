@@ -6,6 +6,7 @@ import pytest
 import hmatddm as hd
 from hmatddm.errors import InputError
 from hmatddm.kernels import line2d
+from hmatddm.kernels.drivers import traction_block
 from hmatddm.layered import LayeredMedium, images2d, split_at_interfaces
 
 
@@ -20,6 +21,12 @@ from hmatddm.layered import LayeredMedium, images2d, split_at_interfaces
     (dict(interfaces=[0.0], shear_modulus=[1, 1], poisson_ratio=[.2, .5]), "poisson_ratio"),
     (dict(interfaces=[0.0], shear_modulus=[1, 1], poisson_ratio=[.2, .2], images=-1), "images"),
     (dict(interfaces=[0.0], shear_modulus=[1, 1], poisson_ratio=[.2, .2], toughness=[1.0]), "toughness"),
+    (dict(interfaces=[0.0], shear_modulus=[1, 1], poisson_ratio=[.2, .2], toughness=[1.0, 0.0]),
+     r"toughness\[1\] must be > 0 Pa m\^0.5, got 0"),
+    (dict(interfaces=[0.0], shear_modulus=[1, 1], poisson_ratio=[.2, .2], gauss_points=33),
+     r"gauss_points must be an integer in \[1, 32\], got 33"),
+    (dict(interfaces=[0.0], shear_modulus=[1, 1], poisson_ratio=[.2, .2], image_tol=1.0),
+     r"image_tol must be in \(0, 1\), got 1"),
     (dict(interfaces=[0.0], shear_modulus=[1, 1], poisson_ratio=[.2, .2], in_situ_stress=np.zeros((3, 2, 2))),
      "in_situ_stress"),
 ])
@@ -157,9 +164,8 @@ def test_image_quadrature_converges_with_gauss_points():
     rows = cols = np.arange(mesh.n_elements)
     blocks = []
     for n_gauss in (1, 2, 4, 8, 16):
-        settings = np.array([1.0, float(n_gauss), 1.0])  # one sub-segment
         block = np.empty((2 * mesh.n_elements, 2 * mesh.n_elements))
-        images2d.traction_block(data[:7] + (settings,) + data[8:], rows, cols, block)
+        traction_block(data._replace(gauss_points=n_gauss, max_subdivisions=1), rows, cols, block)  # one sub-segment
         blocks.append(block)
     errors = [np.max(np.abs(b - blocks[-1])) / np.max(np.abs(blocks[-1])) for b in blocks[:-1]]
     assert errors[0] > 1e-3

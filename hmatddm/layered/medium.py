@@ -12,9 +12,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validation import finite_scalar
 from ..errors import InputError
 from ..material import Elastic
+from ..settings import LAYER, LAYERED_MEDIUM, check_fields, integer
 
 #: Default largest number of reflections of a Hansen potential (``images="auto"`` stops
 #: earlier when the next image changes the sampled influence block by < ``image_tol``).
@@ -24,6 +24,10 @@ MAX_IMAGES = 30
 @dataclass(frozen=True, eq=False)
 class LayeredMedium:
     """Parallel elastic layers bonded at planar interfaces (ref. Sec. 3.3).
+
+    The ranges, defaults and units of the per-layer values and of the image options are
+    declared once in :data:`hmatddm.settings.LAYER` and :data:`hmatddm.settings.LAYERED_MEDIUM`
+    (the scene's ``[[layer]]`` tables read the same declarations).
 
     Parameters
     ----------
@@ -38,14 +42,14 @@ class LayeredMedium:
     in_situ_stress : None or (n_layers, d, d)
         Optional per-layer in-situ stress tensor (Pa, tension positive).
     toughness : None or sequence of float
-        Optional per-layer fracture toughness K_Ic (Pa m^0.5), >= 0.
+        Optional per-layer fracture toughness K_Ic (Pa m^0.5), > 0 (a void layer may give 0).
     images : int >= 0 or "auto"
         Largest number of reflections of a Hansen potential (ref. Fig. 3.4, n_max);
         transmissions are not counted. ``"auto"``: the smallest number (<= ``MAX_IMAGES``)
         for which one more image changes a sampled influence block by less than
         ``image_tol`` (relative, max norm); the operator reports it in ``stats``.
     image_tol : float in (0, 1)
-    gauss_points : int >= 1
+    gauss_points : int in [1, 32]
         Gauss points per sub-segment for the regular image terms (ref. Eqs 3.12-3.13);
         sub-segments are added where an image lies close to the receiver.
     """
@@ -56,8 +60,8 @@ class LayeredMedium:
     in_situ_stress: object = None
     toughness: object = None
     images: object = "auto"
-    image_tol: float = 1e-4
-    gauss_points: int = 4
+    image_tol: float = LAYERED_MEDIUM["image_tol"].default
+    gauss_points: int = LAYERED_MEDIUM["gauss_points"].default
 
     def __post_init__(self):
         d = _float_list("interfaces", self.interfaces)
@@ -75,8 +79,7 @@ class LayeredMedium:
                 raise InputError(f"interfaces must be strictly decreasing (listed top down, no overlap); "
                                  f"interfaces[{k}] = {d[k]} and interfaces[{k + 1}] = {d[k + 1]}")
         for k, value in enumerate(g):
-            if value < 0.0:
-                raise InputError(f"shear_modulus[{k}] must be >= 0 Pa (0: a void layer, a free surface), got {value}")
+            LAYER["shear_modulus"].value(f"shear_modulus[{k}]", value)
             if value == 0.0 and 0 < k < len(g) - 1:
                 raise InputError(f"shear_modulus[{k}] = 0 (void) is allowed only for the top or bottom layer")
         if len(g) > 1 and all(value == 0.0 for value in g):
@@ -84,8 +87,7 @@ class LayeredMedium:
         if len(g) == 1 and g[0] == 0.0:
             raise InputError("shear_modulus[0] must be > 0 for a single layer")
         for k, value in enumerate(nu):
-            if not 0.0 <= value < 0.5:
-                raise InputError(f"poisson_ratio[{k}] must be in [0, 0.5), got {value}")
+            LAYER["poisson_ratio"].value(f"poisson_ratio[{k}]", value)
         object.__setattr__(self, "interfaces", tuple(d))
         object.__setattr__(self, "shear_modulus", tuple(g))
         object.__setattr__(self, "poisson_ratio", tuple(nu))
@@ -99,21 +101,18 @@ class LayeredMedium:
             object.__setattr__(self, "in_situ_stress", s)
         if self.toughness is not None:
             k_ic = _float_list("toughness", self.toughness)
-            if len(k_ic) != len(g) or any(value < 0.0 for value in k_ic):
-                raise InputError(f"toughness must hold {len(g)} values >= 0 Pa m^0.5, got {list(k_ic)}")
+            if len(k_ic) != len(g):
+                raise InputError(f"toughness must hold one value per layer ({len(g)}), got {list(k_ic)}")
+            for k, value in enumerate(k_ic):
+                if g[k] > 0.0 or value != 0.0:  # a void layer may give 0: it has no rock to break
+                    LAYER["toughness"].value(f"toughness[{k}]", value)
             object.__setattr__(self, "toughness", tuple(k_ic))
         if self.images != "auto":
-            if isinstance(self.images, bool) or not isinstance(self.images, (int, np.integer)) or self.images < 0:
-                raise InputError(f"images must be an integer >= 0 or 'auto', got {self.images!r}")
-            object.__setattr__(self, "images", int(self.images))
-        tol = finite_scalar("image_tol", self.image_tol)
-        if not 0.0 < tol < 1.0:
-            raise InputError(f"image_tol must be in (0, 1), got {tol}")
-        object.__setattr__(self, "image_tol", tol)
-        if isinstance(self.gauss_points, bool) or not isinstance(self.gauss_points, (int, np.integer)) \
-                or not 1 <= self.gauss_points <= 32:
-            raise InputError(f"gauss_points must be an integer in [1, 32], got {self.gauss_points!r}")
-        object.__setattr__(self, "gauss_points", int(self.gauss_points))
+            try:
+                object.__setattr__(self, "images", integer("images", self.images, minimum=0))
+            except InputError:
+                raise InputError(f"images must be an integer >= 0 or 'auto', got {self.images!r}") from None
+        check_fields(self, LAYERED_MEDIUM)
 
     # -- queries ---------------------------------------------------------------------
     @property

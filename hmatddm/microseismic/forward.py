@@ -19,6 +19,7 @@ import numpy as np
 
 from .._validation import finite_array
 from ..errors import InputError
+from ..settings import MICROSEISMIC
 
 CHUNK = 4096  # events per chunk: (chunk, receivers, 3) arrays stay small
 
@@ -31,9 +32,9 @@ class Well:
 
     x: float
     y: float
-    top: float = 20.0
-    bottom: float = -20.0
-    spacing: float = 5.0
+    top: float = MICROSEISMIC["receiver_top"].default
+    bottom: float = MICROSEISMIC["receiver_bottom"].default
+    spacing: float = MICROSEISMIC["receiver_spacing"].default
 
     def receivers(self):
         """Receiver positions (K, 3), from the bottom up."""
@@ -42,7 +43,7 @@ class Well:
         return np.column_stack([np.full(count, self.x), np.full(count, self.y), z])
 
 
-def wells_from_positions(positions, top=20.0, bottom=-20.0, spacing=5.0, prefix=""):
+def wells_from_positions(positions, top=Well.top, bottom=Well.bottom, spacing=Well.spacing, prefix=""):
     """Wells at plan positions ``[[x, y], ...]``; refuses no wells, a bad depth range
     or spacing, naming ``prefix + field``."""
     positions = np.asarray(positions, dtype=float) if len(positions) else np.zeros((0, 2))
@@ -51,11 +52,10 @@ def wells_from_positions(positions, top=20.0, bottom=-20.0, spacing=5.0, prefix=
                          f"{np.asarray(positions).tolist()}")
     if not np.all(np.isfinite(positions)):
         raise InputError(f"{prefix}wells must hold finite [x, y] positions (m)")
-    top, bottom, spacing = float(top), float(bottom), float(spacing)
-    if not (np.isfinite(top) and np.isfinite(bottom)) or bottom > top:
+    top, bottom, spacing = (MICROSEISMIC[key].value(prefix + key, value) for key, value in
+                            (("receiver_top", top), ("receiver_bottom", bottom), ("receiver_spacing", spacing)))
+    if bottom > top:
         raise InputError(f"{prefix}receiver_bottom must be <= {prefix}receiver_top = {top:.6g} m, got {bottom:.6g}")
-    if not np.isfinite(spacing) or spacing <= 0.0:
-        raise InputError(f"{prefix}receiver_spacing must be > 0 m, got {spacing:.6g}")
     return [Well(float(x), float(y), top, bottom, spacing) for x, y in positions]
 
 

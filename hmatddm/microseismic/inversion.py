@@ -35,6 +35,7 @@ import numpy as np
 from scipy.optimize import brentq, differential_evolution, least_squares
 
 from ..errors import InputError
+from ..settings import integer
 
 RMS_FACTOR_P = 0.52  # ref. Sec. 7.3.2: RMS of F_P over the focal sphere (sqrt(4/15) = 0.516)
 RMS_FACTOR_S = 0.63  # ref. Sec. 7.3.2: RMS of F_S over the focal sphere (sqrt(2/5) = 0.632)
@@ -295,8 +296,7 @@ def invert_source_draws(observations, medium, levels, draws, seed=0, constraint=
     the optimiser seeded from ``seed``: the spread of the answers, not one answer."""
     from .noise import add_noise
 
-    if isinstance(draws, bool) or int(draws) < 1:
-        raise InputError(f"draws must be an integer >= 1, got {draws!r}")
+    draws = integer("draws", draws)
     single = observations if len(observations.distance) == 1 else _one_event(observations, event)
     position = single.receivers[0] - single.distance[0, 0] * single.direction[0, 0]
     rows = []

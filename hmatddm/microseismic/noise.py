@@ -16,7 +16,10 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..errors import InputError
+from ..settings import MICROSEISMIC
+
+_SCENE_KEYS = {"rotation_deg": "rotation_noise_deg", "travel_time": "travel_time_noise",
+               "amplitude_share": "amplitude_noise"}  # field -> its microseismic.* scene key
 
 
 @dataclass(frozen=True)
@@ -28,11 +31,9 @@ class NoiseLevels:
     travel_time: float = 0.0
     amplitude_share: float = 0.0
 
-    def __post_init__(self):
-        for name in ("rotation_deg", "travel_time", "amplitude_share"):
-            value = getattr(self, name)
-            if not np.isfinite(value) or value < 0.0:
-                raise InputError(f"{name} (noise standard deviation) must be >= 0, got {value!r}")
+    def __post_init__(self):  # ranges: the scene keys of hmatddm.settings.MICROSEISMIC
+        for name, key in _SCENE_KEYS.items():
+            object.__setattr__(self, name, MICROSEISMIC[key].value(name, getattr(self, name)))
 
     @property
     def is_zero(self):

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
+from ..settings import integer
 
 
 @dataclass
@@ -60,8 +61,7 @@ def fit_traces(positions, eps=None, min_samples=3):
     from sklearn.cluster import DBSCAN
     from sklearn.decomposition import PCA
 
-    if isinstance(min_samples, bool) or int(min_samples) < 2:
-        raise InputError(f"min_samples must be an integer >= 2, got {min_samples!r}")
+    min_samples = integer("min_samples", min_samples, minimum=2)
     plan = np.atleast_2d(np.asarray(positions, dtype=float))[:, :2]
     if len(plan) < min_samples:
         return []

@@ -26,29 +26,20 @@ from scipy.spatial import cKDTree
 
 from .._validation import finite_array
 from ..errors import InputError
+from ..settings import MICROSEISMIC
 
 MAGNITUDE_OFFSET = 6.0  # ref. Eq. 7.2 (M0 in N m)
-DEFAULT_SHEAR_RATIO = 2.0  # ref. Eq. 7.29
-
-
-def _positive(name, value, unit):
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise InputError(f"{name} must be a number > 0 {unit}, got {value!r}") from None
-    if not np.isfinite(number) or number <= 0.0:
-        raise InputError(f"{name} must be a finite number > 0 {unit}, got {value!r}")
-    return number
+DEFAULT_SHEAR_RATIO = MICROSEISMIC["shear_ratio"].default  # ref. Eq. 7.29
 
 
 def check_wave_speeds(p_wave_speed, s_wave_speed, density, prefix=""):
     """Validated ``(v_P, v_S, rho)``; messages name ``prefix + field``.
 
-    ``0 < v_S < (sqrt(3)/2) v_P`` so that the bulk modulus is positive (``v_S >= v_P``
+    Ranges and units are :data:`hmatddm.settings.MICROSEISMIC`'s; besides,
+    ``v_S < (sqrt(3)/2) v_P`` so that the bulk modulus is positive (``v_S >= v_P``
     is always refused)."""
-    vp = _positive(f"{prefix}p_wave_speed", p_wave_speed, "m/s")
-    vs = _positive(f"{prefix}s_wave_speed", s_wave_speed, "m/s")
-    rho = _positive(f"{prefix}density", density, "kg/m^3")
+    vp, vs, rho = (MICROSEISMIC[name].value(prefix + name, value) for name, value in
+                   (("p_wave_speed", p_wave_speed), ("s_wave_speed", s_wave_speed), ("density", density)))
     limit = 0.5 * np.sqrt(3.0) * vp
     if vs >= limit:
         raise InputError(f"{prefix}s_wave_speed must be < sqrt(3)/2 * {prefix}p_wave_speed = {limit:.6g} m/s "
@@ -63,9 +54,9 @@ class Medium:
     Parameters are the P- and S-wave speeds (m/s) and the density (kg/m^3); the
     dynamic moduli follow from them (ref. Eqs 7.27-7.28)."""
 
-    p_wave_speed: float = 4000.0
-    s_wave_speed: float = 2350.0
-    density: float = 3000.0
+    p_wave_speed: float = MICROSEISMIC["p_wave_speed"].default
+    s_wave_speed: float = MICROSEISMIC["s_wave_speed"].default
+    density: float = MICROSEISMIC["density"].default
 
     def __post_init__(self):
         vp, vs, rho = check_wave_speeds(self.p_wave_speed, self.s_wave_speed, self.density)
@@ -351,8 +342,7 @@ def shear_events(centers, normals, displacement_discontinuity, areas, medium, fr
     diagonals); the default, one event per element, is the reference's choice and keeps
     the location of every event on its element.
     """
-    if not np.isfinite(shear_ratio) or shear_ratio < 0.0:
-        raise InputError(f"shear_ratio must be >= 0, got {shear_ratio!r}")
+    shear_ratio = MICROSEISMIC["shear_ratio"].value("shear_ratio", shear_ratio)
     centers, normals = _as_3d(centers), _as_3d(normals)
     dd = _as_3d(displacement_discontinuity)
     areas = np.asarray(areas, dtype=float)

@@ -25,25 +25,19 @@ import numpy as np
 from .. import mesh as _mesh
 from .._validation import finite_array, finite_scalar, positive_int, positive_scalar
 from ..errors import InputError
-
-_BOUNDARY_MODES = ("resample", "clip")
+from ..settings import NETWORK_GENERATOR, NETWORK_GEOMETRY, integer, show
 
 
 def _rng(rng):
     """A numpy Generator from a Generator, an integer seed or None (fresh entropy)."""
     if isinstance(rng, np.random.Generator):
         return rng
-    if rng is not None and (isinstance(rng, bool) or not isinstance(rng, (int, np.integer)) or rng < 0):
-        raise InputError(f"rng must be a numpy.random.Generator, an integer seed >= 0 or None, got {rng!r}")
-    return np.random.default_rng(rng)
+    return np.random.default_rng(None if rng is None else integer("rng", rng, minimum=0))
 
 
 def _check_lengths(exponent, l_min, l_max, exponent_name="exponent"):
-    exponent = finite_scalar(exponent_name, exponent)
-    if exponent < 1.0:
-        raise InputError(f"{exponent_name} must be >= 1 (ref. Eq. 6.1 a > 1; a = 1 is the log-uniform limit), "
-                         f"got {exponent}")
-    l_min = positive_scalar("l_min", l_min)
+    exponent = NETWORK_GENERATOR["length_exponent"].value(exponent_name, exponent)
+    l_min = NETWORK_GENERATOR["l_min"].value("l_min", l_min)
     try:
         l_max = float(l_max)
     except (TypeError, ValueError):
@@ -169,6 +163,41 @@ def bimodal_directions(n, means, kappas, weights, rng=None, return_modes=False):
     return azimuths
 
 
+def check_spec(values, prefix=""):
+    """The checks between the fields of a network generator (each field already in its
+    range of :data:`hmatddm.settings.NETWORK_GENERATOR`): ``values`` maps the field names
+    of :class:`NetworkSpec` (the ``network.*`` keys of a scene) to plain numbers and
+    lists; messages name ``prefix + field``. Returns the weights of the orientation
+    sets (equal when ``values["weights"]`` is None or absent), summing to 1."""
+    x_min, x_max, y_min, y_max = values["region"]
+    if not (x_min < x_max and y_min < y_max):
+        raise InputError(f"{prefix}region must be [x_min, x_max, y_min, y_max] with x_min < x_max and "
+                         f"y_min < y_max, got {show(list(values['region']))}")
+    area = (x_max - x_min) * (y_max - y_min)
+    if round(values["density"] * area) < 1:
+        raise InputError(f"{prefix}density must be >= {0.5 / area:.6g} 1/m^2 so that {prefix}region "
+                         f"(area {area:.6g} m^2) holds at least one fracture (ref. Eq. 6.12), "
+                         f"got {show(values['density'])}")
+    if values["l_max"] < values["l_min"]:
+        raise InputError(f"{prefix}l_max must be >= {prefix}l_min = {show(values['l_min'])} m, "
+                         f"got {show(values['l_max'])}")
+    modes = len(values["mean_azimuths_deg"])
+    weights = values.get("weights")
+    weights = [1.0 / modes] * modes if weights is None else list(weights)
+    if len(values["kappas"]) != modes or len(weights) != modes:
+        raise InputError(f"{prefix}mean_azimuths_deg, {prefix}kappas and {prefix}weights must have the same "
+                         f"length (one entry per orientation set), got {modes}, {len(values['kappas'])}, "
+                         f"{len(weights)}")
+    if abs(sum(weights) - 1.0) > 1e-9:
+        raise InputError(f"{prefix}weights must sum to 1, got {show(weights)} (sum {sum(weights):.6g})")
+    fit = min(x_max - x_min, y_max - y_min)
+    if values["boundary"] == "resample" and values["l_max"] > fit:
+        raise InputError(f"{prefix}l_max must be <= min(region width, region height) = {fit:.6g} m with "
+                         f"{prefix}boundary = 'resample' (use 'clip' for longer fractures), "
+                         f"got {show(values['l_max'])}")
+    return [w / sum(weights) for w in weights]
+
+
 def _as_tuple(name, value):
     array = np.atleast_1d(finite_array(name, value))
     if array.ndim != 1 or array.size == 0:
@@ -210,57 +239,32 @@ class NetworkSpec:
 
     region: tuple
     density: float
-    length_exponent: float = 2.0
-    l_min: float = 1.0
-    l_max: float = 30.0
-    mean_azimuths_deg: tuple = (45.0,)
-    kappas: tuple = (5.0,)
+    length_exponent: float = NETWORK_GENERATOR["length_exponent"].default
+    l_min: float = NETWORK_GENERATOR["l_min"].default
+    l_max: float = NETWORK_GENERATOR["l_max"].default
+    mean_azimuths_deg: tuple = tuple(NETWORK_GENERATOR["mean_azimuths_deg"].default)
+    kappas: tuple = tuple(NETWORK_GENERATOR["kappas"].default)
     weights: tuple = None
-    height: float = 1.0
-    z_center: float = 0.0
-    seed: int = 0
-    boundary: str = "resample"
+    height: float = NETWORK_GEOMETRY["height"].default
+    z_center: float = NETWORK_GEOMETRY["z_center"].default
+    seed: int = NETWORK_GENERATOR["seed"].default
+    boundary: str = NETWORK_GENERATOR["boundary"].default
 
     def __post_init__(self):
         def put(name, value):
             object.__setattr__(self, name, value)
 
-        region = finite_array("region", self.region, (4,))
-        x_min, x_max, y_min, y_max = (float(v) for v in region)
-        if not (x_min < x_max and y_min < y_max):
-            raise InputError("region must be (x_min, x_max, y_min, y_max) with x_min < x_max and "
-                             f"y_min < y_max, got {tuple(region.tolist())}")
-        put("region", (x_min, x_max, y_min, y_max))
-        area = (x_max - x_min) * (y_max - y_min)
-        density = positive_scalar("density", self.density)
-        if np.rint(density * area) < 1:
-            raise InputError(f"density must be >= {0.5 / area:.6g} per m^2 so that the region of area "
-                             f"{area:.6g} m^2 holds at least one fracture (Eq. 6.12), got {density}")
-        put("density", density)
-        a, l_min, l_max = _check_lengths(self.length_exponent, self.l_min, self.l_max, "length_exponent")
-        if np.isinf(l_max):
-            raise InputError("l_max must be finite for a network in a bounded region, got inf")
-        put("length_exponent", a)
-        put("l_min", l_min)
-        put("l_max", l_max)
-        means = _as_tuple("mean_azimuths_deg", self.mean_azimuths_deg)
-        kappas = _as_tuple("kappas", self.kappas)
-        weights = None if self.weights is None else _as_tuple("weights", self.weights)
-        _, _, normalised = _check_modes(means, kappas, weights, ("mean_azimuths_deg", "kappas", "weights"))
-        put("mean_azimuths_deg", means)
-        put("kappas", kappas)
-        put("weights", tuple(float(w) for w in normalised))
-        put("height", positive_scalar("height", self.height))
-        put("z_center", finite_scalar("z_center", self.z_center))
-        if self.seed is not None:
-            put("seed", positive_int("seed", self.seed, minimum=0))
-        if self.boundary not in _BOUNDARY_MODES:
-            raise InputError(f"boundary must be one of {', '.join(map(repr, _BOUNDARY_MODES))}, got {self.boundary!r}")
-        if self.boundary == "resample":
-            fit = min(x_max - x_min, y_max - y_min)
-            if l_max > fit:
-                raise InputError(f"l_max must be <= min(region width, region height) = {fit:.6g} with "
-                                 f"boundary='resample' (use boundary='clip' for longer fractures), got {l_max}")
+        values = {"region": list(finite_array("region", self.region, (4,))),
+                  "mean_azimuths_deg": list(_as_tuple("mean_azimuths_deg", self.mean_azimuths_deg)),
+                  "kappas": list(_as_tuple("kappas", self.kappas)),
+                  "weights": None if self.weights is None else list(_as_tuple("weights", self.weights))}
+        for name, setting in {**NETWORK_GENERATOR, **NETWORK_GEOMETRY}.items():
+            value = values.get(name, getattr(self, name))
+            if not (name == "seed" and value is None):  # seed None: fresh entropy
+                put(name, setting.value(name, value))
+        put("weights", check_spec(self.__dict__))
+        for name in ("region", "mean_azimuths_deg", "kappas", "weights"):
+            put(name, tuple(getattr(self, name)))
 
     @property
     def area(self):

@@ -38,6 +38,7 @@ from ..errors import HmatddmError, InputError
 from ..io import atomic_output
 from ..io.vtk import cells_of
 from ..mesh import Mesh2D, Mesh3D
+from ..settings import integer
 
 HYDRAULIC, INTACT_NATURAL, FAILED_NATURAL = 0, 1, 2
 VIEWS = ("plan", "oblique")
@@ -95,8 +96,7 @@ def _check_window_size(window_size):
     except (TypeError, ValueError):
         raise InputError(f"window_size must be a pair (width, height) of pixels, got {window_size!r}") from None
     for name, value in (("width", width), ("height", height)):
-        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not 16 <= value <= 16384:
-            raise InputError(f"window_size {name} must be an integer in [16, 16384], got {value!r}")
+        integer(f"window_size {name}", value, 16, 16384)
     return int(width), int(height)
 
 

@@ -20,8 +20,8 @@ import math
 
 import numpy as np
 
+from .. import settings
 from ..errors import InputError
-from ..options import BACKENDS, CONTACT_MODES, DEFAULT_EPS, DEFAULT_ETA, DEFAULT_LEAF_SIZE, SINGULAR_CORRECTIONS
 from ..settings import (ABSENT, CLUSTER, FLUID, LEAK_OFF, MATERIAL, NATURAL_FRACTURE, PROPAGATION, REQUIRED,
                         SCHEME, show)
 from ..settings import Setting as Key  # a key of a scene section is one setting
@@ -29,7 +29,6 @@ from ..settings import Setting as Key  # a key of a scene section is one setting
 REFERENCE_KINDS = ("radial-k", "radial-m", "kgd-k", "kgd-m")
 SHAPES = {2: ("line",), 3: ("rectangle", "penny")}
 CROSSING_CRITERIA = ("mohr-coulomb", "energy-release-rate", "stress-intensity")
-NETWORK_BOUNDARY = ("resample", "clip")
 
 
 # ---------------------------------------------------------------------------------
@@ -76,41 +75,8 @@ SHAPE_KEYS = {  # key -> default (REQUIRED or a value) for each shape
 }
 
 
-_UNIT_INTERVAL = dict(low=0.0, high=1.0, low_open=True, high_open=True)
-NUMERICS = {
-    "time_step": Key("number", 1.0, low=0.0, low_open=True, unit="s"),
-    "end_time": Key("number", REQUIRED, low=0.0, low_open=True, unit="s"),
-    "backend": Key("choice", "hmatrix", choices=BACKENDS),
-    "eps": Key("number", DEFAULT_EPS, **_UNIT_INTERVAL),
-    "eta": Key("number", DEFAULT_ETA, low=0.0, low_open=True),
-    "leaf_size": Key("integer", DEFAULT_LEAF_SIZE, low=1),
-    "scheme": SCHEME["scheme"],
-    "tolerance_pressure": SCHEME["tolerance_pressure"],
-    "tolerance_opening": SCHEME["tolerance_opening"],
-    "max_iterations": SCHEME["max_iterations"],
-    "relaxation": SCHEME["relaxation"],
-    "min_relaxation": SCHEME["min_relaxation"],
-    "omega": SCHEME["omega"],
-    "relaxation_growth": SCHEME["relaxation_growth"],
-    "linear_rtol": SCHEME["linear_rtol"],
-    "linear_restart": SCHEME["linear_restart"],
-    "linear_maxiter": SCHEME["linear_maxiter"],
-    "initial_pressure": Key("number", 0.0, unit="Pa"),
-    "initial_opening": Key("number", 1e-5, low=0.0, unit="m"),
-    "minimum_width": Key("number", low=0.0, low_open=True, unit="m"),
-    "singular_correction": Key("choice", "none", choices=SINGULAR_CORRECTIONS),
-    "alpha": Key("number", low=1.0),
-    "contact": Key("choice", "natural", choices=CONTACT_MODES,
-                   doc="elements that close with contact and Coulomb friction: natural, all, none "
-                       "(default: all in a scene with natural fractures, natural otherwise)"),
-    "keep_checkpoints": Key("integer", 3, low=1),
-    "max_elements": Key("integer", 200_000, low=1,
-                        doc="refuse a scene (or stop a run, resumably) with more elements than this"),
-}
-
-SCHEME_KEYS = ("scheme", "omega", "relaxation", "min_relaxation", "tolerance_pressure", "tolerance_opening",
-               "max_iterations", "linear_rtol", "linear_restart", "linear_maxiter",
-               "relaxation_growth")  # -> SchemeSettings
+NUMERICS = settings.NUMERICS
+SCHEME_KEYS = tuple(SCHEME)  # -> SchemeSettings
 
 OUTPUT = {
     "every": Key("integer", 1, low=1, doc="write a .vtu every k steps (the last step always)"),
@@ -132,21 +98,9 @@ NETWORK_MECHANICS = {  # defaults: ref. Table 6.2 (natural-fracture properties)
     "crossing": Key("choice", "mohr-coulomb", choices=CROSSING_CRITERIA),
     "remote_failure": Key("boolean", True),
     "element_size": Key("number", 1.0, **_POSITIVE_LENGTH),
-    "height": Key("number", 1.0, **_POSITIVE_LENGTH),
-    "z_center": Key("number", 0.0, unit="m"),
+    **settings.NETWORK_GEOMETRY,
 }
-NETWORK_GENERATOR = {  # defaults: ref. Table 6.1, as hmatddm.network.NetworkSpec
-    "region": Key("point", length=4, unit="m", doc="[x_min, x_max, y_min, y_max]"),
-    "density": Key("number", low=0.0, low_open=True, unit="1/m^2"),
-    "length_exponent": Key("number", 2.0, low=1.0),
-    "l_min": Key("number", 1.0, **_POSITIVE_LENGTH),
-    "l_max": Key("number", 30.0, **_POSITIVE_LENGTH),
-    "mean_azimuths_deg": Key("numbers", [45.0], unit="deg"),
-    "kappas": Key("numbers", [5.0], low=0.0),
-    "weights": Key("numbers", low=0.0),
-    "seed": Key("integer", 0, low=0),
-    "boundary": Key("choice", "resample", choices=NETWORK_BOUNDARY),
-}
+NETWORK_GENERATOR = settings.NETWORK_GENERATOR
 NETWORK = {**NETWORK_MECHANICS, **NETWORK_GENERATOR}
 
 NATURAL_FRACTURE = {
@@ -154,30 +108,8 @@ NATURAL_FRACTURE = {
     "p1": Key("point", REQUIRED, length=2, unit="m"),
 }
 
-MICROSEISMIC = {  # synthetic monitoring of the run (ref. Ch. 7): hmatddm.microseismic
-    "wells": Key("points", REQUIRED, length=2, unit="m", doc="plan positions [x, y] of vertical observation wells"),
-    "receiver_top": Key("number", 20.0, unit="m"),
-    "receiver_bottom": Key("number", -20.0, unit="m"),
-    "receiver_spacing": Key("number", 5.0, **_POSITIVE_LENGTH),
-    "p_wave_speed": Key("number", 4000.0, low=0.0, low_open=True, unit="m/s"),
-    "s_wave_speed": Key("number", 2350.0, low=0.0, low_open=True, unit="m/s"),
-    "density": Key("number", 3000.0, low=0.0, low_open=True, unit="kg/m^3"),
-    "shear_ratio": Key("number", 2.0, low=0.0, doc="events: |slip| >= shear_ratio |opening| (ref. Eq. 7.29)"),
-    "rotation_noise_deg": Key("number", 0.0, low=0.0, unit="deg"),
-    "travel_time_noise": Key("number", 0.0, low=0.0, unit="s"),
-    "amplitude_noise": Key("number", 0.0, low=0.0, doc="share of the largest amplitude"),
-    "seed": Key("integer", 0, low=0),
-    "merge": Key("boolean", False, doc="merge neighbouring elements failing in the same step"),
-}
-
-LAYER = {  # 2D vertical cross-section, y up; tables listed top down (ref. Ch. 3, hmatddm.LayeredMedium)
-    "bottom": Key("number", unit="m", doc="height of the interface below this layer; omit for the last layer"),
-    "shear_modulus": Key("number", REQUIRED, low=0.0, unit="Pa", doc="0: void (a free surface), top or bottom only"),
-    "poisson_ratio": Key("number", REQUIRED, low=0.0, high=0.5, high_open=True),
-    "s_hmin": Key("number", unit="Pa", doc="compressive stress along x in this layer (default: the [stress] one)"),
-    "toughness": Key("number", low=0.0, low_open=True, unit="Pa m^0.5",
-                     doc="K_Ic of this layer (default: propagation.toughness)"),
-}
+MICROSEISMIC = settings.MICROSEISMIC  # synthetic monitoring of the run (ref. Ch. 7): hmatddm.microseismic
+LAYER = settings.LAYER  # 2D vertical cross-section, y up; tables listed top down (ref. Ch. 3, hmatddm.LayeredMedium)
 
 # name -> (keys, array of tables?, required?)
 SECTIONS = {
@@ -355,30 +287,11 @@ def _check_network(echo, given):
         return echo
     if "region" not in given:
         raise InputError("network.region = [x_min, x_max, y_min, y_max] (m) is required with network.density")
-    x_min, x_max, y_min, y_max = echo["region"]
-    if not (x_min < x_max and y_min < y_max):
-        raise InputError(f"network.region must be [x_min, x_max, y_min, y_max] with x_min < x_max and "
-                         f"y_min < y_max, got {show(echo['region'])}")
-    area = (x_max - x_min) * (y_max - y_min)
-    if round(echo["density"] * area) < 1:
-        raise InputError(f"network.density must be >= {0.5 / area:.6g} 1/m^2 so that network.region "
-                         f"(area {area:.6g} m^2) holds at least one fracture, got {show(echo['density'])}")
-    if echo["l_max"] < echo["l_min"]:
-        raise InputError(f"network.l_max must be >= network.l_min = {show(echo['l_min'])} m, "
-                         f"got {show(echo['l_max'])}")
+    from ..network.generation import check_spec
+
+    check_spec(echo, "network.")
     modes = len(echo["mean_azimuths_deg"])
-    weights = echo.get("weights", [1.0 / modes] * modes)
-    if len(echo["kappas"]) != modes or len(weights) != modes:
-        raise InputError(f"network.mean_azimuths_deg, network.kappas and network.weights must have the same "
-                         f"length (one entry per orientation set), got {modes}, {len(echo['kappas'])}, "
-                         f"{len(weights)}")
-    if abs(sum(weights) - 1.0) > 1e-9:
-        raise InputError(f"network.weights must sum to 1, got {show(weights)} (sum {sum(weights):.6g})")
-    echo["weights"] = weights
-    fit = min(x_max - x_min, y_max - y_min)
-    if echo["boundary"] == "resample" and echo["l_max"] > fit:
-        raise InputError(f"network.l_max must be <= min(region width, region height) = {fit:.6g} m with "
-                         f"network.boundary = 'resample' (use 'clip' for longer fractures), got {show(echo['l_max'])}")
+    echo.setdefault("weights", [1.0 / modes] * modes)  # the echo keeps the weights as given
     return echo
 
 
@@ -498,8 +411,8 @@ def validate(raw, name=None):
 
 def _check_layers(scene):
     layers = scene["layer"]
-    if scene["dimension"] != 2:
-        raise InputError("[[layer]] tables need dimension = 2 (a vertical cross-section, y up)")
+    if scene["dimension"] not in (2, 3):  # 2D: a vertical cross-section, y up; 3D: z up
+        raise InputError("[[layer]] tables need dimension = 2 (a vertical cross-section, y up) or 3 (z up)")
     for i, layer in enumerate(layers):
         last = i == len(layers) - 1
         if not last and "bottom" not in layer:
