@@ -7,7 +7,7 @@ import pytest
 
 from hmatddm import settings
 from hmatddm.errors import InputError
-from hmatddm.scene import schema
+from hmatddm.scene import schema, sections
 from hmatddm.settings import Setting, integer
 
 
@@ -46,14 +46,16 @@ def test_value_outside_a_scene_takes_numeric_strings_and_refuses_nan():
 
 
 def test_scene_sections_are_the_declarations():
-    """The schema holds the very objects the dataclasses check against."""
-    assert schema.NUMERICS is settings.NUMERICS and schema.LAYER is settings.LAYER
-    assert schema.MICROSEISMIC is settings.MICROSEISMIC
-    assert schema.NETWORK_GENERATOR is settings.NETWORK_GENERATOR
+    """The scene's sections hold the very objects the dataclasses check against."""
+    assert sections.NUMERICS is settings.NUMERICS and sections.LAYER is settings.LAYER
+    assert sections.MICROSEISMIC is settings.MICROSEISMIC
+    assert sections.NETWORK_GENERATOR is settings.NETWORK_GENERATOR
     for key, setting in settings.SCHEME.items():
-        assert schema.NUMERICS[key] is setting
+        assert sections.NUMERICS[key] is setting
     for key in ("eps", "eta", "leaf_size", "singular_correction", "alpha"):
-        assert schema.NUMERICS[key] is settings.OPERATOR[key]
+        assert sections.NUMERICS[key] is settings.OPERATOR[key]
+    for key in ("friction_coefficient", "cohesion", "tensile_strength", "toughness", "critical_radius"):
+        assert sections.NETWORK[key] is settings.NATURAL_FRACTURE[key]
 
 
 def test_dataclass_defaults_come_from_the_declarations():

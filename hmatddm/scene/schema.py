@@ -1,4 +1,5 @@
-"""The scene schema: what a scene file may hold, its defaults and its allowed ranges.
+"""The scene schema: checking a scene against what a scene file may hold (its sections,
+keys, defaults and ranges are declared in :mod:`hmatddm.scene.sections`).
 
 A scene is a TOML document (read with the standard library's ``tomllib``). Every
 quantity is in SI units (Pa, m, s, Pa s, m^3/s, 1/Pa); angles are in degrees and the
@@ -20,115 +21,11 @@ import math
 
 import numpy as np
 
-from .. import settings
 from ..errors import InputError
-from ..settings import (ABSENT, CLUSTER, FLUID, LEAK_OFF, MATERIAL, NATURAL_FRACTURE, PROPAGATION, REQUIRED,
-                        SCHEME, show)
-from ..settings import Setting as Key  # a key of a scene section is one setting
-
-REFERENCE_KINDS = ("radial-k", "radial-m", "kgd-k", "kgd-m")
-SHAPES = {2: ("line",), 3: ("rectangle", "penny")}
-CROSSING_CRITERIA = ("mohr-coulomb", "energy-release-rate", "stress-intensity")
-
-
-# ---------------------------------------------------------------------------------
-# The sections
-# ---------------------------------------------------------------------------------
-
-TOP = {
-    "name": Key("string", doc="short name of the scene (default: the file name)"),
-    "description": Key("string", "", doc="one line shown by `hmatddm scenes`"),
-    "dimension": Key("integer", 3, choices=(2, 3), doc="2: plane strain in the x-y plane; 3: rectangles in space"),
-    "height": Key("number", 1.0, low=0.0, low_open=True, unit="m",
-                  doc="2D only: flow height of the plane-strain fractures (ref. Table 4.2)"),
-}
-
-STRESS = {
-    "tensor": Key("matrix", unit="Pa", doc="full tensor, compressive positive, symmetric"),
-    "s_hmin": Key("number", unit="Pa", doc="minimum horizontal stress, compressive positive"),
-    "s_hmax": Key("number", unit="Pa", doc="maximum horizontal stress, compressive positive"),
-    "s_v": Key("number", unit="Pa", doc="vertical stress (along z), compressive positive; 3D only"),
-    "azimuth_deg": Key("number", low=-360.0, high=360.0, unit="deg",
-                       doc="direction of s_hmax, degrees from +x counter-clockwise (default 0)"),
-}
-
-_POSITIVE_LENGTH = dict(low=0.0, low_open=True, unit="m")
-INITIAL_FRACTURE = {
-    "shape": Key("choice", choices=("rectangle", "penny", "line"),
-                 doc="rectangle (3D, default), penny (3D) or line (2D, default)"),
-    "center": Key("point", length=3, unit="m"),
-    "e1": Key("point", length=3, doc="rectangle: direction of its length"),
-    "e2": Key("point", length=3, doc="rectangle: direction of its height"),
-    "normal": Key("point", length=3, doc="penny: its unit normal"),
-    "length": Key("number", **_POSITIVE_LENGTH),
-    "height": Key("number", **_POSITIVE_LENGTH),
-    "radius": Key("number", **_POSITIVE_LENGTH),
-    "p0": Key("point", length=2, unit="m"),
-    "p1": Key("point", length=2, unit="m"),
-    "element_size": Key("number", REQUIRED, **_POSITIVE_LENGTH),
-}
-SHAPE_KEYS = {  # key -> default (REQUIRED or a value) for each shape
-    "rectangle": {"center": [0.0, 0.0, 0.0], "e1": [1.0, 0.0, 0.0], "e2": [0.0, 0.0, 1.0],
-                  "length": REQUIRED, "height": REQUIRED, "element_size": REQUIRED},
-    "penny": {"center": [0.0, 0.0, 0.0], "normal": [0.0, 1.0, 0.0], "radius": REQUIRED, "element_size": REQUIRED},
-    "line": {"p0": REQUIRED, "p1": REQUIRED, "element_size": REQUIRED},
-}
-
-
-NUMERICS = settings.NUMERICS
-SCHEME_KEYS = tuple(SCHEME)  # -> SchemeSettings
-
-OUTPUT = {
-    "every": Key("integer", 1, low=1, doc="write a .vtu every k steps (the last step always)"),
-    "vtu": Key("boolean", True),
-    "snapshots": Key("boolean", True, doc="PNG views of the last state"),
-    "history_plot": Key("boolean", True),
-}
-
-REFERENCE = {
-    "kind": Key("choice", REQUIRED, choices=REFERENCE_KINDS),
-}
-
-NETWORK_MECHANICS = {  # defaults: ref. Table 6.2 (natural-fracture properties)
-    "friction_coefficient": NATURAL_FRACTURE["friction_coefficient"],
-    "cohesion": NATURAL_FRACTURE["cohesion"],
-    "tensile_strength": NATURAL_FRACTURE["tensile_strength"],
-    "toughness": NATURAL_FRACTURE["toughness"],
-    "critical_radius": NATURAL_FRACTURE["critical_radius"],
-    "crossing": Key("choice", "mohr-coulomb", choices=CROSSING_CRITERIA),
-    "remote_failure": Key("boolean", True),
-    "element_size": Key("number", 1.0, **_POSITIVE_LENGTH),
-    **settings.NETWORK_GEOMETRY,
-}
-NETWORK_GENERATOR = settings.NETWORK_GENERATOR
-NETWORK = {**NETWORK_MECHANICS, **NETWORK_GENERATOR}
-
-NATURAL_FRACTURE = {
-    "p0": Key("point", REQUIRED, length=2, unit="m"),
-    "p1": Key("point", REQUIRED, length=2, unit="m"),
-}
-
-MICROSEISMIC = settings.MICROSEISMIC  # synthetic monitoring of the run (ref. Ch. 7): hmatddm.microseismic
-LAYER = settings.LAYER  # 2D vertical cross-section, y up; tables listed top down (ref. Ch. 3, hmatddm.LayeredMedium)
-
-# name -> (keys, array of tables?, required?)
-SECTIONS = {
-    "material": (MATERIAL, False, True),
-    "fluid": (FLUID, False, True),
-    "stress": (STRESS, False, True),
-    "cluster": (CLUSTER, True, True),
-    "initial_fracture": (INITIAL_FRACTURE, True, True),
-    "propagation": (PROPAGATION, False, False),
-    "leak_off": (LEAK_OFF, False, False),
-    "numerics": (NUMERICS, False, True),
-    "output": (OUTPUT, False, False),
-    "reference": (REFERENCE, False, False),
-    "network": (NETWORK, False, False),
-    "natural_fracture": (NATURAL_FRACTURE, True, False),
-    "microseismic": (MICROSEISMIC, False, False),
-    "layer": (LAYER, True, False),
-}
-FILLED_WHEN_ABSENT = ("leak_off", "output")  # optional sections echoed with their defaults
+from ..settings import ABSENT, REQUIRED, show  # noqa: F401  (show: re-exported for scene.build and preflight)
+from .echo import far_field_stress, has_natural_fractures, to_toml  # noqa: F401  (the scene's public names)
+from .sections import (FILLED_WHEN_ABSENT, INITIAL_FRACTURE, NETWORK_GENERATOR, SCHEME_KEYS,  # noqa: F401
+                       SECTIONS, SHAPE_KEYS, SHAPES, TOP)
 
 
 # ---------------------------------------------------------------------------------
@@ -427,69 +324,3 @@ def _check_layers(scene):
             raise InputError(f"layer[{i}].shear_modulus = 0 (void) is allowed only for the top or bottom layer")
     if "toughness" in [k for layer in layers for k in layer] and "propagation" not in scene:
         raise InputError("layer toughness needs a [propagation] section")
-
-
-def has_natural_fractures(scene):
-    """Whether a validated scene declares natural fractures (a network or explicit ones)."""
-    return "network" in scene or bool(scene.get("natural_fracture"))
-
-
-def far_field_stress(scene):
-    """The (d, d) far-field stress tensor the engine wants (tension positive, Pa).
-
-    The file's stresses are compressive positive: ``tensor`` is negated; the principal
-    form puts ``s_hmax`` along the azimuth (degrees from +x, counter-clockwise),
-    ``s_hmin`` perpendicular to it in the x-y plane and ``s_v`` along z.
-    """
-    stress = scene["stress"]
-    dim = scene["dimension"]
-    if "tensor" in stress:
-        return -np.array(stress["tensor"], dtype=float) + 0.0
-    angle = math.radians(stress["azimuth_deg"])
-    along = np.array([math.cos(angle), math.sin(angle)])
-    across = np.array([-math.sin(angle), math.cos(angle)])
-    horizontal = stress["s_hmax"] * np.outer(along, along) + stress["s_hmin"] * np.outer(across, across)
-    if dim == 2:
-        return -horizontal + 0.0
-    tensor = np.zeros((3, 3))
-    tensor[:2, :2] = horizontal
-    tensor[2, 2] = stress["s_v"]
-    return -tensor + 0.0
-
-
-# ---------------------------------------------------------------------------------
-# TOML output (the echo written next to a run, readable by tomllib)
-# ---------------------------------------------------------------------------------
-
-def _toml_value(value):
-    import json
-
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, int):
-        return str(value)
-    if isinstance(value, float):
-        if math.isinf(value):
-            return "inf" if value > 0 else "-inf"
-        return repr(value)
-    if isinstance(value, str):
-        return json.dumps(value, ensure_ascii=False)
-    if isinstance(value, (list, tuple)):
-        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
-    raise TypeError(f"cannot write {type(value).__name__} as TOML")  # pragma: no cover
-
-
-def to_toml(scene, header=None):
-    """A validated scene as TOML text (``tomllib`` reads it back to the same echo)."""
-    lines = [f"# {line}" for line in (header or "").splitlines()]
-    for key in TOP:
-        if key in scene:
-            lines.append(f"{key} = {_toml_value(scene[key])}")
-    for section, (_, is_array, _) in SECTIONS.items():
-        if section not in scene:
-            continue
-        tables = scene[section] if is_array else [scene[section]]
-        for table in tables:
-            lines += ["", f"[[{section}]]" if is_array else f"[{section}]"]
-            lines += [f"{key} = {_toml_value(value)}" for key, value in table.items()]
-    return "\n".join(lines) + "\n"
