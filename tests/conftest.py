@@ -29,3 +29,43 @@ def random_rotation(rng):
 def rotation_2d(angle):
     c, s = np.cos(angle), np.sin(angle)
     return np.array([[c, -s], [s, c]])
+
+
+# -- CPU time per test (load-independent, unlike --durations' wall time) -------------------
+# `python -m pytest --cpu-durations=30` lists the 30 tests that used the most CPU time
+# (this process and its threads, plus waited-for child processes), and the session's total:
+# on a shared machine this is what a test would cost on a quiet one.
+
+def pytest_addoption(parser):
+    parser.addoption("--cpu-durations", type=int, default=None, metavar="N",
+                     help="list the N tests with the most CPU time (setup + call + teardown)")
+
+
+_CPU_SECONDS = {}
+
+
+def _cpu_now():
+    import resource
+
+    own, children = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_protocol(item, nextitem):
+    if item.config.getoption("--cpu-durations") is None:
+        yield
+        return
+    start = _cpu_now()
+    yield
+    _CPU_SECONDS[item.nodeid] = _cpu_now() - start
+
+
+def pytest_terminal_summary(terminalreporter, exitstatus, config):
+    count = config.getoption("--cpu-durations")
+    if count is None or not _CPU_SECONDS:
+        return
+    terminalreporter.section(f"most CPU time ({count} of {len(_CPU_SECONDS)} tests)")
+    for nodeid, seconds in sorted(_CPU_SECONDS.items(), key=lambda kv: -kv[1])[:count]:
+        terminalreporter.write_line(f"{seconds:8.2f}s cpu  {nodeid}")
+    terminalreporter.write_line(f"{sum(_CPU_SECONDS.values()):8.2f}s cpu  in all tests")

@@ -19,8 +19,8 @@ square metre (Eq. 6.12).
 from .._lazy import attach
 
 _EXPORTS = {
-    "Network": ".generation", "NetworkSpec": ".generation", "bimodal_directions": ".generation",
-    "generate_network": ".generation", "power_law_lengths": ".generation", "von_mises_directions": ".generation",
+    "Network": ".generation", "NetworkSpec": ".generation", "bimodal_directions": ".sampling",
+    "generate_network": ".generation", "power_law_lengths": ".sampling", "von_mises_directions": ".sampling",
     "IntersectionGraph": ".intersections", "Intersections": ".intersections", "find_intersections": ".intersections",
     "intersection_frequency": ".intersections", "intersection_graph": ".intersections",
     "scanline_frequency": ".intersections", "split_at_intersections": ".intersections",
