@@ -142,7 +142,7 @@ def snapshot_views(mesh):
     """The views worth drawing: the plan view only in 2D, plan and oblique in 3D. A
     plan view of (mostly) vertical 3D fractures, which looking down z would see edge
     on, draws their horizontal traces coloured by the largest opening over the height
-    (:func:`hmatddm.render.snapshots.plan_traces`)."""
+    (:func:`hmatddm.render.layout.plan_traces`)."""
     if mesh.dim == 2:
         return ("plan",)
     return ("plan", "oblique")

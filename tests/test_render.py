@@ -5,13 +5,17 @@ import pytest
 
 import hmatddm as hd
 from hmatddm.render import plot_history, snapshot, snapshots
-from hmatddm.render.snapshots import FAILED_NATURAL, HYDRAULIC, INTACT_NATURAL
+from hmatddm.render.layout import FAILED_NATURAL, HYDRAULIC, INTACT_NATURAL
 
 WINDOW = (400, 300)
 
 
 @pytest.fixture(scope="module")
 def scene3d():
+    return vertical_scene()
+
+
+def vertical_scene():
     """A vertical hydraulic fracture (8 x 4) crossed by a natural one (4 x 4), part of
     which has failed and slips."""
     hydraulic = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 0, 1], 4, 2, 8, 4)
@@ -117,26 +121,8 @@ def test_plan_view_of_vertical_fractures_draws_their_traces(tmp_path, scene3d):
     assert np.sum(_coloured_pixels(image)) > 3 * np.sum(_coloured_pixels(_image(edge_on))[:, :int(0.8 * WINDOW[0])])
 
 
-def test_plan_traces_merge_each_column_with_its_largest_opening(scene3d):
-    from hmatddm.render.snapshots import plan_traces
-
-    mesh, fields = scene3d
-    traces, opening, state, slip, column = plan_traces(mesh, **fields)
-    assert isinstance(traces, hd.Mesh2D) and traces.n_elements == 8 + 4  # 8 + 4 columns of 4 elements
-    assert column.shape == (mesh.n_elements,)
-    for line in range(traces.n_elements):
-        members = np.flatnonzero(column == line)
-        assert members.size == 4 and np.unique(mesh.fracture_id[members]).size == 1
-        assert opening[line] == np.max(fields["opening"][members])
-        assert np.allclose(mesh.centers[members, :2], traces.centers[line])
-        expected = FAILED_NATURAL if np.any(fields["state"][members] == FAILED_NATURAL) else fields["state"][members[0]]
-        assert state[line] == expected
-    assert np.allclose(slip[state == FAILED_NATURAL], [0.0, 1e-4])  # the horizontal part of the slip
-    assert np.all(slip[state != FAILED_NATURAL] == 0.0)
-
-
 def test_plan_view_of_a_mostly_vertical_mesh_keeps_its_other_elements(tmp_path, scene3d):
-    from hmatddm.render.snapshots import is_mostly_vertical
+    from hmatddm.render.layout import is_mostly_vertical
 
     mesh, fields = scene3d
     horizontal = hd.mesh.rectangle([3.0, -1.5, 0.5], [1, 0, 0], [0, 1, 0], 1.0, 1.0, 2, 2, fracture_id=3)
@@ -233,23 +219,10 @@ def test_plot_history_bad_inputs_raise_input_error(tmp_path, records, reference,
 
 # -- pictures that tell the truth (issue 19 item 7) -------------------------------------
 
-def test_plan_frame_puts_the_fractures_left_of_the_colour_bar_and_above_the_legend():
-    from hmatddm.render.snapshots import PLAN_BOX, plan_frame
-
-    for extent, window in (((-50.0, 50.0, -1.0, 1.0), (1200, 900)), ((0.0, 1.0, -30.0, 10.0), (400, 300))):
-        centre_x, centre_y, scale, box = plan_frame(extent, window)
-        aspect = window[0] / window[1]
-        fx = [0.5 + (x - centre_x) / (2 * scale * aspect) for x in extent[:2]]
-        fy = [0.5 + (y - centre_y) / (2 * scale) for y in extent[2:]]
-        assert box == PLAN_BOX
-        assert PLAN_BOX[0] - 1e-9 <= fx[0] < fx[1] <= PLAN_BOX[1] + 1e-9
-        assert PLAN_BOX[2] - 1e-9 <= fy[0] < fy[1] <= PLAN_BOX[3] + 1e-9
-        assert max(fx[1] - fx[0] - (PLAN_BOX[1] - PLAN_BOX[0]), fy[1] - fy[0] - (PLAN_BOX[3] - PLAN_BOX[2])) > -1e-9
-
 
 def test_a_long_2d_crack_ends_left_of_the_colour_bar(tmp_path):
     """The kgd picture: the right tip was hidden under the colour bar."""
-    from hmatddm.render.snapshots import BAR_LEFT
+    from hmatddm.render.layout import BAR_LEFT
 
     mesh = hd.mesh.line([-60.0, 0.0], [60.0, 0.0], 120)
     opening = 1e-3 * np.sqrt(np.clip(1 - (mesh.centers[:, 0] / 60.0) ** 2, 1e-4, None))
@@ -263,7 +236,7 @@ def test_a_long_2d_crack_ends_left_of_the_colour_bar(tmp_path):
 
 
 def test_negative_openings_are_drawn_as_zero_and_said_so(tmp_path, scene2d):
-    from hmatddm.render.snapshots import opening_colour_range
+    from hmatddm.render.layout import opening_colour_range
 
     clim, title = opening_colour_range(np.array([-1.4e-2, 0.0, 0.5]))
     assert clim == [0.0, 0.5] and "< 0 drawn as 0" in title and "-0.014" in title
@@ -274,17 +247,8 @@ def test_negative_openings_are_drawn_as_zero_and_said_so(tmp_path, scene2d):
     _assert_picture(snapshot(mesh, tmp_path / "closed.png", window_size=WINDOW, **closed), WINDOW)
 
 
-def test_legend_names_activated_natural_elements_and_the_slip_arrows():
-    from hmatddm.render.snapshots import legend_labels
-
-    state = np.array([HYDRAULIC, INTACT_NATURAL, FAILED_NATURAL])
-    assert [text for text, _ in legend_labels(state, slip_shown=True)] == [
-        "natural fracture, intact", "natural fracture, activated or failed", "slip (arrow length ~ slip)"]
-    assert legend_labels(np.zeros(3, int)) == []
-
-
 def test_plan_views_carry_a_round_length_scale(tmp_path, scene3d):
-    from hmatddm.render.snapshots import scale_bar_length
+    from hmatddm.render.layout import scale_bar_length
 
     assert [scale_bar_length(span) for span in (120.0, 3.0, 0.75, 40.0)] == [20.0, 0.5, 0.1, 5.0]
 
@@ -293,17 +257,6 @@ def test_plan_views_carry_a_round_length_scale(tmp_path, scene3d):
     image = _image(path)
     black = (image.max(axis=2) < 0.15)[int(0.88 * WINDOW[1]):, :int(0.3 * WINDOW[0])]  # lower left corner
     assert black.sum() > 10, "no length scale in the lower left corner"
-
-
-def test_the_scale_bar_of_a_vertical_section_follows_the_shown_width():
-    """A vertical 2D section is ~0 wide in x; its bar is still a fifth of what the box shows."""
-    from hmatddm.render.snapshots import plan_frame, plan_scale_bar
-
-    extent, window = (-0.05, 0.05, -14.0, 14.0), (1200, 900)
-    _, _, scale, box = plan_frame(extent, window)
-    shown = 2.0 * scale * (window[0] / window[1]) * (box[1] - box[0])
-    assert 0.1 * shown <= plan_scale_bar(extent, window) <= 0.2 * shown
-    assert plan_scale_bar((-60.0, 60.0, -1.0, 1.0), window) == 20.0  # wide views: as before
 
 
 def test_a_layered_section_draws_its_interfaces_across_the_picture(tmp_path):

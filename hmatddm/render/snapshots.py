@@ -33,143 +33,28 @@ from pathlib import Path
 
 import numpy as np
 
-from .._validation import finite_array
-from ..errors import HmatddmError, InputError
-from ..io import atomic_output
+from ..errors import InputError
 from ..io.vtk import cells_of
 from ..mesh import Mesh2D, Mesh3D
-from ..settings import integer
-
-HYDRAULIC, INTACT_NATURAL, FAILED_NATURAL = 0, 1, 2
-VIEWS = ("plan", "oblique")
-
-OPENING_COLORMAP = "viridis"
-PLAIN_SURFACE_COLOR = "tan"
-INTACT_COLOR = "darkgrey"  # light grey, still readable as legend text on white
-FAILED_COLOR = "red"
-SLIP_ARROW_COLOR = "magenta"  # stands out on dark (closed) and bright (open) elements
-SLIP_VISIBLE_FRACTION = 1e-3  # arrows where |slip| > this fraction of the largest slip
-MAX_ELEMENTS_WITH_EDGES = 2000  # element borders drawn on smaller meshes only
-MAX_SLIP_ARROWS = 400  # more slipping elements than this: every k-th gets an arrow
-VERTICAL_NORMAL_Z = 0.05  # an element is vertical when |n_z| <= this (within ~2.9 degrees)
-MOSTLY_VERTICAL_AREA = 0.5  # plan view as traces when vertical elements hold this share of the area
-PLAN_STYLES = ("auto", "traces", "surfaces")
-# layout of a picture, in fractions of its width and height: the colour bar stands at
-# x in [BAR_LEFT, BAR_LEFT + 0.08]; a plan view puts the fractures inside PLAN_BOX
-# (left, right, bottom, top), left of the bar, above the legend and the length scale
-# (SCALE_Y) and below the title
-BAR_LEFT = 0.86
-PLAN_BOX = (0.04, 0.82, 0.19, 0.90)
-PLAN_BOX_WITHOUT_BAR_RIGHT = 0.96
-PLAN_BOX_WITHOUT_TITLE_TOP = 0.96
-SCALE_Y = 0.07
-# a column of elements shows its highest-ranked state: failed > hydraulic > intact
-_RANK_OF_STATE = np.array([1, 0, 2])                     # indexed by state code 0, 1, 2
-_STATE_OF_RANK = np.array([INTACT_NATURAL, HYDRAULIC, FAILED_NATURAL])
+from .layout import (BAR_LEFT, FAILED_COLOR, FAILED_NATURAL, INTACT_COLOR, INTACT_NATURAL, MAX_ELEMENTS_WITH_EDGES,
+                     MAX_SLIP_ARROWS, OPENING_COLORMAP, PLAIN_SURFACE_COLOR, PLAN_STYLES, SCALE_Y, SLIP_ARROW_COLOR,
+                     SLIP_VISIBLE_FRACTION, VERTICAL_NORMAL_Z, VIEWS, check_fields, check_mesh_type, check_window_size,
+                     mesh_diagonal, length_text, plan_extent, slip_shown, is_mostly_vertical, legend_labels,
+                     opening_colour_range, plan_frame, plan_scale_bar, plan_traces, slip_arrow_length,
+                     vertical_elements)
+from .offscreen import new_plotter, offscreen_pyvista, save_png, screenshot
 
 
 # ---------------------------------------------------------------------------------
-# Inputs
+# Geometry
 # ---------------------------------------------------------------------------------
-
-def _check_mesh(mesh):
-    if not isinstance(mesh, (Mesh2D, Mesh3D)):
-        raise InputError(f"mesh must be a Mesh2D or Mesh3D, got {type(mesh).__name__}")
-    return mesh
-
-
-def _check_state(state, n_elements):
-    array = np.asarray(state)
-    if array.shape != (n_elements,) or not (np.issubdtype(array.dtype, np.integer) or array.dtype == bool):
-        raise InputError(f"state must be an integer array of shape ({n_elements},), "
-                         f"got {array.dtype} {array.shape}")
-    bad = np.flatnonzero(~np.isin(array, (HYDRAULIC, INTACT_NATURAL, FAILED_NATURAL)))
-    if bad.size:
-        raise InputError(f"state values must be 0 (hydraulic), 1 (intact natural) or 2 (failed natural); "
-                         f"element {int(bad[0])} has {int(array[bad[0]])}")
-    return array.astype(np.int64)
-
-
-def _check_window_size(window_size):
-    try:
-        width, height = window_size
-    except (TypeError, ValueError):
-        raise InputError(f"window_size must be a pair (width, height) of pixels, got {window_size!r}") from None
-    for name, value in (("width", width), ("height", height)):
-        integer(f"window_size {name}", value, 16, 16384)
-    return int(width), int(height)
-
-
-def _check_fields(mesh, opening, state, slip):
-    n = mesh.n_elements
-    opening = None if opening is None else finite_array("opening", opening, (n,))
-    state = None if state is None else _check_state(state, n)
-    slip = None if slip is None else finite_array("slip", slip, (n, mesh.dim))
-    return opening, state, slip
-
-
-# ---------------------------------------------------------------------------------
-# pyvista
-# ---------------------------------------------------------------------------------
-
-def _pyvista():
-    """pyvista, switched to offscreen rendering."""
-    try:
-        import pyvista
-    except ImportError as error:  # pragma: no cover - pyvista is a dependency
-        raise HmatddmError(f"snapshots need pyvista, which could not be imported: {error}") from error
-    pyvista.OFF_SCREEN = True
-    return pyvista
-
-
-def _no_render_context(cause):
-    return HmatddmError(
-        "pyvista could not create an offscreen render context, so no snapshot was written "
-        f"({type(cause).__name__}: {cause}). On a headless machine use a VTK build with EGL or "
-        "OSMesa (e.g. the 'vtk-osmesa' wheel) or run under a virtual display (xvfb-run)."
-    )
-
-
-def _new_plotter(pyvista, window_size):
-    """An offscreen plotter on a white background.
-
-    VTK's warning while it falls back from X to EGL/OSMesa on a headless machine
-    ("bad X server connection") is silenced while the plotter is made; errors still
-    show.
-    """
-    from vtkmodules.vtkCommonCore import vtkLogger
-
-    verbosity = vtkLogger.GetCurrentVerbosityCutoff()
-    vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_ERROR)
-    try:
-        plotter = pyvista.Plotter(off_screen=True, window_size=list(window_size),
-                                  theme=pyvista.themes.DocumentTheme())
-    except Exception as error:
-        raise _no_render_context(error) from error
-    finally:
-        vtkLogger.SetStderrVerbosity(verbosity)
-    if not _supports_opengl(plotter):
-        plotter.close()
-        raise _no_render_context(RuntimeError("the render window reports no OpenGL support"))
-    return plotter
-
-
-def _supports_opengl(plotter):
-    """Whether VTK can make an OpenGL context for this plotter (True when VTK cannot tell)."""
-    supports = getattr(plotter.render_window, "SupportsOpenGL", None)
-    if supports is None:
-        return True
-    try:
-        return bool(supports())
-    except Exception:
-        return False
 
 
 def element_geometry(mesh):
     """The elements as pyvista ``PolyData``, one cell per element in mesh order:
     quads for a Mesh3D, line segments at ``z = 0`` for a Mesh2D (the cells the
     ``.vtu`` files hold, :func:`hmatddm.io.vtk.cells_of`)."""
-    pyvista = _pyvista()
+    pyvista = offscreen_pyvista()
     points, connectivity, _ = cells_of(mesh)
     n_elements, nodes_per_cell = connectivity.shape
     cells = np.column_stack([np.full(n_elements, nodes_per_cell), connectivity]).reshape(-1)
@@ -185,28 +70,9 @@ def _part(mesh, indices, lift=0.0):
     return part.translate((0.0, 0.0, lift), inplace=False) if lift else part
 
 
-def _diagonal(mesh):
-    extent = np.ptp(mesh.centers, axis=0)
-    return float(np.hypot.reduce(extent)) + 2.0 * float(np.max(mesh.radii))
-
-
 # ---------------------------------------------------------------------------------
 # Layers
 # ---------------------------------------------------------------------------------
-
-def opening_colour_range(opening_mm):
-    """``(clim, bar_title)`` of the opening colour bar: from 0 to the largest opening
-    (mm). Negative openings (closed elements pressed a little into each other, or the
-    round-off of contact) are drawn in the colour of 0 and the bar title says so,
-    with the smallest value, instead of stretching the scale below zero."""
-    low = float(np.min(opening_mm))
-    high = max(float(np.max(opening_mm)), 0.0)
-    if high <= 1e-12:
-        high = 1e-9
-    title = "opening (mm)"
-    if low < 0.0:
-        title = f"opening (mm)\n< 0 drawn as 0\n(min {low:.2g})"
-    return [0.0, high], title
 
 
 def _line_width(coloured=True):
@@ -248,7 +114,7 @@ def _add_intact(plotter, mesh, indices, lift=0.0):
 def _region_boundary(mesh, indices):
     """Outer edges of the patch made of the cells ``indices`` (corners merged)."""
     patch = _part(mesh, indices)
-    patch = patch.clean(tolerance=1e-9 * _diagonal(mesh), absolute=True)
+    patch = patch.clean(tolerance=1e-9 * mesh_diagonal(mesh), absolute=True)
     return patch.extract_feature_edges(boundary_edges=True, non_manifold_edges=True,
                                        feature_edges=False, manifold_edges=False)
 
@@ -267,7 +133,7 @@ def _add_failed_outline(plotter, mesh, indices, lift=0.0):
     if indices.size == 0:
         return
     if isinstance(mesh, Mesh2D):
-        part = _part(mesh, indices, lift - 0.1 * _diagonal(mesh))
+        part = _part(mesh, indices, lift - 0.1 * mesh_diagonal(mesh))
         # flat and unlit: the visible rim of a lit tube is shaded to dark red
         plotter.add_mesh(part, color=FAILED_COLOR, line_width=2 * _line_width(), lighting=False)
         return
@@ -276,21 +142,11 @@ def _add_failed_outline(plotter, mesh, indices, lift=0.0):
     plotter.add_mesh(_region_boundary(mesh, indices), color=FAILED_COLOR, line_width=4)
 
 
-def slip_arrow_length(mesh, slipping, n_arrows):
-    """Length of the arrow of the largest slip: about 1.5 arrow spacings (the
-    ``slipping`` elements' area, or length in 2D, shared among ``n_arrows``), within
-    3-12% of the mesh diagonal."""
-    covered = float(np.sum(mesh.areas[slipping]))
-    spacing = covered / n_arrows if isinstance(mesh, Mesh2D) else np.sqrt(covered / n_arrows)
-    diagonal = _diagonal(mesh)
-    return float(np.clip(1.5 * spacing, 0.03 * diagonal, 0.12 * diagonal))
-
-
 def _add_slip_arrows(plotter, mesh, slip, lift=0.0):
     """Arrows centred on the slipping elements (moved up by ``lift``), length
     proportional to ``|slip|`` (on at most ``MAX_SLIP_ARROWS`` of them, evenly thinned
     in element order)."""
-    pyvista = _pyvista()
+    pyvista = offscreen_pyvista()
     magnitude = np.linalg.norm(slip, axis=1)
     largest = float(np.max(magnitude))
     if largest <= 0.0:
@@ -312,19 +168,6 @@ def _add_slip_arrows(plotter, mesh, slip, lift=0.0):
     plotter.add_mesh(arrows, color=SLIP_ARROW_COLOR)
 
 
-def legend_labels(state, slip_shown=False):
-    """``[[text, colour], ...]`` of the legend: the natural-fracture states present and
-    the slip arrows when drawn."""
-    labels = []
-    if state is not None and np.any(state == INTACT_NATURAL):
-        labels.append(["natural fracture, intact", INTACT_COLOR])
-    if state is not None and np.any(state == FAILED_NATURAL):
-        labels.append(["natural fracture, activated or failed", FAILED_COLOR])
-    if slip_shown:
-        labels.append(["slip (arrow length ~ slip)", SLIP_ARROW_COLOR])
-    return labels
-
-
 def _add_legend(plotter, state, slip_shown=False):
     """The legend at the bottom, between the length scale and the colour bar, below the
     fractures in a plan view (:func:`plan_frame`)."""
@@ -334,77 +177,22 @@ def _add_legend(plotter, state, slip_shown=False):
                            size=(0.4, 0.028 * len(labels) + 0.008))
 
 
-def _slip_shown(slip):
-    return slip is not None and bool(np.any(slip))
-
-
 def _set_view(plotter, mesh, view):
     """Oblique: isometric, framing every actor (plan views: :func:`_frame_plan`)."""
     plotter.view_isometric()
     plotter.reset_camera()
 
 
-def _plan_extent(mesh):
-    """``(x_min, x_max, y_min, y_max)`` of the elements seen from above (their corners, or
-    segment ends)."""
-    if isinstance(mesh, Mesh2D):
-        points = np.concatenate(mesh.endpoints)
-    else:
-        points = mesh.corners().reshape(-1, 3)[:, :2]
-    low, high = points.min(axis=0), points.max(axis=0)
-    pad = 0.02 * max(float(np.max(high - low)), float(np.max(mesh.radii)))  # room for tubes and arrows
-    return low[0] - pad, high[0] + pad, low[1] - pad, high[1] + pad
-
-
-def plan_frame(extent, window_size, colour_bar=True, title=True):
-    """The camera of a plan view: ``(centre_x, centre_y, parallel_scale, box)`` so that
-    ``extent`` (x_min, x_max, y_min, y_max, m) fills ``box`` (fractions of the window,
-    :data:`PLAN_BOX`; wider without a colour bar, taller without a title) at the same
-    scale in x and y -- never under the colour bar, the legend or the title."""
-    left, right, bottom, top = PLAN_BOX
-    right = right if colour_bar else PLAN_BOX_WITHOUT_BAR_RIGHT
-    top = top if title else PLAN_BOX_WITHOUT_TITLE_TOP
-    width, height = window_size
-    aspect = width / height
-    x_min, x_max, y_min, y_max = extent
-    span_x = max(x_max - x_min, 1e-12 * max(1.0, abs(x_max)))
-    span_y = max(y_max - y_min, 1e-12 * max(1.0, abs(y_max)))
-    scale = max(span_x / (2.0 * aspect * (right - left)), span_y / (2.0 * (top - bottom)))
-    centre_x = 0.5 * (x_min + x_max) - (0.5 * (left + right) - 0.5) * 2.0 * scale * aspect
-    centre_y = 0.5 * (y_min + y_max) - (0.5 * (bottom + top) - 0.5) * 2.0 * scale
-    return centre_x, centre_y, scale, (left, right, bottom, top)
-
-
-def scale_bar_length(span):
-    """A round length (1, 2 or 5 x 10^k m) of about a fifth of ``span`` (m, > 0)."""
-    target = 0.2 * float(span)
-    power = 10.0 ** np.floor(np.log10(target))
-    return float(max(m * power for m in (1.0, 2.0, 5.0) if m * power <= target))
-
-
-def plan_scale_bar(extent, window_size, colour_bar=True, title=True):
-    """The length scale of a plan view (m): a round length of about a fifth of the width
-    the plot box shows at :func:`plan_frame`'s scale -- not of the fractures' own x
-    extent, which is ~0 for a vertical 2D section (it made the bar a dot there)."""
-    _, _, scale, box = plan_frame(extent, window_size, colour_bar, title)
-    aspect = window_size[0] / window_size[1]
-    return scale_bar_length(2.0 * scale * aspect * (box[1] - box[0]))
-
-
-def _length_text(length):
-    return f"{length * 1e3:g} mm" if length < 1e-2 else (f"{length:g} m" if length < 1e3 else f"{length / 1e3:g} km")
-
-
 def _frame_plan(plotter, mesh, window_size, colour_bar, title, interfaces=()):
     """Look down ``-z`` (parallel projection) with the fractures inside :data:`PLAN_BOX`,
     and draw a length scale under them (and, in a 2D section, the layer ``interfaces``
     that cross the box as grey lines across it)."""
-    pyvista = _pyvista()
-    extent = _plan_extent(mesh)
+    pyvista = offscreen_pyvista()
+    extent = plan_extent(mesh)
     centre_x, centre_y, scale, box = plan_frame(extent, window_size, colour_bar, title)
     aspect = window_size[0] / window_size[1]
     z_top = float(np.max(mesh.corners()[..., 2])) if isinstance(mesh, Mesh3D) else 0.0
-    diagonal = _diagonal(mesh)
+    diagonal = mesh_diagonal(mesh)
     x_left = centre_x + (box[0] - 0.5) * 2.0 * scale * aspect
     x_right = centre_x + (box[1] - 0.5) * 2.0 * scale * aspect
     y_low, y_high = (centre_y + (edge - 0.5) * 2.0 * scale for edge in (box[2], box[3]))
@@ -423,7 +211,7 @@ def _frame_plan(plotter, mesh, window_size, colour_bar, title, interfaces=()):
     lift = z_top + 0.5 * diagonal
     plotter.add_mesh(pyvista.Line((x0, y0, lift), (x0 + length, y0, lift)), color="black", line_width=4)
     right_end = box[0] + length / (2.0 * scale * aspect)
-    plotter.add_text(_length_text(length), position=(int((right_end + 0.01) * window_size[0]),
+    plotter.add_text(length_text(length), position=(int((right_end + 0.01) * window_size[0]),
                                                      int((SCALE_Y - 0.02) * window_size[1])),
                      font_size=10, color="black")
     plotter.view_xy()  # the camera pyvista frames (its distance keeps the lighting), moved over the box
@@ -445,7 +233,7 @@ def _draw(plotter, mesh, opening, state, slip):
         _add_coloured(plotter, mesh, every[state != INTACT_NATURAL], opening)
         _add_intact(plotter, mesh, every[state == INTACT_NATURAL])
         _add_failed_outline(plotter, mesh, every[state == FAILED_NATURAL])
-    _add_legend(plotter, state, _slip_shown(slip))
+    _add_legend(plotter, state, slip_shown(slip))
     if slip is not None:
         _add_slip_arrows(plotter, mesh, slip)
 
@@ -453,79 +241,6 @@ def _draw(plotter, mesh, opening, state, slip):
 # ---------------------------------------------------------------------------------
 # Plan view of vertical fractures: traces
 # ---------------------------------------------------------------------------------
-
-def vertical_elements(mesh):
-    """Boolean mask of the elements of a Mesh3D that stand vertical (``|n_z| <=
-    VERTICAL_NORMAL_Z``, within ~2.9 degrees), which a plan view sees edge on."""
-    return np.abs(mesh.normals[:, 2]) <= VERTICAL_NORMAL_Z
-
-
-def is_mostly_vertical(mesh):
-    """Whether a plan view of ``mesh`` should draw traces: a Mesh3D whose vertical
-    elements hold at least ``MOSTLY_VERTICAL_AREA`` of its area."""
-    if not isinstance(mesh, Mesh3D):
-        return False
-    areas = mesh.areas
-    return float(np.sum(areas[vertical_elements(mesh)])) >= MOSTLY_VERTICAL_AREA * float(np.sum(areas))
-
-
-def plan_traces(mesh, opening=None, state=None, slip=None):
-    """The vertical elements of a Mesh3D as plan-view line elements, one per column.
-
-    Each vertical element's horizontal mid-line (:func:`hmatddm.simulation.natural.plan_segments`)
-    is its trace; the elements of one fracture with the same trace (a column stacked
-    over the height) become one line. Per line:
-
-    * ``opening``: the LARGEST opening of the column (max over the height: the plan
-      view shows where the fracture is open at all, as the DFN maps of ref. Figs
-      6.10-6.14 do);
-    * ``state``: failed natural (2) when any element of the column failed or was
-      activated, else hydraulic (0) when any is hydraulic, else intact natural (1);
-    * ``slip``: the horizontal (x, y) part of the slip of the column's element that
-      slips most (dip-slip is invisible in plan).
-
-    Returns ``(traces, opening, state, slip, column)``: ``traces`` a Mesh2D (same
-    ``fracture_id``), the per-line fields (None where not given) and ``column`` (for
-    each vertical element in mesh order, the index of its line). Non-vertical
-    elements are left out (see :func:`vertical_elements`).
-    """
-    from ..simulation.natural import plan_segments
-
-    _check_mesh(mesh)
-    if not isinstance(mesh, Mesh3D):
-        raise InputError("plan_traces needs a Mesh3D (a Mesh2D already is a plan view)")
-    opening, state, slip = _check_fields(mesh, opening, state, slip)
-    vertical = np.flatnonzero(vertical_elements(mesh))
-    if vertical.size == 0:
-        raise InputError("plan_traces: the mesh has no vertical element (|n_z| <= "
-                         f"{VERTICAL_NORMAL_Z})")
-    part = mesh.subset(vertical)
-    p0, p1, _ = plan_segments(part)
-    # one key per column: fracture id and the trace's end points (ordered, rounded)
-    ends = np.stack([p0, p1], axis=1)                                   # (n, 2, 2)
-    swap = (ends[:, 0, 0] > ends[:, 1, 0]) | ((ends[:, 0, 0] == ends[:, 1, 0]) & (ends[:, 0, 1] > ends[:, 1, 1]))
-    ends[swap] = ends[swap][:, ::-1]
-    tolerance = 1e-6 * _diagonal(mesh)
-    key = np.column_stack([part.fracture_id, np.round(ends.reshape(-1, 4) / tolerance).astype(np.int64)])
-    _, first, column = np.unique(key, axis=0, return_index=True, return_inverse=True)
-    column = column.reshape(-1)
-    n_lines = first.size
-    traces = Mesh2D.from_segments(p0[first], p1[first], fracture_id=part.fracture_id[first])
-    line_opening = line_state = line_slip = None
-    if opening is not None:
-        line_opening = np.full(n_lines, -np.inf)
-        np.maximum.at(line_opening, column, opening[vertical])
-    if state is not None:
-        top = np.zeros(n_lines, dtype=np.int64)
-        np.maximum.at(top, column, _RANK_OF_STATE[state[vertical]])
-        line_state = _STATE_OF_RANK[top].astype(np.int64)
-    if slip is not None:
-        magnitude = np.linalg.norm(slip[vertical], axis=1)
-        order = np.lexsort((magnitude, column))          # by column, largest slip last
-        is_last = np.r_[column[order][1:] != column[order][:-1], True]
-        line_slip = np.zeros((n_lines, 2))
-        line_slip[column[order][is_last]] = slip[vertical][order[is_last], :2]
-    return traces, line_opening, line_state, line_slip, column
 
 
 def _draw_plan_traces(plotter, mesh, opening, state, slip):
@@ -551,7 +266,7 @@ def _draw_plan_traces(plotter, mesh, opening, state, slip):
             _add_slip_arrows(plotter, mesh.subset(others), slip[others])
     # ... and the traces above every element (the camera looks down -z), with room
     # for their red borders (:func:`_add_failed_outline`) in between
-    lift = float(np.max(mesh.corners()[..., 2])) + 0.2 * _diagonal(mesh)
+    lift = float(np.max(mesh.corners()[..., 2])) + 0.2 * mesh_diagonal(mesh)
     lines = np.arange(traces.n_elements)
     if line_state is None:
         _add_coloured(plotter, traces, lines, line_opening, lift=lift, clim=clim)
@@ -559,7 +274,7 @@ def _draw_plan_traces(plotter, mesh, opening, state, slip):
         _add_coloured(plotter, traces, lines[line_state != INTACT_NATURAL], line_opening, lift=lift, clim=clim)
         _add_intact(plotter, traces, lines[line_state == INTACT_NATURAL], lift=lift)
         _add_failed_outline(plotter, traces, lines[line_state == FAILED_NATURAL], lift=lift)
-    _add_legend(plotter, state, _slip_shown(line_slip) or (slip is not None and _slip_shown(slip[others])))
+    _add_legend(plotter, state, slip_shown(line_slip) or (slip is not None and slip_shown(slip[others])))
     if line_slip is not None and np.any(line_slip):
         _add_slip_arrows(plotter, traces, line_slip, lift=lift)
 
@@ -567,26 +282,6 @@ def _draw_plan_traces(plotter, mesh, opening, state, slip):
 # ---------------------------------------------------------------------------------
 # Output
 # ---------------------------------------------------------------------------------
-
-def _save_png(image, path):
-    """Write an (H, W, 3|4) uint8 image as PNG, atomically."""
-    from PIL import Image
-
-    with atomic_output(path) as temporary:
-        Image.fromarray(np.ascontiguousarray(image)).save(temporary, format="PNG")
-    return path
-
-
-def _screenshot(plotter, window_size):
-    try:
-        image = plotter.screenshot(return_img=True, window_size=list(window_size))
-    except Exception as error:
-        raise _no_render_context(error) from error
-    if image is None or image.size == 0 or int(np.max(image)) == 0:
-        # A white-background scene that renders all black means no working GL context.
-        raise _no_render_context(RuntimeError("the rendered image is empty (all black)"))
-    return image
-
 
 def snapshot(mesh, path, opening=None, state=None, slip=None, view="oblique", title=None,
              window_size=(1200, 900), plan_style="auto", interfaces=()):
@@ -639,13 +334,13 @@ def snapshot(mesh, path, opening=None, state=None, slip=None, view="oblique", ti
     HmatddmError
         pyvista cannot render offscreen on this machine.
     """
-    _check_mesh(mesh)
+    check_mesh_type(mesh)
     if view not in VIEWS:
         raise InputError(f"view must be one of {VIEWS}, got {view!r}")
     if plan_style not in PLAN_STYLES:
         raise InputError(f"plan_style must be one of {PLAN_STYLES}, got {plan_style!r}")
-    window_size = _check_window_size(window_size)
-    opening, state, slip = _check_fields(mesh, opening, state, slip)
+    window_size = check_window_size(window_size)
+    opening, state, slip = check_fields(mesh, opening, state, slip)
     interfaces = np.asarray(interfaces if interfaces is not None else (), dtype=float).ravel()
     if not np.all(np.isfinite(interfaces)):
         raise InputError("interfaces must be finite heights (m)")
@@ -654,8 +349,8 @@ def snapshot(mesh, path, opening=None, state=None, slip=None, view="oblique", ti
     if traces and not np.any(vertical_elements(mesh)):
         raise InputError(f"plan_style='traces' needs vertical elements (|n_z| <= {VERTICAL_NORMAL_Z}); "
                          "this mesh has none")
-    pyvista = _pyvista()
-    plotter = _new_plotter(pyvista, window_size)
+    pyvista = offscreen_pyvista()
+    plotter = new_plotter(pyvista, window_size)
     try:
         if traces:
             _draw_plan_traces(plotter, mesh, opening, state, slip)
@@ -670,10 +365,10 @@ def snapshot(mesh, path, opening=None, state=None, slip=None, view="oblique", ti
                         interfaces=interfaces if isinstance(mesh, Mesh2D) else ())
         else:
             _set_view(plotter, mesh, view)
-        image = _screenshot(plotter, window_size)
+        image = screenshot(plotter, window_size)
     finally:
         plotter.close()
-    return _save_png(image, Path(path))
+    return save_png(image, Path(path))
 
 
 def snapshots(mesh, folder, stem, **fields):
@@ -690,6 +385,4 @@ def snapshots(mesh, folder, stem, **fields):
     return [snapshot(mesh, folder / f"{stem}_{view}.png", view=view, **fields) for view in views]
 
 
-__all__ = ["snapshot", "snapshots", "element_geometry", "slip_arrow_length", "plan_traces",
-           "is_mostly_vertical", "vertical_elements", "HYDRAULIC", "INTACT_NATURAL", "FAILED_NATURAL", "VIEWS",
-           "PLAN_STYLES"]
+__all__ = ["snapshot", "snapshots", "element_geometry"]
