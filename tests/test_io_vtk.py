@@ -138,8 +138,8 @@ def test_pvd_lists_times_and_relative_names_readable_by_vtk(tmp_path, mesh3d):
 
 
 @pytest.mark.parametrize("entries, message", [
-    ([(float("nan"), "a.vtu")], "time must be finite"),
-    ([("soon", "a.vtu")], "time must be a number"),
+    ([(float("nan"), "a.vtu")], "time must be a finite number, got nan"),
+    ([("soon", "a.vtu")], "time must be a finite number, got 'soon'"),
     ([(0.0, "")], "file_name"),
     ([(0.0,)], r"entries\[0\] must be a pair"),
 ])

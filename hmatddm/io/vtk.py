@@ -18,13 +18,13 @@ Every file is written atomically (a temporary file in the same folder, then
 ``os.replace``), so a running ParaView or a crash never sees a half-written file.
 """
 import base64
-import math
 import os
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
+from .._validation import finite_scalar
 from ..errors import InputError
 from ..mesh import Mesh2D, Mesh3D
 from . import atomic_output
@@ -254,12 +254,7 @@ def write_pvd(path, entries):
             time, file_name = entry
         except (TypeError, ValueError):
             raise InputError(f"entries[{index}] must be a pair (time, file_name), got {entry!r}") from None
-        try:
-            time = float(time)
-        except (TypeError, ValueError):
-            raise InputError(f"entries[{index}] time must be a number, got {time!r}") from None
-        if not math.isfinite(time):
-            raise InputError(f"entries[{index}] time must be finite, got {time}")
+        time = finite_scalar(f"entries[{index}] time", time)
         if not isinstance(file_name, (str, os.PathLike)) or not str(file_name):
             raise InputError(f"entries[{index}] file_name must be a non-empty path, got {file_name!r}")
         relative = _collection_file_name(path.parent, file_name)
