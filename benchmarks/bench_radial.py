@@ -71,6 +71,8 @@ CASES = {
     "M": dict(toughness=1e6, initial_opening=4e-6, viscosity=1e-3),
     "K": dict(toughness=5e6, initial_opening=1e-5, viscosity=1e-3),
     "K-vertex": dict(toughness=5e6, initial_opening=1e-5, viscosity=1e-5),
+    # the K case again, compared with Dontsov's (2016) solution of the K-M transition (K_m 1.8-2.9)
+    "K-M": dict(toughness=5e6, initial_opening=1e-5, viscosity=1e-3),
 }
 
 
@@ -91,6 +93,9 @@ def closed_form(case, t, h):
                                                                     material) for r, ti in zip(np.atleast_1d(rho),
                                                                                                np.atleast_1d(t))])
         return radius, width, pressure.reshape(t.shape), "M-vertex"
+    if case == "K-M":  # no net pressure in this approximation
+        radius, width = hd.analytical.radial_transition(t, RATE, params["viscosity"], params["toughness"], material)
+        return radius, width, np.full(t.shape, np.nan), "K-M transition (Dontsov 2016)"
     radius, width, pressure = hd.analytical.radial_k_vertex(t, RATE, params["toughness"], material)
     return radius, width, pressure, "K-vertex"
 
@@ -208,13 +213,13 @@ def rms_errors(row, t_from=10.0):
     keep = t >= t_from
     out = {}
     for key, ref_key in (("radius", "radius"), ("max_opening", "max_width"), ("net_pressure", "net_pressure")):
-        e = np.array(h[key])[keep] / np.array(ref[ref_key])[keep] - 1.0
-        out[key] = float(np.sqrt(np.mean(e * e))) if e.size else None
+        e = np.array(h[key])[keep] / np.array(ref[ref_key], dtype=float)[keep] - 1.0
+        out[key] = float(np.sqrt(np.mean(e * e))) if e.size and np.all(np.isfinite(e)) else None
     return out
 
 
 def pct(value):
-    return "-" if value is None else f"{100 * value:+.1f}%"
+    return "-" if value is None or not np.isfinite(value) else f"{100 * value:+.1f}%"
 
 
 def dense_twin(rows):
@@ -381,15 +386,34 @@ FRONT_RUNS = [  # (case, h, backend, front, t_end), cheapest first
     ("M", 2.0, "hmatrix", "element", 50.0), ("M", 2.0, "hmatrix", "asymptotic", 50.0),
     ("M", 2.0, "dense", "asymptotic", 50.0), ("M", 1.0, "hmatrix", "element", 50.0),
     ("M", 1.0, "hmatrix", "asymptotic", 50.0), ("M", 0.5, "hmatrix", "asymptotic", 12.0),
-    ("K-vertex", 1.0, "hmatrix", "asymptotic", 50.0), ("K", 1.0, "hmatrix", "asymptotic", 50.0),
+    ("K-vertex", 1.0, "hmatrix", "element", 50.0), ("K-vertex", 1.0, "hmatrix", "asymptotic", 50.0),
+    ("K-M", 1.0, "hmatrix", "element", 50.0), ("K-M", 1.0, "hmatrix", "asymptotic", 50.0),
 ]
 
 
 def run_front_rows(spec, threads):
-    """Only the FRONT_RUNS rows whose index is in ``spec`` (comma-separated), e.g. to resume."""
+    """Only the FRONT_RUNS rows whose index is in ``spec`` (comma-separated), merged into the
+    saved study (a row of the same case, h, backend and front is replaced), e.g. to resume."""
     keep = [int(i) for i in spec.split(",")]
-    return [spawn(case, h, backend, t_end, threads=threads, front=front, timeout=3600)
-            for k, (case, h, backend, front, t_end) in enumerate(FRONT_RUNS) if k in keep]
+    path = os.path.join(OUT, "radial_front.json")
+    rows = []
+    if os.path.exists(path):
+        with open(path) as f:
+            rows = json.load(f)
+    for k, (case, h, backend, front, t_end) in enumerate(FRONT_RUNS):
+        if k not in keep:
+            continue
+        row = spawn(case, h, backend, t_end, threads=threads, front=front, timeout=3600)
+        same = [i for i, r in enumerate(rows) if (r.get("case"), r.get("h"), r.get("backend"), r.get("front"))
+                == (case, h, backend, front)]
+        if same:
+            rows[same[0]] = row
+        else:
+            rows.append(row)
+        with open(path, "w") as f:
+            json.dump(rows, f)
+    order = {(c, h, b, f): i for i, (c, h, b, f, _) in enumerate(FRONT_RUNS)}
+    return sorted(rows, key=lambda r: order.get((r.get("case"), r.get("h"), r.get("backend"), r.get("front")), 99))
 
 
 KGD_CASES = {"K": 5e6, "M": 0.2e6}  # K_Ic of the ref. Table 4.2 setup: K_m = 4.9 and 0.2
@@ -436,19 +460,21 @@ def front_table(rows):
     out = []
     for r in rows:
         if "error" not in r:
-            out.append([r.get("case"), r.get("front"), r.get("h"), r.get("backend"), r.get("t_end"),
+            out.append([r.get("case"), "", r.get("front"), r.get("h"), r.get("backend"), r.get("t_end"),
                         f"failed: {r.get('failure')}"] + [""] * 9)
             continue
         rms = rms_errors(r)
         circ = [c for c, t in zip(r["history"]["front_circularity"], r["history"]["time"]) if c and t >= 10.0]
-        out.append([r["case"], r["front"], f"{r['h']:g}", r["backend"], f"{r['t_end']:g}", r["final_elements"],
+        out.append([r["case"], r.get("reference_name", ""), r["front"], f"{r['h']:g}", r["backend"], f"{r['t_end']:g}",
+                    r["final_elements"],
                     f"{r['wall_s']:.0f}", f"{r.get('process_cpu_s', float('nan')):.0f}",
                     f"{r.get('background_cores', float('nan')):.2f}", pct(r["error"]["radius"]),
                     pct(r["error"]["centre_width"]), pct(r["error"]["net_pressure"]),
                     " / ".join("-" if v is None else f"{100 * v:.1f}%" for v in rms.values()),
                     f"{100 * (max(circ) - 1):.1f}%" if circ else "-",
                     r.get("failure") or ""])
-    return markdown_table(["case", "front", "h (m)", "backend", "t_end (s)", "elements", "wall (s)", "CPU (s)",
+    return markdown_table(["case", "reference", "front", "h (m)", "backend", "t_end (s)", "elements", "wall (s)",
+                           "CPU (s)",
                            "background (cores)", "R error", "centre w error", "p_net error",
                            "RMS 10 s-t_end (R / w_max / p_net)", "worst circularity 10 s-t_end", "note"], out)
 
@@ -490,6 +516,8 @@ def main():
                                                       "(default 2,1.5,1,0.75,0.5)")
     parser.add_argument("--dense-limit", type=int, default=2500,
                         help="dense backend only for meshes expected below this many elements at t_end")
+    parser.add_argument("--front-rows", default=None,
+                        help="comma-separated indices of FRONT_RUNS to run again, merged into the saved front study")
     parser.add_argument("--skip", default="", help="comma-separated studies to skip: table41, cost, front, kgd, threads")
     parser.add_argument("--report", action="store_true",
                         help="print the tables and redraw the plots from the JSON of the last run (no runs)")
@@ -582,7 +610,13 @@ def main():
         plot_cost(rows, os.path.join(plots, "radial_accuracy_cost.png"))
 
     if "front" not in skip:
-        rows_f = study("front", lambda: run_front_study(args.threads))
+        if args.front_rows:
+            rows_f = run_front_rows(args.front_rows, args.threads)
+            for row in rows_f:
+                if row.get("history", {}).get("time"):
+                    add_reference(row)  # rows kept from an earlier run: today's closed forms
+        else:
+            rows_f = study("front", lambda: run_front_study(args.threads))
         print("\n## Front models: element switch against the asymptotic front (radial, hmatrix unless said)\n")
         print(front_table(rows_f))
         plot_front(rows_f, os.path.join(plots, "radial_front_accuracy_cost.png"))

@@ -20,7 +20,7 @@ def radial(h=1.0, backend="hmatrix", toughness=1e6, viscosity=1e-3, opening=4e-6
 
 
 def test_radial_m_vertex_early_growth_is_round_and_conserves_volume():
-    sim = radial()
+    sim = radial(backend="dense")  # ~180 elements: dense is the faster backend (hmatrix: the next test)
     records = sim.run(6.0)
     radius, width = hd.analytical.radial_m_vertex(6.0, 0.01, 1e-3, MATERIAL)
     last = records[-1]
@@ -44,26 +44,33 @@ def test_dense_and_hmatrix_runs_agree():
 
 
 def test_resume_from_checkpoint_gives_the_same_run(tmp_path):
-    whole = radial(h=2.0).run(3.0)
-    first = radial(h=2.0, checkpoint_dir=tmp_path)
+    whole = radial(h=2.0, backend="dense").run(3.0)
+    first = radial(h=2.0, backend="dense", checkpoint_dir=tmp_path)
     first.run(2.0)
-    resumed = radial(h=2.0, checkpoint_dir=tmp_path)
+    resumed = radial(h=2.0, backend="dense", checkpoint_dir=tmp_path)
     records = resumed.run(3.0, resume=True)
     assert records[-1]["radius"] == pytest.approx(whole[-1]["radius"], rel=1e-9)
     assert records[-1]["n_elements"] == whole[-1]["n_elements"]
 
 
-def test_kgd_toughness_vertex():
-    # ref. Table 4.2 setup with K_Ic 5 MPa m^1/2 (K_m = 4.9: K-vertex), 1 m segments
+@pytest.mark.parametrize("toughness, tolerance", [(5e6, 0.02), (0.2e6, 0.03)])
+def test_kgd_vertices(toughness, tolerance):
+    # ref. Table 4.2 setup with K_Ic 5 MPa m^1/2 (K_m = 4.9: K-vertex) and 0.2 MPa m^1/2 (K_m =
+    # 0.2: M-vertex), 1 m segments, 24 s (half-length ~7 and ~13 elements): measured +0.3% / +0.7%
+    # (K) and +1.9% / +0.6% (M; +1.2% / 0.0% at 100 s, benchmarks/RESULTS.md). The semi-infinite
+    # asymptote without the finite-fracture factor gives -3.4% / +3.0% for the K-vertex here
     material = hd.Elastic(10e9, 0.25)
     sim = hd.Simulation(hd.mesh.line([-1.5, 0.0], [1.5, 0.0], 3), material, hd.Fluid(1e-3, 4.5e-10),
                         [hd.Cluster((0.0, 0.0), 5e-4, 0.5)], far_field_stress=np.diag([-1e6, -0.5e6]), time_step=2.0,
-                        propagation=hd.Propagation(toughness=5e6, front="asymptotic"), initial_pressure=1e6,
-                        initial_opening=1e-4)
+                        propagation=hd.Propagation(toughness=toughness, front="asymptotic"), initial_pressure=1e6,
+                        initial_opening=1e-4, backend="dense")
     records = sim.run(24.0)
-    half_length, width, _ = hd.analytical.kgd_k_vertex(24.0, 5e-4, 5e6, material)
-    assert abs(records[-1]["half_length"] / half_length - 1.0) < 0.04
-    assert abs(records[-1]["max_opening"] / width - 1.0) < 0.06
+    if toughness > 1e6:
+        half_length, width, _ = hd.analytical.kgd_k_vertex(24.0, 5e-4, toughness, material)
+    else:
+        half_length, width, _ = hd.analytical.kgd_m_vertex(24.0, 5e-4, 1e-3, material)
+    assert abs(records[-1]["half_length"] / half_length - 1.0) < tolerance
+    assert abs(records[-1]["max_opening"] / width - 1.0) < 0.02
 
 
 def test_unsupported_setups_are_refused():

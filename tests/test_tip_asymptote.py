@@ -57,3 +57,30 @@ def test_front_never_retreats():
     s, velocity = asymptote.front_distance(w, s_old, 1.0)
     np.testing.assert_array_equal(s, s_old)
     np.testing.assert_array_equal(velocity, 0.0)
+
+
+def test_finite_fracture_asymptote_is_griffith_and_sneddon_near_the_front():
+    # a crack of half-length (or radius) a under net pressure p at toughness, K' = 4 p (2a)^(1/2):
+    # Griffith 4 p (a^2 - x^2)^(1/2) / E' and Sneddon 8 p (a^2 - r^2)^(1/2) / (pi E') with
+    # K_I = 2 p (a/pi)^(1/2) both equal K' s^(1/2) (1 - s/(2a))^(1/2) / E' for s = a - x <= a/2
+    from hmatddm.fracture.tip_asymptote import finite_fracture_factor
+
+    a, p = 17.0, 1e6
+    s = np.linspace(0.0, 0.5 * a, 9)
+    griffith = TipAsymptote(E_PRIME, p * np.sqrt(np.pi * a), MU_PRIME)
+    np.testing.assert_allclose(griffith.width(s, 0.0, length=a), 4.0 * p * np.sqrt(a * a - (a - s) ** 2) / E_PRIME,
+                               rtol=1e-12, atol=1e-20)
+    sneddon = TipAsymptote(E_PRIME, 2.0 * p * np.sqrt(a / np.pi), MU_PRIME)
+    np.testing.assert_allclose(sneddon.width(s, 0.0, length=a),
+                               8.0 * p * np.sqrt(a * a - (a - s) ** 2) / (np.pi * E_PRIME), rtol=1e-12, atol=1e-20)
+    assert finite_fracture_factor(s, np.inf) == pytest.approx(1.0)
+    assert finite_fracture_factor(a, a) == finite_fracture_factor(0.5 * a, a)  # held beyond a/2
+    # the inversion of the finite-fracture asymptote, toughness and viscosity together
+    asymptote = TipAsymptote(E_PRIME, 1e6, MU_PRIME)
+    s_old, dt, length = np.array([0.3, 0.5, 1.2, 2.0, 3.0]), 0.7, 6.0
+    s_true = s_old + np.array([0.01, 0.2, 0.8, 0.5, 1.5])  # the last beyond L/2
+    w = asymptote.width(s_true, (s_true - s_old) / dt, length=length)
+    distance, _ = asymptote.front_distance(w, s_old, dt, length=length)
+    np.testing.assert_allclose(distance, s_true, rtol=1e-9)
+    bare, _ = asymptote.front_distance(w, s_old, dt)
+    assert np.all(bare < s_true)  # the semi-infinite asymptote reads the front short

@@ -251,11 +251,12 @@ def sample_offsets(k, n_sub):
     return np.column_stack([x.ravel(), y.ravel()]), corners
 
 
-def fill(cells, field, asymptote, n_sub=8):
+def fill(cells, field, asymptote, n_sub=8, length=np.inf):
     """Filled fraction, mean opening and "fully inside" of cells (M, k) of the grid.
 
-    The mean opening is the asymptote ``w(-phi, V)`` averaged over the cell's sample
-    points, zero outside the front.
+    The mean opening is the asymptote ``w(-phi, V)`` (with the finite-fracture factor of
+    ``length``, :func:`~hmatddm.fracture.tip_asymptote.finite_fracture_factor`) averaged over
+    the cell's sample points, zero outside the front.
     """
     cells = np.asarray(cells, np.int64).reshape(-1, field.k)
     k, h = field.k, field.h
@@ -267,7 +268,7 @@ def fill(cells, field, asymptote, n_sub=8):
     inside = phi < 0.0
     width = np.zeros(len(points))
     if np.any(inside):
-        width[inside] = asymptote.width(-phi[inside], field.velocity(points[inside]))
+        width[inside] = asymptote.width(-phi[inside], field.velocity(points[inside]), length=length)
     fraction = inside.reshape(m, n_s).mean(axis=1)
     mean_width = width.reshape(m, n_s).mean(axis=1)
     corner_phi = field((centre[:, None, :] + h * corners[None]).reshape(-1, k))

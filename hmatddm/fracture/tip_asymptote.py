@@ -24,7 +24,25 @@ the opening satisfies ``s^ = g_delta(K^, C^)``,
 (``beta_c = 0.9911799823``, the constant of their paper). ``K^ = 1`` is the k-vertex
 (``s^ = 0``), ``K^ = C^ = 0`` gives ``delta = 1/3``, ``C_1 = 6 sqrt(3) = beta_m^3 / 3`` and the
 m-vertex. Everything here is vectorised numpy (bisection: robust, no derivative).
+
+The asymptote is the opening of a semi-infinite crack. A fracture of radius (3D) or
+half-length (2D) ``L`` opens by ``w(s) (1 - s/(2L))^lambda`` near its front: exactly so for
+the K-vertex (Sneddon's penny and Griffith's crack, ``lambda = 1/2``) and in Dontsov's (2016)
+approximate radial solution at any ``K_m`` (``lambda`` = 0.487 at the M-vertex;
+:func:`hmatddm.analytical.radial_transition_profile`). :func:`finite_fracture_factor` is that
+factor with ``lambda = 1/2``; ``width`` and ``front_distance`` take ``length = L`` to include it
+(default infinite: the bare asymptote). Without it the inversion at ``s ~ h`` behind the front
+reads the toughness ``(1 - s/(2L))^(-1/2)`` too high: +3% at ``L = 18 h``, which put the K-vertex
+radius 1.2% short at h = 1 m (issue 16).
 """
+
+
+def finite_fracture_factor(s, length):
+    """``(1 - s/(2L))^(1/2)``, the opening of a fracture of radius or half-length ``L`` at
+    distance ``s`` from its front relative to the semi-infinite asymptote (module docstring);
+    1 for ``L = inf``. Held at its value ``(3/4)^(1/2)`` beyond ``s = L/2`` (a point that far
+    from the front is not in any tip region; it keeps ``w(s)`` increasing)."""
+    return np.sqrt(1.0 - 0.5 * np.minimum(np.asarray(s, float), 0.5 * length) / length)
 import numpy as np
 
 BETA_M3 = 2.0 * 3.0**2.5          # beta_m^3 = 18 sqrt(3)
@@ -90,8 +108,9 @@ class TipAsymptote:
         return BETA_M * (self.mu_prime * np.maximum(velocity, 0.0) / self.e_prime) ** (1.0 / 3.0) * \
             np.asarray(s, float) ** (2.0 / 3.0)
 
-    def width(self, s, velocity, iterations=36):
-        """Opening ``w(s)`` at distance ``s >= 0`` behind a front moving at ``velocity``.
+    def width(self, s, velocity, iterations=36, length=np.inf):
+        """Opening ``w(s)`` at distance ``s >= 0`` behind a front moving at ``velocity``
+        (times :func:`finite_fracture_factor` of ``length``).
 
         Bisection in ``log w`` between ``max(w_k, w_m)`` and ``w_k + w_m`` (the
         asymptote lies between them; tests/test_tip_asymptote.py checks it over 16 decades
@@ -110,26 +129,33 @@ class TipAsymptote:
             narrow = self.residual(s_safe, velocity, mid) > 0.0
             lo = np.where(narrow, mid, lo)
             hi = np.where(narrow, hi, mid)
-        return np.where(positive, np.sqrt(lo * hi), 0.0)
+        return np.where(positive, np.sqrt(lo * hi), 0.0) * finite_fracture_factor(s, length)
 
-    def front_distance(self, w, distance_old, dt, iterations=64):
+    def front_distance(self, w, distance_old, dt, iterations=64, length=np.inf):
         """Invert the asymptote for the distance ``s`` from a point of opening ``w`` to the
         front, with ``V = (s - s_old) / dt`` (the front never retreats: ``s >= s_old``).
 
         ``w(s, (s - s_old)/dt)`` grows with ``s``; it equals ``K' s_old^(1/2)/E'`` at
         ``s = s_old`` and exceeds ``w`` at the toughness distance ``s_k = (E' w / K')^2``,
         so the root is bracketed in ``[s_old, s_k]`` when ``s_k > s_old`` (else the front
-        stands still). Returns ``(s, V)``.
+        stands still). With a finite ``length`` ``L`` the opening is read against the asymptote
+        times :func:`finite_fracture_factor` (which keeps that product growing with ``s``):
+        ``s_k`` solves ``s (1 - s/(2L)) = (E' w / K')^2`` (``s (3/4)`` beyond ``L/2``).
+        Returns ``(s, V)``.
         """
         w, s_old = np.broadcast_arrays(np.asarray(w, float), np.asarray(distance_old, float))
         w = np.maximum(w, 1e-300)
         s_k = (self.e_prime * w / self.k_prime) ** 2
+        if np.isfinite(length):
+            near = s_k < 0.375 * length  # s (1 - s/(2L)) at s = L/2
+            s_k = np.where(near, length * (1.0 - np.sqrt(np.maximum(1.0 - 2.0 * s_k / length, 0.0))), s_k / 0.75)
         moves = s_k > s_old
         lo = s_old.copy()
         hi = np.where(moves, s_k, s_old)
         for _ in range(iterations):
             mid = 0.5 * (lo + hi)
-            wide = self.residual(np.maximum(mid, 1e-300), (mid - s_old) / dt, w) < 0.0  # w wider than asymptote
+            w_bare = w / finite_fracture_factor(mid, length)
+            wide = self.residual(np.maximum(mid, 1e-300), (mid - s_old) / dt, w_bare) < 0.0  # wider than asymptote
             lo = np.where(moves & wide, mid, lo)
             hi = np.where(moves & ~wide, mid, hi)
         s = np.where(moves, 0.5 * (lo + hi), s_old)

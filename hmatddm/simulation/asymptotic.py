@@ -18,6 +18,11 @@ time step, with the ribbon elements (channel elements next to the front) fixed:
    s_r^n) / dt`` (:meth:`~hmatddm.fracture.tip_asymptote.TipAsymptote.front_distance`);
 
 until no ``s_r`` changes by more than ``front_tolerance`` element sizes.
+
+Both the inversion (3) and the tip openings (1) use the asymptote of a fracture of finite size
+``L`` (:func:`~hmatddm.fracture.tip_asymptote.finite_fracture_factor`), with ``L`` the radius
+``sqrt(A/pi)`` (3D) or the half-length (2D) at the start of the step plus the trial front's
+mean advance (``AsymptoticFront.finite_fracture = False``: the bare semi-infinite asymptote).
 """
 import logging
 import time
@@ -69,6 +74,8 @@ class PrescribedOpening:
 
 class AsymptoticFront:
     """The asymptotic front of one :class:`~hmatddm.Simulation` (checks its setup)."""
+
+    finite_fracture = True  # the asymptote of a fracture of the current size (module docstring)
 
     def __init__(self, simulation):
         sim = simulation
@@ -170,7 +177,12 @@ class AsymptoticFront:
                          cells[front_class == CHANNEL])
         distance_old = np.maximum(-old.at_cells(cells[ribbon]), 0.0)
         velocity = old.velocity(cells[ribbon] * h)
+        length_old = np.inf
+        if self.finite_fracture:
+            size = self.measures(s, sim)
+            length_old = size["radius"] if grid.k == 2 else size["half_length"]
         distance = distance_old + velocity * dt
+        length = length_old + float(np.mean(distance - distance_old))
 
         totals = dict(nonlinear_iterations=0, linear_iterations=0, restarts=0, contact_changes=0)
         relaxation = s.relaxation
@@ -180,7 +192,7 @@ class AsymptoticFront:
         for iterations in range(1, prop.front_iterations + 1):
             field = self.field(cells[ribbon], distance, velocity, cells[channel])
             candidates = self._candidates(cells, channel, field)
-            fraction, mean_width, full = fill(candidates, field, self.asymptote, SUB_SAMPLES[self.grid.k])
+            fraction, mean_width, full = fill(candidates, field, self.asymptote, SUB_SAMPLES[self.grid.k], length)
             index = {key: i for i, key in enumerate(grid.key(cells).tolist())}
             where = np.array([index.get(key, -1) for key in grid.key(candidates).tolist()], np.int64)
             new = (where < 0) & (fraction > 0.0)
@@ -221,7 +233,7 @@ class AsymptoticFront:
             for key in totals:
                 totals[key] += info.get(key, 0)
             ribbon_width = np.sum(dd[ribbon] * mesh.normals[ribbon], axis=1)
-            new_distance, _ = self.asymptote.front_distance(ribbon_width, distance_old, dt)
+            new_distance, _ = self.asymptote.front_distance(ribbon_width, distance_old, dt, length=length)
             # at most one element per iteration: far from the fixed point the ribbon takes the
             # volume the trial front leaves out, and the asymptote answers with a far front
             new_distance = np.maximum(np.clip(new_distance, distance - h, distance + h), distance_old)
@@ -233,6 +245,7 @@ class AsymptoticFront:
             last_update = update
             distance = distance + weight * update
             velocity = (distance - distance_old) / dt
+            length = length_old + float(np.mean(distance - distance_old))  # the trial front's size
             logger.debug("front iteration %d: %d elements, %d ribbon, %d tip, %d empty, change %.3g elements",
                          iterations, mesh.n_elements, len(ribbon), np.count_nonzero(state == TIP),
                          np.count_nonzero(state == EMPTY), change)
