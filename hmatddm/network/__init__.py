@@ -21,9 +21,9 @@ from .._lazy import attach
 _EXPORTS = {
     "Network": ".generation", "NetworkSpec": ".generation", "bimodal_directions": ".sampling",
     "generate_network": ".generation", "power_law_lengths": ".sampling", "von_mises_directions": ".sampling",
-    "IntersectionGraph": ".intersections", "Intersections": ".intersections", "find_intersections": ".intersections",
-    "intersection_frequency": ".intersections", "intersection_graph": ".intersections",
-    "scanline_frequency": ".intersections", "split_at_intersections": ".intersections",
+    "IntersectionGraph": ".connectivity", "Intersections": ".intersections", "find_intersections": ".intersections",
+    "intersection_frequency": ".connectivity", "intersection_graph": ".connectivity",
+    "scanline_frequency": ".connectivity", "split_at_intersections": ".intersections",
 }
 __getattr__, __dir__ = attach(__name__, _EXPORTS)
 
