@@ -139,6 +139,21 @@ def _best_row_element(residual_cols, visited, d):
 
 
 @njit(cache=True, nogil=True)
+def _next_pivot_row(residual_cols, visited, d, revisit, negligible):
+    """Row element of the next pivot: the unvisited one with the largest residual in
+    the m x d_c residual columns; when every row element was a pivot once (and
+    ``revisit``), the one with the largest residual if it exceeds ``negligible``: a
+    d_r x d_c pivot with d_c < d_r (or a weak direction left by :func:`_add_cross`)
+    captures only part of a row element's rows. -1 when there is none."""
+    row, _ = _best_row_element(residual_cols, visited, d)
+    if row < 0 and revisit:
+        row, norm2 = _best_row_element(residual_cols, np.zeros(visited.shape[0], dtype=np.bool_), d)
+        if row >= 0 and np.sqrt(norm2) <= negligible:
+            row = -1
+    return row
+
+
+@njit(cache=True, nogil=True)
 def _next_unvisited(visited, position, hop):
     """Next unvisited index after ``position`` walking by ``hop`` (coprime with len); -1 if none."""
     count = visited.shape[0]
@@ -392,6 +407,11 @@ def aca_advance(ut, vt, rows, cols, row_visited, col_visited, ints, floats):
             ints[_CHECKS] = 0  # the check failed: this row is the next pivot
             ints[_ROW] = row
         col, largest = _best_element(rows, col_visited, dc)
+        if col < 0 and rank < max_rank:
+            # every column element was a pivot once, but a weak direction of a pivot
+            # (see _add_cross) may have stayed in the residual: pivot on the largest
+            # residual entry again (blocks with few column elements, e.g. 18 x 2 DDs)
+            col, largest = _best_element(rows, np.zeros(col_visited.shape[0], dtype=np.bool_), dc)
         if col < 0:
             return ut, vt, REQUEST_DONE, 0
         if largest > NEGLIGIBLE * floats[_SCALE]:
@@ -419,7 +439,7 @@ def aca_advance(ut, vt, rows, cols, row_visited, col_visited, ints, floats):
             request, index = _next_check(row_visited, col_visited, ints)
             return ut, vt, request, index
         ints[_CHECKS] = 0  # the check failed: pivot on this column's largest residual row
-        row, _ = _best_row_element(cols, row_visited, d)
+        row = _next_pivot_row(cols, row_visited, d, rank < max_rank, NEGLIGIBLE * floats[_SCALE])
         if row < 0:
             return ut, vt, REQUEST_DONE, 0
         row_visited[row] = True
@@ -435,6 +455,8 @@ def aca_advance(ut, vt, rows, cols, row_visited, col_visited, ints, floats):
         else:
             col_visited[probe] = True  # its residual column is zero and stays zero
             row = _next_unvisited(row_visited, ints[_ROW], ints[_ROW_HOP])
+            if row < 0 and rank < max_rank:
+                row = _next_pivot_row(cols, row_visited, d, True, NEGLIGIBLE * floats[_SCALE])
         if row < 0:
             return ut, vt, REQUEST_DONE, 0
         row_visited[row] = True
@@ -459,7 +481,7 @@ def aca_advance(ut, vt, rows, cols, row_visited, col_visited, ints, floats):
     if update_norm2 <= floats[_EPS] ** 2 * floats[_NORM2]:
         request, index = _next_check(row_visited, col_visited, ints)
         return ut, vt, request, index
-    row, _ = _best_row_element(cols, row_visited, d)
+    row = _next_pivot_row(cols, row_visited, d, True, NEGLIGIBLE * floats[_SCALE])
     if row < 0:
         return ut, vt, REQUEST_DONE, 0
     row_visited[row] = True

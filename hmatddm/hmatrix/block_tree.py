@@ -7,6 +7,13 @@ A block (row cluster tau, column cluster sigma) is admissible when
 on the axis-aligned bounding boxes (dist = 0 when the boxes touch or overlap, so
 such blocks are never admissible). Inadmissible blocks are split into the children
 pairs until both clusters are leaves; those leaf pairs form the near field.
+
+A square operator has one tree for rows and columns and both sides are split at once
+(blocks stay square, the diagonal blocks hold the self terms). A rectangular matrix
+has a row tree and a column tree of different points (targets and sources) whose
+clusters may differ in size by orders of magnitude: there only the cluster with the
+larger diameter is split (the other when it is a leaf), so that every block pairs
+clusters of similar size.
 """
 
 from dataclasses import dataclass
@@ -21,8 +28,9 @@ class BlockTree:
     """Leaves of the block cluster tree as flat (row cluster, column cluster) lists.
 
     ``admissible_rows[b], admissible_cols[b]`` is the b-th far block;
-    ``near_rows[b], near_cols[b]`` the b-th near (dense) leaf block. Together they
-    cover every (element, element) pair exactly once.
+    ``near_rows[b], near_cols[b]`` the b-th near (dense) leaf block (row clusters of
+    the row tree, column clusters of the column tree). Together they cover every
+    (row element, column element) pair exactly once.
     """
 
     admissible_rows: np.ndarray
@@ -32,32 +40,37 @@ class BlockTree:
     eta: float
 
 
-def box_distance(tree, rows, cols):
-    """Euclidean distance between the bounding boxes of clusters rows[k], cols[k]."""
+def box_distance(tree, rows, cols, col_tree=None):
+    """Euclidean distance between the bounding boxes of clusters rows[k] (of ``tree``)
+    and cols[k] (of ``col_tree``, default ``tree``)."""
+    col_tree = tree if col_tree is None else col_tree
     gap = np.maximum(
         0.0,
-        np.maximum(tree.bbox_min[cols] - tree.bbox_max[rows], tree.bbox_min[rows] - tree.bbox_max[cols]),
+        np.maximum(col_tree.bbox_min[cols] - tree.bbox_max[rows], tree.bbox_min[rows] - col_tree.bbox_max[cols]),
     )
     return np.sqrt(np.einsum("ij,ij->i", gap, gap))
 
 
-def is_admissible(tree, rows, cols, eta):
+def is_admissible(tree, rows, cols, eta, col_tree=None):
     """Admissibility ``min(diam) <= eta * dist`` of cluster pairs (vectorised)."""
-    diameter = tree.diameter
-    distance = box_distance(tree, rows, cols)
-    return (distance > 0.0) & (np.minimum(diameter[rows], diameter[cols]) <= eta * distance)
+    col_tree = tree if col_tree is None else col_tree
+    distance = box_distance(tree, rows, cols, col_tree)
+    return (distance > 0.0) & (np.minimum(tree.diameter[rows], col_tree.diameter[cols]) <= eta * distance)
 
 
-def block_tree(tree, eta=3.0):
-    """Partition ``tree x tree`` into admissible and near blocks.
+def block_tree(tree, eta=3.0, col_tree=None):
+    """Partition ``tree x col_tree`` (default ``tree x tree``) into admissible and near blocks.
 
     Traverses the block tree level by level with vectorised numpy: an inadmissible
-    pair is replaced by the pairs of children (a leaf stands for itself) until both
-    sides are leaves. Cost O(number of visited pairs) = O(N/leaf_size * log N) for
-    an eta-admissible partition of a quasi-uniform cloud.
+    pair is replaced by the pairs of children (a leaf stands for itself; with a
+    separate ``col_tree`` only the larger cluster is split, see the module docstring)
+    until both sides are leaves. Cost O(number of visited pairs) = O(N/leaf_size *
+    log N) for an eta-admissible partition of a quasi-uniform cloud.
     """
     if not np.isfinite(eta) or eta <= 0:
         raise InputError(f"eta must be > 0, got {eta!r}")
+    if col_tree is not None and col_tree is not tree:
+        return _rectangular_block_tree(tree, col_tree, float(eta))
     rows = np.zeros(1, dtype=np.int64)
     cols = np.zeros(1, dtype=np.int64)
     far_rows, far_cols, near_rows, near_cols = [], [], [], []
@@ -90,3 +103,35 @@ def block_tree(tree, eta=3.0):
         eta=float(eta),
     )
 
+
+
+def _rectangular_block_tree(row_tree, col_tree, eta):
+    """:func:`block_tree` of two different trees: an inadmissible pair is replaced by the
+    children of its cluster with the larger diameter (of the other one when that is a
+    leaf) until it is admissible or both are leaves."""
+    row_diameter, col_diameter = row_tree.diameter, col_tree.diameter
+    rows = np.zeros(1, dtype=np.int64)
+    cols = np.zeros(1, dtype=np.int64)
+    far_rows, far_cols, near_rows, near_cols = [], [], [], []
+    while rows.size:
+        admissible = is_admissible(row_tree, rows, cols, eta, col_tree)
+        far_rows.append(rows[admissible])
+        far_cols.append(cols[admissible])
+        rows, cols = rows[~admissible], cols[~admissible]
+        row_leaf, col_leaf = row_tree.left[rows] < 0, col_tree.left[cols] < 0
+        both = row_leaf & col_leaf
+        near_rows.append(rows[both])
+        near_cols.append(cols[both])
+        rows, cols, row_leaf, col_leaf = rows[~both], cols[~both], row_leaf[~both], col_leaf[~both]
+        split_row = ~row_leaf & (col_leaf | (row_diameter[rows] >= col_diameter[cols]))
+        rows, cols = (np.concatenate((np.where(split_row, row_tree.left[rows], rows),
+                                      np.where(split_row, row_tree.right[rows], rows))),
+                      np.concatenate((np.where(split_row, cols, col_tree.left[cols]),
+                                      np.where(split_row, cols, col_tree.right[cols]))))
+    return BlockTree(
+        admissible_rows=np.concatenate(far_rows),
+        admissible_cols=np.concatenate(far_cols),
+        near_rows=np.concatenate(near_rows),
+        near_cols=np.concatenate(near_cols),
+        eta=float(eta),
+    )

@@ -84,6 +84,40 @@ def matrix_kernel(data, rows, cols, out):
                     out[d * a + p, d * b + q] = matrix[d * rows[a] + p, d * cols[b] + q]
 
 
+@njit(cache=True, nogil=True)
+def field_kernel(data, rows, cols, out):
+    """Rectangular kernel: targets (rows, ``row_dof`` = dim values each) x sources
+    (columns, 2 strengths each), ``data = (targets, sources)``; with r = x_t - y_s,
+
+        K_p0 = r_p / |r|^3   (the field of a point charge),
+        K_p1 = r_p r_0 / |r|^4  (an anisotropic second source type).
+
+    Like the stress at points induced by elements: different points for rows and
+    columns, different unknowns per row and per column element."""
+    targets, sources = data
+    dim = targets.shape[1]
+    for a in range(rows.shape[0]):
+        i = rows[a]
+        for b in range(cols.shape[0]):
+            j = cols[b]
+            r2 = 0.0
+            for k in range(dim):
+                r2 += (targets[i, k] - sources[j, k]) ** 2
+            inverse = 1.0 / np.sqrt(r2)
+            for p in range(dim):
+                rp = (targets[i, p] - sources[j, p]) * inverse
+                out[dim * a + p, 2 * b] = rp * inverse * inverse
+                out[dim * a + p, 2 * b + 1] = rp * (targets[i, 0] - sources[j, 0]) * inverse * inverse * inverse
+
+
+def field_generator(targets, sources, source_radii=0.0):
+    """Rectangular BlockGenerator of :func:`field_kernel` (targets x sources)."""
+    targets = np.ascontiguousarray(targets, dtype=np.float64)
+    sources = np.ascontiguousarray(sources, dtype=np.float64)
+    return BlockGenerator(field_kernel, (targets, sources), targets, 0.0, targets.shape[1], col_points=sources,
+                          col_radii=source_radii, col_dof=2)
+
+
 def inverse_distance_generator(points, diagonal=1.0):
     """BlockGenerator of the 1/r kernel with ``diagonal`` on the diagonal (d = 1)."""
     points = np.ascontiguousarray(points, dtype=np.float64)

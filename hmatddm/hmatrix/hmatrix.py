@@ -1,4 +1,10 @@
-"""The HMatrix: a compressed matrix of d x d element blocks, usable as a LinearOperator."""
+"""The HMatrix: a compressed matrix of element blocks, usable as a LinearOperator.
+
+Square operators (d x d blocks, one cluster tree) and rectangular matrices (a row tree
+and a column tree of different points, d_r x d_c blocks: e.g. the stress at target
+points induced by the DDs of elements, :mod:`hmatddm.fields`) are built and applied by
+the same code; the near-field extraction (preconditioners) exists for square ones.
+"""
 
 import math
 import time
@@ -51,29 +57,38 @@ class HMatrix(LinearOperator):
     Build with :meth:`HMatrix.build`. Vectors are in the ORIGINAL element-major
     ordering (unknown ``d*i + p`` = component p of element i); the permutation to the
     cluster-tree ordering is applied inside :meth:`matvec` / :meth:`matmat`.
+    ``tree`` is the row tree, ``col_tree`` the column tree (the same object for a
+    square operator).
     """
 
-    def __init__(self, generator, tree, blocks, storage, eps, eta, leaf_size, build_seconds):
-        n = generator.n_elements * generator.dof
-        super().__init__(dtype=np.dtype(np.float64), shape=(n, n))
+    def __init__(self, generator, tree, blocks, storage, eps, eta, leaf_size, build_seconds, col_tree=None):
+        super().__init__(dtype=np.dtype(np.float64), shape=generator.shape)
         self.generator = generator
         self.tree = tree
+        self.col_tree = tree if col_tree is None else col_tree
         self.blocks = blocks
         self.storage = storage
         self.eps = float(eps)
         self.eta = float(eta)
         self.leaf_size = int(leaf_size)
         self.dof = generator.dof
+        self.col_dof = generator.column_dof
         self.n_elements = generator.n_elements
+        self.n_col_elements = generator.n_col_elements
         self.build_seconds = float(build_seconds)
         # unknown permutation: permuted unknown d*k + p <-> original d*permutation[k] + p
-        self._unknown_permutation = (
-            self.dof * tree.permutation[:, None] + np.arange(self.dof)[None, :]
-        ).ravel()
+        self._unknown_permutation = _unknowns(tree.permutation, self.dof)
+        self._col_permutation = _unknowns(self.col_tree.permutation, self.col_dof)
+
+    @property
+    def rectangular(self):
+        """True for a matrix with its own column elements (see :class:`BlockGenerator`)."""
+        return self.generator.rectangular
 
     # ------------------------------------------------------------------ construction
     @classmethod
-    def build(cls, generator, eps=1e-4, eta=3.0, leaf_size=64, factor_dtype=None, check_finite=False, groups=None):
+    def build(cls, generator, eps=1e-4, eta=3.0, leaf_size=64, factor_dtype=None, check_finite=False, groups=None,
+              col_leaf_size=None):
         """Cluster, partition and compress the matrix of ``generator``.
 
         Parameters
@@ -98,6 +113,10 @@ class HMatrix(LinearOperator):
         groups : (N,) int array, optional
             Group of each element (e.g. its fracture): clusters are split between
             whole groups first (see :func:`~hmatddm.hmatrix.cluster_tree.cluster_tree`).
+        col_leaf_size : int >= 1, optional
+            Leaf size of the column tree of a rectangular generator (default
+            ``leaf_size``); the row tree is built on ``generator.points``, the column
+            tree on ``generator.col_points``.
 
         Cost: O(N log N) for the trees, kernel evaluations of the near field plus
         O((m + n) k) per far block, run on numba's thread count.
@@ -105,16 +124,21 @@ class HMatrix(LinearOperator):
         if not isinstance(generator, BlockGenerator):
             raise InputError(f"generator must be a BlockGenerator, got {type(generator).__name__}")
         _check_parameters(eps, eta, leaf_size)
+        col_leaf_size = leaf_size if col_leaf_size is None else col_leaf_size
+        _check_parameters(eps, eta, col_leaf_size)
         dtype = _factor_dtype(factor_dtype, eps)
         started = time.perf_counter()
         tree = cluster_tree(generator.points, generator.radii, int(leaf_size), groups=groups)
-        blocks = block_tree(tree, float(eta))
+        col_tree = tree
+        if generator.rectangular:
+            col_tree = cluster_tree(generator.col_points, generator.col_radii, int(col_leaf_size))
+        blocks = block_tree(tree, float(eta), col_tree=col_tree)
         try:
-            storage = assemble(generator, tree, blocks, float(eps), factor_dtype=dtype)
+            storage = assemble(generator, tree, blocks, float(eps), factor_dtype=dtype, col_tree=col_tree)
         except np.linalg.LinAlgError as error:  # the SVD of a pivot refuses NaN/inf
             raise InputError(f"the kernel returned NaN or inf entries (in a far-field block): {error}") from None
         seconds = time.perf_counter() - started
-        hmatrix = cls(generator, tree, blocks, storage, eps, eta, leaf_size, seconds)
+        hmatrix = cls(generator, tree, blocks, storage, eps, eta, leaf_size, seconds, col_tree=col_tree)
         if check_finite and not hmatrix.is_finite():
             raise InputError("the kernel returned NaN or inf entries; no H-matrix was built")
         return hmatrix
@@ -124,16 +148,16 @@ class HMatrix(LinearOperator):
         X = np.asarray(X, dtype=np.float64)
         if X.ndim == 1:
             X = X[:, None]
-        permuted = np.ascontiguousarray(X[self._unknown_permutation].T)
+        permuted = np.ascontiguousarray(X[self._col_permutation].T)
         result = self.storage.matmat_permuted(permuted)
-        out = np.empty((X.shape[0], X.shape[1]))
+        out = np.empty((self.shape[0], X.shape[1]))
         out[self._unknown_permutation] = result.T
         return out
 
     def _matvec(self, x):
         x = np.asarray(x, dtype=np.float64).reshape(-1)
-        result = self.storage.matmat_permuted(x[self._unknown_permutation].reshape(1, -1))
-        out = np.empty(x.shape[0])
+        result = self.storage.matmat_permuted(x[self._col_permutation].reshape(1, -1))
+        out = np.empty(self.shape[0])
         out[self._unknown_permutation] = result[0]
         return out
 
@@ -142,20 +166,20 @@ class HMatrix(LinearOperator):
 
     # ------------------------------------------------------------------ inspection
     def to_dense(self):
-        """Dense (N d x N d) array of the approximation, original ordering. O((N d)^2)."""
+        """Dense array of the approximation (``self.shape``), original ordering."""
         s = self.storage
-        d = self.dof
+        d, dc = self.dof, self.col_dof
         dense = np.zeros(self.shape)
-        index = self._unknown_permutation
+        index, col_index = self._unknown_permutation, self._col_permutation
         for b in range(s.dense_offset.size - 1):
             rows = index[d * s.dense_row_start[b]:d * s.dense_row_stop[b]]
-            cols = index[d * s.dense_col_start[b]:d * s.dense_col_stop[b]]
+            cols = col_index[dc * s.dense_col_start[b]:dc * s.dense_col_stop[b]]
             block = s.dense_values[s.dense_offset[b]:s.dense_offset[b + 1]].reshape(rows.size, cols.size)
             dense[np.ix_(rows, cols)] = block
         for b in range(s.lowrank_rank.size):
             u, v = self._factors(b)
             rows = index[d * s.lowrank_row_start[b]:d * s.lowrank_row_stop[b]]
-            cols = index[d * s.lowrank_col_start[b]:d * s.lowrank_col_stop[b]]
+            cols = col_index[dc * s.lowrank_col_start[b]:dc * s.lowrank_col_stop[b]]
             dense[np.ix_(rows, cols)] = u @ v.T
         return dense
 
@@ -192,11 +216,14 @@ class HMatrix(LinearOperator):
             "near_field_bytes": int(8 * (s.dense_offset[-1] - s.dense_offset[n_far_dense])),
             "index_bytes": s.index_bytes,
             "n_clusters": int(self.tree.n_clusters),
+            "n_col_clusters": int(self.col_tree.n_clusters),
             "eps": self.eps,
             "eta": self.eta,
             "leaf_size": self.leaf_size,
             "n_elements": int(self.n_elements),
+            "n_col_elements": int(self.n_col_elements),
             "dof": int(self.dof),
+            "col_dof": int(self.col_dof),
             "factor_dtype": str(s.u_values.dtype),
             "n_threads": int(numba.get_num_threads()),
         }
@@ -218,11 +245,11 @@ class HMatrix(LinearOperator):
             raise InputError(f"n_samples must be an integer >= 1, got {n_samples!r}")
         rng = np.random.default_rng(seed)
         s = self.storage
-        tree = self.tree
+        tree, col_tree = self.tree, self.col_tree
         errors = np.zeros(s.admissible_kind.size)
         for b in range(errors.size):
             rs, re = tree.start[self.blocks.admissible_rows[b]], tree.stop[self.blocks.admissible_rows[b]]
-            cs, ce = tree.start[self.blocks.admissible_cols[b]], tree.stop[self.blocks.admissible_cols[b]]
+            cs, ce = col_tree.start[self.blocks.admissible_cols[b]], col_tree.stop[self.blocks.admissible_cols[b]]
             me, ne = int(re - rs), int(ce - cs)
             if me * ne <= n_samples:
                 samples = [(np.arange(me), np.arange(ne))]
@@ -234,7 +261,7 @@ class HMatrix(LinearOperator):
             difference2 = 0.0
             reference2 = 0.0
             for row_pick, col_pick in samples:
-                exact = self.generator.fill(tree.permutation[rs + row_pick], tree.permutation[cs + col_pick])
+                exact = self.generator.fill(tree.permutation[rs + row_pick], col_tree.permutation[cs + col_pick])
                 approx = self._admissible_entries(b, me, ne, row_pick, col_pick)
                 difference2 += float(np.sum((approx - exact) ** 2))
                 reference2 += float(np.sum(exact**2))
@@ -247,17 +274,16 @@ class HMatrix(LinearOperator):
     def _admissible_entries(self, b, me, ne, row_pick, col_pick):
         """Stored approximation of admissible block b at local row/column elements."""
         s = self.storage
-        d = self.dof
-        local = np.arange(d)
-        row_unknowns = (d * row_pick[:, None] + local).ravel()
-        col_unknowns = (d * col_pick[:, None] + local).ravel()
+        d, dc = self.dof, self.col_dof
+        row_unknowns = (d * row_pick[:, None] + np.arange(d)).ravel()
+        col_unknowns = (dc * col_pick[:, None] + np.arange(dc)).ravel()
         kind = s.admissible_kind[b]
         index = s.admissible_index[b]
         if kind == KIND_LOWRANK:
             u, v = self._factors(index)
             return u[row_unknowns] @ v[col_unknowns].T
         if kind == KIND_DENSE:
-            block = s.dense_values[s.dense_offset[index]:s.dense_offset[index + 1]].reshape(d * me, d * ne)
+            block = s.dense_values[s.dense_offset[index]:s.dense_offset[index + 1]].reshape(d * me, dc * ne)
             return block[np.ix_(row_unknowns, col_unknowns)]
         return np.zeros((row_unknowns.size, col_unknowns.size))
 
@@ -268,6 +294,7 @@ class HMatrix(LinearOperator):
 
     # ------------------------------------------------------------------ near field
     def _near_field_arguments(self, part, threshold):
+        self._require_square("the near field")
         if part not in ("near", "leaf_diagonal", "element_diagonal"):
             raise InputError(f"part must be 'near', 'leaf_diagonal' or 'element_diagonal', got {part!r}")
         if isinstance(threshold, bool) or not (
@@ -337,6 +364,7 @@ class HMatrix(LinearOperator):
 
     def element_diagonal_blocks(self):
         """(N, d, d) array: the exact d x d diagonal block of each element (original order)."""
+        self._require_square("element_diagonal_blocks")
         s = self.storage
         d = self.dof
         blocks = np.empty((self.n_elements, d, d))
@@ -348,6 +376,11 @@ class HMatrix(LinearOperator):
             blocks[self.tree.permutation[s.dense_row_start[b] + local]] = dense[local, :, local, :]
         return blocks
 
+    def _require_square(self, what):
+        if self.rectangular:
+            raise InputError(f"{what} exists for square operators only; this H-matrix is rectangular "
+                             f"({self.shape[0]}x{self.shape[1]})")
+
     def is_finite(self):
         """True when every stored entry (dense blocks, U, V) is finite. O(memory)."""
         s = self.storage
@@ -357,10 +390,17 @@ class HMatrix(LinearOperator):
     def __repr__(self):
         st = self.stats
         return (
-            f"<HMatrix {self.shape[0]}x{self.shape[1]} (N={self.n_elements}, d={self.dof}) eps={self.eps:g} "
+            f"<HMatrix {self.shape[0]}x{self.shape[1]} (N={self.n_elements}, d={self.dof}"
+            + (f"; columns N={self.n_col_elements}, d={self.col_dof}" if self.rectangular else "")
+            + f") eps={self.eps:g} "
             f"eta={self.eta:g} leaf_size={self.leaf_size} compression={st['compression']:.2f} "
             f"max_rank={st['max_rank']}>"
         )
+
+
+def _unknowns(permutation, dof):
+    """Unknown permutation of an element permutation: ``dof*permutation[k] + p``."""
+    return (dof * permutation[:, None] + np.arange(dof)[None, :]).ravel()
 
 
 @njit(cache=True)

@@ -1,7 +1,9 @@
 """Flat storage of an H-matrix, its parallel assembly and its parallel matvec.
 
-Everything lives in a few flat arrays, in the PERMUTED ordering of the cluster tree
-(tree position k holds original element ``permutation[k]``; unknown ``d*k + p``):
+Everything lives in a few flat arrays, in the PERMUTED ordering of the cluster trees
+(tree position k holds original element ``permutation[k]``; unknown ``d*k + p``; a
+rectangular matrix has a row tree with d_r unknowns per element and a column tree with
+d_c, a square one the same tree and d for both):
 
 * dense blocks (near field, plus far blocks whose low rank would not pay): element
   ranges ``dense_row_start/stop``, ``dense_col_start/stop`` (tree positions), values
@@ -37,6 +39,8 @@ class BlockStorage:
 
     dof: int
     n_elements: int
+    col_dof: int
+    n_col_elements: int
     dense_row_start: np.ndarray
     dense_row_stop: np.ndarray
     dense_col_start: np.ndarray
@@ -80,8 +84,8 @@ class BlockStorage:
         return int(total)
 
     def matmat_permuted(self, x):
-        """y = A x for x of shape (nrhs, N*d) (transposed!) in the permuted ordering;
-        returns y of shape (nrhs, N*d). Parallel and race-free; on one thread below
+        """y = A x for x of shape (nrhs, N_c*d_c) (transposed!) in the permuted ordering;
+        returns y of shape (nrhs, N*d_r). Parallel and race-free; on one thread below
         ``SERIAL_MATVEC_ENTRIES`` stored entries x right-hand sides and on the cores
         other processes leave free (:func:`~hmatddm.hmatrix._threads.threads_for`;
         the same result whatever the count)."""
@@ -94,6 +98,8 @@ class BlockStorage:
     def _matmat_permuted(self, x, kernel):
         return kernel(
             self.dof,
+            self.col_dof,
+            self.n_elements * self.dof,
             self.dense_col_start,
             self.dense_row_start,
             self.dense_col_stop,
@@ -285,8 +291,9 @@ class _GrowingArray:
         return self.values
 
 
-def assemble(generator, tree, blocks, eps, n_threads=None, factor_dtype=np.float64):
-    """Compress and store all blocks of ``blocks`` (a BlockTree over ``tree``).
+def assemble(generator, tree, blocks, eps, n_threads=None, factor_dtype=np.float64, col_tree=None):
+    """Compress and store all blocks of ``blocks`` (a BlockTree over ``tree`` x
+    ``col_tree``; default ``tree`` x ``tree``).
 
     Far blocks: whole-element ACA + recompression, in batches on ``n_threads``
     threads (default: numba's thread count); factors stored as ``factor_dtype``
@@ -294,22 +301,23 @@ def assemble(generator, tree, blocks, eps, n_threads=None, factor_dtype=np.float
     (float64) dense array. Cost: the near-field kernel entries plus, per far block,
     O((m + n) k) kernel entries and O((m + n) k^2) flops.
     """
-    d = generator.dof
+    d, dc = generator.dof, generator.column_dof
+    col_tree = tree if col_tree is None else col_tree
     n_threads = numba.get_num_threads() if n_threads is None else int(n_threads)
-    permutation = tree.permutation
+    permutation, col_permutation = tree.permutation, col_tree.permutation
     kernel, data = generator.kernel, generator.data
 
     far_rows_start = tree.start[blocks.admissible_rows]
     far_rows_stop = tree.stop[blocks.admissible_rows]
-    far_cols_start = tree.start[blocks.admissible_cols]
-    far_cols_stop = tree.stop[blocks.admissible_cols]
+    far_cols_start = col_tree.start[blocks.admissible_cols]
+    far_cols_stop = col_tree.stop[blocks.admissible_cols]
     n_far = far_rows_start.size
     empty = np.empty(0)
     no_offsets = np.zeros(n_far, dtype=np.int64)
     driver = build_driver(data)
 
     def far_batch(ids):
-        return driver(kernel, data, permutation, permutation, d, d, float(eps), far_rows_start[ids],
+        return driver(kernel, data, permutation, col_permutation, d, dc, float(eps), far_rows_start[ids],
                       far_rows_stop[ids], far_cols_start[ids], far_cols_stop[ids], np.ones(ids.size, dtype=np.bool_),
                       no_offsets[ids], empty)
 
@@ -348,13 +356,13 @@ def assemble(generator, tree, blocks, eps, n_threads=None, factor_dtype=np.float
     # Dense storage: far blocks stored dense first, then the near field.
     near_rows_start = tree.start[blocks.near_rows]
     near_rows_stop = tree.stop[blocks.near_rows]
-    near_cols_start = tree.start[blocks.near_cols]
-    near_cols_stop = tree.stop[blocks.near_cols]
+    near_cols_start = col_tree.start[blocks.near_cols]
+    near_cols_stop = col_tree.stop[blocks.near_cols]
     dense_row_start = np.concatenate((far_rows_start[far_dense], near_rows_start))
     dense_row_stop = np.concatenate((far_rows_stop[far_dense], near_rows_stop))
     dense_col_start = np.concatenate((far_cols_start[far_dense], near_cols_start))
     dense_col_stop = np.concatenate((far_cols_stop[far_dense], near_cols_stop))
-    dense_size = d * d * (dense_row_stop - dense_row_start) * (dense_col_stop - dense_col_start)
+    dense_size = d * dc * (dense_row_stop - dense_row_start) * (dense_col_stop - dense_col_start)
     dense_offset = np.concatenate(([0], np.cumsum(dense_size))).astype(np.int64)
     dense_values = np.empty(dense_offset[-1])
     far_dense_values = far_dense_values.finish()
@@ -365,7 +373,7 @@ def assemble(generator, tree, blocks, eps, n_threads=None, factor_dtype=np.float
     near_offset = dense_offset[far_dense.size:-1]
 
     def near_batch(ids):
-        return driver(kernel, data, permutation, permutation, d, d, float(eps), near_rows_start[ids],
+        return driver(kernel, data, permutation, col_permutation, d, dc, float(eps), near_rows_start[ids],
                       near_rows_stop[ids], near_cols_start[ids], near_cols_stop[ids],
                       np.zeros(ids.size, dtype=np.bool_), near_offset[ids], dense_values)
 
@@ -378,7 +386,7 @@ def assemble(generator, tree, blocks, eps, n_threads=None, factor_dtype=np.float
     rows_lr = far_rows_stop[lowrank] - far_rows_start[lowrank]
     cols_lr = far_cols_stop[lowrank] - far_cols_start[lowrank]
     u_offset = np.concatenate(([0], np.cumsum(d * rows_lr * lowrank_rank))).astype(np.int64)
-    v_offset = np.concatenate(([0], np.cumsum(d * cols_lr * lowrank_rank))).astype(np.int64)
+    v_offset = np.concatenate(([0], np.cumsum(dc * cols_lr * lowrank_rank))).astype(np.int64)
     rank_offset = np.concatenate(([0], np.cumsum(lowrank_rank))).astype(np.int64)
     assert u_offset[-1] == u_values.size and v_offset[-1] == v_values.size
 
@@ -394,6 +402,8 @@ def assemble(generator, tree, blocks, eps, n_threads=None, factor_dtype=np.float
     return BlockStorage(
         dof=d,
         n_elements=tree.n_elements,
+        col_dof=dc,
+        n_col_elements=col_tree.n_elements,
         dense_row_start=dense_row_start,
         dense_row_stop=dense_row_stop,
         dense_col_start=dense_col_start,
@@ -446,27 +456,30 @@ def _segment_lists(segment_start, block_row_start, block_row_stop):
 
 
 @njit(parallel=True, cache=True, fastmath=FAST)
-def _matmat_permuted(dof, dense_col_start, dense_row_start, dense_col_stop, dense_offset, dense_values,
+def _matmat_permuted(dof, col_dof, n_rows, dense_col_start, dense_row_start, dense_col_stop, dense_offset, dense_values,
                      lowrank_row_start, lowrank_row_stop, lowrank_col_start, lowrank_col_stop, lowrank_rank,
                      u_offset, v_offset, rank_offset, u_values, v_values, segment_start, segment_dense_ptr,
                      segment_dense_ids, segment_lowrank_ptr, segment_lowrank_ids, x):
-    """Y = A X for X given TRANSPOSED, x of shape (nrhs, N*d), permuted ordering.
+    """Y = A X for X given TRANSPOSED, x of shape (nrhs, N_c*d_c), permuted ordering
+    (``dof`` d_r unknowns per row element, ``col_dof`` d_c per column element,
+    ``n_rows`` = N*d_r rows).
 
     Phase 1 (parallel over low-rank blocks): t_b = V_b^T x_cols (each block owns t_b).
     Phase 2 (parallel over segments): y_seg = sum of dense rows and U_b rows times t_b
     over the blocks covering the segment. O(stored entries * nrhs) flops; all inner
-    loops run over contiguous memory. Returns y of shape (nrhs, N*d).
+    loops run over contiguous memory. Returns y of shape (nrhs, n_rows).
     """
     # Inner loops index slices (views) from 0: with computed offsets numba cannot
     # prove indices non-negative and its wrap-around checks block SIMD (3x slower).
     d = dof
+    dc = col_dof
     nrhs = x.shape[0]
     n_lowrank = lowrank_rank.shape[0]
     t = np.zeros((nrhs, rank_offset[n_lowrank]))
     for b in prange(n_lowrank):
         k = lowrank_rank[b]
-        c0 = d * lowrank_col_start[b]
-        nc = d * (lowrank_col_stop[b] - lowrank_col_start[b])
+        c0 = dc * lowrank_col_start[b]
+        nc = dc * (lowrank_col_stop[b] - lowrank_col_start[b])
         t0 = rank_offset[b]
         for r in range(nrhs):
             x_cols = x[r, c0:c0 + nc]
@@ -477,15 +490,15 @@ def _matmat_permuted(dof, dense_col_start, dense_row_start, dense_col_stop, dens
                     total += v_column[j] * x_cols[j]
                 t[r, t0 + q] = total
     n_segments = segment_start.shape[0] - 1
-    y = np.zeros((nrhs, x.shape[1]))
+    y = np.zeros((nrhs, n_rows))
     for s in prange(n_segments):
         r0 = d * segment_start[s]
         r1 = d * segment_start[s + 1]
         rows = r1 - r0
         for e in range(segment_dense_ptr[s], segment_dense_ptr[s + 1]):
             b = segment_dense_ids[e]
-            c0 = d * dense_col_start[b]
-            nc = d * (dense_col_stop[b] - dense_col_start[b])
+            c0 = dc * dense_col_start[b]
+            nc = dc * (dense_col_stop[b] - dense_col_start[b])
             base = dense_offset[b] + (r0 - d * dense_row_start[b]) * nc
             for r in range(nrhs):
                 x_cols = x[r, c0:c0 + nc]
