@@ -77,6 +77,8 @@ from hmatddm.network import NetworkSpec, generate_network  # noqa: E402
 from hmatddm.operators import NEAR_SINGULAR_FRACTION  # noqa: E402
 from hmatddm.simulation import checkpoint as checkpoint_module  # noqa: E402
 from hmatddm.simulation import natural as natural_module  # noqa: E402
+from hmatddm.simulation import growing_operator as growing_operator_module  # noqa: E402
+from hmatddm.simulation import growth_pass as growth_pass_module  # noqa: E402
 from hmatddm.simulation import simulation as simulation_module  # noqa: E402
 from hmatddm.simulation.natural import plan_segments  # noqa: E402
 
@@ -218,8 +220,8 @@ def instrumented():
     timer = PartTimer()
     sim_class = simulation_module.Simulation
     timer.wrap(sim_class, "_solve", "solve")            # coupled solve (includes operator)
-    timer.wrap(sim_class, "_build_base", "operator")     # H-matrix / dense builds
-    timer.wrap(sim_class, "_grow", "grow")               # tips, new elements, encounters
+    timer.wrap(growing_operator_module.GrowingOperator, "build", "operator")  # H-matrix / dense builds
+    timer.wrap(growth_pass_module, "grow", "grow")       # tips, new elements, encounters
     timer.wrap(sim_class, "save_checkpoint", "checkpoint")
     timer.wrap(natural_module, "stress_at", "remote_stress")
     try:
@@ -312,7 +314,7 @@ def run(scene, backend="hmatrix", end_time=None, checkpoint_dir=None, keep_centr
 
 
 def _operator_stats(sim):
-    base = sim._base
+    base = sim.base_operator
     if base is None:
         return None
     stats = base.stats

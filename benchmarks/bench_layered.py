@@ -124,7 +124,7 @@ def height_runs(end_time):
             times.append(step)
         wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
         curves.append((label, times, heights))
-        images = sim._base.stats.get("n_images")  # the last full build (growth adds exact borders)
+        images = sim.base_operator.stats.get("n_images")  # the last full build (growth adds exact borders)
         rows.append([label, f"{heights[-1]:.2f}", sim.state.mesh.n_elements, images, f"{wall:.0f} / {cpu:.0f}"])
     fig, ax = plt.subplots(figsize=(6.5, 4.2))
     for label, times, heights in curves:

@@ -128,7 +128,8 @@ def test_two_tips_reaching_one_natural_element_activate_it_once(monkeypatch, hyd
     from types import SimpleNamespace
 
     from hmatddm import topology
-    from hmatddm.simulation import simulation as simulation_module
+    from hmatddm.simulation import growth_pass, linking
+    from hmatddm.simulation.state import State, StepEvents
 
     # natural fracture in the plane y = 0: 4 x 2 elements of 1 m, centres z = -0.5, 0.5
     natural = hd.mesh.rectangle([2.0, 0.0, 0.0], [1, 0, 0], [0, 0, 1], 4.0, 2.0, 4, 2)
@@ -153,24 +154,28 @@ def test_two_tips_reaching_one_natural_element_activate_it_once(monkeypatch, hyd
     hydraulic_candidate = hd.mesh.rectangle([hydraulic_x, 0.0, -0.5], [0, 1, 0], [0, 0, 1], 1.0, 1.0, 1, 1)
     candidates = hd.mesh.concatenate([hydraulic_candidate, natural.subset(np.array([target]))])
     tips = SimpleNamespace(edge=np.array(tip_edges), k_1=np.zeros(2), k_2=np.zeros(2), theta=np.zeros(2))
-    monkeypatch.setattr(simulation_module, "evaluate_tips", lambda *args, **kwargs: tips)
-    monkeypatch.setattr(simulation_module, "new_elements",
+    monkeypatch.setattr(growth_pass, "evaluate_tips", lambda *args, **kwargs: tips)
+    monkeypatch.setattr(growth_pass, "new_elements",
                         lambda *args, **kwargs: (candidates, np.array([0, 1]), np.array([0, 1])))
     monkeypatch.setattr(sim.network, "decide_crossing", lambda *args, **kwargs: False)  # always deflect
-    sim._events = dict(natural_crossed=0, natural_deflected=0, junctions=0)
-    new_mesh, parent, new_natural, connections, new_origin, _ = sim._grow(
-        mesh, edges, faces, np.zeros((2, 3)), origin, natural_index, intact)
-    assert new_mesh.n_elements == 1 and list(new_natural) == [target] and list(new_origin) == [1]
-    assert list(parent) == [0]
+    events = StepEvents()
+    state = State(mesh, np.zeros((2, 3)), np.zeros(2), np.zeros(2), 0.0, 0, 1.0, 0.0, 0.0, origin=origin,
+                  natural_index=natural_index, intact=intact, failed=np.zeros(natural.n_elements, bool),
+                  extra_faces=np.zeros((0, 6)))
+    growth = growth_pass.grow(sim, state, edges, faces, None, events)
+    new, connections = growth.elements, growth.connections
+    assert new.mesh.n_elements == 1 and list(new.natural_index) == [target] and list(new.origin) == [1]
+    assert list(new.parent) == [0]
     deflected = [(0, 0)] if hydraulic_x != 2.5 else []  # the deflected tip's own link
-    assert [(k, tip) for k, tip, *_ in connections] == deflected + [(0, 1)]
-    assert sim._events["natural_deflected"] == len(deflected)
+    assert [(c.target, c.tip) for c in connections] == deflected + [(0, 1)]
+    assert all(c.target_is_new for c in connections)
+    assert events.natural_deflected == len(deflected)
     # the natural tip and the target share an edge: the mesh topology gives their face,
     # and the explicit link is dropped (no doubled conductance); the deflected hydraulic
     # tip keeps its link
-    grown_mesh = hd.mesh.concatenate([mesh, new_mesh])
-    links = np.array([[tip, 2 + k, length, d_tip, d_nat, edge] for k, tip, length, d_tip, d_nat, edge in connections])
+    grown_mesh = hd.mesh.concatenate([mesh, new.mesh])
+    links = np.array([c.face(first_new=2) for c in connections])
     plain = topology.element_faces(grown_mesh, topology.element_edges(grown_mesh, None))
     assert {1, 2} in [{int(a), int(b)} for a, b in zip(plain.first, plain.second)]
-    faces = simulation_module.with_links(plain, links)
+    faces = linking.with_links(plain, links)
     assert len(faces.first) == len(plain.first) + len(deflected)

@@ -180,9 +180,9 @@ def test_relaxation_grows_back_after_an_easy_step_in_the_coupled_schemes(monkeyp
     without restart the coupled schemes double it again (up to the initial alpha), the
     segregated ones keep it (ref. Fig. 4.10). Before, one hard step in the 3D DFN benchmark
     left alpha at 1/8 for every later step (~140 iterations a step instead of ~10)."""
-    from hmatddm.simulation import simulation as simulation_module
+    from hmatddm.simulation import step_solve
 
-    solve = simulation_module.solve_step
+    solve = step_solve.solve_step
     calls = []
 
     def solve_halving_once(problem, settings, dd, p, relaxation):
@@ -192,7 +192,7 @@ def test_relaxation_grows_back_after_an_easy_step_in_the_coupled_schemes(monkeyp
             info = dict(info, relaxation=relaxation / 2.0, restarts=1)
         return dd, p, info
 
-    monkeypatch.setattr(simulation_module, "solve_step", solve_halving_once)
+    monkeypatch.setattr(step_solve, "solve_step", solve_halving_once)
     sim = kgd_simulation(scheme=scheme)
     states = []
     for _ in range(3):

@@ -2,9 +2,10 @@
 from .._lazy import attach
 
 _EXPORTS = {
-    "CheckpointError": ".checkpoint", "RECORD_KEYS": ".simulation", "Simulation": ".simulation",
-    "State": ".simulation",
+    "CheckpointError": ".checkpoint", "RECORD_KEYS": ".records", "Simulation": ".simulation", "State": ".state",
+    "OperatorSettings": ".settings", "RebuildSettings": ".settings", "CheckpointSettings": ".settings",
 }
 __getattr__, __dir__ = attach(__name__, _EXPORTS)
 
-__all__ = ["Simulation", "State", "RECORD_KEYS", "CheckpointError"]
+__all__ = ["Simulation", "State", "RECORD_KEYS", "CheckpointError", "OperatorSettings", "RebuildSettings",
+           "CheckpointSettings"]

@@ -20,8 +20,9 @@ natural element, plus the far field and the undrained pore-pressure change
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ..fracture.crossing import crosses
-from ..mesh import Mesh3D
+from ..errors import InputError
+from ..fracture.crossing import NaturalFractureProperties, crosses
+from ..mesh import Mesh3D, check_mesh
 from ..operators import NEAR_SINGULAR_FRACTION
 from ..solve import stress_at
 
@@ -135,3 +136,21 @@ class NaturalNetwork:
                                                >= props.tensile_strength)
         normal_stress[targets], shear_stress[targets] = sigma_n, tau
         return failed, normal_stress, shear_stress, pore_change
+
+
+def natural_network(mesh, natural_fractures, properties=None):
+    """The :class:`NaturalNetwork` of a run on hydraulic fractures ``mesh``: the checked
+    ``natural_fractures`` (same mesh type), their fracture ids moved past those of
+    ``mesh`` so that they never collide, and their ``properties`` (default
+    :class:`~hmatddm.NaturalFractureProperties` if None)."""
+    if type(natural_fractures) is not type(mesh):
+        raise InputError(f"natural_fractures must be a {type(mesh).__name__} like mesh, "
+                         f"got {type(natural_fractures).__name__}")
+    check_mesh(natural_fractures, "natural_fractures")
+    properties = NaturalFractureProperties() if properties is None else properties
+    if not isinstance(properties, NaturalFractureProperties):
+        raise InputError("natural must be an hmatddm.NaturalFractureProperties or None")
+    offset = int(mesh.fracture_id.max()) + 1 - int(natural_fractures.fracture_id.min())
+    shifted = natural_fractures.subset(np.arange(natural_fractures.n_elements))
+    object.__setattr__(shifted, "fracture_id", natural_fractures.fracture_id + offset)
+    return NaturalNetwork(shifted, properties)

@@ -1,0 +1,78 @@
+"""The elasticity operator of a growing mesh: built once, extended by exact border
+blocks while the mesh grows a little, rebuilt when it grew too much.
+
+The operator is rebuilt only when the mesh has grown, never inside the nonlinear
+iterations of a step.
+"""
+import warnings
+from dataclasses import asdict
+
+import numpy as np
+
+from ..errors import MeshQualityWarning
+from ..extended_operator import ExtendedElasticityOperator
+from ..operators import ElasticityOperator
+
+
+class GrowingOperator:
+    """The operators of one run's meshes (``operator_settings``: an
+    :class:`~hmatddm.simulation.settings.OperatorSettings`; ``rebuild_settings``: a
+    :class:`~hmatddm.simulation.settings.RebuildSettings`)."""
+
+    def __init__(self, material, operator_settings, rebuild_settings):
+        self.material = material
+        self.operator_settings, self.rebuild_settings = operator_settings, rebuild_settings
+        self.base = None     # the last full build (compressed, for the hmatrix backend)
+        self.builds = 0      # full builds so far
+        self._mesh = None    # the mesh of the last operator handed out
+        self._operator = None
+        self._mesh_quality_warned = False
+
+    def __call__(self, mesh):
+        """The elasticity operator of ``mesh``: the last one if the mesh is unchanged, the
+        compressed base plus exact borders if the mesh only grew a little, else a new build."""
+        if self._mesh is mesh:
+            return self._operator
+        base = self.base
+        n = mesh.n_elements
+        extends = (base is not None and n >= base.mesh.n_elements
+                   and np.array_equal(mesh.centers[:base.mesh.n_elements], base.mesh.centers))
+        if extends and n == base.mesh.n_elements:
+            operator = base
+        elif (extends and self.operator_settings.backend == "hmatrix"
+              and self.rebuild_settings.border_fits(base.mesh.n_elements, n - base.mesh.n_elements, base.dof)):
+            # the border blocks of the elements the last operator had are copied, not re-evaluated
+            operator = ExtendedElasticityOperator(base, mesh, previous=self._operator)
+        else:
+            operator = self.build(mesh)
+        self._operator, self._mesh = operator, mesh
+        return operator
+
+    def build(self, mesh):
+        """A full build of the operator of ``mesh``, which becomes the base."""
+        # the mesh-quality check runs at every build of a growing mesh: warn once per run
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", MeshQualityWarning)
+            self.base = ElasticityOperator(mesh, self.material, **asdict(self.operator_settings))
+        for warning in caught:
+            if issubclass(warning.category, MeshQualityWarning):
+                if not self._mesh_quality_warned:
+                    self._mesh_quality_warned = True
+                    warnings.warn(f"{warning.message} (warned once per simulation)", MeshQualityWarning,
+                                  stacklevel=2)
+            else:
+                warnings.warn_explicit(warning.message, warning.category, warning.filename, warning.lineno)
+        self.builds += 1
+        return self.base
+
+    def restore(self, mesh, compressed_elements):
+        """Rebuild the base an interrupted run had (its first ``compressed_elements``
+        elements of ``mesh``), so that a resumed run applies the same operator, bit for bit."""
+        self.base = self._mesh = self._operator = None
+        if 0 < compressed_elements <= mesh.n_elements:
+            self.build(mesh.subset(np.arange(compressed_elements)))
+
+    @property
+    def compressed_elements(self):
+        """Elements in the compressed base operator (0 before the first build)."""
+        return 0 if self.base is None else self.base.mesh.n_elements

@@ -1,0 +1,77 @@
+"""One growth pass of a time step (ref. Fig. 4.1): the elements and flow connections to
+add after a solve, or None when nothing grows.
+
+Tips that grow (ref. Sec. 4.2.2) add elements ahead of them
+(:func:`hmatddm.fracture.new_elements`); in a layered medium they are cut at the
+interfaces; a candidate that would cut another hydraulic fracture stops there
+(:mod:`~hmatddm.simulation.junctions`); with natural fractures, each candidate is checked
+against them (:mod:`~hmatddm.simulation.encounters`). When no tip grows, intact natural
+elements that fail remotely (ref. Sec. 5.3) join instead.
+"""
+import numpy as np
+
+from .. import topology
+from ..fracture import evaluate_tips, new_elements
+from .encounters import meet_natural_fractures
+from .junctions import stop_at_other_fractures
+from .state import Growth, NewElements, Origin
+
+
+def grow(simulation, state, edges, faces, drained, events):
+    """The :class:`~hmatddm.simulation.state.Growth` of the tips of ``state`` (``edges``,
+    ``faces``: its mesh's, as solved) or None. Tips of ``drained`` elements (remotely
+    failed, not reached by the fluid) do not grow; ``events`` counts what happened."""
+    sim, mesh = simulation, state.mesh
+    element, edge = topology.tip_edges(mesh, faces, edges)
+    if sim.growing_fractures is not None:
+        keep = np.isin(mesh.fracture_id[element], sim.growing_fractures)
+        element, edge = element[keep], edge[keep]
+    if drained is not None and np.any(drained):
+        keep = ~drained[element]
+        element, edge = element[keep], edge[keep]
+    if element.size == 0:
+        return None
+    tips = evaluate_tips(mesh, edges, element, edge, state.dd, sim.elastic_constants(mesh, element), sim.propagation)
+    if sim.medium is not None:  # per-layer toughness; new elements end on interfaces
+        from ..layered import engine as layered_engine
+
+        tips = layered_engine.tip_criterion(tips, sim.elastic_constants(mesh, element),
+                                            layered_engine.layers_ahead(edges, element, edge, sim.medium),
+                                            sim.medium, sim.propagation)
+    candidates = new_elements(mesh, edges, tips, sim.propagation, return_tips=True)
+    if candidates is None:
+        return None
+    grown, parent, rows = candidates
+    # cut at interfaces (3D: also between equal layers, the 3D kernels refuse straddling rectangles)
+    if sim.medium is not None and (mesh.dim == 3 or not layered_engine.uniform(sim.medium)):
+        grown, parent, rows = layered_engine.split_new_elements(grown, parent, rows, sim.medium)
+    grown, parent, rows, junctions = stop_at_other_fractures(mesh, edges, tips, grown, parent, rows, state.origin,
+                                                             events)
+    if grown is None:
+        return Growth(None, junctions)
+    if sim.network is None:
+        return Growth(NewElements.hydraulic(grown, parent), junctions)
+    elements, connections = meet_natural_fractures(sim, state, edges, faces, tips, grown, parent, rows, events)
+    connections = junctions + connections
+    if elements is None and not connections:
+        return None
+    return Growth(elements, connections)
+
+
+def remote_failures(simulation, state, events):
+    """Intact natural elements of ``state`` that fail (ref. Sec. 5.3) as the
+    :class:`~hmatddm.simulation.state.Growth` that adds them (no parent, at the pore
+    pressure plus the undrained change, ref. Eq. 5.18), or None."""
+    sim = simulation
+    if sim.network is None or not sim.remote_failure or not np.any(state.intact):
+        return None
+    failed, _, _, pore_change = sim.network.remote_failure(state.mesh, state.dd, sim.material, sim.far_field_stress,
+                                                           state.intact, sim.operator_settings.singular_correction)
+    index = np.flatnonzero(failed)
+    if index.size == 0:
+        return None
+    events.natural_newly_failed += int(index.size)
+    m = index.size
+    pressure = sim.network.properties.pore_pressure + pore_change[index]
+    return Growth(NewElements(sim.network.mesh.subset(index), -np.ones(m, np.int64), np.full(m, Origin.FAILED, np.int64),
+                              index.astype(np.int64), pressure))

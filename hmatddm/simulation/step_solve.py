@@ -1,0 +1,87 @@
+"""The coupled solve of one pass of a time step (ref. Sec. 4.4): the elasticity and flow
+of the trial state's mesh from the start of the step, with contact on the elements that
+may close (:mod:`hmatddm.coupled.contact`) and the pressure of remotely failed elements
+that no fluid reaches held at their failure pressure."""
+from dataclasses import replace
+from typing import NamedTuple
+
+import numpy as np
+
+from .. import topology
+from ..coupled import ElasticSolver, StepProblem, solve_step
+from ..coupled.contact import ContactLaw, ContactModel
+from ..flow import fracture_compliance
+from .linking import with_links
+from .state import Origin
+
+
+class SolvedMesh(NamedTuple):
+    """What a solve built of its mesh, which the growth pass and the record reuse."""
+
+    edges: object  # hmatddm.topology.Edges
+    faces: object  # flow faces, intersection links included
+    flow: object   # the LubricationModel
+
+
+def contact_law(simulation, origin):
+    """The :class:`~hmatddm.coupled.contact.ContactLaw` of elements with ``origin``
+    (``simulation.contact`` says which may close; natural elements with their friction
+    and cohesion)."""
+    natural = origin >= Origin.ACTIVATED
+    enabled = {"natural": natural, "all": np.ones_like(natural), "none": np.zeros_like(natural)}[simulation.contact]
+    friction = np.zeros(len(origin))
+    cohesion = np.zeros(len(origin))
+    if simulation.network is not None:
+        friction[natural] = simulation.network.properties.friction
+        cohesion[natural] = simulation.network.properties.cohesion
+    return ContactLaw(enabled, friction, cohesion)
+
+
+def drained(simulation, mesh, faces, origin):
+    """Remotely failed elements that no fluid path connects to an injection point."""
+    failed = origin == Origin.FAILED
+    if not np.any(failed):
+        return failed
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    n = mesh.n_elements
+    graph = coo_matrix((np.ones(faces.n_faces), (faces.first, faces.second)), shape=(n, n))
+    _, label = connected_components(graph, directed=False)
+    fed = np.isin(label, label[simulation.injection_elements])
+    return failed & ~fed
+
+
+def solve(simulation, trial, start, t_old, t_new, relaxation):
+    """The coupled step of ``simulation`` from ``start`` (a
+    :class:`~hmatddm.simulation.state.StepStart`) to ``t_new`` on the mesh of ``trial``
+    (a :class:`~hmatddm.simulation.state.State`), from its DD and pressure with
+    relaxation ``relaxation``: ``(trial with the solution, info, SolvedMesh)``;
+    ``info`` is :func:`hmatddm.coupled.solve_step`'s plus ``contact_frozen`` and
+    ``drained`` (the remotely failed elements no fluid reaches)."""
+    sim, mesh = simulation, trial.mesh
+    edges = topology.element_edges(mesh, sim.height)
+    faces = with_links(topology.element_faces(mesh, edges), trial.extra_faces)
+    flow = sim.flow_model(mesh, faces)
+    elastic = ElasticSolver(sim.operator(mesh), rtol=sim.settings.linear_rtol)
+    contact, fixed_pressure, pressure_guess = None, None, trial.pressure
+    law = contact_law(sim, trial.origin)
+    if np.any(law.enabled):
+        contact = ContactModel(law, mesh.normals, start.dd, trial.contact_status, trial.slip_direction,
+                               elastic.normal_stiffness(mesh.normals))
+    no_fluid = drained(sim, mesh, faces, trial.origin)
+    if np.any(no_fluid):
+        fixed_pressure = np.where(no_fluid, trial.failure_pressure, np.nan)
+        pressure_guess = np.where(no_fluid, trial.failure_pressure, pressure_guess)
+    problem = StepProblem(elastic=elastic, normals=mesh.normals, far_field=sim.far_field_traction(mesh), flow=flow,
+                          compliance=fracture_compliance(mesh, sim.elastic_constants(mesh)), dt=t_new - t_old,
+                          width_old=start.width, pressure_old=start.pressure,
+                          leak_off_rate=flow.leak_off_rate(trial.creation_time, t_old, t_new),
+                          contact=contact, fixed_pressure=fixed_pressure)
+    dd, p, info = solve_step(problem, sim.settings, trial.dd.ravel(), pressure_guess, relaxation)
+    solution = dict(dd=dd.reshape(mesh.n_elements, mesh.dim), pressure=p)
+    if contact is not None:
+        solution.update(contact_status=contact.status.copy(), slip_direction=contact.direction.copy())
+    info["contact_frozen"] = 0 if contact is None else contact.frozen
+    info["drained"] = no_fluid
+    return replace(trial, **solution), info, SolvedMesh(edges, faces, flow)
