@@ -27,9 +27,9 @@ def positive_scalar(name, value):
     return result
 
 
-def positive_int(name, value, minimum=1):
-    """``value`` as an int >= ``minimum``: the one integer check (:func:`hmatddm.settings.integer`)."""
-    return integer(name, value, minimum)
+#: ``positive_int(name, value, minimum=1, maximum=None)``: the one integer check,
+#: :func:`hmatddm.settings.integer`, under the name the engine modules import.
+positive_int = integer
 
 
 def finite_array(name, value, shape=None, dtype=np.float64):
