@@ -1,11 +1,12 @@
-"""Induced stress at points (hmatddm.solve.stress_at / mean_stress_at): the contracted
-kernels against the per-component kernels, and the compressed (tree) sum against the exact
-direct sum on a DFN-like scene."""
+"""Stress fields at points (hmatddm.fields, behind hd.stress_at / hd.mean_stress_at): the
+exact sum against an independent per-pair sum of the kernels' ``stress_pair``, and the
+points x elements H-matrix against the exact sum (2D and 3D, points near and far)."""
 import numpy as np
 import pytest
 
 import hmatddm as hd
-from hmatddm.kernels import element_data, line2d, rectangle3d
+from hmatddm.fields import StressField
+from hmatddm.kernels import line2d, rectangle3d
 from hmatddm.network import NetworkSpec, generate_network
 
 
@@ -23,11 +24,22 @@ def _random_mesh3d(rng, n=30):
     return hd.Mesh3D.from_rectangles(centers, e1, e2, rng.uniform(0.2, 1.0, n), rng.uniform(0.2, 1.0, n))
 
 
-def _reference3d(mesh, material, dd, points, shift=0.0):
-    """The per-DD-component kernel of hmatddm.kernels.rectangle3d (the original evaluation)."""
-    centers, frames, half_a, half_b, params, _ = element_data(mesh, material, singular_shift=shift)
-    out = np.empty((len(points), 3, 3))
-    rectangle3d.stress_at_points(np.ascontiguousarray(points), centers, frames, half_a, half_b, params, dd, out)
+def _reference(mesh, material, dd, points, shift=0.0):
+    """Sum over elements of the kernels' per-pair global stress (``stress_pair``: unit
+    global DD components, rotated component by component), written apart from
+    hmatddm.fields: (M, d, d)."""
+    g, nu, d = material.shear_modulus, material.poisson_ratio, mesh.dim
+    pair, work = np.empty((d, d, d)), np.empty((d, d, d))
+    out = np.zeros((len(points), d, d))
+    for t, point in enumerate(np.asarray(points, dtype=float)):
+        for j in range(mesh.n_elements):
+            if d == 3:
+                rectangle3d.stress_pair(point, mesh.centers[j], mesh.frames[j], mesh.half_a[j], mesh.half_b[j], g,
+                                        nu, shift, pair, work)
+            else:
+                line2d.stress_pair(point, mesh.centers[j], mesh.frames[j], mesh.half_length[j], g, nu, shift, pair,
+                                   work)
+            out[t] += np.einsum("qij,q->ij", pair, dd[j])
     return out
 
 
@@ -36,7 +48,7 @@ def test_direct_3d_matches_component_kernel(material):
     mesh = _random_mesh3d(rng)
     dd = rng.normal(size=(mesh.n_elements, 3)) * 1e-3
     points = rng.uniform(-6, 6, (200, 3))
-    reference = _reference3d(mesh, material, dd, points)
+    reference = _reference(mesh, material, dd, points)
     stress = hd.stress_at(mesh, material, dd, points, method="direct")
     assert np.max(np.abs(stress - reference)) <= 1e-12 * np.max(np.abs(reference))
     assert np.allclose(stress, np.transpose(stress, (0, 2, 1)), rtol=0, atol=0)
@@ -50,7 +62,7 @@ def test_edge_points_3d_average_or_refuse(material):
     mesh = _random_mesh3d(rng, 8)
     dd = rng.normal(size=(mesh.n_elements, 3)) * 1e-3
     on_edge = mesh.centers[:4] + mesh.half_a[:4, None] * mesh.frames[:4, 0]
-    reference = _reference3d(mesh, material, dd, on_edge, shift=1e-3)
+    reference = _reference(mesh, material, dd, on_edge, shift=1e-3)
     stress = hd.stress_at(mesh, material, dd, on_edge, singular_correction="average", method="direct")
     assert np.max(np.abs(stress - reference)) <= 1e-12 * np.max(np.abs(reference))
     mean = hd.mean_stress_at(mesh, material, dd, on_edge, singular_correction="average")
@@ -98,9 +110,7 @@ def test_direct_2d_matches_component_kernel(material):
     mesh = hd.mesh.line([0.0, 0.0], [3.0, 1.0], 12)
     dd = rng.normal(size=(12, 2)) * 1e-3
     points = rng.uniform(-3, 4, (150, 2))
-    centers, frames, half_a, _, params, _ = element_data(mesh, material)
-    reference = np.empty((150, 2, 2))
-    line2d.stress_at_points(points, centers, frames, half_a, params, dd, reference)
+    reference = _reference(mesh, material, dd, points)
     assert np.max(np.abs(hd.stress_at(mesh, material, dd, points) - reference)) <= 1e-12 * np.max(np.abs(reference))
     mean = hd.mean_stress_at(mesh, material, dd, points)
     expected = (1.0 + material.poisson_ratio) * np.trace(reference, axis1=1, axis2=2) / 3.0
@@ -211,3 +221,42 @@ def test_tree_mixed_element_sizes(material):
     for eps in (1e-3, 1e-5):
         approx = hd.stress_at(mesh, material, dd, points, method="tree", eps=eps)
         assert np.max(np.abs(approx - exact)) <= eps * np.max(np.abs(exact))
+
+
+def test_tree_matches_direct_in_2d_near_and_far(material):
+    """2D (plane strain): a branched set of segments, points on a grid around them (near
+    and far, some within an element length of a tip): the H-matrix sum within eps of the
+    largest component of the exact sum, stress and mean stress."""
+    parts = [hd.mesh.line([-20.0, 0.0], [20.0, 0.0], 160), hd.mesh.line([5.0, -10.0], [12.0, 8.0], 70)]
+    mesh = hd.mesh.concatenate(parts)
+    rng = np.random.default_rng(7)
+    dd = 1e-3 * mesh.normals + 1e-4 * rng.normal(size=(mesh.n_elements, 2))
+    x, y = np.meshgrid(np.linspace(-60.0, 60.0, 90), np.linspace(-40.0, 40.0, 61) + 0.013)
+    points = np.column_stack([x.ravel(), y.ravel()])
+    exact = hd.stress_at(mesh, material, dd, points, singular_correction="average", method="direct")
+    for eps in (1e-4, 1e-6):
+        info = {}
+        approx = hd.stress_at(mesh, material, dd, points, singular_correction="average", method="tree", eps=eps,
+                              info=info)
+        assert info["method"] == "tree" and info["pairs_compressed"] > 0.25 * len(points) * mesh.n_elements
+        assert np.max(np.abs(approx - exact)) <= eps * np.max(np.abs(exact))
+    exact_mean = hd.mean_stress_at(mesh, material, dd, points, singular_correction="average", method="direct")
+    approx_mean = hd.mean_stress_at(mesh, material, dd, points, singular_correction="average", method="tree",
+                                    eps=1e-6)
+    assert np.max(np.abs(approx_mean - exact_mean)) <= 1e-6 * np.max(np.abs(exact_mean))
+
+
+def test_stress_field_applies_to_any_dd(material, dfn_scene):
+    """One StressField (the H-matrix built once) applied to two different DDs gives the
+    exact sum of each; the direct field gives the same as hd.stress_at."""
+    mesh, dd, points = dfn_scene
+    points = points[::4]
+    tree = StressField(mesh, material, points, "stress", "average", method="tree", eps=1e-6)
+    direct = StressField(mesh, material, points, "stress", "average", method="direct")
+    assert tree.hmatrix is not None and tree.hmatrix.rectangular and direct.hmatrix is None
+    for k, scaled in enumerate((dd, np.roll(dd, 7, axis=0) * [1.0, -2.0, 0.5])):
+        exact = direct(scaled)
+        if k == 0:
+            stress = hd.stress_at(mesh, material, scaled, points, singular_correction="average", method="direct")
+            np.testing.assert_array_equal(exact[:, 0], stress[:, 0, 0])
+        assert np.max(np.abs(tree(scaled) - exact)) <= 1e-6 * np.max(np.abs(exact))

@@ -1,0 +1,386 @@
+"""Stress fields: the stress that the DDs of a mesh induce at points (ref. Eq. 2.59; mean
+stress ref. Eqs 5.24-5.28), for the results (:func:`hmatddm.stress_at`,
+:func:`hmatddm.mean_stress_at`) and the remote-failure check of a natural-fracture
+network (ref. Sec. 5.3).
+
+The stress at M points from N elements is a points x elements matrix applied to the DDs:
+row ``n_out * t + c`` is component ``c`` of the stress at point ``t`` (3D: xx, yy, zz, xy,
+xz, yz; 2D plane strain: xx, yy, xy; or the mean stress alone, ``n_out = 1``), column
+``d * j + q`` the global DD component ``q`` of element ``j``. Its entries come from the
+per-pair kernels of :mod:`hmatddm.kernels` (``local_stress_corrected`` of
+:mod:`~hmatddm.kernels.rectangle3d` and :mod:`~hmatddm.kernels.line2d`), contracted with
+a local DD and rotated to the global frame (ref. Eq. 2.57). Two ways to apply it:
+
+* ``"direct"``: the exact sum over all elements, parallel over a fixed split of the points
+  (the result does not depend on the thread count), each pair's DD contracted before the
+  one rotation;
+* ``"tree"``: a rectangular H-matrix of the generic engine (:mod:`hmatddm.hmatrix`: a
+  cluster tree of the points, one of the elements, whole-element ACA of the far blocks
+  to ``eps``), then one matvec. :class:`StressField` keeps it for further DDs on the
+  same points and elements (a time loop checking the same targets step after step).
+"""
+import time
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit, prange
+
+from ._validation import finite_array, finite_scalar
+from .errors import InputError
+from .kernels.line2d import local_stress_corrected as _segment_local_stress
+from .kernels.rectangle3d import local_stress_corrected as _rectangle_local_stress
+from .material import Elastic
+from .mesh import Mesh2D, Mesh3D, check_mesh
+
+#: What a field holds at each point.
+QUANTITIES = ("stress", "mean")
+METHODS = ("auto", "direct", "tree")
+#: Relative Frobenius accuracy asked of every compressed block (``method="tree"``, and
+#: ``"auto"`` on large problems): the largest error of any component is then about
+#: 0.01-0.1 ``eps`` times the largest induced stress (measured, benchmarks/bench_fields.py).
+DEFAULT_STRESS_EPS = 1e-5
+#: ``method="auto"`` compresses when (points x elements) reaches this and both counts
+#: exceed twice the leaf size.
+AUTO_TREE_PAIRS = 2_000_000
+#: Admissibility ``min(diam) <= eta * dist`` and leaf size of both cluster trees.
+FIELD_ETA = 3.0
+FIELD_LEAF_SIZE = 64
+_DIRECT_CHUNKS = 64  # fixed split of the point range in the direct sum
+
+
+def n_components(dim, quantity):
+    """Values per point: 6 (3D) or 3 (2D) stress components, 1 for the mean stress."""
+    return 1 if quantity == "mean" else (6 if dim == 3 else 3)
+
+
+# ---------------------------------------------------------------------------- kernels
+
+class FieldSources(NamedTuple):
+    """What the field kernels read (numba reads the fields by name): the target
+    ``points`` (M, dim), the elements (``centers``, ``frames`` with the local axes as
+    rows, half sizes ``half_a``, ``half_b``; in 2D both are the half length), the
+    material, the singular-point treatment: ``singular_shift`` (0: NaN at singular
+    points, else the averaging offset of ref. Sec. 6.2.3) and ``near_fraction``, and a
+    weight per element that scales its columns (see :class:`StressField`)."""
+
+    points: np.ndarray
+    centers: np.ndarray
+    frames: np.ndarray
+    half_a: np.ndarray
+    half_b: np.ndarray
+    shear_modulus: float
+    poisson_ratio: float
+    singular_shift: float
+    near_fraction: float
+    column_weight: np.ndarray
+
+
+def field_sources(mesh, material, points, singular_correction="none", near_fraction=0.0, column_weight=None):
+    """The :class:`FieldSources` of ``mesh`` seen from ``points`` (contiguous float64
+    arrays: one compiled specialisation of each kernel, whatever slicing or
+    concatenation produced the mesh)."""
+    half_a, half_b = (mesh.half_length, mesh.half_length) if mesh.dim == 2 else (mesh.half_a, mesh.half_b)
+    arrays = (np.ascontiguousarray(a, dtype=np.float64) for a in (points, mesh.centers, mesh.frames, half_a, half_b))
+    weight = np.ones(mesh.n_elements) if column_weight is None else column_weight
+    return FieldSources(*arrays, float(material.shear_modulus), float(material.poisson_ratio),
+                        1e-3 if singular_correction == "average" else 0.0, float(near_fraction),
+                        np.ascontiguousarray(weight, dtype=np.float64))
+
+
+@njit(cache=True, nogil=True)
+def _local_response(sources, point, j, work3, work2):
+    """Local stress of element ``j`` at ``point`` per unit local DD component
+    (``work3[k]`` in 3D, ``work2[k]`` in 2D): the kernels' ``local_stress_corrected``
+    (points on an edge or end, or within ``near_fraction`` of the element's smaller half
+    size of one, are averaged across it when ``singular_shift > 0``, else NaN)."""
+    centers = sources.centers
+    frame = sources.frames[j]
+    g = sources.shear_modulus
+    nu = sources.poisson_ratio
+    if centers.shape[1] == 3:
+        dx = point[0] - centers[j, 0]
+        dy = point[1] - centers[j, 1]
+        dz = point[2] - centers[j, 2]
+        x1 = frame[0, 0] * dx + frame[0, 1] * dy + frame[0, 2] * dz
+        x2 = frame[1, 0] * dx + frame[1, 1] * dy + frame[1, 2] * dz
+        x3 = frame[2, 0] * dx + frame[2, 1] * dy + frame[2, 2] * dz
+        a = sources.half_a[j]
+        b = sources.half_b[j]
+        _rectangle_local_stress(x1, x2, x3, a, b, g, nu, sources.singular_shift, work3,
+                                sources.near_fraction * min(a, b))
+    else:
+        dx = point[0] - centers[j, 0]
+        dy = point[1] - centers[j, 1]
+        a = sources.half_a[j]
+        _segment_local_stress(frame[0, 0] * dx + frame[0, 1] * dy, frame[1, 0] * dx + frame[1, 1] * dy, a, g, nu,
+                              sources.singular_shift, work2, sources.near_fraction * a)
+
+
+@njit(cache=True, nogil=True)
+def _components(work3, work2, dim, l0, l1, l2, frame, n_out, nu, out):
+    """``out[:n_out]``: the global components of the stress of local DD ``(l0, l1, l2)``
+    (``l2`` unused in 2D) from the local responses: ``s = sum_k l_k work[k]``, rotated
+    ``F^T s F`` (``frame`` rows are the local axes, ref. Eq. 2.57), or the mean stress
+    ``tr(s)/3`` (2D plane strain: ``(1 + nu) tr(s) / 3``, since ``s_zz = nu tr(s)``)."""
+    if dim == 3:
+        s00 = l0 * work3[0, 0, 0] + l1 * work3[1, 0, 0] + l2 * work3[2, 0, 0]
+        s11 = l0 * work3[0, 1, 1] + l1 * work3[1, 1, 1] + l2 * work3[2, 1, 1]
+        s22 = l0 * work3[0, 2, 2] + l1 * work3[1, 2, 2] + l2 * work3[2, 2, 2]
+        if n_out == 1:
+            out[0] = (s00 + s11 + s22) / 3.0
+            return
+        s01 = l0 * work3[0, 0, 1] + l1 * work3[1, 0, 1] + l2 * work3[2, 0, 1]
+        s02 = l0 * work3[0, 0, 2] + l1 * work3[1, 0, 2] + l2 * work3[2, 0, 2]
+        s12 = l0 * work3[0, 1, 2] + l1 * work3[1, 1, 2] + l2 * work3[2, 1, 2]
+        t00 = s00 * frame[0, 0] + s01 * frame[1, 0] + s02 * frame[2, 0]
+        t01 = s00 * frame[0, 1] + s01 * frame[1, 1] + s02 * frame[2, 1]
+        t02 = s00 * frame[0, 2] + s01 * frame[1, 2] + s02 * frame[2, 2]
+        t10 = s01 * frame[0, 0] + s11 * frame[1, 0] + s12 * frame[2, 0]
+        t11 = s01 * frame[0, 1] + s11 * frame[1, 1] + s12 * frame[2, 1]
+        t12 = s01 * frame[0, 2] + s11 * frame[1, 2] + s12 * frame[2, 2]
+        t20 = s02 * frame[0, 0] + s12 * frame[1, 0] + s22 * frame[2, 0]
+        t21 = s02 * frame[0, 1] + s12 * frame[1, 1] + s22 * frame[2, 1]
+        t22 = s02 * frame[0, 2] + s12 * frame[1, 2] + s22 * frame[2, 2]
+        out[0] = frame[0, 0] * t00 + frame[1, 0] * t10 + frame[2, 0] * t20
+        out[1] = frame[0, 1] * t01 + frame[1, 1] * t11 + frame[2, 1] * t21
+        out[2] = frame[0, 2] * t02 + frame[1, 2] * t12 + frame[2, 2] * t22
+        out[3] = frame[0, 0] * t01 + frame[1, 0] * t11 + frame[2, 0] * t21
+        out[4] = frame[0, 0] * t02 + frame[1, 0] * t12 + frame[2, 0] * t22
+        out[5] = frame[0, 1] * t02 + frame[1, 1] * t12 + frame[2, 1] * t22
+        return
+    s00 = l0 * work2[0, 0, 0] + l1 * work2[1, 0, 0]
+    s11 = l0 * work2[0, 1, 1] + l1 * work2[1, 1, 1]
+    if n_out == 1:
+        out[0] = (1.0 + nu) * (s00 + s11) / 3.0
+        return
+    s01 = l0 * work2[0, 0, 1] + l1 * work2[1, 0, 1]
+    t00 = s00 * frame[0, 0] + s01 * frame[1, 0]
+    t01 = s00 * frame[0, 1] + s01 * frame[1, 1]
+    t10 = s01 * frame[0, 0] + s11 * frame[1, 0]
+    t11 = s01 * frame[0, 1] + s11 * frame[1, 1]
+    out[0] = frame[0, 0] * t00 + frame[1, 0] * t10
+    out[1] = frame[0, 1] * t01 + frame[1, 1] * t11
+    out[2] = frame[0, 0] * t01 + frame[1, 0] * t11
+
+
+@njit(cache=True, nogil=True)
+def field_block(data, rows, cols, out):
+    """Block generator kernel of the points x elements matrix (see
+    :class:`hmatddm.hmatrix.BlockGenerator`): ``out[n_out * a + c, d * b + q]`` =
+    component ``c`` at point ``rows[a]`` from a global DD component ``q`` of element
+    ``j = cols[b]`` equal to ``column_weight[j]``. ``data``: :class:`FieldSources`; ``n_out`` (6, 3 or 1) is read
+    from the shape of ``out``."""
+    points = data.points
+    dim = data.centers.shape[1]
+    n_out = out.shape[0] // rows.shape[0]
+    nu = data.poisson_ratio
+    work3 = np.empty((3, 3, 3))
+    work2 = np.empty((2, 2, 2))
+    value = np.empty(6)
+    for a in range(rows.shape[0]):
+        point = points[rows[a]]
+        for b in range(cols.shape[0]):
+            j = cols[b]
+            frame = data.frames[j]
+            weight = data.column_weight[j]
+            _local_response(data, point, j, work3, work2)
+            for q in range(dim):
+                # local components of the unit global DD q: column q of the frame
+                _components(work3, work2, dim, frame[0, q], frame[1, q], frame[dim - 1, q], frame, n_out, nu,
+                            value)
+                for c in range(n_out):
+                    out[n_out * a + c, dim * b + q] = weight * value[c]
+
+
+@njit(cache=True, parallel=True)
+def direct_sum(sources, dd, out):
+    """``out[t] = sum_j`` (stress at point ``t`` of element ``j`` with its global DD
+    ``dd[j]``), exact, ``n_out = out.shape[1]``. Each pair contracts its DD before the
+    one rotation; parallel over a fixed split of the points, the sum over ``j`` in
+    element order (the result does not depend on the thread count)."""
+    points = sources.points
+    frames = sources.frames
+    m = points.shape[0]
+    dim = sources.centers.shape[1]
+    n_out = out.shape[1]
+    nu = sources.poisson_ratio
+    n_chunks = min(_DIRECT_CHUNKS, m)
+    for chunk in prange(n_chunks):
+        work3 = np.empty((3, 3, 3))
+        work2 = np.empty((2, 2, 2))
+        value = np.empty(6)
+        for t in range(chunk * m // n_chunks, (chunk + 1) * m // n_chunks):
+            for c in range(n_out):
+                out[t, c] = 0.0
+            for j in range(frames.shape[0]):
+                frame = frames[j]
+                _local_response(sources, points[t], j, work3, work2)
+                l0 = frame[0, 0] * dd[j, 0] + frame[0, 1] * dd[j, 1]
+                l1 = frame[1, 0] * dd[j, 0] + frame[1, 1] * dd[j, 1]
+                l2 = 0.0
+                if dim == 3:
+                    l0 += frame[0, 2] * dd[j, 2]
+                    l1 += frame[1, 2] * dd[j, 2]
+                    l2 = frame[2, 0] * dd[j, 0] + frame[2, 1] * dd[j, 1] + frame[2, 2] * dd[j, 2]
+                _components(work3, work2, dim, l0, l1, l2, frame, n_out, nu, value)
+                for c in range(n_out):
+                    out[t, c] += value[c]
+
+
+# ---------------------------------------------------------------------------- fields
+
+def _check_common(mesh, material, singular_correction, near_fraction, quantity):
+    if not isinstance(mesh, (Mesh2D, Mesh3D)):
+        raise InputError(f"mesh must be a Mesh2D or Mesh3D, got {type(mesh).__name__}")
+    check_mesh(mesh)
+    if getattr(mesh, "n_nodes", 1) > 1:
+        raise InputError("StressField takes constant elements (element_order 0); linear and quadratic elements "
+                         "are summed by hmatddm.nodal.stress_at")
+    if not isinstance(material, Elastic):
+        raise InputError(f"material must be an hmatddm.Elastic, got {type(material).__name__}")
+    if singular_correction not in ("none", "average"):
+        raise InputError(f"singular_correction must be one of ('none', 'average'), got {singular_correction!r}")
+    near_fraction = finite_scalar("near_fraction", near_fraction)
+    if not 0.0 <= near_fraction < 1.0:
+        raise InputError(f"near_fraction must be in [0, 1), got {near_fraction}")
+    if quantity not in QUANTITIES:
+        raise InputError(f"quantity must be one of {QUANTITIES}, got {quantity!r}")
+    return near_fraction
+
+
+class StressField:
+    """The stress that the DDs of ``mesh`` induce at fixed ``points``, ready to apply to
+    any DDs (ref. Eq. 2.59).
+
+    Parameters
+    ----------
+    mesh : Mesh2D or Mesh3D (constant elements)
+    material : Elastic
+    points : (M, d)
+    quantity : ``"stress"`` (the global components, 6 in 3D, 3 in 2D) or ``"mean"``
+    singular_correction, near_fraction : as :func:`hmatddm.stress_at`
+    method : ``"auto"``, ``"direct"`` or ``"tree"`` (see :func:`hmatddm.stress_at`)
+    eps : float in (0, 1) or None (``DEFAULT_STRESS_EPS``)
+    typical_dd : (N, d) or None
+        DDs like those the field will be applied to. The compressed matrix is that of
+        the columns of element ``j`` scaled by ``|typical_dd[j]|``, so that ``eps``
+        bounds each block's error relative to what its elements actually induce (a
+        small element with a large DD next to large elements with small ones is then
+        as accurate as they are); None: unscaled columns.
+
+    With ``"tree"`` the H-matrix is built once here (its build is most of the cost) and
+    each call is one matvec; ``"direct"`` sums the kernels at every call.
+    ``field(dd)`` returns the (M, n_out) components; ``field.info`` says what was done.
+    """
+
+    def __init__(self, mesh, material, points, quantity="stress", singular_correction="none", method="auto",
+                 eps=None, near_fraction=0.0, typical_dd=None):
+        near_fraction = _check_common(mesh, material, singular_correction, near_fraction, quantity)
+        if method not in METHODS:
+            raise InputError(f"method must be one of {METHODS}, got {method!r}")
+        eps = DEFAULT_STRESS_EPS if eps is None else finite_scalar("eps", eps)
+        if not 0.0 < eps < 1.0:
+            raise InputError(f"eps must be in (0, 1), got {eps}")
+        self.mesh = mesh
+        self.points = np.ascontiguousarray(finite_array("points", points, (None, mesh.dim)))
+        self.n_out = n_components(mesh.dim, quantity)
+        self.eps = float(eps)
+        self.near_fraction = near_fraction
+        weight = None
+        if typical_dd is not None:
+            size = np.linalg.norm(_dd_array(mesh, typical_dd), axis=1)
+            if size.max() > 0.0:
+                weight = np.maximum(size, 1e-12 * size.max())
+        self.sources = field_sources(mesh, material, self.points, singular_correction, near_fraction, weight)
+        m, n = len(self.points), mesh.n_elements
+        if method == "auto":
+            method = "tree" if m * n >= AUTO_TREE_PAIRS and min(m, n) > 2 * FIELD_LEAF_SIZE else "direct"
+        if min(m, n) <= FIELD_LEAF_SIZE:
+            method = "direct"  # one leaf: nothing to compress
+        self.method = method
+        self.hmatrix = None
+        started = time.perf_counter()
+        self.info = {"method": method, "eps": self.eps, "points": m, "elements": n}
+        if method == "tree":
+            self.hmatrix = self._build()
+            self.info.update(self._tree_info())
+        else:
+            self.info.update(n_far=0, n_near=1, pairs_exact=m * n, pairs_compressed=0)
+        self.info["build_seconds"] = time.perf_counter() - started
+
+    def _build(self):
+        from .hmatrix import BlockGenerator, HMatrix
+
+        mesh = self.mesh
+        generator = BlockGenerator(field_block, self.sources, self.points, 0.0, self.n_out,
+                                   col_points=mesh.centers, col_radii=mesh.radii, col_dof=mesh.dim)
+        return HMatrix.build(generator, eps=self.eps, eta=FIELD_ETA, leaf_size=FIELD_LEAF_SIZE,
+                             factor_dtype=np.float64)
+
+    def _tree_info(self):
+        h = self.hmatrix
+        s = h.storage
+        rows = h.tree.size[h.blocks.admissible_rows]
+        cols = h.col_tree.size[h.blocks.admissible_cols]
+        compressed = s.admissible_kind != 1  # low rank or zero (hmatrix.storage.KIND_DENSE = 1)
+        pairs_compressed = int(np.sum(rows[compressed] * cols[compressed]))
+        ranks = s.lowrank_rank
+        return {"n_far": int(rows.size), "n_near": int(h.blocks.near_rows.size),
+                "n_fallback": int(np.count_nonzero(~compressed)), "max_rank": int(ranks.max()) if ranks.size else 0,
+                "pairs_compressed": pairs_compressed,
+                "pairs_exact": len(self.points) * self.mesh.n_elements - pairs_compressed,
+                "memory_bytes": int(s.memory_bytes)}
+
+    def __call__(self, dd):
+        """(M, n_out) components induced by the global DDs ``dd`` ((N, d) or (N*d,))."""
+        dd = _dd_array(self.mesh, dd)
+        started = time.perf_counter()
+        m = len(self.points)
+        if m == 0:
+            out = np.zeros((0, self.n_out))
+        elif self.hmatrix is not None:
+            out = self.hmatrix.matvec((dd / self.sources.column_weight[:, None]).reshape(-1)).reshape(m, self.n_out)
+        else:
+            out = np.empty((m, self.n_out))
+            direct_sum(self.sources, np.ascontiguousarray(dd), out)
+        self.info["apply_seconds"] = time.perf_counter() - started
+        return out
+
+
+def _dd_array(mesh, dd):
+    """``dd`` as a contiguous (N, d) float64 array ((N, d) or (N*d,) given)."""
+    dd = finite_array("dd", dd)
+    if dd.shape not in ((mesh.n_elements, mesh.dim), (mesh.n_elements * mesh.dim,)):
+        raise InputError(f"dd must have shape ({mesh.n_elements}, {mesh.dim}) or "
+                         f"({mesh.n_elements * mesh.dim},), got {dd.shape}")
+    return np.ascontiguousarray(dd.reshape(mesh.n_elements, mesh.dim), dtype=np.float64)
+
+
+def refuse_singular(values, near_fraction):
+    """InputError naming the first point whose value is singular (NaN: on an edge, or
+    within ``near_fraction`` of one, without ``singular_correction='average'``)."""
+    bad = np.flatnonzero(~np.all(np.isfinite(values), axis=1))
+    if bad.size:
+        where = "on an element edge" if near_fraction == 0.0 else \
+            f"on an element edge or within near_fraction = {near_fraction:g} half sizes of one"
+        raise InputError(f"points[{int(bad[0])}] lies {where}, where the stress is singular; "
+                         "move it or pass singular_correction='average'")
+
+
+def induced(mesh, material, dd, points, quantity, singular_correction="none", method="auto", eps=None, info=None,
+            near_fraction=0.0):
+    """(M, n_out) components of ``quantity`` induced at ``points`` by ``dd``, singular
+    points refused; what :func:`hmatddm.stress_at` and :func:`hmatddm.mean_stress_at`
+    compute for constant elements in a homogeneous medium."""
+    started = time.perf_counter()
+    field = StressField(mesh, material, points, quantity, singular_correction, method, eps, near_fraction,
+                        typical_dd=dd)
+    values = field(dd)
+    if info is not None:
+        info.update(field.info, seconds=time.perf_counter() - started)
+    refuse_singular(values, field.near_fraction)
+    return values
+
+
+__all__ = ["StressField", "FieldSources", "field_sources", "field_block", "direct_sum", "induced", "refuse_singular", "n_components",
+           "DEFAULT_STRESS_EPS", "AUTO_TREE_PAIRS", "FIELD_ETA", "FIELD_LEAF_SIZE", "METHODS", "QUANTITIES"]
