@@ -69,3 +69,22 @@ def pytest_terminal_summary(terminalreporter, exitstatus, config):
     for nodeid, seconds in sorted(_CPU_SECONDS.items(), key=lambda kv: -kv[1])[:count]:
         terminalreporter.write_line(f"{seconds:8.2f}s cpu  {nodeid}")
     terminalreporter.write_line(f"{sum(_CPU_SECONDS.values()):8.2f}s cpu  in all tests")
+
+
+# -- a child process killed at a point it announces (event-driven, never sleep-driven) -----
+
+def kill_when_announced(script):
+    """Run ``python -c script``; wait for its first stdout line (the child prints it when
+    it has reached the point to kill at, then waits), SIGKILL it and return that line
+    ('' when the child died before announcing). No wall-clock limit: a busy machine only
+    makes it slower (tests/test_simulation.py, tests/test_layered_engine3d.py)."""
+    import signal
+    import subprocess
+
+    process = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
+    try:
+        return process.stdout.readline()
+    finally:
+        process.send_signal(signal.SIGKILL)
+        process.wait()
+        process.stdout.close()

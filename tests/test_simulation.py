@@ -2,14 +2,12 @@
 twin, records, mass balance, checkpoints and resume after a kill."""
 import json
 import os
-import signal
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 
 import hmatddm as hd
+from conftest import kill_when_announced
 from hmatddm.errors import InputError
 from hmatddm.simulation import RECORD_KEYS, CheckpointError
 from hmatddm.simulation import checkpoint as checkpoints
@@ -108,10 +106,7 @@ def test_resume_after_sigkill_gives_identical_results(tmp_path, kgd_run):
         "        print('checkpointed', record['step'], flush=True)\n"
         "        time.sleep(3600)\n"
         "t.kgd_simulation(%r).run(20.0, callback=announce)\n" % (os.path.dirname(__file__), str(folder)))
-    process = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
-    announced = process.stdout.readline()  # blocks until step 6 is on disk (or the child dies)
-    process.send_signal(signal.SIGKILL)
-    process.wait()
+    announced = kill_when_announced(script)  # blocks until the checkpoint is on disk (or the child dies)
     assert announced.split() == ["checkpointed", "6"], announced
     assert checkpoints.list_checkpoints(folder)[-1] == 6
     resumed = kgd_simulation(folder)
