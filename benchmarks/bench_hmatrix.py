@@ -4,6 +4,8 @@
     python benchmarks/bench_hmatrix.py --quick         # N = 1k, 4k only, short eps sweep
     python benchmarks/bench_hmatrix.py --case planar --n 10000 --eps 1e-4   # one case, JSON
     python benchmarks/bench_hmatrix.py --tree-study 4000   # cloud: principal-axis vs fractures-first tree
+    python benchmarks/bench_hmatrix.py --memory-study 10000,40000 --variants 1e-4:32:float64,1e-4:16:float32
+                                                       # planar: where the memory goes, growth exponents
 
 Three studies, each printed as a markdown table and saved (JSON + PNG) in benchmarks/out/:
 
@@ -180,15 +182,16 @@ def tree_study(n, leaf_size=32):
     near field, ranks and the sampled smooth-field error. Returns a list of dicts."""
     import hmatddm as hd
     from hmatddm.hmatrix import BlockGenerator, HMatrix
+    from hmatddm.kernels.drivers import traction_block
     from hmatddm.operators import influence_data
 
     mesh = cloud(n)
-    kernels, data = influence_data(mesh, hd.Elastic(shear_modulus=10e9, poisson_ratio=0.25))
-    generator = BlockGenerator(kernel=kernels.traction_block, data=data, points=mesh.centers, radii=mesh.radii, dof=3)
+    data = influence_data(mesh, hd.Elastic(shear_modulus=10e9, poisson_ratio=0.25))
+    generator = BlockGenerator(kernel=traction_block, data=data, points=mesh.centers, radii=mesh.radii, dof=3)
     x = smooth_field(mesh)
     rows = np.sort(np.random.default_rng(2).choice(mesh.n_elements, 300, replace=False))
     exact_rows = np.empty((3 * rows.size, 3 * mesh.n_elements))
-    kernels.traction_block(data, rows, np.arange(mesh.n_elements), exact_rows)
+    traction_block(data, rows, np.arange(mesh.n_elements), exact_rows)
     exact = exact_rows @ x
     index = (3 * rows[:, None] + np.arange(3)).ravel()
     out = []
@@ -203,6 +206,103 @@ def tree_study(n, leaf_size=32):
                         smooth_error=error))
         print(json.dumps(out[-1]), flush=True)
     return out
+
+
+def sampled_smooth_error(mesh, data, y, n_rows=300, chunk=10):
+    """Relative error of ``y`` (an H-matrix product with the smooth field) on ``n_rows``
+    exact rows computed by the kernel, ``chunk`` rows at a time (bounded memory at 250k)."""
+    from hmatddm.kernels.drivers import traction_block
+
+    x = smooth_field(mesh)
+    rows = np.sort(np.random.default_rng(2).choice(mesh.n_elements, n_rows, replace=False))
+    exact = np.empty(3 * rows.size)
+    columns = np.arange(mesh.n_elements)
+    for k in range(0, rows.size, chunk):
+        part = rows[k:k + chunk]
+        block = np.empty((3 * part.size, 3 * mesh.n_elements))
+        traction_block(data, part, columns, block)
+        exact[3 * k:3 * k + 3 * part.size] = block @ x
+    index = (3 * rows[:, None] + np.arange(3)).ravel()
+    return float(np.linalg.norm(y[index] - exact) / np.linalg.norm(exact))
+
+
+def memory_case(n, eps=1e-4, leaf_size=32, near_dtype="float64", geometry="planar"):
+    """Planar crack (or cloud, fractures-first tree as ElasticityOperator builds it) of N elements: where the H-matrix memory goes (near-field dense
+    blocks, far blocks stored dense, low-rank factors, index), build wall and CPU time,
+    peak RSS and the sampled smooth-field error, with the near field stored as
+    ``near_dtype``. Returns a dict (run in a fresh process by --memory-study)."""
+    import hmatddm as hd
+    from _common import peak_rss_bytes
+    from hmatddm.hmatrix import BlockGenerator, HMatrix
+    from hmatddm.kernels.drivers import traction_block
+    from hmatddm.operators import influence_data
+
+    mesh = (planar if geometry == "planar" else cloud)(n)
+    data = influence_data(mesh, hd.Elastic(shear_modulus=10e9, poisson_ratio=0.25))
+    generator = BlockGenerator(kernel=traction_block, data=data, points=mesh.centers, radii=mesh.radii, dof=3)
+    groups = None if geometry == "planar" else mesh.fracture_id
+    with open("/proc/loadavg") as f:
+        load = float(f.read().split()[0])
+    t0, c0 = time.perf_counter(), time.process_time()
+    h = HMatrix.build(generator, eps=eps, eta=3.0, leaf_size=leaf_size, near_dtype=np.dtype(near_dtype),
+                      groups=groups)
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    s = h.storage
+    near = int(sum(s.dense_offset[b + 1] - s.dense_offset[b] for b in np.flatnonzero(s.dense_is_near)))
+    item = s.dense_values.itemsize
+    row = dict(geometry=geometry, n=mesh.n_elements, eps=eps, leaf_size=leaf_size, near_dtype=str(np.dtype(near_dtype)),
+               build_s=wall, build_cpu_s=cpu, load_before=load, memory_mb=s.memory_bytes / 2**20,
+               near_mb=near * item / 2**20, far_dense_mb=(s.dense_values.size - near) * item / 2**20,
+               lowrank_mb=(s.u_values.nbytes + s.v_values.nbytes) / 2**20, index_mb=s.index_bytes / 2**20,
+               factor_dtype=str(s.u_values.dtype), max_rank=int(s.lowrank_rank.max(initial=0)),
+               mean_rank=float(s.lowrank_rank.mean()) if s.lowrank_rank.size else 0.0,
+               peak_rss_mb=peak_rss_bytes() / 2**20)
+    row["kb_per_element"] = s.memory_bytes / mesh.n_elements / 1024
+    x = smooth_field(mesh)
+    t0 = time.perf_counter()
+    y = h @ x
+    row["matvec_s"] = time.perf_counter() - t0
+    row["smooth_error"] = sampled_smooth_error(mesh, data, y)
+    return row
+
+
+def memory_table(rows):
+    from _common import markdown_table
+
+    header = ["geometry", "N", "eps", "leaf", "near field", "build wall / CPU (s)", "load", "H memory (MB)", "near field (MB)",
+              "far dense (MB)", "low-rank (MB)", "KB / element", "mean / max rank", "peak RSS (MB)",
+              "smooth-field error (sampled)"]
+    body = [[r.get("geometry", "planar"), r["n"], f"{r['eps']:.0e}", r["leaf_size"], r["near_dtype"], f"{r['build_s']:.1f} / {r['build_cpu_s']:.1f}",
+             f"{r['load_before']:.1f}", f"{r['memory_mb']:.0f}", f"{r['near_mb']:.0f}", f"{r['far_dense_mb']:.0f}",
+             f"{r['lowrank_mb']:.0f}", f"{r['kb_per_element']:.1f}", f"{r['mean_rank']:.1f} / {r['max_rank']}",
+             f"{r['peak_rss_mb']:.0f}", f"{r['smooth_error']:.1e}"] for r in rows if "failed" not in r]
+    return markdown_table(header, body)
+
+
+def memory_slopes(rows):
+    """Log-log slopes of build CPU time and memory against N per (geometry, eps, leaf, near dtype)."""
+    out = {}
+    variant = lambda r: (r.get("geometry", "planar"), r["eps"], r["leaf_size"], r["near_dtype"])  # noqa: E731
+    for key in sorted({variant(r) for r in rows if "failed" not in r}):
+        sel = sorted((r for r in rows if "failed" not in r and variant(r) == key), key=lambda r: r["n"])
+        if len(sel) >= 2:
+            n = np.log([r["n"] for r in sel])
+            out[key] = dict(sizes=[r["n"] for r in sel],
+                            build_cpu=float(np.polyfit(n, np.log([r["build_cpu_s"] for r in sel]), 1)[0]),
+                            memory=float(np.polyfit(n, np.log([r["memory_mb"] for r in sel]), 1)[0]))
+    return out
+
+
+def spawn_memory(n, eps, leaf_size, near_dtype, geometry="planar"):
+    cmd = [sys.executable, os.path.abspath(__file__), "--memory-case", json.dumps(
+        dict(n=n, eps=eps, leaf_size=leaf_size, near_dtype=near_dtype, geometry=geometry))]
+    print("  running", cmd[-1], flush=True)
+    result = subprocess.run(cmd, capture_output=True, text=True, cwd=HERE)
+    if result.returncode != 0:
+        print(result.stdout, result.stderr, file=sys.stderr)
+        return dict(geometry=geometry, n=n, eps=eps, leaf_size=leaf_size, near_dtype=near_dtype,
+                    failed=result.stderr.strip().splitlines()[-1:])
+    return json.loads(result.stdout.strip().splitlines()[-1])
 
 
 def dense_reference(mesh, material, x_smooth, x_random, traction, op, solve_limit):
@@ -361,8 +461,35 @@ def main():
     parser.add_argument("--geometries", default="planar,cloud", help="comma-separated: planar, cloud")
     parser.add_argument("--tree-study", type=int, default=None, metavar="N",
                         help="cloud of N elements: principal-axis tree against fractures-first tree, then exit")
+    parser.add_argument("--memory-study", default=None, metavar="N,N,...",
+                        help="memory per element by kind (near field, low rank) and its growth, then exit")
+    parser.add_argument("--variants", default="1e-4:32:float64,1e-4:32:float32",
+                        help="memory study: comma-separated eps:leaf:near_dtype[:geometry] (geometry planar or cloud)")
+    parser.add_argument("--memory-case", default=None, help=argparse.SUPPRESS)
     args = parser.parse_args()
     sys.path.insert(0, HERE)
+    if args.memory_case:
+        print(json.dumps(memory_case(**json.loads(args.memory_case))))
+        return
+    if args.memory_study:
+        from _common import machine
+
+        print(f"Machine: {machine()}")
+        rows = []
+        for n in (int(v) for v in args.memory_study.split(",")):
+            for variant in args.variants.split(","):
+                eps, leaf, near_dtype, geometry = (variant + ":planar").split(":")[:4]
+                rows.append(spawn_memory(n, float(eps), int(leaf), near_dtype, geometry))
+                print(json.dumps(rows[-1]), flush=True)
+        os.makedirs(OUT, exist_ok=True)
+        with open(os.path.join(OUT, "hmatrix_memory.json"), "w") as f:
+            json.dump(rows, f, indent=1)
+        print("\n## Memory per element\n")
+        print(memory_table(rows))
+        for (geometry, eps, leaf, near_dtype), s in memory_slopes(rows).items():
+            print(f"- {geometry}, eps {eps:.0e}, leaf {leaf}, near {near_dtype}: N = {s['sizes']}: build CPU exponent "
+                  f"{s['build_cpu']:.2f}, memory exponent {s['memory']:.2f}")
+        return
     if args.tree_study:
         tree_study(args.tree_study)
         return

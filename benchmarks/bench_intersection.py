@@ -38,7 +38,7 @@ Two geometries:
   0.48 of the self term, so ``alpha=1`` changes nothing.
 
 The engine has no rule yet for a growing tip that reaches an element of ANOTHER active
-fracture (``Simulation._grow`` only checks intact natural fractures): fracture 2 would
+fracture (the growth pass only checks intact natural fractures): fracture 2 would
 grow straight through fracture 1 (its next centre lies 0.5 m from fracture 1's element
 centre, beyond the 0.25 m overlap test of ``new_elements``), and the two fractures are
 never connected hydraulically (faces only join edges that coincide). Here fracture 2 is
@@ -158,13 +158,14 @@ def neighbour_ratio(mesh, width, k):
 
 def coupling_ratio(mesh, material, alpha, i, j):
     """max |A_ij| / max |A_jj| (receiver i, source j) of the operator the run used."""
+    from hmatddm.kernels.drivers import traction_block
     from hmatddm.operators import influence_data
 
-    kernels, data = influence_data(mesh, material, "average", alpha)
+    data = influence_data(mesh, material, "average", alpha)
     d = mesh.dim
     block, self_block = np.empty((d, d)), np.empty((d, d))
-    kernels.traction_block(data, np.array([i]), np.array([j]), block)
-    kernels.traction_block(data, np.array([j]), np.array([j]), self_block)
+    traction_block(data, np.array([i]), np.array([j]), block)
+    traction_block(data, np.array([j]), np.array([j]), self_block)
     return float(np.max(np.abs(block)) / np.max(np.abs(self_block)))
 
 

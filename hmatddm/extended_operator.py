@@ -17,6 +17,7 @@ import scipy.linalg
 from scipy.sparse.linalg import LinearOperator
 
 from .errors import InputError
+from .kernels.drivers import traction_block
 from .operator_inverse import solve_with_inverse
 from .operators import ElasticityOperator, influence_data, refuse_singular
 
@@ -47,8 +48,8 @@ class ExtendedElasticityOperator(LinearOperator):
         self.dof = d = base.dof
         self.n_base = n0
         super().__init__(dtype=np.float64, shape=(n * d, n * d))
-        self._kernels, data = influence_data(mesh, base.material, base.singular_correction, base.alpha,
-                                             n_images=base.stats.get("n_images"))  # layered: the base's images
+        data = influence_data(mesh, base.material, base.singular_correction, base.alpha,
+                              n_images=base.stats.get("n_images"))  # layered: the base's images
         self._data = data
         self.n_reused = self._shared_new_elements(previous)
         self.on, self.no, self.nn = self._border_blocks(previous, self.n_reused)
@@ -104,7 +105,7 @@ class ExtendedElasticityOperator(LinearOperator):
 
     def _block(self, data, rows, cols):
         out = np.empty((len(rows) * self.dof, len(cols) * self.dof))
-        self._kernels.traction_block(data, rows, cols, out)
+        traction_block(data, rows, cols, out)
         return out
 
     @property

@@ -13,19 +13,17 @@ The influence of a node's shape function is the sum of
   (:func:`hmatddm.layered.images2d.subdivisions`); ``max_subdivisions = 1`` is the
   reference's plain rule (ref. Table 3.2: 1-3 Gauss points).
 
-Block-generator data (same contract as :mod:`hmatddm.kernels.line2d_higher_order`,
-``2 n`` unknowns per element, node-major): the tuple of
-:func:`hmatddm.layered.influence2d.influence_data` followed by the shape functions'
-``coefficients`` (n, 3) and ``nodes`` (n,):
-``(centers, frames, half_length, half_length, params, self_max, layer, settings,
-interfaces, shear_modulus, poisson_ratio, coefficients, nodes)`` with ``settings =
-[n_images, gauss_points, max_subdivisions]``.
+Kernel data: :class:`LayeredNodalSegments` (``2 n`` unknowns per element, node-major),
+served by the drivers of :mod:`hmatddm.kernels.drivers`.
 """
-import numpy as np
-from numba import njit, prange
+from typing import NamedTuple
 
-from .kernels.line2d_higher_order import (edge_distance, near_distance, node_point, set_node_rows,
-                                          store_block, stress_nodes, traction_nodes)
+import numpy as np
+from numba import njit
+
+from .kernels.drivers import KernelKind, influence_matrix, register_kind, self_block_max, stress_sum
+from .kernels.line2d_higher_order import (edge_distance, near_distance, node_point, set_node_rows, stress_nodes,
+                                          traction_nodes)
 from .layered.images2d import composite_rule, image_element_stress, subdivisions
 
 
@@ -40,115 +38,120 @@ def _shape_values(coefficients, xi):
 
 
 @njit(cache=True)
-def image_nodes(point, receiver_layer, center, frame, a, source_layer, coefficients, settings, interfaces,
-                shear_modulus, poisson_ratio, out):
+def image_nodes(point, receiver_layer, center, frame, a, source_layer, coefficients, n_images, gauss_points,
+                max_subdivisions, interfaces, shear_modulus, poisson_ratio, out):
     """``out[k, b, i, j]``: complementary stress at ``point`` (in ``receiver_layer``) for
-    a unit global DD ``b`` at node ``k`` of the segment (in ``source_layer``)."""
+    a unit global DD ``b`` at node ``k`` of the segment (in ``source_layer``), with
+    ``n_images`` images and ``gauss_points`` per sub-segment (at most ``max_subdivisions``)."""
     p0 = np.empty(2)
     p1 = np.empty(2)
     for c in range(2):
         p0[c] = center[c] - a * frame[0, c]
         p1[c] = center[c] + a * frame[0, c]
-    n_sub = subdivisions(point[0], point[1], receiver_layer, p0, p1, source_layer, interfaces, int(settings[2]))
-    xi, weight = composite_rule(int(settings[1]), n_sub)
+    n_sub = subdivisions(point[0], point[1], receiver_layer, p0, p1, source_layer, interfaces, max_subdivisions)
+    xi, weight = composite_rule(gauss_points, n_sub)
     image_element_stress(point[0], point[1], receiver_layer, p0, p1, source_layer, interfaces, shear_modulus,
-                         poisson_ratio, int(settings[0]), xi, weight, _shape_values(coefficients, xi), out)
+                         poisson_ratio, n_images, xi, weight, _shape_values(coefficients, xi), out)
+
+
+class LayeredNodalSegments(NamedTuple):
+    """Kernel data of linear and quadratic 2D elements in a layered medium (the record
+    :mod:`hmatddm.kernels.drivers` take): :class:`hmatddm.layered.images2d.LayeredSegments`
+    plus the shape functions."""
+
+    centers: np.ndarray  #: (N, 2) element midpoints
+    frames: np.ndarray  #: (N, 2, 2) rows: unit tangent, unit normal
+    half_length: np.ndarray  #: (N,) half lengths
+    layer: np.ndarray  #: (N,) int64 layer of each element
+    interfaces: np.ndarray  #: (L - 1,) interface heights, top down
+    shear_modulus: np.ndarray  #: (L,) per layer (0: void)
+    poisson_ratio: np.ndarray  #: (L,) per layer
+    n_images: int  #: reflections per interface (ref. Fig. 3.4)
+    gauss_points: int  #: Gauss-Legendre points per sub-segment of the image quadrature (ref. Table 3.2)
+    max_subdivisions: int  #: largest number of sub-segments (:func:`hmatddm.layered.images2d.subdivisions`)
+    singular_shift: float  #: see :mod:`hmatddm.kernels.drivers` (singular points)
+    near_fraction: float  #: near-miss distance, fraction of the smaller half size
+    alpha: float  #: ref. Eq. 6.11 scaling (0: none)
+    self_max: np.ndarray  #: (N,) largest |entry| of each self block (ref. Eq. 6.11)
+    coefficients: np.ndarray  #: (n, 3) monomial coefficients of the n shape functions
+    nodes: np.ndarray  #: (n,) intrinsic coordinates of the collocation nodes
 
 
 @njit(cache=True)
-def traction_block(data, rows, cols, out):
-    """Block generator: ``out[(a n + r) 2 + p, (b n + k) 2 + q]`` is the traction p at
-    node r of element ``rows[a]`` for a unit global DD q at node k of ``cols[b]``
-    (original + complementary parts; ``data``: see the module docstring)."""
-    (centers, frames, half_length, _unused, params, self_max, layer, settings, interfaces, shear_modulus,
-     poisson_ratio, coefficients, nodes) = data
-    shift = params[2]
-    alpha = params[3]
-    near_fraction = params[4]
-    n_nodes = nodes.shape[0]
-    work = np.empty((n_nodes, 2, 2, 2))
-    pair = np.empty((n_nodes, 2, 2))
-    image = np.empty((n_nodes, 2, 2, 2))
-    block = np.empty((2 * n_nodes, 2 * n_nodes))
-    point = np.empty(2)
-    for ia in range(rows.shape[0]):
-        i = rows[ia]
-        normal = frames[i, 1]
-        lr = layer[i]
-        for jb in range(cols.shape[0]):
-            j = cols[jb]
-            ls = layer[j]
-            near = 0.0
-            if i != j:
-                near = near_distance(near_fraction, half_length[i], half_length[j], nodes)
-            for r in range(n_nodes):
-                node_point(centers[i], frames[i], half_length[i], nodes[r], point)
-                traction_nodes(point, normal, centers[j], frames[j], half_length[j], coefficients, shear_modulus[ls],
-                               poisson_ratio[ls], shift, pair, work, near)
-                if interfaces.shape[0] > 0:
-                    image_nodes(point, lr, centers[j], frames[j], half_length[j], ls, coefficients, settings,
-                                interfaces, shear_modulus, poisson_ratio, image)
-                    for k in range(n_nodes):
-                        for p in range(2):
-                            for q in range(2):
-                                pair[k, p, q] += image[k, q, p, 0] * normal[0] + image[k, q, p, 1] * normal[1]
-                set_node_rows(block, pair, r)
-            store_block(block, out, ia, jb, i, j, alpha, self_max)
-
-
-@njit(cache=True, parallel=True)
-def traction_matrix(data, out):
-    """Dense assembly, parallel over row elements."""
-    n = data[0].shape[0]
-    dof = 2 * data[-1].shape[0]
-    cols = np.arange(n)
-    for i in prange(n):
-        rows = np.array([i])
-        traction_block(data, rows, cols, out[dof * i:dof * i + dof, :])
+def unknowns(data):
+    """``2 n`` unknowns per element (n nodes, global DD x, y each)."""
+    return 2 * data.nodes.shape[0]
 
 
 @njit(cache=True)
-def singular_pairs(data, rows, cols, out):
-    """``out[k]`` = True when the block of receiver ``rows[k]`` and source ``cols[k]`` is not finite."""
-    dof = 2 * data[-1].shape[0]
-    block = np.empty((dof, dof))
-    for k in range(rows.shape[0]):
-        traction_block(data, rows[k:k + 1], cols[k:k + 1], block)
-        out[k] = not np.all(np.isfinite(block))
+def workspace(data):
+    """Scratch: local stress per node (n, 2, 2, 2), traction per node (n, 2, 2), image
+    stress per node (n, 2, 2, 2) and a point."""
+    n_nodes = data.nodes.shape[0]
+    return np.empty((n_nodes, 2, 2, 2)), np.empty((n_nodes, 2, 2)), np.empty((n_nodes, 2, 2, 2)), np.empty(2)
 
 
-@njit(cache=True, parallel=True)
-def stress_at_points(points, point_layer, data, dd, out):
-    """Stress ``out`` (M, 2, 2) at ``points`` (in layers ``point_layer``; void layers give
-    zero) of the nodal DDs ``dd`` (N, n, 2). ``params[4]`` (near_fraction): points within
-    that fraction of a half length of an element end count as on it."""
-    (centers, frames, half_length, _unused, params, _self_max, layer, settings, interfaces, shear_modulus,
-     poisson_ratio, coefficients, nodes) = data
-    shift = params[2]
-    near_fraction = params[4]
+@njit(cache=True)
+def source_state(data, j, work):
+    """Nothing is shared between the receivers of a source."""
+    return 0
+
+
+@njit(cache=True)
+def element_traction(data, i, j, state, work, block):
+    """``block[2 r + p, 2 k + q]``: traction p at node r of element ``i`` for a unit
+    global DD q at node k of element ``j`` (original + complementary parts)."""
+    local, pair, image, point = work
+    nodes = data.nodes
+    half_length = data.half_length
+    g = data.shear_modulus
+    nu = data.poisson_ratio
     n_nodes = nodes.shape[0]
-    for m in prange(points.shape[0]):
-        work = np.empty((n_nodes, 2, 2, 2))
-        pair = np.empty((n_nodes, 2, 2, 2))
-        image = np.empty((n_nodes, 2, 2, 2))
-        acc = np.zeros((2, 2))
-        lr = point_layer[m]
-        if shear_modulus[lr] > 0.0:
-            for j in range(centers.shape[0]):
-                ls = layer[j]
-                stress_nodes(points[m], centers[j], frames[j], half_length[j], coefficients, shear_modulus[ls],
-                             poisson_ratio[ls], shift, pair, work, near_fraction * half_length[j])
-                if interfaces.shape[0] > 0:
-                    image_nodes(points[m], lr, centers[j], frames[j], half_length[j], ls, coefficients, settings,
-                                interfaces, shear_modulus, poisson_ratio, image)
-                    pair += image
-                for k in range(n_nodes):
+    normal = data.frames[i, 1]
+    lr = data.layer[i]
+    ls = data.layer[j]
+    near = 0.0
+    if i != j:
+        near = near_distance(data.near_fraction, half_length[i], half_length[j], nodes)
+    for r in range(n_nodes):
+        node_point(data.centers[i], data.frames[i], half_length[i], nodes[r], point)
+        traction_nodes(point, normal, data.centers[j], data.frames[j], half_length[j], data.coefficients, g[ls],
+                       nu[ls], data.singular_shift, pair, local, near)
+        if data.interfaces.shape[0] > 0:
+            image_nodes(point, lr, data.centers[j], data.frames[j], half_length[j], ls, data.coefficients,
+                        data.n_images, data.gauss_points, data.max_subdivisions, data.interfaces, g, nu, image)
+            for k in range(n_nodes):
+                for p in range(2):
                     for q in range(2):
-                        dq = dd[j, k, q]
-                        for i in range(2):
-                            for c in range(2):
-                                acc[i, c] += pair[k, q, i, c] * dq
-        out[m] = acc
+                        pair[k, p, q] += image[k, q, p, 0] * normal[0] + image[k, q, p, 1] * normal[1]
+        set_node_rows(block, pair, r)
+
+
+@njit(cache=True)
+def element_stress(data, point, point_layer, j, work, out):
+    """``out[2 k + q]`` (2n, 2, 2): stress at ``point`` (in ``point_layer``; zero in a void
+    layer) for a unit global DD q at node k of element ``j``; a point within
+    ``near_fraction`` half lengths of an end counts as on it."""
+    local, pair, image, point_work = work
+    g = data.shear_modulus
+    nu = data.poisson_ratio
+    if g[point_layer] <= 0.0:
+        out[:] = 0.0
+        return
+    n_nodes = data.nodes.shape[0]
+    nodal = out.reshape((n_nodes, 2, 2, 2))
+    ls = data.layer[j]
+    a = data.half_length[j]
+    stress_nodes(point, data.centers[j], data.frames[j], a, data.coefficients, g[ls], nu[ls],
+                 data.singular_shift, nodal, local, data.near_fraction * a)
+    if data.interfaces.shape[0] > 0:
+        image_nodes(point, point_layer, data.centers[j], data.frames[j], a, ls, data.coefficients, data.n_images,
+                    data.gauss_points, data.max_subdivisions, data.interfaces, g, nu, image)
+        nodal += image
+
+
+register_kind(LayeredNodalSegments, KernelKind(unknowns, workspace, source_state, element_traction, element_stress,
+                                               edge_distance))
 
 
 def _constant_data(mesh, medium, singular_shift, near_fraction, n_images, gauss_points, max_subdivisions):
@@ -159,31 +162,25 @@ def _constant_data(mesh, medium, singular_shift, near_fraction, n_images, gauss_
 
     data = influence2d.influence_data(mesh, medium, singular_shift, 0.0, near_fraction, n_images)
     if gauss_points is not None:
-        data[7][1] = float(gauss_points)
+        data = data._replace(gauss_points=int(gauss_points))
     if max_subdivisions is not None:
-        data[7][2] = float(max_subdivisions)
+        data = data._replace(max_subdivisions=int(max_subdivisions))
     return data
 
 
 def influence_data(mesh, medium, singular_shift, alpha, near_fraction, n_images, gauss_points=None,
                    max_subdivisions=None):
-    """The data tuple of :func:`traction_block` for a linear or quadratic 2D ``mesh`` in
-    ``medium``; ``gauss_points`` (default ``medium.gauss_points``) and
+    """The kernel data (:class:`LayeredNodalSegments`) of a linear or quadratic 2D
+    ``mesh`` in ``medium``; ``gauss_points`` (default ``medium.gauss_points``) and
     ``max_subdivisions`` (default that of :mod:`hmatddm.layered.influence2d`) set the
     image quadrature; ``alpha > 0`` fills ``self_max`` for ref. Eq. 6.11."""
     from .shape_functions import coefficients, nodes
 
-    data = _constant_data(mesh, medium, singular_shift, near_fraction, n_images, gauss_points, max_subdivisions)
-    data[4][3] = float(alpha)
-    data = data + (coefficients(mesh.element_order), nodes(mesh.element_order))
+    constant = _constant_data(mesh, medium, singular_shift, near_fraction, n_images, gauss_points, max_subdivisions)
+    data = LayeredNodalSegments(*constant._replace(alpha=float(alpha)), coefficients(mesh.element_order),
+                                nodes(mesh.element_order))
     if alpha > 0.0:
-        self_max = data[5]
-        dof = 2 * mesh.n_nodes
-        block = np.empty((dof, dof))
-        for i in range(mesh.n_elements):
-            index = np.array([i], dtype=np.int64)
-            traction_block(data, index, index, block)
-            self_max[i] = np.max(np.abs(block))
+        self_block_max(data, data.self_max)
     return data
 
 
@@ -212,8 +209,7 @@ def stress_at(mesh, medium, dd, points, singular_correction="none", near_fractio
     dd = np.ascontiguousarray(nodal_array("dd", dd, mesh))
     data = influence_data(mesh, medium, 1e-3 if singular_correction == "average" else 0.0, 0.0, near_fraction,
                           n_images)
-    out = np.zeros((len(points), 2, 2))
-    stress_at_points(points, medium.layer_of(points[:, 1]).astype(np.int64), data, dd, out)
+    out = stress_sum(data, points, dd, medium.layer_of(points[:, 1]).astype(np.int64))
     bad = np.flatnonzero(~np.all(np.isfinite(out.reshape(len(points), -1)), axis=1))
     if bad.size:
         from .errors import InputError
@@ -229,21 +225,14 @@ def dense_matrix(mesh, medium, n_images, gauss_points=None, max_subdivisions=Non
     """The dense traction matrix of a 2D mesh of any element order in ``medium`` with a
     given number of images and image quadrature (``max_subdivisions = 1``: the plain
     ``gauss_points``-point rule of ref. Table 3.2), for studies of those settings."""
-    from .layered import images2d
     from .operators import NEAR_SINGULAR_FRACTION
 
     if mesh.element_order == 0:
         data = _constant_data(mesh, medium, 0.0, NEAR_SINGULAR_FRACTION, n_images, gauss_points, max_subdivisions)
-        assemble = images2d.traction_matrix
     else:
         data = influence_data(mesh, medium, 0.0, 0.0, NEAR_SINGULAR_FRACTION, n_images, gauss_points,
                               max_subdivisions)
-        assemble = traction_matrix
-    n = mesh.n_elements * 2 * mesh.n_nodes
-    out = np.empty((n, n))
-    assemble(data, out)
-    return out
+    return influence_matrix(data)
 
 
-__all__ = ["traction_block", "traction_matrix", "edge_distance", "singular_pairs", "stress_at_points", "influence_data",
-           "image_count", "stress_at", "image_nodes", "dense_matrix"]
+__all__ = ["LayeredNodalSegments", "influence_data", "image_count", "stress_at", "image_nodes", "dense_matrix"]

@@ -14,7 +14,7 @@ import numpy as np
 from ._validation import finite_array, finite_scalar
 from .errors import InputError
 from .material import Elastic
-from .shape_functions import coefficients, values
+from .shape_functions import values
 
 
 def nodal_array(name, array, mesh, uniform=False):
@@ -71,7 +71,8 @@ def stress_at(mesh, material, dd, points, singular_correction="none", method="au
     mesh, summed directly over all elements (the arguments of :func:`hmatddm.stress_at`;
     ``method`` may be ``"auto"`` or ``"direct"``; the compressed sum exists for
     constant elements only)."""
-    from .kernels import line2d_higher_order
+    from .kernels import element_data
+    from .kernels.drivers import stress_sum
     from .layered.medium import LayeredMedium
 
     if not isinstance(material, (Elastic, LayeredMedium)):
@@ -90,15 +91,10 @@ def stress_at(mesh, material, dd, points, singular_correction="none", method="au
         return layered_stress_at(mesh, material, dd, points, singular_correction, near_fraction)
     dd = np.ascontiguousarray(nodal_array("dd", dd, mesh))
     points = np.ascontiguousarray(finite_array("points", points, (None, 2)))
-    params = np.array([material.shear_modulus, material.poisson_ratio,
-                       1e-3 if singular_correction == "average" else 0.0, 0.0, near_fraction])
-    out = np.zeros((len(points), 2, 2))
+    data = element_data(mesh, material, singular_shift=1e-3 if singular_correction == "average" else 0.0,
+                        near_fraction=near_fraction)
     started = time.perf_counter()
-    if len(points):
-        line2d_higher_order.stress_at_points(points, np.ascontiguousarray(mesh.centers),
-                                             np.ascontiguousarray(mesh.frames),
-                                             np.ascontiguousarray(mesh.half_length),
-                                             coefficients(mesh.element_order), params, dd, out)
+    out = stress_sum(data, points, dd)
     bad = np.flatnonzero(~np.all(np.isfinite(out.reshape(len(points), -1)), axis=1))
     if bad.size:
         where = "on an element end" if near_fraction == 0.0 else \

@@ -18,15 +18,15 @@ import time
 import numpy as np
 from scipy.sparse.linalg import LinearOperator
 
-from ._validation import finite_scalar, positive_int
 from .errors import InputError
-from .kernels import element_data, kernel_module
+from .kernels import drivers, element_data
 from .layered.medium import LayeredMedium
 from .material import Elastic
 from .mesh import Mesh2D, Mesh3D, check_mesh, check_parallel_spacing
 from .operator_inverse import modified_near_field_inverse, solve_with_inverse
 
 from .options import BACKENDS, DEFAULT_EPS, DEFAULT_ETA, DEFAULT_LEAF_SIZE, SINGULAR_CORRECTIONS  # noqa: F401
+from .settings import OPERATOR
 _AVERAGE_SHIFT = 1e-3  # fraction of the element half size used by the NaN averaging
 
 #: A collocation point closer than this fraction of the smaller half size (of the
@@ -95,21 +95,10 @@ class ElasticityOperator(LinearOperator):
         if not isinstance(material, (Elastic, LayeredMedium)):
             raise InputError(f"material must be an hmatddm.Elastic or hmatddm.LayeredMedium, got "
                              f"{type(material).__name__}")
-        if backend not in BACKENDS:
-            raise InputError(f"backend must be one of {BACKENDS}, got {backend!r}")
-        if singular_correction not in SINGULAR_CORRECTIONS:
-            raise InputError(f"singular_correction must be one of {SINGULAR_CORRECTIONS}, got {singular_correction!r}")
-        eps = finite_scalar("eps", eps)
-        if not 0.0 < eps < 1.0:
-            raise InputError(f"eps must be in (0, 1), got {eps}")
-        eta = finite_scalar("eta", eta)
-        if eta <= 0.0:
-            raise InputError(f"eta must be > 0, got {eta}")
-        leaf_size = positive_int("leaf_size", leaf_size)
-        if alpha is not None:
-            alpha = finite_scalar("alpha", alpha)
-            if alpha < 1.0:
-                raise InputError(f"alpha must be >= 1 (or None for no scaling), got {alpha}")
+        backend, singular_correction, eps, eta, leaf_size, alpha = (
+            OPERATOR[name].value(name, value) for name, value in
+            (("backend", backend), ("singular_correction", singular_correction), ("eps", eps), ("eta", eta),
+             ("leaf_size", leaf_size), ("alpha", alpha)))
 
         check_mesh(mesh)
         _refuse_coincident(mesh)
@@ -123,12 +112,12 @@ class ElasticityOperator(LinearOperator):
         n = mesh.n_elements * self.dof
         super().__init__(dtype=np.float64, shape=(n, n))
 
-        self._kernels, self.data = influence_data(mesh, material, singular_correction, alpha)
+        self.data = influence_data(mesh, material, singular_correction, alpha)
 
         t0 = time.perf_counter()
         if backend == "dense":
             self._matrix = np.empty(self.shape)
-            self._kernels.traction_matrix(self.data, self._matrix)
+            drivers.traction_matrix(self.data, self._matrix)
             self._hmatrix = None
             if not np.all(np.isfinite(self._matrix)):
                 self._refuse_singular()
@@ -141,7 +130,7 @@ class ElasticityOperator(LinearOperator):
             from .hmatrix import BlockGenerator, HMatrix
 
             self._matrix = None
-            generator = BlockGenerator(kernel=self._kernels.traction_block, data=self.data,
+            generator = BlockGenerator(kernel=drivers.traction_block, data=self.data,
                                        points=mesh.centers, radii=mesh.radii, dof=self.dof)
             # 3D: clusters split between whole fractures first (clouds of tall fractures:
             # -24% build CPU, -12% memory at 40k, benchmarks/RESULTS.md "Solver at scale")
@@ -152,7 +141,7 @@ class ElasticityOperator(LinearOperator):
             self._stats = dict(self._hmatrix.stats)
             self._stats["backend"] = "hmatrix"
         if isinstance(material, LayeredMedium):
-            self._stats["n_images"] = int(self.data[7][0])
+            self._stats["n_images"] = int(self.data.n_images)
         self._lu = None
         self._preconditioner = None
 
@@ -196,7 +185,7 @@ class ElasticityOperator(LinearOperator):
         rows = np.ascontiguousarray(rows, dtype=np.int64)
         cols = np.ascontiguousarray(cols, dtype=np.int64)
         out = np.empty((len(rows) * self.dof, len(cols) * self.dof))
-        self._kernels.traction_block(self.data, rows, cols, out)
+        drivers.traction_block(self.data, rows, cols, out)
         return out
 
     def check_against_dense(self, n_samples=64):
@@ -274,7 +263,7 @@ class ElasticityOperator(LinearOperator):
 
     # -- helpers ------------------------------------------------------------------------
     def _refuse_singular(self):
-        refuse_singular(self.mesh, self._kernels, self.data)
+        refuse_singular(self.mesh, self.data)
 
 
 def _refuse_coincident(mesh):
@@ -289,59 +278,53 @@ def _refuse_coincident(mesh):
 
 
 def influence_data(mesh, material, singular_correction="none", alpha=None, n_images=None):
-    """``(kernel_module, element_data)`` that fill exact influence blocks of ``mesh``
-    with the same options (NaN averaging of singular and near-singular points,
-    Eq. 6.11 scaling) as the operator uses."""
+    """The kernel data record (see :mod:`hmatddm.kernels.drivers`) that fills exact
+    influence blocks of ``mesh`` with the same options (NaN averaging of singular and
+    near-singular points, Eq. 6.11 scaling) as the operator uses."""
     shift = _AVERAGE_SHIFT if singular_correction == "average" else 0.0
     if isinstance(material, LayeredMedium):  # ref. Ch. 3: closed form + image terms
         return _layered_influence_data(mesh, material, shift, alpha, n_images)
-    kernels = kernel_module(mesh)
     self_max = None
     if alpha is not None:
-        data = element_data(mesh, material, singular_shift=shift, near_fraction=NEAR_SINGULAR_FRACTION)
-        self_max = np.empty(mesh.n_elements)
-        block = np.empty((mesh.dim * mesh.n_nodes, mesh.dim * mesh.n_nodes))
-        for i in range(mesh.n_elements):
-            index = np.array([i], dtype=np.int64)
-            kernels.traction_block(data, index, index, block)
-            self_max[i] = np.max(np.abs(block))
-    return kernels, element_data(mesh, material, singular_shift=shift, alpha=alpha or 0.0, self_max=self_max,
-                                 near_fraction=NEAR_SINGULAR_FRACTION)
+        self_max = drivers.self_block_maxima(element_data(mesh, material, singular_shift=shift,
+                                                          near_fraction=NEAR_SINGULAR_FRACTION))
+    return element_data(mesh, material, singular_shift=shift, alpha=alpha or 0.0, self_max=self_max,
+                        near_fraction=NEAR_SINGULAR_FRACTION)
 
 
 def _layered_influence_data(mesh, medium, shift, alpha, n_images=None):
-    """Kernels and data of a layered medium; ``n_images`` None: the medium's choice (for
+    """Kernel data of a layered medium; ``n_images`` None: the medium's choice (for
     ``"auto"``, made on this mesh), else that number (an extended operator keeps its base's)."""
-    from .layered import images2d, influence2d
+    from .layered import influence2d, influence3d
 
     if mesh.dim == 2 and mesh.element_order > 0:  # linear / quadratic elements (ref. Sec. 3.5)
         from . import layered_higher_order
 
         if n_images is None:
             n_images = layered_higher_order.image_count(mesh, medium, shift)
-        return layered_higher_order, layered_higher_order.influence_data(mesh, medium, shift, alpha or 0.0,
-                                                                         NEAR_SINGULAR_FRACTION, n_images)
+        return layered_higher_order.influence_data(mesh, medium, shift, alpha or 0.0, NEAR_SINGULAR_FRACTION,
+                                                   n_images)
+    influence = influence3d if mesh.dim == 3 else influence2d  # constant rectangles / segments
     if n_images is None:
-        data = influence2d.influence_data(mesh, medium, shift, 0.0, NEAR_SINGULAR_FRACTION, 0)
-        n_images = influence2d.choose_images(mesh, medium, data)
-    data = influence2d.influence_data(mesh, medium, shift, alpha or 0.0, NEAR_SINGULAR_FRACTION, n_images)
-    return images2d, data
+        data = influence.influence_data(mesh, medium, shift, 0.0, NEAR_SINGULAR_FRACTION, 0)
+        n_images = influence.choose_images(mesh, medium, data)
+    return influence.influence_data(mesh, medium, shift, alpha or 0.0, NEAR_SINGULAR_FRACTION, n_images)
 
 
-def element_sizes(mesh):
-    """(N,) the half size the near-singular test uses: the half length in 2D,
-    ``min(half_a, half_b)`` in 3D."""
+def smaller_half_sides(mesh):
+    """(N,) the half size the near-singular test uses: the half length in 2D, the
+    smaller half side ``min(half_a, half_b)`` in 3D."""
     return mesh.half_length.copy() if mesh.dim == 2 else np.minimum(mesh.half_a, mesh.half_b)
 
 
-def singular_pairs(mesh, kernels, data):
+def singular_pairs(mesh, data):
     """(receivers, sources): every element pair whose influence block is singular
     (a collocation point on, or nearer than the near-singular distance to, another
     element's edge), sorted. Candidates come from a KD-tree on the centres."""
     from scipy.spatial import cKDTree
 
-    near_fraction = float(data[4][4])
-    reach = mesh.radii * (1.0 + 1e-9) + near_fraction * element_sizes(mesh)
+    near_fraction = float(data.near_fraction)
+    reach = mesh.radii * (1.0 + 1e-9) + near_fraction * smaller_half_sides(mesh)
     if mesh.n_nodes > 1:  # collocation nodes of linear / quadratic elements lie off the centre
         reach = reach + np.max(mesh.radii)
     tree = cKDTree(mesh.centers)
@@ -352,12 +335,12 @@ def singular_pairs(mesh, kernels, data):
     keep = receivers != sources
     receivers, sources = receivers[keep], sources[keep]
     bad = np.zeros(len(receivers), dtype=np.bool_)
-    kernels.singular_pairs(data, receivers, sources, bad)
+    drivers.singular_pairs(data, receivers, sources, bad)
     order = np.lexsort((sources[bad], receivers[bad]))
     return receivers[bad][order], sources[bad][order]
 
 
-def refuse_singular(mesh=None, kernels=None, data=None):
+def refuse_singular(mesh=None, data=None):
     """Raise the InputError of a mesh with collocation points on (or, closer than
     :data:`NEAR_SINGULAR_FRACTION` half sizes, near) element edges; given the mesh and
     its kernel data, the message names the first such pair and its gap."""
@@ -369,11 +352,12 @@ def refuse_singular(mesh=None, kernels=None, data=None):
             f"another element's centre) and ~1/gap within {NEAR_SINGULAR_FRACTION} half sizes of one (a near "
             f"miss), which pins the solution")
     if mesh is not None:
-        receivers, sources = singular_pairs(mesh, kernels, data)
+        receivers, sources = singular_pairs(mesh, data)
         if len(receivers):
             i, j = int(receivers[0]), int(sources[0])
-            gap = float(kernels.edge_distance(data, i, j))
-            size = float(min(element_sizes(mesh)[i], element_sizes(mesh)[j]))
+            gap = float(drivers.edge_distance(data, i, j))
+            half_sides = smaller_half_sides(mesh)
+            size = float(min(half_sides[i], half_sides[j]))
             point = "centre" if mesh.n_nodes == 1 else "collocation node"
             where = ("on an edge" if gap <= 1e-9 * size else
                      f"{gap:.3g} m ({gap / size:.2g} of the smaller half size) from an edge")

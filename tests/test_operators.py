@@ -169,7 +169,7 @@ def test_averaged_near_miss_is_the_touching_junction(material, make_mesh, touchi
     assert hmat.stats["n_admissible"] > 0
     A, H = dense.to_dense(), hmat.to_dense()
     assert np.all(np.isfinite(A))
-    receivers, sources = hd.operators.singular_pairs(mesh, *hd.operators.influence_data(mesh, material))
+    receivers, sources = hd.operators.singular_pairs(mesh, hd.operators.influence_data(mesh, material))
     assert len(receivers) > 0
     d = mesh.dim
     for i, j in zip(receivers, sources):

@@ -19,8 +19,7 @@ def test_near_singular_fraction_is_the_operators():
 
 
 def _kernel_pairs(mesh):
-    kernels, data = operators.influence_data(mesh, hd.Elastic(10e9, 0.25))
-    return operators.singular_pairs(mesh, kernels, data)
+    return operators.singular_pairs(mesh, operators.influence_data(mesh, hd.Elastic(10e9, 0.25)))
 
 
 def _meshes_with_junctions():

@@ -15,14 +15,16 @@ ref. App. A eqs 15-19 (eqs 18-19 there print ``r^2`` where ``r^4`` belongs). The
 singular points are the segment's two end points (dislocations), handled as in
 :mod:`hmatddm.kernels.rectangle3d`; points on the extension of the segment are regular.
 Points merely *near* an end point (a near-miss junction) are treated as on it when the
-caller passes a ``near`` distance (see :func:`traction_block`).
+caller passes a ``near`` distance (see :func:`element_traction`). The loops over element
+pairs are :mod:`hmatddm.kernels.drivers`; :class:`Segments` is the kernel data.
 """
 import math
+from typing import NamedTuple
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
-from .correction import scale_to_self
+from .drivers import KernelKind, register_kind
 
 _INV_4PI = 1.0 / (4.0 * math.pi)
 
@@ -154,81 +156,68 @@ def rotate_to_global(frame, local, out):
                 out[q, i, j] = acc
 
 
-@njit(cache=True)
-def traction_block(data, rows, cols, out):
-    """Block generator kernel for 2D meshes, as :func:`rectangle3d.traction_block`.
+class Segments(NamedTuple):
+    """Kernel data of constant 2D elements (the record :mod:`.drivers` take)."""
 
-    ``data = (centers, frames, half_length, half_length, params, self_max)`` (the half
-    length is passed twice so that 2D and 3D data tuples have the same layout), with
-    ``params = [G, nu, singular_shift, alpha, near_fraction]``. A collocation point
-    closer than ``near_fraction * min(a_i, a_j)`` (half lengths of receiver and source)
-    to an end point of another element is singular (see :func:`local_stress_corrected`).
-    """
-    centers, frames, half_length, _unused, params, self_max = data
-    g = params[0]
-    nu = params[1]
-    shift = params[2]
-    alpha = params[3]
-    near_fraction = params[4] if params.shape[0] > 4 else 0.0
-    work = np.empty((2, 2, 2))
-    pair = np.empty((2, 2))
-    for ia in range(rows.shape[0]):
-        i = rows[ia]
-        point = centers[i]
-        normal = frames[i, 1]
-        for jb in range(cols.shape[0]):
-            j = cols[jb]
-            near = 0.0
-            if i != j:
-                near = near_fraction * min(half_length[i], half_length[j])
-            traction_pair(point, normal, centers[j], frames[j], half_length[j], g, nu, shift, pair, work, near)
-            if alpha > 0.0 and i != j:
-                scale_to_self(pair, alpha * self_max[j])
-            for p in range(2):
-                for q in range(2):
-                    out[2 * ia + p, 2 * jb + q] = pair[p, q]
+    centers: np.ndarray  #: (N, 2) element midpoints
+    frames: np.ndarray  #: (N, 2, 2) rows: unit tangent, unit normal
+    half_length: np.ndarray  #: (N,) half lengths a
+    shear_modulus: float
+    poisson_ratio: float
+    singular_shift: float  #: see :mod:`hmatddm.kernels.drivers` (singular points)
+    near_fraction: float  #: near-miss distance, fraction of the smaller half size
+    alpha: float  #: ref. Eq. 6.11 scaling (0: none)
+    self_max: np.ndarray  #: (N,) largest |entry| of each self block (ref. Eq. 6.11)
+
+
+@njit(cache=True)
+def unknowns(data):
+    """Two unknowns per element (global DD x, y)."""
+    return 2
+
+
+@njit(cache=True)
+def workspace(data):
+    """Scratch of :func:`traction_pair` / :func:`stress_pair`: the local stress (2, 2, 2)."""
+    return np.empty((2, 2, 2))
+
+
+@njit(cache=True)
+def source_state(data, j, work):
+    """Nothing is shared between the receivers of a source."""
+    return 0
+
+
+@njit(cache=True)
+def element_traction(data, i, j, state, work, block):
+    """``block`` (2, 2): :func:`traction_pair` at the centre of element ``i`` (its normal)
+    from element ``j``; a centre closer than ``near_fraction * min(a_i, a_j)`` to an end of
+    ``j`` counts as on it (see :func:`local_stress_corrected`)."""
+    near = 0.0
+    if i != j:
+        near = data.near_fraction * min(data.half_length[i], data.half_length[j])
+    traction_pair(data.centers[i], data.frames[i, 1], data.centers[j], data.frames[j], data.half_length[j],
+                  data.shear_modulus, data.poisson_ratio, data.singular_shift, block, work, near)
+
+
+@njit(cache=True)
+def element_stress(data, point, point_layer, j, work, out):
+    """``out`` (2, 2, 2): :func:`stress_pair` of element ``j`` at ``point``."""
+    a = data.half_length[j]
+    stress_pair(point, data.centers[j], data.frames[j], a, data.shear_modulus, data.poisson_ratio,
+                data.singular_shift, out, work, data.near_fraction * a)
 
 
 @njit(cache=True)
 def edge_distance(data, i, j):
-    """Distance from element ``i``'s collocation point to the nearer end of element ``j``."""
-    centers, frames, half_length = data[0], data[1], data[2]
+    """Distance from element ``i``'s centre to the nearer end of element ``j`` (any record
+    with ``centers``, ``frames`` and ``half_length``)."""
+    centers, frames = data.centers, data.frames
     dx = centers[i, 0] - centers[j, 0]
     dy = centers[i, 1] - centers[j, 1]
     x = frames[j, 0, 0] * dx + frames[j, 0, 1] * dy
     y = frames[j, 1, 0] * dx + frames[j, 1, 1] * dy
-    return tip_distance(x, y, half_length[j])
-
-
-@njit(cache=True, parallel=True)
-def traction_matrix(data, out):
-    """Dense assembly of the whole traction matrix, parallel over row elements."""
-    centers = data[0]
-    n = centers.shape[0]
-    cols = np.arange(n)
-    for i in prange(n):
-        rows = np.array([i])
-        traction_block(data, rows, cols, out[2 * i:2 * i + 2, :])
-
-
-@njit(cache=True, parallel=True)
-def stress_at_points(points, centers, frames, half_length, params, dd, out):
-    """Induced global stress at ``points`` (M, 2) by DDs ``dd`` (N, 2): ``out`` (M, 2, 2)."""
-    g = params[0]
-    nu = params[1]
-    shift = params[2]
-    for m in prange(points.shape[0]):
-        work = np.empty((2, 2, 2))
-        pair = np.empty((2, 2, 2))
-        acc = np.zeros((2, 2))
-        for j in range(centers.shape[0]):
-            stress_pair(points[m], centers[j], frames[j], half_length[j], g, nu, shift, pair, work)
-            for q in range(2):
-                dq = dd[j, q]
-                for i in range(2):
-                    for k in range(2):
-                        acc[i, k] += pair[q, i, k] * dq
-        out[m] = acc
+    return tip_distance(x, y, data.half_length[j])
 
 
 @njit(cache=True)
@@ -254,16 +243,4 @@ def mean_stress_pair(point, center, frame, a, shear_modulus, poisson_ratio, out)
         out[q] = frame[0, q] * m0 + frame[1, q] * m1
 
 
-@njit(cache=True)
-def singular_pairs(data, rows, cols, out):
-    """``out[k]`` = True when the influence block of receiver ``rows[k]`` and source
-    ``cols[k]`` (from :func:`traction_block`) is not finite: a singular pair."""
-    pair = np.empty((2, 2))
-    for k in range(rows.shape[0]):
-        traction_block(data, rows[k:k + 1], cols[k:k + 1], pair)
-        finite = True
-        for p in range(2):
-            for q in range(2):
-                if not np.isfinite(pair[p, q]):
-                    finite = False
-        out[k] = not finite
+register_kind(Segments, KernelKind(unknowns, workspace, source_state, element_traction, element_stress, edge_distance))

@@ -29,18 +29,17 @@ cancellation (its terms grow like ``(R/a)^m`` against a result that decays), so 
 the same integrals are taken by Gauss-Legendre quadrature of the point kernel with
 ``FAR_GAUSS_POINTS`` (fewer the farther), exact to round-off at that distance.
 
-Data layout of the block generator (:func:`traction_block`):
-``(centers, frames, half_length, half_length, params, self_max, coefficients, nodes)`` --
-the six arrays of :func:`hmatddm.kernels.element_data` plus the shape functions'
-monomial coefficients ``(n, 3)`` and nodes ``(n,)``. Unknowns of element ``e`` are
-``(e * n + k) * 2 + q`` for node ``k`` and global component ``q`` (docs/conventions.md §2).
+Kernel data: :class:`NodalSegments` (the loops over element pairs are
+:mod:`hmatddm.kernels.drivers`). Unknowns of element ``e`` are ``(e * n + k) * 2 + q``
+for node ``k`` and global component ``q`` (docs/conventions.md §2).
 """
 import math
+from typing import NamedTuple
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
-from .correction import scale_to_self
+from .drivers import KernelKind, register_kind
 from .line2d import on_tip, rotate_to_global, tip_distance
 
 _INV_4PI = 1.0 / (4.0 * math.pi)
@@ -253,38 +252,68 @@ def near_distance(near_fraction, a_receiver, a_source, nodes):
     return near_fraction * (1.0 - outer) * min(a_receiver, a_source)
 
 
+class NodalSegments(NamedTuple):
+    """Kernel data of linear and quadratic 2D elements (the record :mod:`.drivers` take)."""
+
+    centers: np.ndarray  #: (N, 2) element midpoints
+    frames: np.ndarray  #: (N, 2, 2) rows: unit tangent, unit normal
+    half_length: np.ndarray  #: (N,) half lengths a
+    shear_modulus: float
+    poisson_ratio: float
+    singular_shift: float  #: see :mod:`hmatddm.kernels.drivers` (singular points)
+    near_fraction: float  #: near-miss distance, fraction of the smaller half size
+    alpha: float  #: ref. Eq. 6.11 scaling (0: none)
+    self_max: np.ndarray  #: (N,) largest |entry| of each self block (ref. Eq. 6.11)
+    coefficients: np.ndarray  #: (n, 3) monomial coefficients of the n shape functions
+    nodes: np.ndarray  #: (n,) intrinsic coordinates of the collocation nodes
+
+
 @njit(cache=True)
-def traction_block(data, rows, cols, out):
-    """Block generator kernel (see :mod:`hmatddm.hmatrix.generator`) with ``2 n`` unknowns
-    per element: ``out[(a n + r) 2 + p, (b n + k) 2 + q]`` is the traction component p at
-    node r of element ``rows[a]`` for a unit DD component q at node k of ``cols[b]``.
-    ``data`` as in the module docstring; ``params = [G, nu, singular_shift, alpha,
-    near_fraction]`` as for :func:`hmatddm.kernels.line2d.traction_block`."""
-    centers, frames, half_length, _unused, params, self_max, coefficients, nodes = data
-    g = params[0]
-    nu = params[1]
-    shift = params[2]
-    alpha = params[3]
-    near_fraction = params[4]
-    n_nodes = nodes.shape[0]
-    work = np.empty((n_nodes, 2, 2, 2))
-    pair = np.empty((n_nodes, 2, 2))
-    block = np.empty((2 * n_nodes, 2 * n_nodes))
-    point = np.empty(2)
-    for ia in range(rows.shape[0]):
-        i = rows[ia]
-        normal = frames[i, 1]
-        for jb in range(cols.shape[0]):
-            j = cols[jb]
-            near = 0.0
-            if i != j:
-                near = near_distance(near_fraction, half_length[i], half_length[j], nodes)
-            for r in range(n_nodes):
-                node_point(centers[i], frames[i], half_length[i], nodes[r], point)
-                traction_nodes(point, normal, centers[j], frames[j], half_length[j], coefficients, g, nu, shift, pair,
-                               work, near)
-                set_node_rows(block, pair, r)
-            store_block(block, out, ia, jb, i, j, alpha, self_max)
+def unknowns(data):
+    """``2 n`` unknowns per element (n nodes, global DD x, y each)."""
+    return 2 * data.nodes.shape[0]
+
+
+@njit(cache=True)
+def workspace(data):
+    """Scratch: local stress per node (n, 2, 2, 2), traction per node (n, 2, 2), a point."""
+    n_nodes = data.nodes.shape[0]
+    return np.empty((n_nodes, 2, 2, 2)), np.empty((n_nodes, 2, 2)), np.empty(2)
+
+
+@njit(cache=True)
+def source_state(data, j, work):
+    """Nothing is shared between the receivers of a source."""
+    return 0
+
+
+@njit(cache=True)
+def element_traction(data, i, j, state, work, block):
+    """``block[2 r + p, 2 k + q]``: traction p at node r of element ``i`` for a unit DD q
+    at node k of element ``j`` (:func:`traction_nodes`; near misses: :func:`near_distance`)."""
+    local, pair, point = work
+    nodes = data.nodes
+    half_length = data.half_length
+    near = 0.0
+    if i != j:
+        near = near_distance(data.near_fraction, half_length[i], half_length[j], nodes)
+    normal = data.frames[i, 1]
+    for r in range(nodes.shape[0]):
+        node_point(data.centers[i], data.frames[i], half_length[i], nodes[r], point)
+        traction_nodes(point, normal, data.centers[j], data.frames[j], half_length[j], data.coefficients,
+                       data.shear_modulus, data.poisson_ratio, data.singular_shift, pair, local, near)
+        set_node_rows(block, pair, r)
+
+
+@njit(cache=True)
+def element_stress(data, point, point_layer, j, work, out):
+    """``out[2 k + q]`` (2n, 2, 2): :func:`stress_nodes` of element ``j`` at ``point``; a
+    point within ``near_fraction`` half lengths of an end counts as on it."""
+    n_nodes = data.nodes.shape[0]
+    a = data.half_length[j]
+    stress_nodes(point, data.centers[j], data.frames[j], a, data.coefficients, data.shear_modulus,
+                 data.poisson_ratio, data.singular_shift, out.reshape((n_nodes, 2, 2, 2)), work[0],
+                 data.near_fraction * a)
 
 
 @njit(cache=True)
@@ -298,35 +327,11 @@ def set_node_rows(block, pair, r):
 
 
 @njit(cache=True)
-def store_block(block, out, ia, jb, i, j, alpha, self_max):
-    """Scale an off-diagonal element block by ref. Eq. 6.11 (``alpha > 0``), then copy it
-    to its place ``(ia, jb)`` in ``out``."""
-    dof = block.shape[0]
-    if alpha > 0.0 and i != j:
-        scale_to_self(block, alpha * self_max[j])
-    for p in range(dof):
-        for q in range(dof):
-            out[dof * ia + p, dof * jb + q] = block[p, q]
-
-
-@njit(cache=True, parallel=True)
-def traction_matrix(data, out):
-    """Dense assembly of the whole traction matrix, parallel over row elements."""
-    centers = data[0]
-    dof = 2 * data[-1].shape[0]
-    n = centers.shape[0]
-    cols = np.arange(n)
-    for i in prange(n):
-        rows = np.array([i])
-        traction_block(data, rows, cols, out[dof * i:dof * i + dof, :])
-
-
-@njit(cache=True)
 def edge_distance(data, i, j):
     """Distance from the collocation nodes of element ``i`` to the nearer end of element
-    ``j`` (any data tuple that starts with centres, frames, half lengths and ends with
-    the nodes, as the layered one of :mod:`hmatddm.layered_higher_order`)."""
-    centers, frames, half_length, nodes = data[0], data[1], data[2], data[-1]
+    ``j`` (any record with ``centers``, ``frames``, ``half_length`` and ``nodes``, as the
+    layered one of :mod:`hmatddm.layered_higher_order`)."""
+    centers, frames, half_length, nodes = data.centers, data.frames, data.half_length, data.nodes
     point = np.empty(2)
     best = np.inf
     for r in range(nodes.shape[0]):
@@ -336,38 +341,5 @@ def edge_distance(data, i, j):
     return best
 
 
-@njit(cache=True)
-def singular_pairs(data, rows, cols, out):
-    """``out[k]`` = True when the influence block of receiver ``rows[k]`` and source
-    ``cols[k]`` (from :func:`traction_block`) is not finite: a singular pair."""
-    dof = 2 * data[-1].shape[0]
-    block = np.empty((dof, dof))
-    for k in range(rows.shape[0]):
-        traction_block(data, rows[k:k + 1], cols[k:k + 1], block)
-        out[k] = not np.all(np.isfinite(block))
-
-
-@njit(cache=True, parallel=True)
-def stress_at_points(points, centers, frames, half_length, coefficients, params, dd, out):
-    """Induced global stress ``out`` (M, 2, 2) at ``points`` (M, 2) by the nodal DDs
-    ``dd`` (N, n, 2). ``params = [G, nu, singular_shift, _, near_fraction]``: a point
-    within ``near_fraction`` half lengths of an end point counts as on it."""
-    g = params[0]
-    nu = params[1]
-    shift = params[2]
-    near_fraction = params[4]
-    n_nodes = coefficients.shape[0]
-    for m in prange(points.shape[0]):
-        work = np.empty((n_nodes, 2, 2, 2))
-        pair = np.empty((n_nodes, 2, 2, 2))
-        acc = np.zeros((2, 2))
-        for j in range(centers.shape[0]):
-            stress_nodes(points[m], centers[j], frames[j], half_length[j], coefficients, g, nu, shift, pair, work,
-                         near_fraction * half_length[j])
-            for n in range(n_nodes):
-                for q in range(2):
-                    dq = dd[j, n, q]
-                    for i in range(2):
-                        for k in range(2):
-                            acc[i, k] += pair[n, q, i, k] * dq
-        out[m] = acc
+register_kind(NodalSegments, KernelKind(unknowns, workspace, source_state, element_traction, element_stress,
+                                        edge_distance))

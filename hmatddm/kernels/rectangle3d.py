@@ -22,15 +22,19 @@ where the stress is infinite) are singular and handled by :func:`local_stress_co
 (see :mod:`hmatddm.kernels.correction`), as are points within a caller-given ``near``
 distance of an edge (near-miss junctions, where the exact value is ~1/gap).
 
+The loops over element pairs are :mod:`hmatddm.kernels.drivers`; :class:`Rectangles` is
+the kernel data.
+
 Sign convention: DD = u(+) - u(-), + being the side ``n = e1 x e2`` points to; an opening
 (DD . n > 0) induces compression on the element itself (docs/conventions.md §1).
 """
 import math
+from typing import NamedTuple
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
-from .correction import scale_to_self
+from .drivers import KernelKind, register_kind
 
 _INV_8PI = 1.0 / (8.0 * math.pi)
 
@@ -295,88 +299,68 @@ def stress_pair(point, center, frame, a, b, shear_modulus, poisson_ratio, singul
                 out[q, i, j] = acc
 
 
+class Rectangles(NamedTuple):
+    """Kernel data of constant 3D rectangles (the record :mod:`.drivers` take)."""
+
+    centers: np.ndarray  #: (N, 3) element centres
+    frames: np.ndarray  #: (N, 3, 3) rows: e1, e2, normal e1 x e2
+    half_a: np.ndarray  #: (N,) half sides along e1
+    half_b: np.ndarray  #: (N,) half sides along e2
+    shear_modulus: float
+    poisson_ratio: float
+    singular_shift: float  #: see :mod:`hmatddm.kernels.drivers` (singular points)
+    near_fraction: float  #: near-miss distance, fraction of the smaller half size
+    alpha: float  #: ref. Eq. 6.11 scaling (0: none)
+    self_max: np.ndarray  #: (N,) largest |entry| of each self block (ref. Eq. 6.11)
+
+
 @njit(cache=True)
-def traction_block(data, rows, cols, out):
-    """Block generator kernel (see :class:`hmatddm.hmatrix.BlockGenerator`).
+def unknowns(data):
+    """Three unknowns per element (global DD x, y, z)."""
+    return 3
 
-    ``data = (centers, frames, half_a, half_b, params, self_max)`` with ``params =
-    [shear_modulus, poisson_ratio, singular_shift, alpha, near_fraction]`` and ``out`` of
-    shape ``(3 len(rows), 3 len(cols))``: traction at the collocation points of ``rows``
-    (with their normals) from unit global DD components of ``cols``.
 
-    * A collocation point on an edge of another element, or closer to one than
-      ``near_fraction * min(size_i, size_j)`` (``size = min(half_a, half_b)`` of the
-      receiver ``i`` and the source ``j``: a near-miss junction), is singular: NaN
-      without averaging (``singular_shift = 0``), else the reference's averaging at the
-      nearest edge point (:func:`local_stress_corrected`).
-    * ``alpha > 0`` applies the reference's scaling of blocks larger than the
-      self-influence (ref. Eq. 6.11), which needs ``data[5]``: the max-abs entry of each
-      element's self block.
-    """
-    centers, frames, half_a, half_b, params, self_max = data
-    g = params[0]
-    nu = params[1]
-    shift = params[2]
-    alpha = params[3]
-    near_fraction = params[4] if params.shape[0] > 4 else 0.0
-    work = np.empty((3, 3, 3))
-    pair = np.empty((3, 3))
-    for ia in range(rows.shape[0]):
-        i = rows[ia]
-        point = centers[i]
-        normal = frames[i, 2]
-        size_i = min(half_a[i], half_b[i])
-        for jb in range(cols.shape[0]):
-            j = cols[jb]
-            near = 0.0
-            if i != j:
-                near = near_fraction * min(size_i, half_a[j], half_b[j])
-            traction_pair(point, normal, centers[j], frames[j], half_a[j], half_b[j], g, nu, shift, pair, work,
-                          near)
-            if alpha > 0.0 and i != j:
-                scale_to_self(pair, alpha * self_max[j])
-            for p in range(3):
-                for q in range(3):
-                    out[3 * ia + p, 3 * jb + q] = pair[p, q]
+@njit(cache=True)
+def workspace(data):
+    """Scratch of :func:`traction_pair` / :func:`stress_pair`: the local stress (3, 3, 3)."""
+    return np.empty((3, 3, 3))
+
+
+@njit(cache=True)
+def source_state(data, j, work):
+    """Nothing is shared between the receivers of a source."""
+    return 0
+
+
+@njit(cache=True)
+def element_traction(data, i, j, state, work, block):
+    """``block`` (3, 3): :func:`traction_pair` at the centre of element ``i`` (its normal)
+    from element ``j``. A centre closer than ``near_fraction * min(size_i, size_j)``
+    (``size = min(half_a, half_b)``) to an edge of ``j`` is singular (a near-miss
+    junction): NaN without averaging, else the reference's averaging at the nearest edge
+    point (:func:`local_stress_corrected`)."""
+    near = 0.0
+    if i != j:
+        near = data.near_fraction * min(data.half_a[i], data.half_b[i], data.half_a[j], data.half_b[j])
+    traction_pair(data.centers[i], data.frames[i, 2], data.centers[j], data.frames[j], data.half_a[j],
+                  data.half_b[j], data.shear_modulus, data.poisson_ratio, data.singular_shift, block, work,
+                  near)
+
+
+@njit(cache=True)
+def element_stress(data, point, point_layer, j, work, out):
+    """``out`` (3, 3, 3): :func:`stress_pair` of element ``j`` at ``point``."""
+    a = data.half_a[j]
+    b = data.half_b[j]
+    stress_pair(point, data.centers[j], data.frames[j], a, b, data.shear_modulus, data.poisson_ratio,
+                data.singular_shift, out, work, data.near_fraction * min(a, b))
 
 
 @njit(cache=True)
 def edge_distance(data, i, j):
-    """Distance from element ``i``'s collocation point to the nearest edge of element ``j``."""
-    centers, frames, half_a, half_b = data[0], data[1], data[2], data[3]
-    x1, x2, x3 = _to_local(centers[i], centers[j], frames[j])
-    return nearest_boundary_point(x1, x2, x3, half_a[j], half_b[j])[0]
-
-
-@njit(cache=True, parallel=True)
-def traction_matrix(data, out):
-    """Dense assembly of the whole traction matrix, parallel over row elements."""
-    centers = data[0]
-    n = centers.shape[0]
-    cols = np.arange(n)
-    for i in prange(n):
-        rows = np.array([i])
-        traction_block(data, rows, cols, out[3 * i:3 * i + 3, :])
-
-
-@njit(cache=True, parallel=True)
-def stress_at_points(points, centers, frames, half_a, half_b, params, dd, out):
-    """Induced global stress at ``points`` (M, 3) by DDs ``dd`` (N, 3): ``out`` (M, 3, 3)."""
-    g = params[0]
-    nu = params[1]
-    shift = params[2]
-    for m in prange(points.shape[0]):
-        work = np.empty((3, 3, 3))
-        pair = np.empty((3, 3, 3))
-        acc = np.zeros((3, 3))
-        for j in range(centers.shape[0]):
-            stress_pair(points[m], centers[j], frames[j], half_a[j], half_b[j], g, nu, shift, pair, work)
-            for q in range(3):
-                dq = dd[j, q]
-                for i in range(3):
-                    for k in range(3):
-                        acc[i, k] += pair[q, i, k] * dq
-        out[m] = acc
+    """Distance from element ``i``'s centre to the nearest edge of element ``j``."""
+    x1, x2, x3 = _to_local(data.centers[i], data.centers[j], data.frames[j])
+    return nearest_boundary_point(x1, x2, x3, data.half_a[j], data.half_b[j])[0]
 
 
 @njit(cache=True)
@@ -396,16 +380,5 @@ def mean_stress_pair(point, center, frame, a, b, shear_modulus, poisson_ratio, o
         out[q] = frame[0, q] * m0 + frame[1, q] * m1 + frame[2, q] * m2
 
 
-@njit(cache=True)
-def singular_pairs(data, rows, cols, out):
-    """``out[k]`` = True when the influence block of receiver ``rows[k]`` and source
-    ``cols[k]`` (from :func:`traction_block`) is not finite: a singular pair."""
-    pair = np.empty((3, 3))
-    for k in range(rows.shape[0]):
-        traction_block(data, rows[k:k + 1], cols[k:k + 1], pair)
-        finite = True
-        for p in range(3):
-            for q in range(3):
-                if not np.isfinite(pair[p, q]):
-                    finite = False
-        out[k] = not finite
+register_kind(Rectangles, KernelKind(unknowns, workspace, source_state, element_traction, element_stress,
+                                     edge_distance))

@@ -56,12 +56,13 @@ because the callers add the closed-form kernel of the source's material at every
 receiver. So with equal layers the complementary stress is exactly zero.
 """
 import math
+from typing import NamedTuple
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from ..kernels import line2d
-from ..kernels.correction import scale_to_self
+from ..kernels.drivers import KernelKind, register_kind
 
 _INV_4PI = 1.0 / (4.0 * math.pi)
 
@@ -577,7 +578,7 @@ def subdivisions(y1, y3, receiver_layer, p0, p1, source_layer, interfaces, max_s
     return min(max(n, 1), max_sub)
 
 
-# -- block generator for constant elements -------------------------------------------------
+# -- constant elements: the kernel data and the per-pair functions of the drivers -----------
 #: Sub-segment levels (2^level sub-segments) whose traced pairs a source keeps.
 _CACHED_LEVELS = 4
 
@@ -607,142 +608,124 @@ def _level_rule(n_gauss, max_level):
     return xi, w, start
 
 
+class LayeredSegments(NamedTuple):
+    """Kernel data of constant 2D elements in a layered medium (the record
+    :mod:`hmatddm.kernels.drivers` take; built by
+    :func:`hmatddm.layered.influence2d.influence_data`)."""
+
+    centers: np.ndarray  #: (N, 2) element midpoints
+    frames: np.ndarray  #: (N, 2, 2) rows: unit tangent, unit normal
+    half_length: np.ndarray  #: (N,) half lengths
+    layer: np.ndarray  #: (N,) int64 layer of each element
+    interfaces: np.ndarray  #: (L - 1,) interface heights, top down
+    shear_modulus: np.ndarray  #: (L,) per layer (0: void)
+    poisson_ratio: np.ndarray  #: (L,) per layer
+    n_images: int  #: reflections per interface (ref. Fig. 3.4)
+    gauss_points: int  #: Gauss-Legendre points per sub-segment of the image quadrature (ref. Table 3.2)
+    max_subdivisions: int  #: largest number of sub-segments (:func:`hmatddm.layered.images2d.subdivisions`)
+    singular_shift: float  #: see :mod:`hmatddm.kernels.drivers` (singular points)
+    near_fraction: float  #: near-miss distance, fraction of the smaller half size
+    alpha: float  #: ref. Eq. 6.11 scaling (0: none)
+    self_max: np.ndarray  #: (N,) largest |entry| of each self block (ref. Eq. 6.11)
+
+
 @njit(cache=True)
-def _source_block(j, rows, centers, frames, half_length, layer, params, settings, interfaces, shear_modulus,
-                  poisson_ratio, alpha, self_max, out, column):
-    """Traction ``out[2 ia + p, column + q]`` at the collocation points of ``rows`` for a
-    unit global DD ``q`` of constant element ``j``: closed form (source layer's material)
-    plus images, the source's traced pairs reused across receivers."""
-    shift = params[2]
-    near_fraction = params[4]
-    n_images = int(settings[0])
-    n_gauss = int(settings[1])
-    max_sub = int(settings[2])
-    ls = layer[j]
-    work = np.empty((2, 2, 2))
-    pair = np.empty((2, 2))
-    image = np.zeros((1, 2, 2, 2))
-    gradient = np.empty((2, 2, 3))
-    p0 = centers[j] - half_length[j] * frames[j, 0]
-    p1 = centers[j] + half_length[j] * frames[j, 0]
-    layered = interfaces.shape[0] > 0
-    max_level = _CACHED_LEVELS - 1
-    xi, wt, start = _level_rule(n_gauss, max_level)
-    # each level is traced when a receiver first needs it (a lone receiver: one level)
-    traced = trace_points(p0, p1, ls, interfaces, shear_modulus, poisson_ratio, n_images, xi, True)
-    is_traced = np.zeros(max_level + 1, dtype=np.bool_)
-    ws = Workspace(traced[4].shape[-1])
-    ws1 = Workspace(1)
-    for ia in range(rows.shape[0]):
-        i = rows[ia]
-        point = centers[i]
-        normal = frames[i, 1]
-        near = 0.0
-        if i != j:
-            near = near_fraction * min(half_length[i], half_length[j])
-        line2d.traction_pair(point, normal, centers[j], frames[j], half_length[j], shear_modulus[ls],
-                             poisson_ratio[ls], shift, pair, work, near)
-        if layered:
-            lr = layer[i]
-            level = _level(subdivisions(point[0], point[1], lr, p0, p1, ls, interfaces, max_sub))
-            image[:] = 0.0
-            if level <= max_level:
-                a, b = start[level], start[level + 1]
-                if not is_traced[level]:
-                    _trace_range(p0, p1, ls, interfaces, shear_modulus, poisson_ratio, n_images, xi, a, b, traced)
-                    is_traced[level] = True
-                _integrate(point[0], point[1], lr, p0, p1, ls, shear_modulus, poisson_ratio, xi[a:b], wt[a:b],
-                           np.ones((b - a, 1)), traced, a, image, gradient, ws, ws1)
-            else:
-                x, w = composite_rule(n_gauss, 2 ** level)
-                image_element_stress(point[0], point[1], lr, p0, p1, ls, interfaces, shear_modulus, poisson_ratio,
-                                     n_images, x, w, np.ones((x.shape[0], 1)), image)
-            for p in range(2):
-                for q in range(2):
-                    pair[p, q] += image[0, q, p, 0] * normal[0] + image[0, q, p, 1] * normal[1]
-        if alpha > 0.0 and i != j:
-            scale_to_self(pair, alpha * self_max[j])
+def unknowns(data):
+    """Two unknowns per element (global DD x, y)."""
+    return 2
+
+
+@njit(cache=True)
+def workspace(data):
+    """Scratch: local stress (2, 2, 2), image stress (1, 2, 2, 2), gradient (2, 2, 3) and
+    the one-order :func:`Workspace`."""
+    return np.empty((2, 2, 2)), np.zeros((1, 2, 2, 2)), np.empty((2, 2, 3)), Workspace(1)
+
+
+@njit(cache=True)
+def source_state(data, j, work):
+    """What the receivers of source ``j`` share: its end points, the stacked composite
+    rules of the cached levels and their image pairs (traced when a receiver first needs
+    a level: a lone receiver traces one)."""
+    ls = data.layer[j]
+    p0 = data.centers[j] - data.half_length[j] * data.frames[j, 0]
+    p1 = data.centers[j] + data.half_length[j] * data.frames[j, 0]
+    xi, wt, start = _level_rule(data.gauss_points, _CACHED_LEVELS - 1)
+    traced = trace_points(p0, p1, ls, data.interfaces, data.shear_modulus, data.poisson_ratio, data.n_images,
+                          xi, True)
+    is_traced = np.zeros(_CACHED_LEVELS, dtype=np.bool_)
+    return p0, p1, xi, wt, start, traced, is_traced, Workspace(traced[4].shape[-1])
+
+
+@njit(cache=True)
+def element_traction(data, i, j, state, work, block):
+    """``block`` (2, 2): traction at the centre of element ``i`` for a unit global DD of
+    constant element ``j``: closed form (source layer's material) plus images, the
+    source's traced pairs reused across receivers. Sub-segments come in powers of two
+    (:func:`subdivisions` rounded up)."""
+    p0, p1, xi, wt, start, traced, is_traced, ws = state
+    local, image, gradient, ws1 = work
+    g = data.shear_modulus
+    nu = data.poisson_ratio
+    interfaces = data.interfaces
+    half_length = data.half_length
+    ls = data.layer[j]
+    point = data.centers[i]
+    normal = data.frames[i, 1]
+    near = 0.0
+    if i != j:
+        near = data.near_fraction * min(half_length[i], half_length[j])
+    line2d.traction_pair(point, normal, data.centers[j], data.frames[j], half_length[j], g[ls], nu[ls],
+                         data.singular_shift, block, local, near)
+    if interfaces.shape[0] > 0:
+        lr = data.layer[i]
+        level = _level(subdivisions(point[0], point[1], lr, p0, p1, ls, interfaces, data.max_subdivisions))
+        image[:] = 0.0
+        if level < _CACHED_LEVELS:
+            a, b = start[level], start[level + 1]
+            if not is_traced[level]:
+                _trace_range(p0, p1, ls, interfaces, g, nu, data.n_images, xi, a, b, traced)
+                is_traced[level] = True
+            _integrate(point[0], point[1], lr, p0, p1, ls, g, nu, xi[a:b], wt[a:b], np.ones((b - a, 1)), traced, a,
+                       image, gradient, ws, ws1)
+        else:
+            x, w = composite_rule(data.gauss_points, 2 ** level)
+            image_element_stress(point[0], point[1], lr, p0, p1, ls, interfaces, g, nu, data.n_images, x, w,
+                                 np.ones((x.shape[0], 1)), image)
         for p in range(2):
             for q in range(2):
-                out[2 * ia + p, column + q] = pair[p, q]
+                block[p, q] += image[0, q, p, 0] * normal[0] + image[0, q, p, 1] * normal[1]
 
 
 @njit(cache=True)
-def traction_block(data, rows, cols, out):
-    """Block generator (same contract as :func:`hmatddm.kernels.line2d.traction_block`)
-    of constant elements in a layered medium. ``data = (centers, frames, half_length,
-    half_length, params, self_max, layer, settings, interfaces, shear_modulus,
-    poisson_ratio)`` with ``params = [0, 0, singular_shift, alpha, near_fraction]``,
-    ``settings = [n_images, gauss_points, max_subdivisions]``. Sub-segments come in
-    powers of two (:func:`subdivisions` rounded up)."""
-    centers, frames, half_length, _unused, params, self_max, layer, settings, interfaces, g, nu = data
-    for jb in range(cols.shape[0]):
-        _source_block(cols[jb], rows, centers, frames, half_length, layer, params, settings, interfaces, g, nu,
-                      params[3], self_max, out, 2 * jb)
+def element_stress(data, point, point_layer, j, work, out):
+    """``out[q, i, k]``: stress at ``point`` (in ``point_layer``; zero in a void layer)
+    for a unit global DD ``q`` of constant element ``j``, closed form plus images (the
+    quadrature of :func:`element_traction`). A point within ``near_fraction`` half
+    lengths of an end counts as on it."""
+    local, image, gradient, ws1 = work
+    g = data.shear_modulus
+    nu = data.poisson_ratio
+    if g[point_layer] <= 0.0:
+        out[:] = 0.0
+        return
+    ls = data.layer[j]
+    a = data.half_length[j]
+    line2d.stress_pair(point, data.centers[j], data.frames[j], a, g[ls], nu[ls], data.singular_shift, out,
+                       local, data.near_fraction * a)
+    if data.interfaces.shape[0] > 0:
+        p0 = data.centers[j] - a * data.frames[j, 0]
+        p1 = data.centers[j] + a * data.frames[j, 0]
+        level = _level(subdivisions(point[0], point[1], point_layer, p0, p1, ls, data.interfaces,
+                                    data.max_subdivisions))
+        xi, wt = composite_rule(data.gauss_points, 2 ** level)  # as the block generator
+        image_element_stress(point[0], point[1], point_layer, p0, p1, ls, data.interfaces, g, nu,
+                             data.n_images, xi, wt, np.ones((xi.shape[0], 1)), image)
+        for q in range(2):
+            for i in range(2):
+                for k in range(2):
+                    out[q, i, k] += image[0, q, i, k]
 
 
-@njit(cache=True, parallel=True)
-def traction_matrix(data, out):
-    """Dense assembly, parallel over source elements (their traced pairs are reused)."""
-    n = data[0].shape[0]
-    rows = np.arange(n)
-    centers, frames, half_length, _unused, params, self_max, layer, settings, interfaces, g, nu = data
-    for j in prange(n):
-        _source_block(j, rows, centers, frames, half_length, layer, params, settings, interfaces, g, nu, params[3],
-                      self_max, out, 2 * j)
-
-
-@njit(cache=True)
-def edge_distance(data, i, j):
-    """Distance from element ``i``'s collocation point to the nearer end of element ``j``."""
-    return line2d.edge_distance(data, i, j)
-
-
-@njit(cache=True)
-def singular_pairs(data, rows, cols, out):
-    """``out[k]`` = True when the block of receiver ``rows[k]`` and source ``cols[k]``
-    is not finite."""
-    pair = np.empty((2, 2))
-    for k in range(rows.shape[0]):
-        traction_block(data, rows[k:k + 1], cols[k:k + 1], pair)
-        out[k] = not np.all(np.isfinite(pair))
-
-
-@njit(cache=True, parallel=True)
-def stress_at_points(points, point_layer, centers, frames, half_length, layer, params, settings, interfaces,
-                     shear_modulus, poisson_ratio, dd, out):
-    """Stress ``out`` (M, 2, 2) at ``points`` (in layers ``point_layer``; void layers
-    give zero) induced by the DDs ``dd`` (N, 2) of constant elements."""
-    shift = params[2]
-    n_images = int(settings[0])
-    n_gauss = int(settings[1])
-    max_sub = int(settings[2])
-    for m in prange(points.shape[0]):
-        work = np.empty((2, 2, 2))
-        pair = np.empty((2, 2, 2))
-        image = np.empty((1, 2, 2, 2))
-        acc = np.zeros((2, 2))
-        lr = point_layer[m]
-        if shear_modulus[lr] > 0.0:
-            for j in range(centers.shape[0]):
-                ls = layer[j]
-                line2d.stress_pair(points[m], centers[j], frames[j], half_length[j], shear_modulus[ls],
-                                   poisson_ratio[ls], shift, pair, work)
-                if interfaces.shape[0] > 0:
-                    p0 = centers[j] - half_length[j] * frames[j, 0]
-                    p1 = centers[j] + half_length[j] * frames[j, 0]
-                    level = _level(subdivisions(points[m, 0], points[m, 1], lr, p0, p1, ls, interfaces, max_sub))
-                    xi, wt = composite_rule(n_gauss, 2 ** level)  # as the block generator
-                    shape = np.ones((xi.shape[0], 1))
-                    image_element_stress(points[m, 0], points[m, 1], lr, p0, p1, ls, interfaces, shear_modulus,
-                                         poisson_ratio, n_images, xi, wt, shape, image)
-                    for q in range(2):
-                        for i in range(2):
-                            for k in range(2):
-                                pair[q, i, k] += image[0, q, i, k]
-                for q in range(2):
-                    dq = dd[j, q]
-                    for i in range(2):
-                        for k in range(2):
-                            acc[i, k] += pair[q, i, k] * dq
-        out[m] = acc
+register_kind(LayeredSegments, KernelKind(unknowns, workspace, source_state, element_traction, element_stress,
+                                          line2d.edge_distance))

@@ -1,10 +1,11 @@
 """Influence data of a 2D mesh of constant DD elements in a :class:`LayeredMedium`:
 element layers, the straddling check, the interface splitter and the automatic number
-of images. The kernels are :mod:`.images2d` (same block-generator contract as
-:mod:`hmatddm.kernels.line2d`)."""
+of images. The kernels are :mod:`.images2d` (kernel data :class:`.images2d.LayeredSegments`,
+served by the drivers of :mod:`hmatddm.kernels.drivers`)."""
 import numpy as np
 
 from ..errors import InputError
+from ..kernels.drivers import self_block_max, stress_sum, traction_block
 from ..mesh import Mesh2D
 from . import images2d
 from .medium import MAX_IMAGES
@@ -83,35 +84,31 @@ def split_at_interfaces(mesh, medium):
 
 
 def influence_data(mesh, medium, singular_shift, alpha, near_fraction, n_images):
-    """The data tuple of :func:`images2d.traction_block` (see there)."""
+    """The kernel data (:class:`images2d.LayeredSegments`) of a constant-element 2D
+    ``mesh`` in ``medium`` with ``n_images`` images; ``alpha > 0`` fills ``self_max``
+    for ref. Eq. 6.11."""
     layers = element_layers(mesh, medium)
     interfaces, g, nu = medium.arrays()
-    params = np.array([0.0, 0.0, float(singular_shift), float(alpha), float(near_fraction)])
-    settings = np.array([float(n_images), float(medium.gauss_points), float(MAX_SUBDIVISIONS)])
-    self_max = np.zeros(mesh.n_elements)
-    data = (mesh.centers, mesh.frames, mesh.half_length, mesh.half_length, params, self_max, layers, settings,
-            interfaces, g, nu)
+    data = images2d.LayeredSegments(mesh.centers, mesh.frames, mesh.half_length, layers, interfaces, g, nu,
+                                    n_images=int(n_images), gauss_points=int(medium.gauss_points),
+                                    max_subdivisions=int(MAX_SUBDIVISIONS), singular_shift=float(singular_shift),
+                                    near_fraction=float(near_fraction), alpha=float(alpha),
+                                    self_max=np.zeros(mesh.n_elements))
     if alpha > 0.0:
-        block = np.empty((2, 2))
-        for i in range(mesh.n_elements):
-            index = np.array([i], dtype=np.int64)
-            images2d.traction_block(data, index, index, block)
-            self_max[i] = np.max(np.abs(block))
+        self_block_max(data, data.self_max)
     return data
 
 
 def with_images(data, n_images):
-    """The data tuple with another number of images."""
-    settings = data[7].copy()
-    settings[0] = float(n_images)
-    return data[:7] + (settings,) + data[8:]
+    """The kernel data with another number of images."""
+    return data._replace(n_images=int(n_images))
 
 
 def choose_images(mesh, medium, data, max_samples=24, max_sources=2000):
     """``medium.images`` when it is a number; for ``"auto"`` the smallest number of
     images after which one more image changes the sampled influence block by less than
     ``medium.image_tol``, measured on what the solution feels: the tractions at up to
-    ``max_samples`` receivers (chosen evenly) due to a uniform unit DD along x, then y,
+    ``max_samples`` receivers (chosen evenly) due to a uniform unit DD along x, then y (z),
     on (up to ``max_sources``) all elements, relative to their largest value. (The
     largest single entry is a poor measure: the image terms are small next to the
     self-influence of an element but add up coherently over a crack; for the crack of
@@ -124,11 +121,12 @@ def choose_images(mesh, medium, data, max_samples=24, max_sources=2000):
     n = mesh.n_elements
     rows = np.unique(np.linspace(0, n - 1, min(n, max_samples)).round().astype(np.int64))
     cols = np.unique(np.linspace(0, n - 1, min(n, max_sources)).round().astype(np.int64))
-    block = np.empty((2 * len(rows), 2 * len(cols)))
+    dof = mesh.dim  # constant elements, 2D or 3D (hmatddm.layered.influence3d)
+    block = np.empty((dof * len(rows), dof * len(cols)))
 
     def response(k):
-        images2d.traction_block(with_images(data, k), rows, cols, block)
-        return np.stack([block[:, 0::2].sum(axis=1), block[:, 1::2].sum(axis=1)])
+        traction_block(with_images(data, k), rows, cols, block)
+        return np.stack([block[:, q::dof].sum(axis=1) for q in range(dof)])
 
     previous = response(0)
     for k in range(1, MAX_IMAGES + 1):
@@ -156,11 +154,8 @@ def stress_at(mesh, medium, dd, points, singular_correction="none", near_fractio
     if n_images is None:
         n_images = choose_images(mesh, medium, data)
     data = with_images(data, n_images)
-    centers, frames, half, _, params, _, layers, settings, interfaces, g, nu = data
-    out = np.zeros((len(points), 2, 2))
     point_layer = medium.layer_of(points[:, 1]).astype(np.int64)
-    images2d.stress_at_points(np.ascontiguousarray(points), point_layer, centers, frames, half, layers, params,
-                              settings, interfaces, g, nu, np.ascontiguousarray(dd), out)
+    out = stress_sum(data, points, dd, point_layer)
     bad = np.flatnonzero(~np.all(np.isfinite(out.reshape(len(points), -1)), axis=1))
     if bad.size:
         raise InputError(f"points[{int(bad[0])}] lies on an element end, where the stress is singular; move it or "
