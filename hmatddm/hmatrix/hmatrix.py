@@ -28,7 +28,7 @@ from .storage import KIND_DENSE, KIND_LOWRANK, assemble
 SINGLE_PRECISION_EPS = 1e-5
 
 
-def _factor_dtype(factor_dtype, eps):
+def _factor_dtype(factor_dtype, eps, name="factor_dtype"):
     if factor_dtype is None:
         return np.dtype(np.float32) if eps >= SINGLE_PRECISION_EPS else np.dtype(np.float64)
     try:
@@ -36,7 +36,7 @@ def _factor_dtype(factor_dtype, eps):
     except TypeError:
         dtype = None
     if dtype not in (np.dtype(np.float32), np.dtype(np.float64)):
-        raise InputError(f"factor_dtype must be None, float32 or float64, got {factor_dtype!r}")
+        raise InputError(f"{name} must be None, float32 or float64, got {factor_dtype!r}")
     return dtype
 
 
@@ -88,7 +88,7 @@ class HMatrix(LinearOperator):
     # ------------------------------------------------------------------ construction
     @classmethod
     def build(cls, generator, eps=1e-4, eta=3.0, leaf_size=64, factor_dtype=None, check_finite=False, groups=None,
-              col_leaf_size=None):
+              col_leaf_size=None, near_dtype=np.float64):
         """Cluster, partition and compress the matrix of ``generator``.
 
         Parameters
@@ -104,7 +104,13 @@ class HMatrix(LinearOperator):
         factor_dtype : None, numpy.float32 or numpy.float64
             Storage of the low-rank factors; None: float32 when eps >= 1e-5 (the
             rounding is then <= 1% of eps; halves the far-field memory and matvec
-            traffic), float64 otherwise. Dense blocks are always float64.
+            traffic), float64 otherwise.
+        near_dtype : numpy.float64 (default) or numpy.float32
+            Storage of the dense blocks (the near field: about half of the memory at
+            eps 1e-4). float32 halves it; its rounding is amplified by the cancellation
+            of the hypersingular near field on smooth fields (N = 10k planar crack at eps
+            1e-4: smooth-field error 6e-7 -> 1.1e-6, benchmarks/RESULTS.md), so it is
+            an opt-in for large problems at eps >= 1e-4.
         check_finite : bool
             Raise InputError when a stored entry is NaN or inf (reads every stored
             entry once, ~0.3% of the build time). Off by default so that callers can
@@ -127,6 +133,7 @@ class HMatrix(LinearOperator):
         col_leaf_size = leaf_size if col_leaf_size is None else col_leaf_size
         _check_parameters(eps, eta, col_leaf_size)
         dtype = _factor_dtype(factor_dtype, eps)
+        near_dtype = _factor_dtype(near_dtype, eps, "near_dtype")
         started = time.perf_counter()
         tree = cluster_tree(generator.points, generator.radii, int(leaf_size), groups=groups)
         col_tree = tree
@@ -134,7 +141,8 @@ class HMatrix(LinearOperator):
             col_tree = cluster_tree(generator.col_points, generator.col_radii, int(col_leaf_size))
         blocks = block_tree(tree, float(eta), col_tree=col_tree)
         try:
-            storage = assemble(generator, tree, blocks, float(eps), factor_dtype=dtype, col_tree=col_tree)
+            storage = assemble(generator, tree, blocks, float(eps), factor_dtype=dtype, col_tree=col_tree,
+                               near_dtype=near_dtype)
         except np.linalg.LinAlgError as error:  # the SVD of a pivot refuses NaN/inf
             raise InputError(f"the kernel returned NaN or inf entries (in a far-field block): {error}") from None
         seconds = time.perf_counter() - started

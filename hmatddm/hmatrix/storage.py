@@ -234,6 +234,16 @@ def _head(buffer, used):
     return out
 
 
+@njit(cache=True, nogil=True)
+def _round_into(source, source_offset, target, target_offset):
+    """target[target_offset[b]:+size_b] = source[source_offset[b]:source_offset[b + 1]]
+    (cast to the target's dtype) for every block b of a batch."""
+    for b in range(target_offset.shape[0]):
+        start = target_offset[b]
+        for i in range(source_offset[b + 1] - source_offset[b]):
+            target[start + i] = source[source_offset[b] + i]
+
+
 def _batches(cost, n_threads, per_thread=16):
     """Split blocks into batches of similar total cost, most expensive first.
 
@@ -291,13 +301,15 @@ class _GrowingArray:
         return self.values
 
 
-def assemble(generator, tree, blocks, eps, n_threads=None, factor_dtype=np.float64, col_tree=None):
+def assemble(generator, tree, blocks, eps, n_threads=None, factor_dtype=np.float64, col_tree=None,
+             near_dtype=np.float64):
     """Compress and store all blocks of ``blocks`` (a BlockTree over ``tree`` x
     ``col_tree``; default ``tree`` x ``tree``).
 
     Far blocks: whole-element ACA + recompression, in batches on ``n_threads``
     threads (default: numba's thread count); factors stored as ``factor_dtype``
-    (float64 or float32). Near blocks: exact kernel fill straight into the final
+    (float64 or float32). Dense blocks are stored as ``near_dtype`` (float64, or
+    float32: filled in float64 per batch, then rounded into the store). Near blocks: exact kernel fill straight into the final
     (float64) dense array. Cost: the near-field kernel entries plus, per far block,
     O((m + n) k) kernel entries and O((m + n) k^2) flops.
     """
@@ -364,7 +376,7 @@ def assemble(generator, tree, blocks, eps, n_threads=None, factor_dtype=np.float
     dense_col_stop = np.concatenate((far_cols_stop[far_dense], near_cols_stop))
     dense_size = d * dc * (dense_row_stop - dense_row_start) * (dense_col_stop - dense_col_start)
     dense_offset = np.concatenate(([0], np.cumsum(dense_size))).astype(np.int64)
-    dense_values = np.empty(dense_offset[-1])
+    dense_values = np.empty(dense_offset[-1], dtype=near_dtype)
     far_dense_values = far_dense_values.finish()
     assert far_dense_values.size == int(dense_size[: far_dense.size].sum())
     dense_values[: far_dense_values.size] = far_dense_values
@@ -372,13 +384,23 @@ def assemble(generator, tree, blocks, eps, n_threads=None, factor_dtype=np.float
 
     near_offset = dense_offset[far_dense.size:-1]
 
+    near_size = dense_size[far_dense.size:]
+
     def near_batch(ids):
-        return driver(kernel, data, permutation, col_permutation, d, dc, float(eps), near_rows_start[ids],
-                      near_rows_stop[ids], near_cols_start[ids], near_cols_stop[ids],
-                      np.zeros(ids.size, dtype=np.bool_), near_offset[ids], dense_values)
+        if dense_values.dtype == np.float64:
+            return driver(kernel, data, permutation, col_permutation, d, dc, float(eps), near_rows_start[ids],
+                          near_rows_stop[ids], near_cols_start[ids], near_cols_stop[ids],
+                          np.zeros(ids.size, dtype=np.bool_), near_offset[ids], dense_values)
+        local = np.concatenate(([0], np.cumsum(near_size[ids]))).astype(np.int64)
+        buffer = np.empty(local[-1])  # the kernel fills float64; the store holds the rounded values
+        driver(kernel, data, permutation, col_permutation, d, dc, float(eps), near_rows_start[ids],
+               near_rows_stop[ids], near_cols_start[ids], near_cols_stop[ids], np.zeros(ids.size, dtype=np.bool_),
+               local[:-1], buffer)
+        _round_into(buffer, local, dense_values, near_offset[ids])
+        return None
 
     started = time.perf_counter()
-    near_cost = dense_size[far_dense.size:].astype(np.float64)
+    near_cost = near_size.astype(np.float64)
     for _ in _run_parallel(near_batch, _batches(near_cost, n_threads), n_threads):
         pass
     near_seconds = time.perf_counter() - started
