@@ -11,6 +11,17 @@ os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
 import hmatddm as hd  # noqa: E402
 
+# a busy machine must not fail a property test: no per-example deadline and no "too slow"
+# health check for every @given (tests may still set their own max_examples)
+try:
+    from hypothesis import HealthCheck, settings as _hypothesis_settings
+
+    _hypothesis_settings.register_profile("hmatddm", deadline=None,
+                                          suppress_health_check=[HealthCheck.too_slow])
+    _hypothesis_settings.load_profile("hmatddm")
+except ImportError:  # pragma: no cover - hypothesis is a test dependency
+    pass
+
 G, NU = 10e9, 0.25
 
 
