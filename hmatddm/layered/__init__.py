@@ -4,6 +4,8 @@
   optional per-layer in-situ stress and toughness.
 * :mod:`.images2d`: complementary (image) stress of DDs in 2D plane strain by the general
   image method (ref. Secs 3.2-3.3), numba; loaded on first use.
+* :mod:`.images3d`: the same for constant rectangles in 3D (any orientation), with the
+  3D Hansen potentials (ref. Eq. 3.24); :mod:`.influence3d` builds their kernel data.
 * :func:`split_at_interfaces`: cut a mesh's elements where they cross interfaces (2D
   segments; 3D rectangles with a horizontal edge).
 """
@@ -13,7 +15,7 @@ from .medium import LayeredMedium
 
 
 def __getattr__(name):
-    if name in ("images2d", "influence2d"):
+    if name in ("images2d", "influence2d", "images3d", "influence3d"):
         return importlib.import_module(f"{__name__}.{name}")
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 

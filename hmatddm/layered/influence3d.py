@@ -1,0 +1,108 @@
+"""Influence data of a 3D mesh of constant rectangles in a :class:`LayeredMedium`:
+element layers, the straddling check, the automatic number of images and the stress
+at points (the splitter is :func:`hmatddm.layered.split_at_interfaces`). The kernels
+are :mod:`.images3d` (kernel data :class:`.images3d.LayeredRectangles`, served by the
+drivers of :mod:`hmatddm.kernels.drivers`)."""
+import numpy as np
+
+from .._validation import finite_array
+from ..errors import InputError
+from ..kernels.drivers import self_block_max, stress_sum
+from . import images3d
+from .influence2d import choose_images as _choose_images
+from .influence2d import with_images
+
+#: Largest number of sub-squares per side of a rectangle for the image quadrature.
+MAX_SUBDIVISIONS = 16
+#: Relative tolerance (of the element size) within which a corner counts as on an interface.
+_ON_INTERFACE = 1e-9
+
+__all__ = ["element_layers", "influence_data", "with_images", "choose_images", "stress_at",
+           "mean_stress_at"]
+
+
+def element_layers(mesh, medium):
+    """(N,) layer of each rectangle (of its centre); InputError naming the first
+    rectangle that straddles an interface, lies in one (unless all layers have the same
+    moduli), or sits in a void layer."""
+    if mesh.dim != 3:
+        raise InputError("element_layers of influence3d takes a Mesh3D")
+    z = mesh.corners()[:, :, 2]
+    lo, hi = z.min(axis=1), z.max(axis=1)
+    tol = _ON_INTERFACE * np.maximum(mesh.radii, 1e-300)
+    if not medium.is_homogeneous:  # equal layers: any layer will do
+        for k, height in enumerate(medium.interfaces):
+            inside = (lo < height - tol) & (hi > height + tol)
+            if np.any(inside):
+                e = int(np.flatnonzero(inside)[0])
+                raise InputError(f"rectangle {e} (fracture {int(mesh.fracture_id[e])}) straddles interface {k} at "
+                                 f"z = {height:g} (its corners span z = {lo[e]:g} .. {hi[e]:g}); rectangles must lie "
+                                 "inside one layer: mesh them so that edges end on interfaces, or cut rectangles "
+                                 "with a horizontal edge by hd.layered.split_at_interfaces(mesh, medium)")
+            along = (np.abs(lo - height) <= tol) & (np.abs(hi - height) <= tol)
+            if np.any(along):
+                e = int(np.flatnonzero(along)[0])
+                raise InputError(f"rectangle {e} lies in interface {k} (z = {height:g}); a rectangle must lie inside "
+                                 "one layer (move it off the interface)")
+    layers = medium.layer_of(0.5 * (lo + hi)).astype(np.int64)
+    void = np.flatnonzero(np.asarray(medium.shear_modulus)[layers] == 0.0)
+    if void.size:
+        e = int(void[0])
+        raise InputError(f"rectangle {e} lies in layer {int(layers[e])}, which is void (shear_modulus = 0)")
+    return layers
+
+
+def influence_data(mesh, medium, singular_shift, alpha, near_fraction, n_images):
+    """The kernel data (:class:`images3d.LayeredRectangles`) of ``mesh`` in ``medium``
+    with ``n_images`` images; ``alpha > 0`` fills ``self_max`` for ref. Eq. 6.11."""
+    layers = element_layers(mesh, medium)
+    interfaces, g, nu = medium.arrays()
+    data = images3d.LayeredRectangles(mesh.centers, mesh.frames, mesh.half_a, mesh.half_b, layers, interfaces, g, nu,
+                                      n_images=int(n_images), gauss_points=int(medium.gauss_points),
+                                      max_subdivisions=int(MAX_SUBDIVISIONS), singular_shift=float(singular_shift),
+                                      near_fraction=float(near_fraction), alpha=float(alpha),
+                                      self_max=np.zeros(mesh.n_elements))
+    if alpha > 0.0:
+        self_block_max(data, data.self_max)
+    return data
+
+
+def choose_images(mesh, medium, data, max_samples=24, max_sources=400):
+    """The number of images (see :func:`hmatddm.layered.influence2d.choose_images`,
+    same criterion, with the 3D kernels)."""
+    return _choose_images(mesh, medium, data, max_samples, max_sources)
+
+
+def _prepared(mesh, medium, dd, points, singular_correction, near_fraction, n_images):
+    from ..operators import _AVERAGE_SHIFT
+
+    points = finite_array("points", points, (None, 3))
+    dd = finite_array("dd", dd).reshape(mesh.n_elements, 3)
+    shift = _AVERAGE_SHIFT if singular_correction == "average" else 0.0
+    data = influence_data(mesh, medium, shift, 0.0, near_fraction, 0)
+    if n_images is None:
+        n_images = choose_images(mesh, medium, data)
+    return points, dd, with_images(data, n_images)
+
+
+def stress_at(mesh, medium, dd, points, singular_correction="none", near_fraction=0.0, n_images=None):
+    """Stress (M, 3, 3) at ``points`` (M, 3) in a layered medium from the DDs ``dd``
+    (N, 3) of a :class:`Mesh3D` (direct sum, parallel over points; points in void
+    layers get zero; a point on an interface belongs to the layer above).
+    ``n_images``: None = ``medium.images``, or for ``"auto"`` the number an
+    :class:`ElasticityOperator` of ``mesh`` would choose."""
+    if mesh.dim != 3:
+        raise InputError("influence3d.stress_at takes a Mesh3D")
+    points, dd, data = _prepared(mesh, medium, dd, points, singular_correction, near_fraction, n_images)
+    out = stress_sum(data, points, dd, medium.layer_of(points[:, 2]).astype(np.int64))
+    bad = np.flatnonzero(~np.all(np.isfinite(out.reshape(len(points), -1)), axis=1))
+    if bad.size:
+        raise InputError(f"points[{int(bad[0])}] lies on an element edge, where the stress is singular; move it or "
+                         "pass singular_correction='average'")
+    return out
+
+
+def mean_stress_at(mesh, medium, dd, points, singular_correction="none", near_fraction=0.0, n_images=None):
+    """Mean stress ``tr(sigma) / 3`` (M,) at ``points``; see :func:`stress_at`."""
+    stress = stress_at(mesh, medium, dd, points, singular_correction, near_fraction, n_images)
+    return np.trace(stress, axis1=1, axis2=2) / 3.0
