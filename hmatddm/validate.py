@@ -77,8 +77,8 @@ def checks():
         ("Griffith slip, remote shear (dense)", lambda: _griffith(material, "dense", "shear"), 0.01),
         ("Sneddon volume, staircase h=c/20 (dense)", lambda: _penny_volume(material, "dense"), 0.05),
         ("Sneddon on-axis stress, z/c>=0.2, /p (dense)", lambda: _penny_axis(material), 0.01),
-        ("radial M-vertex radius, asymptotic front, h=1 m, 6 s", lambda: _radial_m_asymptotic()["radius"], 0.05),
-        ("radial M-vertex centre opening, same run", lambda: _radial_m_asymptotic()["width"], 0.07),
+        ("radial M-vertex radius, asymptotic front, h=1 m, 6 s", lambda: _radial_m_asymptotic()["radius"], 0.02),
+        ("radial M-vertex centre opening, same run", lambda: _radial_m_asymptotic()["width"], 0.03),
         ("radial front circularity max/min - 1, same run", lambda: _radial_m_asymptotic()["circularity"], 0.05),
     ]
 
