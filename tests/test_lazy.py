@@ -1,0 +1,40 @@
+"""hmatddm._lazy: package attributes imported on first use (PEP 562). Each check runs in
+a fresh interpreter, since this test process has long imported everything; no wall-clock
+limit is set (a busy machine only makes it slower)."""
+import subprocess
+import sys
+
+
+def _fresh(code):
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    return result.stdout.split()
+
+
+def test_importing_the_package_loads_no_engine_and_no_renderer():
+    heavy = ("numba", "pyvista", "matplotlib", "scipy.sparse.linalg", "hmatddm.kernels", "hmatddm.hmatrix")
+    loaded = _fresh(f"import sys, hmatddm; print(*[m for m in {heavy!r} if m in sys.modules])")
+    assert loaded == []
+
+
+def test_a_name_is_imported_on_first_access_and_then_bound():
+    out = _fresh("import sys, hmatddm as hd\n"
+                 "print('hmatddm.material' in sys.modules)\n"
+                 "e = hd.Elastic\n"
+                 "print('hmatddm.material' in sys.modules, 'Elastic' in vars(hd))")
+    assert out == ["False", "True", "True"]
+
+
+def test_an_export_wins_over_its_submodule_of_the_same_name():
+    """Importing the module hmatddm.solve must leave hmatddm.solve the function."""
+    out = _fresh("import hmatddm as hd, importlib, types\n"
+                 "f = hd.solve\n"
+                 "importlib.import_module('hmatddm.solve')\n"
+                 "print(isinstance(hd.solve, types.ModuleType), hd.solve is f)")
+    assert out == ["False", "True"]
+
+
+def test_an_unknown_name_is_an_attribute_error():
+    out = _fresh("import hmatddm as hd\n"
+                 "try:\n    hd.no_such_name\nexcept AttributeError as e:\n    print('AttributeError')")
+    assert out == ["AttributeError"]
