@@ -347,6 +347,66 @@ class StressField:
         return out
 
 
+class GrowingMeshField:
+    """The stress at fixed ``points`` from a mesh that grows by appending elements, step
+    after step (the remote-failure check of a time loop, ref. Sec. 5.3: the intact
+    natural elements are the targets, the active elements the sources).
+
+    ``field(mesh, dd)`` returns the (M, n_out) components. The points x elements
+    H-matrix of the mesh seen at the last rebuild is kept; when the mesh is that mesh
+    plus appended elements, their contribution is summed exactly and added to the kept
+    matrix's; the matrix is rebuilt when the appended elements exceed
+    ``rebuild_fraction`` of it, or when the mesh is not an extension of it (elements
+    moved or removed). Results do not depend on the history beyond the accuracy
+    ``eps`` of the compressed blocks (unscaled columns: the DDs change between uses).
+    Other parameters as :class:`StressField` (``method`` of the kept matrix).
+    """
+
+    def __init__(self, material, points, quantity="stress", singular_correction="none", eps=None, near_fraction=0.0,
+                 rebuild_fraction=0.25, method="auto"):
+        self.material = material
+        self.method = method
+        self.points = np.ascontiguousarray(points, dtype=np.float64)
+        self.options = dict(quantity=quantity, singular_correction=singular_correction, eps=eps,
+                            near_fraction=near_fraction)
+        self.rebuild_fraction = finite_scalar("rebuild_fraction", rebuild_fraction)
+        self.base = None  # StressField of the mesh at the last rebuild
+        self.tail = None  # StressField of the elements appended since (direct sum)
+        self.rebuilds = 0
+
+    def _extends_base(self, mesh):
+        base = self.base.mesh
+        n = base.n_elements
+        if mesh.dim != base.dim or mesh.n_elements < n:
+            return False
+        names = ("centers", "frames") + (("half_length",) if mesh.dim == 2 else ("half_a", "half_b"))
+        return all(np.array_equal(getattr(mesh, name)[:n], getattr(base, name)) for name in names)
+
+    def __call__(self, mesh, dd):
+        if self.base is None or not self._extends_base(mesh) or (
+                mesh.n_elements - self.base.mesh.n_elements > self.rebuild_fraction * self.base.mesh.n_elements):
+            self.base = StressField(mesh, self.material, self.points, method=self.method, **self.options)
+            self.tail = None
+            self.rebuilds += 1
+        n = self.base.mesh.n_elements
+        dd = _dd_array(mesh, dd)
+        values = self.base(dd[:n])
+        if mesh.n_elements > n:
+            if self.tail is None or self.tail.mesh.n_elements != mesh.n_elements - n:
+                self.tail = StressField(mesh.subset(np.arange(n, mesh.n_elements)), self.material, self.points,
+                                        method="direct", **self.options)
+            values = values + self.tail(dd[n:])
+        return values
+
+
+def as_tensors(values):
+    """(M, d, d) symmetric tensors from (M, 6) components (xx, yy, zz, xy, xz, yz) or
+    (M, 3) (xx, yy, xy)."""
+    if values.shape[1] == 6:
+        return values[:, [0, 3, 4, 3, 1, 5, 4, 5, 2]].reshape(-1, 3, 3)
+    return values[:, [0, 2, 2, 1]].reshape(-1, 2, 2)
+
+
 def _dd_array(mesh, dd):
     """``dd`` as a contiguous (N, d) float64 array ((N, d) or (N*d,) given)."""
     dd = finite_array("dd", dd)
@@ -382,5 +442,5 @@ def induced(mesh, material, dd, points, quantity, singular_correction="none", me
     return values
 
 
-__all__ = ["StressField", "FieldSources", "field_sources", "field_block", "direct_sum", "induced", "refuse_singular", "n_components",
+__all__ = ["StressField", "GrowingMeshField", "as_tensors", "FieldSources", "field_sources", "field_block", "direct_sum", "induced", "refuse_singular", "n_components",
            "DEFAULT_STRESS_EPS", "AUTO_TREE_PAIRS", "FIELD_ETA", "FIELD_LEAF_SIZE", "METHODS", "QUANTITIES"]

@@ -14,10 +14,6 @@ import numpy as np
 from ._validation import finite_array, finite_scalar
 from .errors import InputError
 from .layered.medium import LayeredMedium
-from .mesh import Mesh3D
-
-#: Re-exported from :mod:`hmatddm.fields` (where field evaluation lives).
-from .fields import AUTO_TREE_PAIRS, DEFAULT_STRESS_EPS, METHODS  # noqa: E402,F401
 
 
 def _as_element_major(name, values, n_elements, dof):
@@ -166,12 +162,10 @@ def stress_at(mesh, material, dd, points, singular_correction="none", method="au
             from .layered.influence2d import stress_at as layered_stress_at
 
         return layered_stress_at(mesh, material, dd, points, singular_correction, near_fraction)
-    from .fields import induced
+    from .fields import as_tensors, induced
 
-    values = induced(mesh, material, dd, points, "stress", singular_correction, method, eps, info, near_fraction)
-    if isinstance(mesh, Mesh3D):
-        return values[:, [0, 3, 4, 3, 1, 5, 4, 5, 2]].reshape(-1, 3, 3)
-    return values[:, [0, 2, 2, 1]].reshape(-1, 2, 2)
+    return as_tensors(induced(mesh, material, dd, points, "stress", singular_correction, method, eps, info,
+                              near_fraction))
 
 
 def mean_stress_at(mesh, material, dd, points, singular_correction="none", method="auto", eps=None, info=None,

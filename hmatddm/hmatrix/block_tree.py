@@ -69,32 +69,22 @@ def block_tree(tree, eta=3.0, col_tree=None):
     """
     if not np.isfinite(eta) or eta <= 0:
         raise InputError(f"eta must be > 0, got {eta!r}")
-    if col_tree is not None and col_tree is not tree:
-        return _rectangular_block_tree(tree, col_tree, float(eta))
+    split = _split_both if col_tree is None or col_tree is tree else _split_larger
+    col_tree = tree if col_tree is None else col_tree
     rows = np.zeros(1, dtype=np.int64)
     cols = np.zeros(1, dtype=np.int64)
     far_rows, far_cols, near_rows, near_cols = [], [], [], []
     while rows.size:
-        admissible = is_admissible(tree, rows, cols, eta)
+        admissible = is_admissible(tree, rows, cols, eta, col_tree)
         far_rows.append(rows[admissible])
         far_cols.append(cols[admissible])
         rows, cols = rows[~admissible], cols[~admissible]
         row_leaf = tree.left[rows] < 0
-        col_leaf = tree.left[cols] < 0
+        col_leaf = col_tree.left[cols] < 0
         both = row_leaf & col_leaf
         near_rows.append(rows[both])
         near_cols.append(cols[both])
-        rows, cols = rows[~both], cols[~both]
-        row_leaf, col_leaf = row_leaf[~both], col_leaf[~both]
-        # Children of each side; a leaf stands in for itself, the second slot is then -1.
-        row_first = np.where(row_leaf, rows, tree.left[rows])
-        row_second = np.where(row_leaf, -1, tree.right[rows])
-        col_first = np.where(col_leaf, cols, tree.left[cols])
-        col_second = np.where(col_leaf, -1, tree.right[cols])
-        new_rows = np.concatenate((row_first, row_first, row_second, row_second))
-        new_cols = np.concatenate((col_first, col_second, col_first, col_second))
-        keep = (new_rows >= 0) & (new_cols >= 0)
-        rows, cols = new_rows[keep], new_cols[keep]
+        rows, cols = split(tree, col_tree, rows[~both], cols[~both], row_leaf[~both], col_leaf[~both])
     return BlockTree(
         admissible_rows=np.concatenate(far_rows),
         admissible_cols=np.concatenate(far_cols),
@@ -104,34 +94,22 @@ def block_tree(tree, eta=3.0, col_tree=None):
     )
 
 
+def _split_both(tree, col_tree, rows, cols, row_leaf, col_leaf):
+    """Pairs of children of both sides (a leaf stands in for itself)."""
+    row_first = np.where(row_leaf, rows, tree.left[rows])
+    row_second = np.where(row_leaf, -1, tree.right[rows])  # -1: no second child
+    col_first = np.where(col_leaf, cols, col_tree.left[cols])
+    col_second = np.where(col_leaf, -1, col_tree.right[cols])
+    new_rows = np.concatenate((row_first, row_first, row_second, row_second))
+    new_cols = np.concatenate((col_first, col_second, col_first, col_second))
+    keep = (new_rows >= 0) & (new_cols >= 0)
+    return new_rows[keep], new_cols[keep]
 
-def _rectangular_block_tree(row_tree, col_tree, eta):
-    """:func:`block_tree` of two different trees: an inadmissible pair is replaced by the
-    children of its cluster with the larger diameter (of the other one when that is a
-    leaf) until it is admissible or both are leaves."""
-    row_diameter, col_diameter = row_tree.diameter, col_tree.diameter
-    rows = np.zeros(1, dtype=np.int64)
-    cols = np.zeros(1, dtype=np.int64)
-    far_rows, far_cols, near_rows, near_cols = [], [], [], []
-    while rows.size:
-        admissible = is_admissible(row_tree, rows, cols, eta, col_tree)
-        far_rows.append(rows[admissible])
-        far_cols.append(cols[admissible])
-        rows, cols = rows[~admissible], cols[~admissible]
-        row_leaf, col_leaf = row_tree.left[rows] < 0, col_tree.left[cols] < 0
-        both = row_leaf & col_leaf
-        near_rows.append(rows[both])
-        near_cols.append(cols[both])
-        rows, cols, row_leaf, col_leaf = rows[~both], cols[~both], row_leaf[~both], col_leaf[~both]
-        split_row = ~row_leaf & (col_leaf | (row_diameter[rows] >= col_diameter[cols]))
-        rows, cols = (np.concatenate((np.where(split_row, row_tree.left[rows], rows),
-                                      np.where(split_row, row_tree.right[rows], rows))),
-                      np.concatenate((np.where(split_row, cols, col_tree.left[cols]),
-                                      np.where(split_row, cols, col_tree.right[cols]))))
-    return BlockTree(
-        admissible_rows=np.concatenate(far_rows),
-        admissible_cols=np.concatenate(far_cols),
-        near_rows=np.concatenate(near_rows),
-        near_cols=np.concatenate(near_cols),
-        eta=float(eta),
-    )
+
+def _split_larger(tree, col_tree, rows, cols, row_leaf, col_leaf):
+    """Children of the cluster with the larger diameter (of the other one when that is a
+    leaf), paired with the other cluster."""
+    split_row = ~row_leaf & (col_leaf | (tree.diameter[rows] >= col_tree.diameter[cols]))
+    return (np.concatenate((np.where(split_row, tree.left[rows], rows), np.where(split_row, tree.right[rows], rows))),
+            np.concatenate((np.where(split_row, cols, col_tree.left[cols]),
+                            np.where(split_row, cols, col_tree.right[cols]))))
