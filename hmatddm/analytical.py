@@ -389,21 +389,50 @@ def _transition_volume_factor(delta, lam):
     return 2.0 ** (1.0 + delta) * (upper(lam + 2.0, delta + 1.0) - upper(lam + 1.0, delta + 2.0))
 
 
-def _transition_state(radius, t, alpha, q, asymptote):
-    """``(volume, w_a, delta, lambda)`` of the approximate solution of radius ``radius`` at ``t``
-    whose radius grows as ``t^alpha`` (front velocity ``alpha R / t``)."""
-    w_a = float(asymptote.width(radius, alpha * radius / t))
+def _transition_state(radius, t, alpha, asymptote):
+    """``(volume, w_a, delta, lambda)`` (arrays) of the approximate solutions of radii ``radius``
+    at times ``t`` whose radii grow as ``t^alpha`` (front velocity ``alpha R / t``)."""
+    w_a = asymptote.width(radius, alpha * radius / t)
     k_hat = asymptote.k_prime * np.sqrt(radius) / (asymptote.e_prime * w_a)
     delta, lam = _transition_shape(k_hat)
     return 2.0 * np.pi * radius**2 * w_a * _transition_volume_factor(delta, lam), w_a, delta, lam
 
 
-def _transition_radius(t, q, asymptote, alpha, bracket):
-    from scipy.optimize import brentq
-
+def _transition_radius(t, q, asymptote, alpha, guess, iterations=12):
+    """Radii (arrays like ``t``) holding ``Q t``: secant iterations on ``ln V(ln R) = ln(Q t)``
+    from ``guess`` (``V`` grows as ``R^2.5`` to ``R^(8/3)``, smoothly: a few iterations reach
+    round-off)."""
     def excess(log_radius):
-        return np.log(_transition_state(np.exp(log_radius), t, alpha, q, asymptote)[0] / (q * t))
-    return float(np.exp(brentq(excess, np.log(bracket[0]), np.log(bracket[1]), xtol=1e-12)))
+        return np.log(_transition_state(np.exp(log_radius), t, alpha, asymptote)[0] / (q * t))
+    x0 = np.log(guess)
+    f0 = excess(x0)
+    x1 = x0 - f0 / 2.5
+    for _ in range(iterations):
+        f1 = excess(x1)
+        slope = np.where(np.abs(x1 - x0) > 1e-14, (f1 - f0) / np.where(x1 != x0, x1 - x0, 1.0), 2.5)
+        slope = np.clip(slope, 2.0, 3.0)
+        x0, f0, x1 = x1, f1, x1 - f1 / slope
+    return np.exp(x1)
+
+
+def _radial_transition(t, injection_rate, viscosity, fracture_toughness, material):
+    """``(radius, w_a, delta, lambda)`` of :func:`radial_transition_profile` at times ``t`` (1D)."""
+    from .fracture.tip_asymptote import TipAsymptote
+
+    q = positive_scalar("injection_rate", injection_rate)
+    viscosity = positive_scalar("viscosity", viscosity)
+    toughness = positive_scalar("fracture_toughness", fracture_toughness)
+    asymptote = TipAsymptote(material.plane_strain_modulus, toughness, 12.0 * viscosity)
+    r_k = radial_k_vertex(t, q, toughness, material)[0]
+    r_m = radial_m_vertex(t, q, viscosity, material)[0]
+    guess = np.minimum(r_k, r_m)  # both dissipations at once: below either vertex
+    alpha, step = np.full(t.shape, 4.0 / 9.0), 0.01
+    for _ in range(3):  # alpha from the radii a little before and after t
+        before = _transition_radius(t * np.exp(-step), q, asymptote, alpha, guess * np.exp(-step * alpha))
+        after = _transition_radius(t * np.exp(step), q, asymptote, alpha, guess * np.exp(step * alpha))
+        alpha = np.clip(np.log(after / before) / (2.0 * step), 0.4, 4.0 / 9.0)
+    radius = _transition_radius(t, q, asymptote, alpha, guess)
+    return (radius,) + _transition_state(radius, t, alpha, asymptote)[1:]
 
 
 def radial_transition_profile(rho, t, injection_rate, viscosity, fracture_toughness, material):
@@ -429,25 +458,11 @@ def radial_transition_profile(rho, t, injection_rate, viscosity, fracture_toughn
     rho = finite_array("rho", rho)
     if np.any((rho < 0.0) | (rho > 1.0)):
         raise InputError(f"rho must be in [0, 1] (r / R), got {rho[(rho < 0.0) | (rho > 1.0)].ravel()[0]}")
-    t = float(_positive_times(t).ravel()[0]) if np.size(t) == 1 else None
-    if t is None:
+    if np.size(t) != 1:
         raise InputError("t must be a scalar > 0 for radial_transition_profile")
-    from .fracture.tip_asymptote import TipAsymptote
-
-    q = positive_scalar("injection_rate", injection_rate)
-    viscosity = positive_scalar("viscosity", viscosity)
-    toughness = positive_scalar("fracture_toughness", fracture_toughness)
-    asymptote = TipAsymptote(material.plane_strain_modulus, toughness, 12.0 * viscosity)
-    r_k = float(radial_k_vertex(t, q, toughness, material)[0])
-    r_m = float(radial_m_vertex(t, q, viscosity, material)[0])
-    bracket = (0.5 * min(r_k, r_m), 2.0 * max(r_k, r_m))
-    alpha, step = 4.0 / 9.0, 0.01
-    for _ in range(4):  # alpha from the radii a little before and after t
-        before = _transition_radius(t * np.exp(-step), q, asymptote, alpha, bracket)
-        after = _transition_radius(t * np.exp(step), q, asymptote, alpha, bracket)
-        alpha = float(np.clip(np.log(after / before) / (2.0 * step), 0.4, 4.0 / 9.0))
-    radius = _transition_radius(t, q, asymptote, alpha, bracket)
-    _, w_a, delta, lam = _transition_state(radius, t, alpha, q, asymptote)
+    t = _positive_times(np.ravel(t))
+    radius, w_a, delta, lam = (float(v[0]) for v in _radial_transition(t, injection_rate, viscosity,
+                                                                        fracture_toughness, material))
     return radius, w_a * (1.0 - rho) ** delta * (0.5 * (1.0 + rho)) ** lam
 
 
@@ -456,8 +471,5 @@ def radial_transition(t, injection_rate, viscosity, fracture_toughness, material
     ``K_m`` (:func:`radial_regime`), zero leak-off: Dontsov's (2016) approximate solution, see
     :func:`radial_transition_profile`. Returns ``(radius, max_width)``, arrays like ``t``."""
     t = _positive_times(t)
-    out = [radial_transition_profile(0.0, ti, injection_rate, viscosity, fracture_toughness, material)
-           for ti in t.ravel()]
-    radius = np.array([r for r, _ in out]).reshape(t.shape)
-    width = np.array([float(np.ravel(w)[0]) for _, w in out]).reshape(t.shape)
-    return radius, width
+    radius, w_a, _, lam = _radial_transition(t.ravel(), injection_rate, viscosity, fracture_toughness, material)
+    return radius.reshape(t.shape), (w_a * 0.5**lam).reshape(t.shape)
