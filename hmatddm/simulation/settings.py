@@ -7,15 +7,17 @@ sorts the flat keywords into their groups.
 """
 from dataclasses import dataclass, fields
 
-from .._validation import finite_scalar, positive_int
+from .._validation import finite_scalar
 from ..errors import InputError
-from ..options import BACKENDS, DEFAULT_EPS, DEFAULT_ETA, DEFAULT_LEAF_SIZE
+from ..options import DEFAULT_EPS, DEFAULT_ETA, DEFAULT_LEAF_SIZE
+from ..settings import NUMERICS, OPERATOR
 
 
 @dataclass(frozen=True)
 class OperatorSettings:
-    """Passed to :class:`~hmatddm.ElasticityOperator` at every build (which checks the
-    numbers; :data:`hmatddm.settings.OPERATOR` declares their ranges)."""
+    """Passed to :class:`~hmatddm.ElasticityOperator` at every build; checked against
+    :data:`hmatddm.settings.OPERATOR` (the values are kept as given: they enter the
+    run's fingerprint)."""
 
     backend: str = "hmatrix"
     eps: float = DEFAULT_EPS
@@ -25,8 +27,8 @@ class OperatorSettings:
     alpha: float = None
 
     def __post_init__(self):
-        if self.backend not in BACKENDS:
-            raise InputError(f"backend must be one of {BACKENDS}, got {self.backend!r}")
+        for name, setting in OPERATOR.items():
+            setting.value(name, getattr(self, name))
 
 
 @dataclass(frozen=True)
@@ -62,7 +64,8 @@ class CheckpointSettings:
     keep_checkpoints: int = 3
 
     def __post_init__(self):
-        object.__setattr__(self, "keep_checkpoints", positive_int("keep_checkpoints", self.keep_checkpoints))
+        object.__setattr__(self, "keep_checkpoints",
+                           NUMERICS["keep_checkpoints"].value("keep_checkpoints", self.keep_checkpoints))
 
 
 GROUPS = {"operator_settings": OperatorSettings, "rebuild_settings": RebuildSettings,

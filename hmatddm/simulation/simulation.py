@@ -22,15 +22,15 @@ from dataclasses import asdict, replace
 
 import numpy as np
 
-from .._validation import finite_array, finite_scalar, positive_int, positive_scalar
+from .._validation import finite_array, positive_scalar
 from ..coupled import SchemeSettings
-from ..coupled.contact import CONTACT_MODES
 from ..errors import InputError, NoInjectionWarning, SizeLimitError
 from ..flow import Cluster, Fluid, LeakOff, LubricationModel
 from ..fracture import Propagation
 from ..layered.medium import LayeredMedium
 from ..material import Elastic
 from ..mesh import Mesh2D, Mesh3D, check_mesh
+from ..settings import NUMERICS
 from . import checkpoint, growth_pass, step_solve
 from .growing_operator import GrowingOperator
 from .natural import natural_network
@@ -157,25 +157,23 @@ class Simulation:
         self.mesh0 = mesh
         self.material, self.fluid, self.clusters, self.leak_off = material, fluid, clusters, leak_off
         self.propagation = propagation
-        self.time_step = positive_scalar("time_step", time_step)
-        self.initial_pressure = finite_scalar("initial_pressure", initial_pressure)
-        self.initial_opening = finite_scalar("initial_opening", initial_opening)
-        if self.initial_opening < 0.0:
-            raise InputError(f"initial_opening must be >= 0 m, got {self.initial_opening}")
+        # the ranges a scene's [numerics] declares (hmatddm.settings.NUMERICS)
+        self.time_step = NUMERICS["time_step"].value("time_step", time_step)
+        self.initial_pressure = NUMERICS["initial_pressure"].value("initial_pressure", initial_pressure)
+        self.initial_opening = NUMERICS["initial_opening"].value("initial_opening", initial_opening)
         minimum_width = self.initial_opening if minimum_width is None else minimum_width
-        self.minimum_width = positive_scalar("minimum_width", minimum_width)
+        self.minimum_width = NUMERICS["minimum_width"].value("minimum_width", minimum_width)
         self.height = positive_scalar("height", height)
         self.settings = scheme if isinstance(scheme, SchemeSettings) else SchemeSettings(scheme=scheme)
         self.growing_fractures = None if growing_fractures is None else np.asarray(sorted(growing_fractures), np.int64)
         self.injection_elements = np.array([c.nearest_element(mesh) for c in clusters], dtype=np.int64)
         self.remote_failure = bool(remote_failure)
-        if contact not in CONTACT_MODES:
-            raise InputError(f"contact must be one of {CONTACT_MODES}, got {contact!r}")
-        self.contact = contact
+        self.contact = NUMERICS["contact"].value("contact", contact)
         self.network = None if natural_fractures is None else natural_network(mesh, natural_fractures, natural)
         # a resource limit, not part of the run's definition: left out of the fingerprint, so
         # that a run stopped by it resumes with a higher one
-        self.max_elements = None if max_elements is None else positive_int("max_elements", max_elements)
+        self.max_elements = None if max_elements is None else NUMERICS["max_elements"].value("max_elements",
+                                                                                             max_elements)
         self.records = []
         self.front = None  # propagation.front == "asymptotic": its AsymptoticFront (raises for unsupported setups)
         if propagation is not None and propagation.front == "asymptotic":
