@@ -109,41 +109,99 @@ def kelvin_coefficients(nu=0.27):
     return out, delta
 
 
+def _base_derivatives(sigma, max_order=4):
+    """``{(a, b, c): f(y1, y2, y3)}``: sympy's derivatives of the base functions
+    (``d1 F``, ``d2 F``, ``L`` of gauge ``sigma``), lambdified, up to total order ``max_order``."""
+    sp, (y1, y2, y3), base, *_ = _setup()
+    big_f, big_l = base(y1, y2, y3, sigma)
+    out = {}
+    for name, expr in (("d1F", sp.diff(big_f, y1)), ("d2F", sp.diff(big_f, y2)), ("L", big_l)):
+        table = {(0, 0, 0): expr}
+        for order in range(1, max_order + 1):
+            for a_ in range(order + 1):
+                for b_ in range(order + 1 - a_):
+                    c_ = order - a_ - b_
+                    if a_ > 0:
+                        parent, var = (a_ - 1, b_, c_), y1
+                    elif b_ > 0:
+                        parent, var = (a_, b_ - 1, c_), y2
+                    else:
+                        parent, var = (a_, b_, c_ - 1), y3
+                    table[(a_, b_, c_)] = sp.diff(table[parent], var)
+        out[name] = {k: sp.lambdify([y1, y2, y3], v, "numpy") for k, v in table.items()}
+    return out
+
+
+_KINDS = (("d1F", "d1F", "d2F"), ("d2F", "d2F", "d1F"), ("L", "L", None))  # base of (force, potential)
+
+
+def _conditions(potential, shear, delta, s):
+    """Displacement and traction sigma_i3 on y3 = 0 (arrays over the points) of a triple
+    ``potential[j](a, b, c)`` (ref. Eq. 3.22 with M_i = eps_ij3 phi3,j)."""
+    def u(i, extra):
+        e = [0, 0, 0]
+        e[i] += 1
+        for k in extra:
+            e[k] += 1
+        p1, p2, p3 = potential
+        v = p1(*e) - p2(*e) - 2 * delta * s * p2(e[0], e[1], e[2] + 1)
+        if 2 in extra:  # d3 of -2 delta s phi2,i3 also gives -2 delta phi2,i3 (here e = e_i + e_3)
+            v = v - 2 * delta * p2(*e)
+        if i == 2:
+            v = v + 2 * p2(e[0], e[1], e[2])
+        if i == 0:
+            v = v + p3(e[0] - 1, e[1] + 1, e[2])
+        if i == 1:
+            v = v - p3(e[0] + 1, e[1] - 1, e[2])
+        return v
+
+    nu = (3 - 1 / delta) / 4
+    lam = 2 * shear * nu / (1 - 2 * nu)
+    grad = [[u(i, (k,)) for k in range(3)] for i in range(3)]
+    div = grad[0][0] + grad[1][1] + grad[2][2]
+    traction = [shear * (grad[0][2] + grad[2][0]), shear * (grad[1][2] + grad[2][1]), lam * div + 2 * shear * grad[2][2]]
+    return [u(i, ()) for i in range(3)] + traction
+
+
 def derive_operators(g1=1.0, g2=2.7, nu1=0.2, nu2=0.35, height=0.8, sigma_coefficients=None):
     """Solve for R and T: coefficients (2, 3, 3, 3) [R/T, j, k, n], residual, for a source
-    at ``height`` (> 0: above the interface, layer 1 = y3 > 0; < 0: below)."""
-    sp, (y1, y2, y3), base, displacement, traction, potentials = _setup()
+    at ``height`` (> 0: above the interface, layer 1 = y3 > 0; < 0: below). The base
+    functions' derivatives are sympy's; the interface conditions are sampled at points."""
     d1, d2 = 1 / (3 - 4 * nu1), 1 / (3 - 4 * nu2)
     h = height
     sigma = -1 if h > 0 else 1  # the incident pair travels toward the interface
     coefficients, _ = sigma_coefficients[sigma]
-    rng = np.random.default_rng(5)
-    pts = rng.uniform(-2.5, 2.5, size=(8, 2))
+    a_, b_, c_, e_, f_ = coefficients
+    scale = ((a_, b_, c_), (a_, b_, -c_), (e_, f_, 0.0))
+    derivatives = _base_derivatives(sigma, 5)
+    pts = np.random.default_rng(5).uniform(-2.5, 2.5, size=(12, 2))
 
-    def evaluate(exprs):
-        f = sp.lambdify([y1, y2, y3], exprs)
-        return np.array([f(p[0], p[1], 0.0) for p in pts], dtype=float).ravel()
+    def triple(force, j_out, k_in, power, mirrored):
+        """Potential j_out = h^n D^n of incident potential k_in (mirrored or not), others 0."""
+        kind = _KINDS[force][k_in]
 
-    def conditions(phi, shear, delta, s):
-        u = displacement(phi, delta, s)
-        return u + traction(u, shear, delta)
+        def value(a, b, c):
+            if kind is None or a < 0 or b < 0:
+                return np.zeros(len(pts))
+            f = derivatives[kind][(a, b, c + power)]
+            sign = (-1) ** (c + power) if mirrored else 1.0  # d/dy3 of B(y1, y2, -y3 - h)
+            values = np.broadcast_to(np.asarray(f(pts[:, 0], pts[:, 1], -h), dtype=float), (len(pts),))
+            return sign * scale[force][k_in] * h ** power * values
+
+        zero = lambda a, b, c: np.zeros(len(pts))  # noqa: E731
+        out = [zero, zero, zero]
+        out[j_out] = value
+        return out
 
     rows, rhs = [], []
-    original_all = potentials(y1, y2, y3 - h, sigma, coefficients)
-    mirrored_all = potentials(y1, y2, -y3 - h, sigma, coefficients)  # incident at the mirrored receiver
     for force in range(3):
-        original = original_all[force]
-        mirrored = mirrored_all[force]
-        known = evaluate(conditions(original, g1, d1, y3 - h))
+        incident = [triple(force, k, k, 0, False)[k] for k in range(3)]
+        known = np.concatenate(_conditions(incident, g1, d1, -h))
         columns = []
         for j, k, n in _ENTRIES:  # reflected, s = y3 + h
-            phi = [0, 0, 0]
-            phi[j] = h ** n * sp.diff(mirrored[k], y3, n) * (-1) ** n  # D^n of the mirrored pair about its point
-            columns.append(evaluate(conditions(phi, g1, d1, y3 + h)))
+            columns.append(np.concatenate(_conditions(triple(force, j, k, n, True), g1, d1, h)))
         for j, k, n in _ENTRIES:  # transmitted, s = y3 - h
-            phi = [0, 0, 0]
-            phi[j] = h ** n * sp.diff(original[k], y3, n)
-            columns.append(-evaluate(conditions(phi, g2, d2, y3 - h)))
+            columns.append(-np.concatenate(_conditions(triple(force, j, k, n, False), g2, d2, -h)))
         rows.append(np.array(columns).T)
         rhs.append(-known)
     a, b = np.vstack(rows), np.concatenate(rhs)
