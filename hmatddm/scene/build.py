@@ -139,11 +139,14 @@ def scheme_settings(scene):
 def build_simulation(scene, checkpoint_dir=None):
     """A :class:`~hmatddm.Simulation` of a validated scene (nothing is solved yet).
 
-    Raises InputError for a cluster off the initial fractures or overlapping initial
+    Raises InputError for more elements than ``numerics.max_elements`` (counted before
+    any mesh is allocated), a cluster off the initial fractures or overlapping initial
     fractures.
     """
     from ..simulation import Simulation  # the engine loads here, not when a scene is validated
+    from .preflight import estimate, refuse_too_many_elements
 
+    refuse_too_many_elements(scene, estimate(scene))
     mesh = initial_mesh(scene)
     _check_clusters(scene, mesh)
     rock = material(scene)
@@ -247,6 +250,9 @@ def _closed_form(scene, times):
         if kind == "radial-k":
             curves["radius"], curves["max_opening"], curves["net_pressure"] = analytical.radial_k_vertex(
                 times, rate, toughness, mat)
+        elif kind == "radial-km":  # Dontsov (2016) between the vertices: no net pressure
+            curves["radius"], curves["max_opening"] = analytical.radial_transition(times, rate, viscosity,
+                                                                                   toughness, mat)
         else:
             curves["radius"], curves["max_opening"] = analytical.radial_m_vertex(times, rate, viscosity, mat)
         curves["dimensionless_toughness"] = analytical.radial_regime(times, rate, viscosity, toughness, mat)

@@ -208,10 +208,10 @@ def estimate(scene):
                     largest=f"initial_fracture[{largest}] ({_count_text(counts[largest])} elements)")
 
 
-def refuse_too_large(scene, size):
-    """InputError when the scene's elements exceed ``numerics.max_elements`` or its
-    operator's memory estimate exceeds the memory available; the message names the
-    estimate and the settings that change it."""
+def refuse_too_many_elements(scene, size):
+    """InputError when the scene's elements (its :class:`Estimate` ``size``) exceed
+    ``numerics.max_elements``, before anything is allocated; returns the advice on which
+    element sizes to raise."""
     cap = scene["numerics"]["max_elements"]
     fix = (f"use a larger element_size ({size.largest.split(' ')[0]}.element_size"
            f"{', network.element_size' if size.natural_elements else ''})")
@@ -221,6 +221,14 @@ def refuse_too_large(scene, size):
             f"{f', {_count_text(size.natural_elements)} natural' if size.natural_elements else ''}), more than "
             f"numerics.max_elements = {cap:,}; ~{_bytes(size.memory_bytes)} with the {size.backend} backend. "
             f"To run it, {fix}, or raise numerics.max_elements if the memory allows")
+    return fix
+
+
+def refuse_too_large(scene, size):
+    """InputError when the scene's elements exceed ``numerics.max_elements`` or its
+    operator's memory estimate exceeds the memory available; the message names the
+    estimate and the settings that change it."""
+    fix = refuse_too_many_elements(scene, size)
     if size.available_bytes is not None and size.memory_bytes > size.available_bytes:
         other = "hmatrix" if size.backend == "dense" else "dense"
         other_bytes = size.hmatrix_bytes if other == "hmatrix" else size.dense_bytes
