@@ -22,29 +22,35 @@ def element_layers(mesh, medium):
     first element that straddles an interface, lies along one (unless all layers have the
     same moduli), or sits in a void layer."""
     if mesh.dim != 2:
-        raise InputError("a LayeredMedium works with 2D meshes (Mesh2D) only, so far")
+        raise InputError("element_layers of influence2d takes a Mesh2D (3D: hmatddm.layered.influence3d)")
     p0, p1 = mesh.endpoints
-    d = np.asarray(medium.interfaces)
-    tol = _ON_INTERFACE * np.maximum(mesh.half_length, 1e-300)
-    lo = np.minimum(p0[:, 1], p1[:, 1])
-    hi = np.maximum(p0[:, 1], p1[:, 1])
-    for k, height in enumerate(d):
-        inside = (lo < height - tol) & (hi > height + tol)
-        if np.any(inside) and not medium.is_homogeneous:  # equal layers: any layer will do
-            e = int(np.flatnonzero(inside)[0])
-            raise InputError(f"element {e} (fracture {int(mesh.fracture_id[e])}) straddles interface {k} at "
-                             f"height {height:g} (its ends are at heights {p0[e, 1]:g} and {p1[e, 1]:g}); elements "
-                             "must end on interfaces: split them with hd.layered.split_at_interfaces(mesh, medium)")
-        along = (np.abs(p0[:, 1] - height) <= tol) & (np.abs(p1[:, 1] - height) <= tol)
-        if np.any(along) and not medium.is_homogeneous:
-            e = int(np.flatnonzero(along)[0])
-            raise InputError(f"element {e} lies along interface {k} (height {height:g}); an element must lie "
-                             "inside one layer (move it off the interface)")
+    return layers_of_extents(medium, np.minimum(p0[:, 1], p1[:, 1]), np.maximum(p0[:, 1], p1[:, 1]),
+                             _ON_INTERFACE * np.maximum(mesh.half_length, 1e-300), mesh.fracture_id)
+
+
+def layers_of_extents(medium, lo, hi, tol, fracture_id, noun="element"):
+    """(N,) layer of elements spanning the heights ``lo .. hi`` (N,) (of their middle
+    height), 2D or 3D; InputError naming the first one that straddles an interface (by
+    more than ``tol``), lies in one (unless all layers have the same moduli), or sits in
+    a void layer."""
+    if not medium.is_homogeneous:  # equal layers: any layer will do
+        for k, height in enumerate(medium.interfaces):
+            inside = (lo < height - tol) & (hi > height + tol)
+            if np.any(inside):
+                e = int(np.flatnonzero(inside)[0])
+                raise InputError(f"{noun} {e} (fracture {int(fracture_id[e])}) straddles interface {k} at height "
+                                 f"{height:g} (it spans heights {lo[e]:g} .. {hi[e]:g}); {noun}s must end on "
+                                 "interfaces: split them with hd.layered.split_at_interfaces(mesh, medium)")
+            along = (np.abs(lo - height) <= tol) & (np.abs(hi - height) <= tol)
+            if np.any(along):
+                e = int(np.flatnonzero(along)[0])
+                raise InputError(f"{noun} {e} lies along interface {k} (height {height:g}); each {noun} must lie "
+                                 "inside one layer (move it off the interface)")
     layers = medium.layer_of(0.5 * (lo + hi)).astype(np.int64)
     void = np.flatnonzero(np.asarray(medium.shear_modulus)[layers] == 0.0)
     if void.size:
         e = int(void[0])
-        raise InputError(f"element {e} lies in layer {int(layers[e])}, which is void (shear_modulus = 0)")
+        raise InputError(f"{noun} {e} lies in layer {int(layers[e])}, which is void (shear_modulus = 0)")
     return layers
 
 

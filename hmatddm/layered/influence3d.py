@@ -10,7 +10,7 @@ from ..errors import InputError
 from ..kernels.drivers import self_block_max, stress_sum
 from . import images3d
 from .influence2d import choose_images as _choose_images
-from .influence2d import with_images
+from .influence2d import layers_of_extents, with_images
 
 #: Largest number of sub-squares per side of a rectangle for the image quadrature.
 MAX_SUBDIVISIONS = 16
@@ -24,32 +24,12 @@ __all__ = ["element_layers", "influence_data", "with_images", "choose_images", "
 def element_layers(mesh, medium):
     """(N,) layer of each rectangle (of its centre); InputError naming the first
     rectangle that straddles an interface, lies in one (unless all layers have the same
-    moduli), or sits in a void layer."""
+    moduli), or sits in a void layer (:func:`.influence2d.layers_of_extents`)."""
     if mesh.dim != 3:
         raise InputError("element_layers of influence3d takes a Mesh3D")
     z = mesh.corners()[:, :, 2]
-    lo, hi = z.min(axis=1), z.max(axis=1)
-    tol = _ON_INTERFACE * np.maximum(mesh.radii, 1e-300)
-    if not medium.is_homogeneous:  # equal layers: any layer will do
-        for k, height in enumerate(medium.interfaces):
-            inside = (lo < height - tol) & (hi > height + tol)
-            if np.any(inside):
-                e = int(np.flatnonzero(inside)[0])
-                raise InputError(f"rectangle {e} (fracture {int(mesh.fracture_id[e])}) straddles interface {k} at "
-                                 f"z = {height:g} (its corners span z = {lo[e]:g} .. {hi[e]:g}); rectangles must lie "
-                                 "inside one layer: mesh them so that edges end on interfaces, or cut rectangles "
-                                 "with a horizontal edge by hd.layered.split_at_interfaces(mesh, medium)")
-            along = (np.abs(lo - height) <= tol) & (np.abs(hi - height) <= tol)
-            if np.any(along):
-                e = int(np.flatnonzero(along)[0])
-                raise InputError(f"rectangle {e} lies in interface {k} (z = {height:g}); a rectangle must lie inside "
-                                 "one layer (move it off the interface)")
-    layers = medium.layer_of(0.5 * (lo + hi)).astype(np.int64)
-    void = np.flatnonzero(np.asarray(medium.shear_modulus)[layers] == 0.0)
-    if void.size:
-        e = int(void[0])
-        raise InputError(f"rectangle {e} lies in layer {int(layers[e])}, which is void (shear_modulus = 0)")
-    return layers
+    return layers_of_extents(medium, z.min(axis=1), z.max(axis=1), _ON_INTERFACE * np.maximum(mesh.radii, 1e-300),
+                             mesh.fracture_id, noun="rectangle")
 
 
 def influence_data(mesh, medium, singular_shift, alpha, near_fraction, n_images):
