@@ -117,7 +117,8 @@ The format, annotated (``=`` values are the defaults unless marked REQUIRED)::
     history_plot = true
 
     [reference]                    # optional closed form reported at every step
-    kind = "radial-k"              # "radial-k", "radial-m" (3D), "kgd-k", "kgd-m" (2D);
+    kind = "radial-k"              # "radial-k", "radial-m", "radial-km" (3D; K-M transition,
+                                   # Dontsov 2016), "kgd-k", "kgd-m" (2D);
                                    # needs one cluster, [propagation] and no leak-off
 
     # Natural fractures: the schema is defined and validated, but the engine has no
