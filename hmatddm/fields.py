@@ -6,7 +6,8 @@ network (ref. Sec. 5.3).
 The stress at M points from N elements is a points x elements matrix applied to the DDs:
 row ``n_out * t + c`` is component ``c`` of the stress at point ``t`` (3D: xx, yy, zz, xy,
 xz, yz; 2D plane strain: xx, yy, xy; or the mean stress alone, ``n_out = 1``), column
-``d * j + q`` the global DD component ``q`` of element ``j``. Its entries come from the
+``d * j + q`` the global DD component ``q`` of element ``j`` (or, for given DDs, one
+column per element: what it induces with its DD). Its entries come from the
 per-pair kernels of :mod:`hmatddm.kernels` (``local_stress_corrected`` of
 :mod:`~hmatddm.kernels.rectangle3d` and :mod:`~hmatddm.kernels.line2d`), contracted with
 a local DD and rotated to the global frame (ref. Eq. 2.57). Two ways to apply it:
@@ -16,8 +17,10 @@ a local DD and rotated to the global frame (ref. Eq. 2.57). Two ways to apply it
   one rotation;
 * ``"tree"``: a rectangular H-matrix of the generic engine (:mod:`hmatddm.hmatrix`: a
   cluster tree of the points, one of the elements, whole-element ACA of the far blocks
-  to ``eps``), then one matvec. :class:`StressField` keeps it for further DDs on the
-  same points and elements (a time loop checking the same targets step after step).
+  to ``eps``), then one matvec. For one evaluation (:func:`induced`, behind
+  ``hd.stress_at``) the matrix is that of the given DDs (one column per element, the
+  ranks of the contracted sum); :class:`StressField` without DDs keeps the matrix of
+  unit DD components for further DDs on the same points and elements.
 """
 import time
 from typing import NamedTuple
@@ -60,8 +63,8 @@ class FieldSources(NamedTuple):
     ``points`` (M, dim), the elements (``centers``, ``frames`` with the local axes as
     rows, half sizes ``half_a``, ``half_b``; in 2D both are the half length), the
     material, the singular-point treatment: ``singular_shift`` (0: NaN at singular
-    points, else the averaging offset of ref. Sec. 6.2.3) and ``near_fraction``, and a
-    weight per element that scales its columns (see :class:`StressField`)."""
+    points, else the averaging offset of ref. Sec. 6.2.3) and ``near_fraction``, and the
+    global DDs ``dd`` (N, dim) that :func:`contribution_block` folds into its columns."""
 
     points: np.ndarray
     centers: np.ndarray
@@ -72,19 +75,19 @@ class FieldSources(NamedTuple):
     poisson_ratio: float
     singular_shift: float
     near_fraction: float
-    column_weight: np.ndarray
+    dd: np.ndarray
 
 
-def field_sources(mesh, material, points, singular_correction="none", near_fraction=0.0, column_weight=None):
+def field_sources(mesh, material, points, singular_correction="none", near_fraction=0.0, dd=None):
     """The :class:`FieldSources` of ``mesh`` seen from ``points`` (contiguous float64
     arrays: one compiled specialisation of each kernel, whatever slicing or
     concatenation produced the mesh)."""
     half_a, half_b = (mesh.half_length, mesh.half_length) if mesh.dim == 2 else (mesh.half_a, mesh.half_b)
     arrays = (np.ascontiguousarray(a, dtype=np.float64) for a in (points, mesh.centers, mesh.frames, half_a, half_b))
-    weight = np.ones(mesh.n_elements) if column_weight is None else column_weight
+    dd = np.zeros((mesh.n_elements, mesh.dim)) if dd is None else dd
     return FieldSources(*arrays, float(material.shear_modulus), float(material.poisson_ratio),
                         1e-3 if singular_correction == "average" else 0.0, float(near_fraction),
-                        np.ascontiguousarray(weight, dtype=np.float64))
+                        np.ascontiguousarray(dd, dtype=np.float64))
 
 
 @njit(cache=True, nogil=True)
@@ -164,11 +167,28 @@ def _components(work3, work2, dim, l0, l1, l2, frame, n_out, nu, out):
 
 
 @njit(cache=True, nogil=True)
+def _contribution(sources, point, j, n_out, work3, work2, value):
+    """``value[:n_out]``: the components at ``point`` of element ``j`` with its global DD
+    ``sources.dd[j]``, contracted in the local frame before the one rotation."""
+    frame = sources.frames[j]
+    dd = sources.dd[j]
+    _local_response(sources, point, j, work3, work2)
+    l0 = frame[0, 0] * dd[0] + frame[0, 1] * dd[1]
+    l1 = frame[1, 0] * dd[0] + frame[1, 1] * dd[1]
+    l2 = 0.0
+    if dd.shape[0] == 3:
+        l0 += frame[0, 2] * dd[2]
+        l1 += frame[1, 2] * dd[2]
+        l2 = frame[2, 0] * dd[0] + frame[2, 1] * dd[1] + frame[2, 2] * dd[2]
+    _components(work3, work2, dd.shape[0], l0, l1, l2, frame, n_out, sources.poisson_ratio, value)
+
+
+@njit(cache=True, nogil=True)
 def field_block(data, rows, cols, out):
     """Block generator kernel of the points x elements matrix (see
     :class:`hmatddm.hmatrix.BlockGenerator`): ``out[n_out * a + c, d * b + q]`` =
-    component ``c`` at point ``rows[a]`` from a global DD component ``q`` of element
-    ``j = cols[b]`` equal to ``column_weight[j]``. ``data``: :class:`FieldSources`; ``n_out`` (6, 3 or 1) is read
+    component ``c`` at point ``rows[a]`` from a unit global DD component ``q`` of
+    element ``cols[b]``. ``data``: :class:`FieldSources`; ``n_out`` (6, 3 or 1) is read
     from the shape of ``out``."""
     points = data.points
     dim = data.centers.shape[1]
@@ -182,28 +202,42 @@ def field_block(data, rows, cols, out):
         for b in range(cols.shape[0]):
             j = cols[b]
             frame = data.frames[j]
-            weight = data.column_weight[j]
             _local_response(data, point, j, work3, work2)
             for q in range(dim):
                 # local components of the unit global DD q: column q of the frame
                 _components(work3, work2, dim, frame[0, q], frame[1, q], frame[dim - 1, q], frame, n_out, nu,
                             value)
                 for c in range(n_out):
-                    out[n_out * a + c, dim * b + q] = weight * value[c]
+                    out[n_out * a + c, dim * b + q] = value[c]
+
+
+@njit(cache=True, nogil=True)
+def contribution_block(data, rows, cols, out):
+    """Block generator kernel of the points x elements matrix of given DDs, one column
+    per element: ``out[n_out * a + c, b]`` = component ``c`` at point ``rows[a]`` of
+    element ``cols[b]`` with its DD ``data.dd[cols[b]]``; the field is this matrix
+    times a vector of ones."""
+    n_out = out.shape[0] // rows.shape[0]
+    work3 = np.empty((3, 3, 3))
+    work2 = np.empty((2, 2, 2))
+    value = np.empty(6)
+    for a in range(rows.shape[0]):
+        point = data.points[rows[a]]
+        for b in range(cols.shape[0]):
+            _contribution(data, point, cols[b], n_out, work3, work2, value)
+            for c in range(n_out):
+                out[n_out * a + c, b] = value[c]
 
 
 @njit(cache=True, parallel=True)
-def direct_sum(sources, dd, out):
+def direct_sum(sources, out):
     """``out[t] = sum_j`` (stress at point ``t`` of element ``j`` with its global DD
-    ``dd[j]``), exact, ``n_out = out.shape[1]``. Each pair contracts its DD before the
-    one rotation; parallel over a fixed split of the points, the sum over ``j`` in
-    element order (the result does not depend on the thread count)."""
+    ``sources.dd[j]``), exact, ``n_out = out.shape[1]``. Each pair contracts its DD
+    before the one rotation; parallel over a fixed split of the points, the sum over
+    ``j`` in element order (the result does not depend on the thread count)."""
     points = sources.points
-    frames = sources.frames
     m = points.shape[0]
-    dim = sources.centers.shape[1]
     n_out = out.shape[1]
-    nu = sources.poisson_ratio
     n_chunks = min(_DIRECT_CHUNKS, m)
     for chunk in prange(n_chunks):
         work3 = np.empty((3, 3, 3))
@@ -212,17 +246,8 @@ def direct_sum(sources, dd, out):
         for t in range(chunk * m // n_chunks, (chunk + 1) * m // n_chunks):
             for c in range(n_out):
                 out[t, c] = 0.0
-            for j in range(frames.shape[0]):
-                frame = frames[j]
-                _local_response(sources, points[t], j, work3, work2)
-                l0 = frame[0, 0] * dd[j, 0] + frame[0, 1] * dd[j, 1]
-                l1 = frame[1, 0] * dd[j, 0] + frame[1, 1] * dd[j, 1]
-                l2 = 0.0
-                if dim == 3:
-                    l0 += frame[0, 2] * dd[j, 2]
-                    l1 += frame[1, 2] * dd[j, 2]
-                    l2 = frame[2, 0] * dd[j, 0] + frame[2, 1] * dd[j, 1] + frame[2, 2] * dd[j, 2]
-                _components(work3, work2, dim, l0, l1, l2, frame, n_out, nu, value)
+            for j in range(sources.frames.shape[0]):
+                _contribution(sources, points[t], j, n_out, work3, work2, value)
                 for c in range(n_out):
                     out[t, c] += value[c]
 
@@ -261,12 +286,12 @@ class StressField:
     singular_correction, near_fraction : as :func:`hmatddm.stress_at`
     method : ``"auto"``, ``"direct"`` or ``"tree"`` (see :func:`hmatddm.stress_at`)
     eps : float in (0, 1) or None (``DEFAULT_STRESS_EPS``)
-    typical_dd : (N, d) or None
-        DDs like those the field will be applied to. The compressed matrix is that of
-        the columns of element ``j`` scaled by ``|typical_dd[j]|``, so that ``eps``
-        bounds each block's error relative to what its elements actually induce (a
-        small element with a large DD next to large elements with small ones is then
-        as accurate as they are); None: unscaled columns.
+    dd : (N, d) or None
+        None: the field applies to any DDs, ``field(dd)`` (the H-matrix has ``d`` columns
+        per element, unit global DD components). Given: the field of these DDs only,
+        ``field()``; the H-matrix has one column per element (what the element induces
+        with its DD), so ``eps`` bounds each block's error relative to what its elements
+        actually induce, and its ranks are those of the contracted sum (about a third).
 
     With ``"tree"`` the H-matrix is built once here (its build is most of the cost) and
     each call is one matvec; ``"direct"`` sums the kernels at every call.
@@ -274,7 +299,7 @@ class StressField:
     """
 
     def __init__(self, mesh, material, points, quantity="stress", singular_correction="none", method="auto",
-                 eps=None, near_fraction=0.0, typical_dd=None):
+                 eps=None, near_fraction=0.0, dd=None):
         near_fraction = _check_common(mesh, material, singular_correction, near_fraction, quantity)
         if method not in METHODS:
             raise InputError(f"method must be one of {METHODS}, got {method!r}")
@@ -286,12 +311,9 @@ class StressField:
         self.n_out = n_components(mesh.dim, quantity)
         self.eps = float(eps)
         self.near_fraction = near_fraction
-        weight = None
-        if typical_dd is not None:
-            size = np.linalg.norm(_dd_array(mesh, typical_dd), axis=1)
-            if size.max() > 0.0:
-                weight = np.maximum(size, 1e-12 * size.max())
-        self.sources = field_sources(mesh, material, self.points, singular_correction, near_fraction, weight)
+        self.contracted = dd is not None
+        self.sources = field_sources(mesh, material, self.points, singular_correction, near_fraction,
+                                     None if dd is None else _dd_array(mesh, dd))
         m, n = len(self.points), mesh.n_elements
         if method == "auto":
             method = "tree" if m * n >= AUTO_TREE_PAIRS and min(m, n) > 2 * FIELD_LEAF_SIZE else "direct"
@@ -312,8 +334,9 @@ class StressField:
         from .hmatrix import BlockGenerator, HMatrix
 
         mesh = self.mesh
-        generator = BlockGenerator(field_block, self.sources, self.points, 0.0, self.n_out,
-                                   col_points=mesh.centers, col_radii=mesh.radii, col_dof=mesh.dim)
+        kernel, col_dof = (contribution_block, 1) if self.contracted else (field_block, mesh.dim)
+        generator = BlockGenerator(kernel, self.sources, self.points, 0.0, self.n_out, col_points=mesh.centers,
+                                   col_radii=mesh.radii, col_dof=col_dof)
         return HMatrix.build(generator, eps=self.eps, eta=FIELD_ETA, leaf_size=FIELD_LEAF_SIZE,
                              factor_dtype=np.float64)
 
@@ -331,72 +354,26 @@ class StressField:
                 "pairs_exact": len(self.points) * self.mesh.n_elements - pairs_compressed,
                 "memory_bytes": int(s.memory_bytes)}
 
-    def __call__(self, dd):
-        """(M, n_out) components induced by the global DDs ``dd`` ((N, d) or (N*d,))."""
-        dd = _dd_array(self.mesh, dd)
+    def __call__(self, dd=None):
+        """(M, n_out) components induced by the global DDs ``dd`` ((N, d) or (N*d,);
+        omitted for a field built with its ``dd``)."""
+        if self.contracted and dd is not None:
+            raise InputError("this StressField was built for its own dd; call it without dd")
+        if not self.contracted and dd is None:
+            raise InputError("dd is required: this StressField applies to any DDs")
         started = time.perf_counter()
         m = len(self.points)
+        sources = self.sources if dd is None else self.sources._replace(dd=_dd_array(self.mesh, dd))
         if m == 0:
             out = np.zeros((0, self.n_out))
         elif self.hmatrix is not None:
-            out = self.hmatrix.matvec((dd / self.sources.column_weight[:, None]).reshape(-1)).reshape(m, self.n_out)
+            x = np.ones(self.mesh.n_elements) if self.contracted else sources.dd.reshape(-1)
+            out = self.hmatrix.matvec(x).reshape(m, self.n_out)
         else:
             out = np.empty((m, self.n_out))
-            direct_sum(self.sources, np.ascontiguousarray(dd), out)
+            direct_sum(sources, out)
         self.info["apply_seconds"] = time.perf_counter() - started
         return out
-
-
-class GrowingMeshField:
-    """The stress at fixed ``points`` from a mesh that grows by appending elements, step
-    after step (the remote-failure check of a time loop, ref. Sec. 5.3: the intact
-    natural elements are the targets, the active elements the sources).
-
-    ``field(mesh, dd)`` returns the (M, n_out) components. The points x elements
-    H-matrix of the mesh seen at the last rebuild is kept; when the mesh is that mesh
-    plus appended elements, their contribution is summed exactly and added to the kept
-    matrix's; the matrix is rebuilt when the appended elements exceed
-    ``rebuild_fraction`` of it, or when the mesh is not an extension of it (elements
-    moved or removed). Results do not depend on the history beyond the accuracy
-    ``eps`` of the compressed blocks (unscaled columns: the DDs change between uses).
-    Other parameters as :class:`StressField` (``method`` of the kept matrix).
-    """
-
-    def __init__(self, material, points, quantity="stress", singular_correction="none", eps=None, near_fraction=0.0,
-                 rebuild_fraction=0.25, method="auto"):
-        self.material = material
-        self.method = method
-        self.points = np.ascontiguousarray(points, dtype=np.float64)
-        self.options = dict(quantity=quantity, singular_correction=singular_correction, eps=eps,
-                            near_fraction=near_fraction)
-        self.rebuild_fraction = finite_scalar("rebuild_fraction", rebuild_fraction)
-        self.base = None  # StressField of the mesh at the last rebuild
-        self.tail = None  # StressField of the elements appended since (direct sum)
-        self.rebuilds = 0
-
-    def _extends_base(self, mesh):
-        base = self.base.mesh
-        n = base.n_elements
-        if mesh.dim != base.dim or mesh.n_elements < n:
-            return False
-        names = ("centers", "frames") + (("half_length",) if mesh.dim == 2 else ("half_a", "half_b"))
-        return all(np.array_equal(getattr(mesh, name)[:n], getattr(base, name)) for name in names)
-
-    def __call__(self, mesh, dd):
-        if self.base is None or not self._extends_base(mesh) or (
-                mesh.n_elements - self.base.mesh.n_elements > self.rebuild_fraction * self.base.mesh.n_elements):
-            self.base = StressField(mesh, self.material, self.points, method=self.method, **self.options)
-            self.tail = None
-            self.rebuilds += 1
-        n = self.base.mesh.n_elements
-        dd = _dd_array(mesh, dd)
-        values = self.base(dd[:n])
-        if mesh.n_elements > n:
-            if self.tail is None or self.tail.mesh.n_elements != mesh.n_elements - n:
-                self.tail = StressField(mesh.subset(np.arange(n, mesh.n_elements)), self.material, self.points,
-                                        method="direct", **self.options)
-            values = values + self.tail(dd[n:])
-        return values
 
 
 def as_tensors(values):
@@ -433,14 +410,13 @@ def induced(mesh, material, dd, points, quantity, singular_correction="none", me
     points refused; what :func:`hmatddm.stress_at` and :func:`hmatddm.mean_stress_at`
     compute for constant elements in a homogeneous medium."""
     started = time.perf_counter()
-    field = StressField(mesh, material, points, quantity, singular_correction, method, eps, near_fraction,
-                        typical_dd=dd)
-    values = field(dd)
+    field = StressField(mesh, material, points, quantity, singular_correction, method, eps, near_fraction, dd=dd)
+    values = field()
     if info is not None:
         info.update(field.info, seconds=time.perf_counter() - started)
     refuse_singular(values, field.near_fraction)
     return values
 
 
-__all__ = ["StressField", "GrowingMeshField", "as_tensors", "FieldSources", "field_sources", "field_block", "direct_sum", "induced", "refuse_singular", "n_components",
+__all__ = ["StressField", "as_tensors", "FieldSources", "field_sources", "field_block", "contribution_block", "direct_sum", "induced", "refuse_singular", "n_components",
            "DEFAULT_STRESS_EPS", "AUTO_TREE_PAIRS", "FIELD_ETA", "FIELD_LEAF_SIZE", "METHODS", "QUANTITIES"]

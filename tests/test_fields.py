@@ -261,28 +261,3 @@ def test_stress_field_applies_to_any_dd(material, dfn_scene):
             np.testing.assert_array_equal(exact[:, 0], stress[:, 0, 0])
         assert np.max(np.abs(tree(scaled) - exact)) <= 1e-6 * np.max(np.abs(exact))
 
-
-def test_growing_mesh_field_follows_a_growing_mesh(material):
-    """A mesh that grows by appended elements (a time loop's active elements) seen from
-    fixed targets: every step equals the exact sum; the kept H-matrix is reused while the
-    appended elements stay below rebuild_fraction, rebuilt after, and rebuilt when the
-    mesh is not an extension of it (an element moved)."""
-    from hmatddm.fields import GrowingMeshField
-
-    rng = np.random.default_rng(11)
-    full = hd.mesh.rectangle([0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], 30.0, 6.0, 30, 6)
-    points = np.column_stack([rng.uniform(-20, 20, 2500), rng.uniform(-30, 30, 2500), rng.uniform(-5, 5, 2500)])
-    dd = 1e-3 * full.normals + 1e-4 * rng.normal(size=(full.n_elements, 3))
-    field = GrowingMeshField(material, points, "stress", "average", eps=1e-6, near_fraction=0.5, method="tree")
-    rebuilds = []
-    for n in (120, 130, 140, 160, 180):
-        mesh = full.subset(np.arange(n))
-        values = field(mesh, dd[:n])
-        exact = StressField(mesh, material, points, "stress", "average", method="direct", near_fraction=0.5)(dd[:n])
-        assert np.max(np.abs(values - exact)) <= 1e-6 * np.max(np.abs(exact))
-        rebuilds.append(field.rebuilds)
-    assert rebuilds == [1, 1, 1, 2, 2]  # 160 > 1.25 * 120
-    moved = hd.mesh.Mesh3D(full.centers[:180] + [0.0, 0.0, 0.01], full.frames[:180], full.half_a[:180],
-                           full.half_b[:180], full.fracture_id[:180])
-    field(moved, dd[:180])
-    assert field.rebuilds == 3

@@ -24,8 +24,6 @@ from ..errors import InputError
 from ..fracture.crossing import NaturalFractureProperties, crosses
 from ..mesh import Mesh3D, check_mesh
 from ..operators import NEAR_SINGULAR_FRACTION
-from ..fields import GrowingMeshField, as_tensors, refuse_singular
-from ..material import Elastic
 from ..solve import stress_at
 
 
@@ -69,7 +67,6 @@ class NaturalNetwork:
         self.p0, self.p1, self.vertical_half = plan_segments(mesh)
         self.tree = cKDTree(mesh.centers)
         self.reach = 2.0 * float(mesh.radii.max())
-        self._fields = {}  # (material, singular_correction) -> GrowingMeshField at every natural centre
 
     def encounter(self, candidate_mesh, index, hinge, intact):
         """The intact natural element cut by candidate ``index`` (hinged at ``hinge``),
@@ -104,22 +101,12 @@ class NaturalNetwork:
 
     def induced_stress(self, active_mesh, dd, material, targets, singular_correction="average"):
         """Stress (len(targets), d, d) the active elements induce at the centres of the
-        natural elements ``targets``. Targets within half an element size of an active
-        element's edge are near misses (stress ~1/gap), averaged like the DDM operator's
-        collocation points. In a homogeneous medium the points x elements H-matrix of
-        every natural centre is kept from step to step while the active mesh only grows
-        (:class:`hmatddm.fields.GrowingMeshField`); otherwise :func:`hmatddm.stress_at`."""
+        natural elements ``targets`` (:func:`hmatddm.stress_at`). Targets within half an
+        element size of an active element's edge are near misses (stress ~1/gap),
+        averaged like the DDM operator's collocation points."""
         near = NEAR_SINGULAR_FRACTION if singular_correction == "average" else 0.0
-        if not isinstance(material, Elastic) or getattr(active_mesh, "n_nodes", 1) > 1:
-            return stress_at(active_mesh, material, dd, self.mesh.centers[targets],
-                             singular_correction=singular_correction, near_fraction=near)
-        key = (material, singular_correction)
-        if key not in self._fields:
-            self._fields = {key: GrowingMeshField(material, self.mesh.centers, "stress", singular_correction,
-                                                  near_fraction=near)}
-        values = self._fields[key](active_mesh, dd)[targets]
-        refuse_singular(values, near)
-        return as_tensors(values)
+        return stress_at(active_mesh, material, dd, self.mesh.centers[targets],
+                         singular_correction=singular_correction, near_fraction=near)
 
     def remote_failure(self, active_mesh, dd, material, far_field, intact, singular_correction="average"):
         """Coulomb check on the intact elements (ref. Sec. 5.3).
