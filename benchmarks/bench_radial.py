@@ -16,10 +16,10 @@ Two studies, printed as markdown tables and saved (JSON in benchmarks/out/, PNG 
    Eq. 4.69), maximum opening and net pressure (wellbore minus S_hmin) against the closed
    forms: K case with the K-vertex (ref. Eqs 4.65-4.67, exact at zero viscosity); M case
    with the M-vertex radius and opening (ref. Eqs 4.62-4.63) and, for the pressure, the
-   Savitski-Detournay M-vertex net pressure at rho = r_w / R, with r_w = h / sqrt(pi) the
-   radius of the disc of the injection element's area (the M-vertex pressure is
-   log-singular at the source: it has no single "wellbore" value without a radius, see
-   hmatddm.analytical.radial_m_vertex_pressure). The dense twin: same number of elements
+   Savitski-Detournay M-vertex net pressure at rho = r_eq / R, with r_eq = exp(-pi/2) h
+   Peaceman's equivalent radius of a finite-volume source cell
+   (hmatddm.analytical.well_element_radius; the M-vertex pressure is log-singular at the
+   source: it has no single "wellbore" value without a radius). The dense twin: same number of elements
    at every step, and the largest relative difference of R, w_max and p over the run.
    Plot: radial_history.png.
 2. cost: the K-vertex at several element sizes h (initial 3 x 3 elements of side h). With
@@ -34,11 +34,14 @@ Two studies, printed as markdown tables and saved (JSON in benchmarks/out/, PNG 
 
 4. front: the two front models (``Propagation(front="element" | "asymptotic")``, issue 16)
    on the M case (h = 2 and 1 m to 50 s, h = 0.5 m to 12 s; dense twin of the asymptotic
-   front at h = 2 m) and the K and K-vertex cases (h = 1 m): errors at t_end, RMS over 10 s
+   front at h = 2 m), the K-vertex and the Table 4.1 K case against Dontsov's (2016)
+   solution of the K-M transition ("K-M", K_m 1.8-2.9; hmatddm.analytical.radial_transition)
+   (h = 1 m): errors at t_end, RMS over 10 s
    to t_end, the worst front circularity (largest / smallest front distance from the well,
    minus 1) over the same times, wall and process CPU time. Plot:
    radial_front_accuracy_cost.png (M-vertex errors against wall time, with the planar-3D
-   level-set simulator's 1.1% / 0.7% in ~121 s). ``--skip table41,cost,kgd,threads`` runs it alone.
+   level-set simulator's 1.1% / 0.7% in ~121 s). ``--skip table41,cost,kgd,threads`` runs it alone;
+   ``--front-rows 4,9`` runs rows of FRONT_RUNS again and merges them into the saved study.
 
 5. kgd: the 2D plane-strain fracture of ref. Table 4.2 with K_Ic 5 and 0.2 MPa m^1/2 (K_m
    4.9 and 0.2) at h = 1 and 0.5 m, both front models, against the KGD K- and M-vertex at
@@ -485,24 +488,29 @@ def plot_front(rows, path):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+    fig, axes = plt.subplots(1, 2, figsize=(12, 6.2))
     for r in rows:
-        if "history" not in r or r["case"] != "M" or r["backend"] != "hmatrix" or r["t_end"] < 50:
+        if ("history" not in r or r["case"] not in ("M", "K-vertex", "K-M") or r["backend"] != "hmatrix"
+                or r["t_end"] < 50):
             continue
-        marker = "o" if r["front"] == "asymptotic" else "s"
-        label = f"{r['front']}, h = {r['h']:g} m"
+        marker = {"M": "o", "K-vertex": "^", "K-M": "D"}[r["case"]]
+        label = f"{r['case']} ({r['reference_name'].split(' (')[0]}), {r['front']}, h = {r['h']:g} m"
         cpu = r.get("process_cpu_s", r["wall_s"])  # the machine was shared: CPU time, not wall
-        axes[0].loglog(cpu, abs(r["error"]["radius"]) * 100, marker, ms=8, label=label)
-        axes[1].loglog(cpu, abs(r["error"]["centre_width"]) * 100, marker, ms=8, label=label)
+        style = dict(ms=8, mfc="none" if r["front"] == "element" else None,
+                     color={"M": "C0", "K-vertex": "C3", "K-M": "C2"}[r["case"]])
+        axes[0].loglog(cpu, abs(r["error"]["radius"]) * 100, marker, label=label, **style)
+        axes[1].loglog(cpu, abs(r["error"]["centre_width"]) * 100, marker, label=label, **style)
     for ax, name in zip(axes, ("radius", "centre opening")):
         ax.loglog([121.0], [1.1 if name == "radius" else 0.7], "k*", ms=12,
                    label="planar-3D level-set peer (~121 s wall)")
         ax.set_xlabel("process CPU time (s), one thread")
         ax.set_ylabel(f"|{name} error| at 50 s (%)")
-        ax.set_title(f"radial M-vertex (ref. Table 4.1 M): {name}")
+        ax.set_title(f"radial (ref. Table 4.1 setup): {name}")
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=8)
-    fig.tight_layout()
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=3, fontsize=8, title="case (reference), front model "
+               "(hollow: element switch), element size")
+    fig.tight_layout(rect=(0, 0.22, 1, 1))
     fig.savefig(path, dpi=110)
     plt.close(fig)
 
