@@ -124,11 +124,12 @@ class TipAsymptote:
         lo = np.where(positive, np.maximum(np.maximum(w_k, w_m), 1e-300), 1e-300)
         hi = np.where(positive, (w_k + w_m) * (1.0 + 1e-12) + 1e-300, 2e-300)
         s_safe = np.where(positive, s, 1.0)
-        for _ in range(iterations):
-            mid = np.sqrt(lo * hi)
-            narrow = self.residual(s_safe, velocity, mid) > 0.0
-            lo = np.where(narrow, mid, lo)
-            hi = np.where(narrow, hi, mid)
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # s = 0 rows: replaced by 0 below
+            for _ in range(iterations):
+                mid = np.sqrt(lo * hi)
+                narrow = self.residual(s_safe, velocity, mid) > 0.0
+                lo = np.where(narrow, mid, lo)
+                hi = np.where(narrow, hi, mid)
         return np.where(positive, np.sqrt(lo * hi), 0.0) * finite_fracture_factor(s, length)
 
     def front_distance(self, w, distance_old, dt, iterations=64, length=np.inf):
