@@ -94,7 +94,8 @@ def disk(monkeypatch):
                 raise _disk_full(temporary)
 
     monkeypatch.setattr(checkpoints, "_atomic_write", atomic_write)
-    for name in ("hmatddm.runner", "hmatddm.io.vtk", "hmatddm.render.snapshots", "hmatddm.render.plots"):
+    for name in ("hmatddm.runner", "hmatddm.run_folder", "hmatddm.io.vtk", "hmatddm.render.offscreen",
+                 "hmatddm.render.plots", "hmatddm.microseismic.catalogue", "hmatddm.microseismic.maps"):
         module = importlib.import_module(name)
         monkeypatch.setattr(module, "atomic_output", atomic_output)
     return state
