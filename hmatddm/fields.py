@@ -45,8 +45,10 @@ DEFAULT_STRESS_EPS = 1e-5
 #: ``method="auto"`` compresses when (points x elements) reaches this and both counts
 #: exceed twice the leaf size.
 AUTO_TREE_PAIRS = 2_000_000
-#: Admissibility ``min(diam) <= eta * dist`` and leaf size of both cluster trees.
-FIELD_ETA = 3.0
+#: Admissibility ``min(diam) <= eta * dist`` and leaf size of both cluster trees. Stricter
+#: than the operator's 3: the field must stay within ~1e-7 of its largest component at
+#: ``DEFAULT_STRESS_EPS`` (measured 1.4e-6 in 2D with 3, benchmarks/RESULTS.md).
+FIELD_ETA = 1.0
 FIELD_LEAF_SIZE = 64
 _DIRECT_CHUNKS = 64  # fixed split of the point range in the direct sum
 
@@ -90,7 +92,21 @@ def field_sources(mesh, material, points, singular_correction="none", near_fract
                         np.ascontiguousarray(dd, dtype=np.float64))
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, inline="always")
+def _may_touch_boundary(x1, x2, x3, a, b, distance):
+    """False when the local point is certainly farther than ``distance`` from the
+    rectangle's boundary (a bounding test, so that the far pairs skip the nearest
+    boundary point search of ``local_stress_corrected``)."""
+    if abs(x3) > distance:
+        return False
+    u = abs(x1)
+    v = abs(x2)
+    if u > a + distance or v > b + distance:
+        return False
+    return abs(u - a) <= distance or abs(v - b) <= distance
+
+
+@njit(cache=True, nogil=True, inline="always")
 def _local_response(sources, point, j, work3, work2):
     """Local stress of element ``j`` at ``point`` per unit local DD component
     (``work3[k]`` in 3D, ``work2[k]`` in 2D): the kernels' ``local_stress_corrected``
@@ -109,8 +125,10 @@ def _local_response(sources, point, j, work3, work2):
         x3 = frame[2, 0] * dx + frame[2, 1] * dy + frame[2, 2] * dz
         a = sources.half_a[j]
         b = sources.half_b[j]
-        _rectangle_local_stress(x1, x2, x3, a, b, g, nu, sources.singular_shift, work3,
-                                sources.near_fraction * min(a, b))
+        near = sources.near_fraction * min(a, b)
+        if near > 0.0 and not _may_touch_boundary(x1, x2, x3, a, b, near):
+            near = 0.0
+        _rectangle_local_stress(x1, x2, x3, a, b, g, nu, sources.singular_shift, work3, near)
     else:
         dx = point[0] - centers[j, 0]
         dy = point[1] - centers[j, 1]
@@ -119,7 +137,7 @@ def _local_response(sources, point, j, work3, work2):
                               sources.singular_shift, work2, sources.near_fraction * a)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _components(work3, work2, dim, l0, l1, l2, frame, n_out, nu, out):
     """``out[:n_out]``: the global components of the stress of local DD ``(l0, l1, l2)``
     (``l2`` unused in 2D) from the local responses: ``s = sum_k l_k work[k]``, rotated
@@ -166,7 +184,7 @@ def _components(work3, work2, dim, l0, l1, l2, frame, n_out, nu, out):
     out[2] = frame[0, 0] * t01 + frame[1, 0] * t11
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _contribution(sources, point, j, n_out, work3, work2, value):
     """``value[:n_out]``: the components at ``point`` of element ``j`` with its global DD
     ``sources.dd[j]``, contracted in the local frame before the one rotation."""
