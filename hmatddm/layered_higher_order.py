@@ -21,7 +21,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from .kernels.drivers import KernelKind, influence_matrix, register_kind, self_block_max, stress_sum
+from .kernels.drivers import KernelKind, influence_matrix, no_source_state, register_kind, self_block_max, stress_sum
 from .kernels.line2d_higher_order import (edge_distance, near_distance, node_point, set_node_rows, stress_nodes,
                                           traction_nodes)
 from .layered.images2d import composite_rule, image_element_stress, subdivisions
@@ -77,7 +77,7 @@ class LayeredNodalSegments(NamedTuple):
     nodes: np.ndarray  #: (n,) intrinsic coordinates of the collocation nodes
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def unknowns(data):
     """``2 n`` unknowns per element (n nodes, global DD x, y each)."""
     return 2 * data.nodes.shape[0]
@@ -91,13 +91,7 @@ def workspace(data):
     return np.empty((n_nodes, 2, 2, 2)), np.empty((n_nodes, 2, 2)), np.empty((n_nodes, 2, 2, 2)), np.empty(2)
 
 
-@njit(cache=True)
-def source_state(data, j, work):
-    """Nothing is shared between the receivers of a source."""
-    return 0
-
-
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def element_traction(data, i, j, state, work, block):
     """``block[2 r + p, 2 k + q]``: traction p at node r of element ``i`` for a unit
     global DD q at node k of element ``j`` (original + complementary parts)."""
@@ -127,7 +121,7 @@ def element_traction(data, i, j, state, work, block):
         set_node_rows(block, pair, r)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def element_stress(data, point, point_layer, j, work, out):
     """``out[2 k + q]`` (2n, 2, 2): stress at ``point`` (in ``point_layer``; zero in a void
     layer) for a unit global DD q at node k of element ``j``; a point within
@@ -150,7 +144,7 @@ def element_stress(data, point, point_layer, j, work, out):
         nodal += image
 
 
-register_kind(LayeredNodalSegments, KernelKind(unknowns, workspace, source_state, element_traction, element_stress,
+register_kind(LayeredNodalSegments, KernelKind(unknowns, workspace, no_source_state, element_traction, element_stress,
                                                edge_distance))
 
 

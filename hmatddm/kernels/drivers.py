@@ -90,6 +90,12 @@ def kind_of(data):
     return kind
 
 
+@njit(cache=True)
+def no_source_state(data, j, work):
+    """The ``source_state`` of kinds whose receivers share nothing about a source."""
+    return 0
+
+
 # -- the per-kind hooks: plain Python for Python callers, resolved by type inside numba --
 def element_unknowns(data):
     """Unknowns per element of ``data``'s kind."""
@@ -116,7 +122,7 @@ def _edge_distance(data, i, j):
     return kind_of(data).edge_distance(data, i, j)
 
 
-@overload(element_unknowns)
+@overload(element_unknowns, inline="always")
 def _overload_unknowns(data):
     function = kind_of(data).unknowns
 
@@ -125,7 +131,7 @@ def _overload_unknowns(data):
     return impl
 
 
-@overload(_workspace)
+@overload(_workspace, inline="always")
 def _overload_workspace(data):
     function = kind_of(data).workspace
 
@@ -134,7 +140,7 @@ def _overload_workspace(data):
     return impl
 
 
-@overload(_source_state)
+@overload(_source_state, inline="always")
 def _overload_source_state(data, j, work):
     function = kind_of(data).source_state
 
@@ -143,7 +149,7 @@ def _overload_source_state(data, j, work):
     return impl
 
 
-@overload(_element_traction)
+@overload(_element_traction, inline="always")
 def _overload_element_traction(data, i, j, state, work, block):
     function = kind_of(data).element_traction
 
@@ -152,7 +158,7 @@ def _overload_element_traction(data, i, j, state, work, block):
     return impl
 
 
-@overload(_element_stress)
+@overload(_element_stress, inline="always")
 def _overload_element_stress(data, point, point_layer, j, work, out):
     function = kind_of(data).element_stress
 
@@ -161,7 +167,7 @@ def _overload_element_stress(data, point, point_layer, j, work, out):
     return impl
 
 
-@overload(_edge_distance)
+@overload(_edge_distance, inline="always")
 def _overload_edge_distance(data, i, j):
     function = kind_of(data).edge_distance
 
@@ -172,11 +178,28 @@ def _overload_edge_distance(data, i, j):
 
 # -- the drivers ---------------------------------------------------------------------------
 @njit(cache=True)
+def _fill_receiver(data, i, cols, out, row, work, block):
+    """``out[row + p, d jb + q]``: the blocks of receiver ``i`` from the sources ``cols``,
+    scaled by ref. Eq. 6.11 when ``alpha > 0`` (off the diagonal); for kinds whose
+    receivers share nothing about a source (rows written contiguously)."""
+    dof = element_unknowns(data)  # a constant of most kinds: the copy loops unroll
+    alpha = data.alpha
+    for jb in range(cols.shape[0]):
+        j = cols[jb]
+        _element_traction(data, i, j, 0, work, block)
+        if alpha > 0.0 and i != j:
+            scale_to_self(block, alpha * data.self_max[j])
+        for p in range(dof):
+            for q in range(dof):
+                out[row + p, dof * jb + q] = block[p, q]
+
+
+@njit(cache=True)
 def _fill_source(data, j, rows, out, column, work, block):
-    """``out[d ia + p, column + q]``: the blocks of source ``j`` at the receivers ``rows``,
-    scaled by ref. Eq. 6.11 when ``alpha > 0`` (off the diagonal)."""
+    """``out[d ia + p, column + q]``: the blocks of source ``j`` at the receivers ``rows``
+    (its ``source_state`` made once), scaled as :func:`_fill_receiver`."""
     state = _source_state(data, j, work)
-    dof = block.shape[0]
+    dof = element_unknowns(data)
     alpha = data.alpha
     for ia in range(rows.shape[0]):
         i = rows[ia]
@@ -188,6 +211,46 @@ def _fill_source(data, j, rows, out, column, work, block):
                 out[dof * ia + p, column + q] = block[p, q]
 
 
+def _fill_block(data, rows, cols, out, work, block):
+    """``rows`` x ``cols`` into ``out``: receiver by receiver, or source by source for
+    kinds with a ``source_state`` (numba picks the loop by the record type)."""
+
+
+def _fill_matrix_part(data, k, everything, out, work, block):
+    """Part ``k`` of the dense matrix: the rows of receiver ``k``, or the columns of
+    source ``k`` for kinds with a ``source_state``."""
+
+
+def _shares_source_state(data):
+    return kind_of(data).source_state is not no_source_state
+
+
+@overload(_fill_block)
+def _overload_fill_block(data, rows, cols, out, work, block):
+    if _shares_source_state(data):
+        def impl(data, rows, cols, out, work, block):
+            dof = block.shape[0]
+            for jb in range(cols.shape[0]):
+                _fill_source(data, cols[jb], rows, out, dof * jb, work, block)
+    else:
+        def impl(data, rows, cols, out, work, block):
+            dof = block.shape[0]
+            for ia in range(rows.shape[0]):
+                _fill_receiver(data, rows[ia], cols, out, dof * ia, work, block)
+    return impl
+
+
+@overload(_fill_matrix_part)
+def _overload_fill_matrix_part(data, k, everything, out, work, block):
+    if _shares_source_state(data):
+        def impl(data, k, everything, out, work, block):
+            _fill_source(data, k, everything, out, block.shape[0] * k, work, block)
+    else:
+        def impl(data, k, everything, out, work, block):
+            _fill_receiver(data, k, everything, out, block.shape[0] * k, work, block)
+    return impl
+
+
 @njit(cache=True)
 def traction_block(data, rows, cols, out):
     """Block generator kernel (see :class:`hmatddm.hmatrix.BlockGenerator`): ``out`` of
@@ -195,23 +258,19 @@ def traction_block(data, rows, cols, out):
     component ``p`` at the collocation point(s) of element ``rows[a]`` for a unit global
     DD unknown ``q`` of element ``cols[b]``."""
     dof = element_unknowns(data)
-    work = _workspace(data)
-    block = np.empty((dof, dof))
-    for jb in range(cols.shape[0]):
-        _fill_source(data, cols[jb], rows, out, dof * jb, work, block)
+    _fill_block(data, rows, cols, out, _workspace(data), np.empty((dof, dof)))
 
 
 @njit(cache=True, parallel=True)
 def traction_matrix(data, out):
     """Dense assembly of the whole traction matrix ``out`` (N d, N d), parallel over
-    source elements (a source's shared state, e.g. traced image pairs, is made once)."""
+    receivers (rows written contiguously), or over sources for kinds with a
+    ``source_state`` (made once per source)."""
     n = data.centers.shape[0]
     dof = element_unknowns(data)
-    rows = np.arange(n)
-    for j in prange(n):
-        work = _workspace(data)
-        block = np.empty((dof, dof))
-        _fill_source(data, j, rows, out, dof * j, work, block)
+    everything = np.arange(n)
+    for k in prange(n):
+        _fill_matrix_part(data, k, everything, out, _workspace(data), np.empty((dof, dof)))
 
 
 @njit(cache=True)
@@ -297,6 +356,6 @@ def stress_sum(data, points, dd, point_layer=None):
     return out
 
 
-__all__ = ["KernelKind", "register_kind", "kind_of", "element_unknowns",
+__all__ = ["KernelKind", "register_kind", "no_source_state", "kind_of", "element_unknowns",
            "traction_block", "traction_matrix", "singular_pairs", "self_block_max", "edge_distance",
            "stress_at_points", "influence_matrix", "self_block_maxima", "stress_sum"]

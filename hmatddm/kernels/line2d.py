@@ -24,7 +24,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from .drivers import KernelKind, register_kind
+from .drivers import KernelKind, no_source_state, register_kind
 
 _INV_4PI = 1.0 / (4.0 * math.pi)
 
@@ -170,7 +170,7 @@ class Segments(NamedTuple):
     self_max: np.ndarray  #: (N,) largest |entry| of each self block (ref. Eq. 6.11)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def unknowns(data):
     """Two unknowns per element (global DD x, y)."""
     return 2
@@ -182,13 +182,7 @@ def workspace(data):
     return np.empty((2, 2, 2))
 
 
-@njit(cache=True)
-def source_state(data, j, work):
-    """Nothing is shared between the receivers of a source."""
-    return 0
-
-
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def element_traction(data, i, j, state, work, block):
     """``block`` (2, 2): :func:`traction_pair` at the centre of element ``i`` (its normal)
     from element ``j``; a centre closer than ``near_fraction * min(a_i, a_j)`` to an end of
@@ -200,7 +194,7 @@ def element_traction(data, i, j, state, work, block):
                   data.shear_modulus, data.poisson_ratio, data.singular_shift, block, work, near)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def element_stress(data, point, point_layer, j, work, out):
     """``out`` (2, 2, 2): :func:`stress_pair` of element ``j`` at ``point``."""
     a = data.half_length[j]
@@ -243,4 +237,5 @@ def mean_stress_pair(point, center, frame, a, shear_modulus, poisson_ratio, out)
         out[q] = frame[0, q] * m0 + frame[1, q] * m1
 
 
-register_kind(Segments, KernelKind(unknowns, workspace, source_state, element_traction, element_stress, edge_distance))
+register_kind(Segments, KernelKind(unknowns, workspace, no_source_state, element_traction, element_stress,
+                                   edge_distance))

@@ -39,7 +39,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from .drivers import KernelKind, register_kind
+from .drivers import KernelKind, no_source_state, register_kind
 from .line2d import on_tip, rotate_to_global, tip_distance
 
 _INV_4PI = 1.0 / (4.0 * math.pi)
@@ -268,7 +268,7 @@ class NodalSegments(NamedTuple):
     nodes: np.ndarray  #: (n,) intrinsic coordinates of the collocation nodes
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def unknowns(data):
     """``2 n`` unknowns per element (n nodes, global DD x, y each)."""
     return 2 * data.nodes.shape[0]
@@ -281,13 +281,7 @@ def workspace(data):
     return np.empty((n_nodes, 2, 2, 2)), np.empty((n_nodes, 2, 2)), np.empty(2)
 
 
-@njit(cache=True)
-def source_state(data, j, work):
-    """Nothing is shared between the receivers of a source."""
-    return 0
-
-
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def element_traction(data, i, j, state, work, block):
     """``block[2 r + p, 2 k + q]``: traction p at node r of element ``i`` for a unit DD q
     at node k of element ``j`` (:func:`traction_nodes`; near misses: :func:`near_distance`)."""
@@ -305,7 +299,7 @@ def element_traction(data, i, j, state, work, block):
         set_node_rows(block, pair, r)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def element_stress(data, point, point_layer, j, work, out):
     """``out[2 k + q]`` (2n, 2, 2): :func:`stress_nodes` of element ``j`` at ``point``; a
     point within ``near_fraction`` half lengths of an end counts as on it."""
@@ -341,5 +335,5 @@ def edge_distance(data, i, j):
     return best
 
 
-register_kind(NodalSegments, KernelKind(unknowns, workspace, source_state, element_traction, element_stress,
+register_kind(NodalSegments, KernelKind(unknowns, workspace, no_source_state, element_traction, element_stress,
                                         edge_distance))

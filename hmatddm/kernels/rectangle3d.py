@@ -34,7 +34,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from .drivers import KernelKind, register_kind
+from .drivers import KernelKind, no_source_state, register_kind
 
 _INV_8PI = 1.0 / (8.0 * math.pi)
 
@@ -314,7 +314,7 @@ class Rectangles(NamedTuple):
     self_max: np.ndarray  #: (N,) largest |entry| of each self block (ref. Eq. 6.11)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def unknowns(data):
     """Three unknowns per element (global DD x, y, z)."""
     return 3
@@ -326,13 +326,7 @@ def workspace(data):
     return np.empty((3, 3, 3))
 
 
-@njit(cache=True)
-def source_state(data, j, work):
-    """Nothing is shared between the receivers of a source."""
-    return 0
-
-
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def element_traction(data, i, j, state, work, block):
     """``block`` (3, 3): :func:`traction_pair` at the centre of element ``i`` (its normal)
     from element ``j``. A centre closer than ``near_fraction * min(size_i, size_j)``
@@ -347,7 +341,7 @@ def element_traction(data, i, j, state, work, block):
                   near)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def element_stress(data, point, point_layer, j, work, out):
     """``out`` (3, 3, 3): :func:`stress_pair` of element ``j`` at ``point``."""
     a = data.half_a[j]
@@ -380,5 +374,5 @@ def mean_stress_pair(point, center, frame, a, b, shear_modulus, poisson_ratio, o
         out[q] = frame[0, q] * m0 + frame[1, q] * m1 + frame[2, q] * m2
 
 
-register_kind(Rectangles, KernelKind(unknowns, workspace, source_state, element_traction, element_stress,
+register_kind(Rectangles, KernelKind(unknowns, workspace, no_source_state, element_traction, element_stress,
                                      edge_distance))

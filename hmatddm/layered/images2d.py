@@ -629,7 +629,7 @@ class LayeredSegments(NamedTuple):
     self_max: np.ndarray  #: (N,) largest |entry| of each self block (ref. Eq. 6.11)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def unknowns(data):
     """Two unknowns per element (global DD x, y)."""
     return 2
@@ -657,7 +657,7 @@ def source_state(data, j, work):
     return p0, p1, xi, wt, start, traced, is_traced, Workspace(traced[4].shape[-1])
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def element_traction(data, i, j, state, work, block):
     """``block`` (2, 2): traction at the centre of element ``i`` for a unit global DD of
     constant element ``j``: closed form (source layer's material) plus images, the
@@ -697,7 +697,7 @@ def element_traction(data, i, j, state, work, block):
                 block[p, q] += image[0, q, p, 0] * normal[0] + image[0, q, p, 1] * normal[1]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def element_stress(data, point, point_layer, j, work, out):
     """``out[q, i, k]``: stress at ``point`` (in ``point_layer``; zero in a void layer)
     for a unit global DD ``q`` of constant element ``j``, closed form plus images (the
