@@ -10,8 +10,9 @@ time step, with the ribbon elements (channel elements next to the front) fixed:
 
 1. from the trial distances ``s_r`` of the ribbon centres to the front, the front
    (:class:`~hmatddm.fracture.front.FrontField`), the tip elements and their openings;
-   elements the front reaches for the first time join the mesh (the operator grows by
-   border blocks, :meth:`Simulation.operator`);
+   elements the front reaches for the first time join the mesh like the element switch's
+   growth (:meth:`~hmatddm.simulation.state.State.joined`, :meth:`~hmatddm.simulation.state.StepStart.joined`;
+   the operator grows by border blocks, :meth:`Simulation.operator`);
 2. the coupled step (:func:`hmatddm.coupled.solve_step`, any scheme) with the tip rows
    ``DD_i = w_i n_i``;
 3. the ribbon openings give new ``s_r`` by inverting the asymptote with ``V = (s_r -
@@ -26,6 +27,7 @@ mean advance (``AsymptoticFront.finite_fracture = False``: the bare semi-infinit
 """
 import logging
 import time
+from dataclasses import replace
 
 import numpy as np
 
@@ -36,7 +38,8 @@ from ..errors import ConvergenceError, InputError, SizeLimitError
 from ..flow import fracture_compliance
 from ..fracture.front import CHANNEL, EMPTY, FILLED, TIP, FrontField, PlanarGrid, fill, front_radii, level_set
 from ..fracture.tip_asymptote import TipAsymptote
-from ..mesh import concatenate
+from .records import StepTally, step_record
+from .state import NewElements, StepStart
 
 logger = logging.getLogger(__name__)
 # sample points per element side for the filled fraction and mean opening of tip elements
@@ -121,7 +124,12 @@ class AsymptoticFront:
         return FrontField(cells, distance, velocity, channel, self.grid.h, margin)
 
     # -- one step ------------------------------------------------------------------------
-    def _solve(self, sim, mesh, prescribed, width, width_old, p_old, creation, dd, p, t_old, t_new, relaxation):
+    def _solve(self, sim, trial, start, prescribed, width, t_old, t_new, relaxation):
+        """The coupled step from ``start`` (a :class:`~hmatddm.simulation.state.StepStart`) on
+        the mesh of ``trial`` with the ``prescribed`` elements' openings held at ``width``:
+        ``(trial with the solution, info, flow model)``. The elastic solver (and its inverse
+        of the modified rows) is kept across the front iterations of one operator."""
+        mesh = trial.mesh
         edges = topology.element_edges(mesh, sim.height)
         faces = topology.element_faces(mesh, edges)
         flow = sim.flow_model(mesh, faces)
@@ -131,12 +139,12 @@ class AsymptoticFront:
         rows = PrescribedOpening(prescribed, width, mesh.normals, self._solver.normal_stiffness(mesh.normals))
         problem = StepProblem(elastic=self._solver, normals=mesh.normals, far_field=sim.far_field_traction(mesh),
                               flow=flow, compliance=fracture_compliance(mesh, sim.material), dt=t_new - t_old,
-                              width_old=width_old, pressure_old=p_old,
-                              leak_off_rate=flow.leak_off_rate(creation, t_old, t_new), contact=rows)
-        guess = dd.copy()
+                              width_old=start.width, pressure_old=start.pressure,
+                              leak_off_rate=flow.leak_off_rate(trial.creation_time, t_old, t_new), contact=rows)
+        guess = trial.dd.copy()
         guess[prescribed] = width[prescribed, None] * mesh.normals[prescribed]
-        dd, p, info = solve_step(problem, sim.settings, guess.ravel(), p, relaxation)
-        return dd.reshape(mesh.n_elements, mesh.dim), p, info, flow
+        dd, p, info = solve_step(problem, sim.settings, guess.ravel(), trial.pressure, relaxation)
+        return replace(trial, dd=dd.reshape(mesh.n_elements, mesh.dim), pressure=p), info, flow
 
     def _candidates(self, cells, channel, field):
         """Cells the front may cross: cells of the field's box within half a diagonal of the
@@ -151,42 +159,39 @@ class AsymptoticFront:
         return both[~np.isin(grid.key(both), grid.key(cells[channel]))]
 
     def step(self, sim, end_time=None):
-        start = time.perf_counter()
-        s = sim.state
+        clock = time.perf_counter()
+        begin = sim.state
         prop = sim.propagation
         grid, h = self.grid, self.grid.h
         t_old, t_new = sim.step_times(end_time)
         dt = t_new - t_old
-        mesh = s.mesh
-        width_old = np.sum(s.dd * mesh.normals, axis=1)
-        p_old, creation = s.pressure.copy(), s.creation_time.copy()
-        dd, p = s.dd.copy(), s.pressure.copy()
-        front_class = s.front_class.copy()
+        start, trial = StepStart.of(begin), begin.copy()
+        tally = StepTally()
         builds = sim.operator_builds
 
         # the front at t_old
-        circle = np.isfinite(s.front_distance)
+        mesh = begin.mesh
+        circle = np.isfinite(begin.front_distance)
         # the ribbon: channel elements with an edge neighbour that is not channel
         cells = grid.cells(mesh.centers)
-        channel = (front_class == CHANNEL) | (front_class == FILLED)
+        channel = (begin.front_class == CHANNEL) | (begin.front_class == FILLED)
         channel_keys = grid.key(cells[channel])
         around = grid.key(grid.neighbours(cells[channel]).reshape(-1, grid.k)).reshape(int(channel.sum()), -1)
         ribbon = np.flatnonzero(channel)[~np.all(np.isin(around, channel_keys), axis=1)]
         # (the field of the old ribbon: inward through the cells that were channel before it)
-        old = self.field(cells[circle], s.front_distance[circle], s.front_velocity[circle],
-                         cells[front_class == CHANNEL])
+        old = self.field(cells[circle], begin.front_distance[circle], begin.front_velocity[circle],
+                         cells[begin.front_class == CHANNEL])
         distance_old = np.maximum(-old.at_cells(cells[ribbon]), 0.0)
         velocity = old.velocity(cells[ribbon] * h)
         length_old = np.inf
         if self.finite_fracture:
-            size = self.measures(s, sim)
+            size = self.measures(begin, sim)
             length_old = size["radius"] if grid.k == 2 else size["half_length"]
         distance = distance_old + velocity * dt
         length = length_old + float(np.mean(distance - distance_old))
 
-        totals = dict(nonlinear_iterations=0, linear_iterations=0, restarts=0, contact_changes=0)
-        relaxation = s.relaxation
-        added, change, iterations, weight = 0, np.inf, 0, 1.0
+        relaxation = begin.relaxation
+        change, iterations, weight = np.inf, 0, 1.0
         last_update = np.zeros(len(ribbon))
         filled = np.zeros(mesh.n_elements, bool)  # filled once in this step: stays filled (no tip/filled cycling)
         for iterations in range(1, prop.front_iterations + 1):
@@ -197,27 +202,12 @@ class AsymptoticFront:
             where = np.array([index.get(key, -1) for key in grid.key(candidates).tolist()], np.int64)
             new = (where < 0) & (fraction > 0.0)
             if np.any(new):
-                grown = grid.elements(candidates[new], mesh)
-                m = grown.n_elements
-                if sim.max_elements is not None and mesh.n_elements + m > sim.max_elements:
-                    raise SizeLimitError(
-                        f"growth in step {s.step + 1} (t = {t_new:g} s) would take the mesh to "
-                        f"{mesh.n_elements + m} elements, more than max_elements = {sim.max_elements}",
-                        elements=mesh.n_elements + m, limit=sim.max_elements)
-                _, parent = level_set(grid.plane(grown.centers), grid.plane(mesh.centers[channel]),
-                                      np.zeros(int(channel.sum())))
-                parent = np.flatnonzero(channel)[parent]
-                where[new] = mesh.n_elements + np.arange(m)
-                mesh = concatenate([mesh, grown])
+                where[new] = mesh.n_elements + np.arange(np.count_nonzero(new))
+                trial, start = self._joined(sim, trial, start, candidates[new], channel, tally, t_old, t_new)
+                mesh = trial.mesh
                 cells = np.concatenate([cells, candidates[new]])
-                width_old = np.concatenate([width_old, np.zeros(m)])
-                p_old = np.concatenate([p_old, p_old[parent]])
-                p = np.concatenate([p, p[parent]])
-                creation = np.concatenate([creation, np.full(m, t_old)])
-                dd = np.concatenate([dd, np.zeros((m, mesh.dim))])
-                channel = np.concatenate([channel, np.zeros(m, bool)])
-                filled = np.concatenate([filled, np.zeros(m, bool)])
-                added += m
+                channel, filled = (np.concatenate([a, np.zeros(mesh.n_elements - len(a), bool)])
+                                   for a in (channel, filled))
             kept = where >= 0
             state = np.full(mesh.n_elements, CHANNEL, np.int64)
             width = np.zeros(mesh.n_elements)
@@ -227,12 +217,10 @@ class AsymptoticFront:
             state[channel] = CHANNEL
             width[where[kept]] = mean_width[kept]
             prescribed = (state == TIP) | (state == EMPTY)
-            dd, p, info, flow = self._solve(sim, mesh, prescribed, width, width_old, p_old, creation, dd, p, t_old,
-                                            t_new, relaxation)
+            trial, info, flow = self._solve(sim, trial, start, prescribed, width, t_old, t_new, relaxation)
             relaxation = info["relaxation"]
-            for key in totals:
-                totals[key] += info.get(key, 0)
-            ribbon_width = np.sum(dd[ribbon] * mesh.normals[ribbon], axis=1)
+            tally.add_solve(info)
+            ribbon_width = np.sum(trial.dd[ribbon] * mesh.normals[ribbon], axis=1)
             new_distance, _ = self.asymptote.front_distance(ribbon_width, distance_old, dt, length=length)
             # at most one element per iteration: far from the fixed point the ribbon takes the
             # volume the trial front leaves out, and the asymptote answers with a far front
@@ -252,33 +240,42 @@ class AsymptoticFront:
             if change < prop.front_tolerance:
                 break
         if not np.isfinite(change) or change > 0.05:
-            raise ConvergenceError(f"the asymptotic front did not converge in step {s.step + 1} (t = {t_new:g} s): "
-                                   f"the ribbon distances still moved by {change:.3g} elements after "
+            raise ConvergenceError(f"the asymptotic front did not converge in step {begin.step + 1} (t = {t_new:g} "
+                                   f"s): the ribbon distances still moved by {change:.3g} elements after "
                                    f"{prop.front_iterations} iterations")
 
-        n = mesh.n_elements
-        front_distance = np.full(n, np.nan)
-        front_velocity = np.full(n, np.nan)
+        front_distance = np.full(mesh.n_elements, np.nan)
+        front_velocity = np.full(mesh.n_elements, np.nan)
         front_distance[ribbon], front_velocity[ribbon] = distance, velocity
-        width = np.sum(dd * mesh.normals, axis=1)
-        leak = np.zeros(n)
-        injected = s.injected_volume + dt * sum(c.rate for c in sim.clusters)
-        next_relaxation = relaxation
-        if totals["restarts"] == 0:
-            next_relaxation = min(sim.settings.relaxation, relaxation * sim.settings.relaxation_growth)
-        sim.state = type(s)(mesh, dd, p, creation, t_new, s.step + 1, next_relaxation, injected,
-                            s.leaked_volume + float(np.sum(leak)) * dt, origin=np.zeros(n, np.int64),
-                            natural_index=-np.ones(n, np.int64), intact=s.intact, failed=s.failed,
-                            extra_faces=s.extra_faces, front_distance=front_distance, front_velocity=front_velocity,
-                            front_class=state)
-        sim._events = dict(natural_crossed=0, natural_deflected=0, natural_newly_failed=0, contact_frozen=0,
-                           junctions=0)
-        record = sim._record(flow, width, totals, added, iterations, relaxation, time.perf_counter() - start,
-                             sim.operator_builds - builds)
+        tally.growth_passes = iterations
+        sim.state = replace(sim._finished(begin, trial, flow, t_old, t_new, relaxation, tally),
+                            front_distance=front_distance, front_velocity=front_velocity, front_class=state)
+        tally.operator_builds = sim.operator_builds - builds
+        width = np.sum(trial.dd * mesh.normals, axis=1)
+        record = step_record(sim, flow, width, tally, relaxation, time.perf_counter() - clock)
         record.update(self.measures(sim.state, sim))
         record["front_iterations"] = int(iterations)
         sim.records.append(record)
         return record
+
+    def _joined(self, sim, trial, start, new_cells, channel, tally, t_old, t_new):
+        """``(trial, start)`` with elements at ``new_cells`` (reached by the trial front for
+        the first time) appended, each taking the pressure of the nearest ``channel``
+        element and starting closed. Raises SizeLimitError past ``max_elements``."""
+        mesh = trial.mesh
+        grown = self.grid.elements(new_cells, mesh)
+        m = grown.n_elements
+        if sim.max_elements is not None and mesh.n_elements + m > sim.max_elements:
+            raise SizeLimitError(
+                f"growth in step {trial.step + 1} (t = {t_new:g} s) would take the mesh to "
+                f"{mesh.n_elements + m} elements, more than max_elements = {sim.max_elements}",
+                elements=mesh.n_elements + m, limit=sim.max_elements)
+        _, parent = level_set(self.grid.plane(grown.centers), self.grid.plane(mesh.centers[channel]),
+                              np.zeros(int(channel.sum())))
+        new = NewElements.hydraulic(grown, np.flatnonzero(channel)[parent])
+        guess = np.zeros((m, mesh.dim))
+        tally.elements_added += m
+        return trial.joined(new, guess, t_old), start.joined(new, guess)
 
     def measures(self, state, sim):
         """Front measures of a state: the fractured area (channel elements plus the filled

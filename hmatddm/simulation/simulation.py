@@ -36,7 +36,7 @@ from .growing_operator import GrowingOperator
 from .natural import natural_network
 from .records import RECORD_KEYS, StepTally, output_view, step_record
 from .settings import group_options
-from .state import Origin, State, StepEvents, StepStart, mesh_arrays
+from .state import Origin, State, StepStart, mesh_arrays
 
 __all__ = ["RECORD_KEYS", "Simulation", "State"]
 
@@ -353,13 +353,6 @@ class Simulation:
         return replace(trial, time=t_new, step=begin.step + 1, relaxation=next_relaxation,
                        injected_volume=begin.injected_volume + dt * sum(c.rate for c in self.clusters),
                        leaked_volume=begin.leaked_volume + float(np.sum(leak)) * dt, failed=failed)
-
-    def _record(self, flow, width, totals, added, passes, relaxation, seconds, builds):
-        """The record of a step counted in ``totals`` (a dict of solve counts) by a caller
-        outside :meth:`step` (the asymptotic front); no growth or natural-fracture events."""
-        tally = StepTally(elements_added=added, growth_passes=passes, operator_builds=builds, events=StepEvents())
-        tally.add_solve(totals)
-        return step_record(self, flow, width, tally, relaxation, seconds)
 
     def view(self):
         """Every element of the run for output: ``(mesh, dd, pressure, state)`` with the

@@ -12,6 +12,7 @@ from enum import IntEnum
 import numpy as np
 
 from ..coupled.contact import OPEN, STICK
+from ..fracture.front import EMPTY
 from ..mesh import Mesh2D, Mesh3D, concatenate
 
 
@@ -172,13 +173,20 @@ class State:
     def joined(self, new, guess, creation_time):
         """The state with :class:`NewElements` ``new`` appended: DD ``guess``, pressure of
         the parent (or the new elements' own), created at ``creation_time``; failed
-        elements start stuck at their failure pressure, the others open."""
+        elements start stuck at their failure pressure, the others open. The asymptotic
+        front's arrays, where carried, mark the new elements off the ribbon (no front
+        distance) and EMPTY until its front iteration classifies them."""
         m = new.mesh.n_elements
         failed = new.origin == Origin.FAILED
         intact = self.intact.copy()
         intact[new.natural_index[new.natural_index >= 0]] = False
+        front = {}
+        if self.front_class is not None:
+            front = dict(front_distance=np.concatenate([self.front_distance, np.full(m, np.nan)]),
+                         front_velocity=np.concatenate([self.front_velocity, np.full(m, np.nan)]),
+                         front_class=np.concatenate([self.front_class, np.full(m, EMPTY, np.int64)]))
         return replace(
-            self, mesh=concatenate([self.mesh, new.mesh]), dd=np.concatenate([self.dd, guess]),
+            self, **front, mesh=concatenate([self.mesh, new.mesh]), dd=np.concatenate([self.dd, guess]),
             pressure=np.concatenate([self.pressure, new.from_parent(self.pressure, new.pressure)]),
             creation_time=np.concatenate([self.creation_time, np.full(m, creation_time)]),
             origin=np.concatenate([self.origin, new.origin]),
