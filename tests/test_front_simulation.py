@@ -73,6 +73,20 @@ def test_kgd_vertices(toughness, tolerance):
     assert abs(records[-1]["max_opening"] / width - 1.0) < 0.02
 
 
+@pytest.mark.parametrize("front", ["asymptotic", "element"])
+def test_growth_past_max_elements_is_refused_and_keeps_the_last_step(front):
+    # 3 x 3 elements of 2 m: the first step's growth needs more than 12 elements
+    mesh = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 6.0, 6.0, 3, 3)
+    sim = hd.Simulation(mesh, MATERIAL, hd.Fluid(1e-3, 4.4e-10), [hd.Cluster((0, 0, 0), 0.01, 0.005)],
+                        far_field_stress=np.diag([0, 0, -8e6]), time_step=1.0,
+                        propagation=hd.Propagation(toughness=1e6, front=front), initial_pressure=10e6,
+                        initial_opening=4e-6, backend="dense", max_elements=12)
+    with pytest.raises(hd.errors.SizeLimitError, match="max_elements = 12") as caught:
+        sim.run(3.0)
+    assert caught.value.limit == 12 and caught.value.elements > 12
+    assert sim.state.mesh.n_elements <= 12 and len(sim.records) == sim.state.step
+
+
 def test_unsupported_setups_are_refused():
     with pytest.raises(InputError, match="front"):
         hd.Propagation(toughness=1e6, front="level-set")

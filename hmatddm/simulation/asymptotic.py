@@ -34,7 +34,7 @@ import numpy as np
 from .. import topology
 from ..coupled import ElasticSolver, StepProblem, solve_step
 from ..coupled.contact import ContactRows
-from ..errors import ConvergenceError, InputError, SizeLimitError
+from ..errors import ConvergenceError, InputError
 from ..flow import fracture_compliance
 from ..fracture.front import CHANNEL, EMPTY, FILLED, TIP, FrontField, PlanarGrid, fill, front_radii, level_set
 from ..fracture.tip_asymptote import TipAsymptote
@@ -265,11 +265,7 @@ class AsymptoticFront:
         mesh = trial.mesh
         grown = self.grid.elements(new_cells, mesh)
         m = grown.n_elements
-        if sim.max_elements is not None and mesh.n_elements + m > sim.max_elements:
-            raise SizeLimitError(
-                f"growth in step {trial.step + 1} (t = {t_new:g} s) would take the mesh to "
-                f"{mesh.n_elements + m} elements, more than max_elements = {sim.max_elements}",
-                elements=mesh.n_elements + m, limit=sim.max_elements)
+        sim.check_growth(mesh.n_elements + m, trial.step + 1, t_new)
         _, parent = level_set(self.grid.plane(grown.centers), self.grid.plane(mesh.centers[channel]),
                               np.zeros(int(channel.sum())))
         new = NewElements.hydraulic(grown, np.flatnonzero(channel)[parent])

@@ -328,15 +328,19 @@ class Simulation:
         new = growth.elements
         if new is None:  # only new connections to elements already in the system
             return trial, start
-        n_elements = trial.mesh.n_elements + new.mesh.n_elements
-        if self.max_elements is not None and n_elements > self.max_elements:
-            raise SizeLimitError(
-                f"growth in step {begin.step + 1} (t = {t_new:g} s) would take the mesh to {n_elements} "
-                f"elements, more than max_elements = {self.max_elements}", elements=n_elements,
-                limit=self.max_elements)
+        self.check_growth(trial.mesh.n_elements + new.mesh.n_elements, begin.step + 1, t_new)
         tally.elements_added += new.mesh.n_elements
         guess = new.first_guess(trial.dd, self.minimum_width)
         return trial.joined(new, guess, t_old), start.joined(new, guess)
+
+    def check_growth(self, n_elements, step, t_new):
+        """Raise SizeLimitError when growth in ``step`` (ending at ``t_new``) would take the
+        mesh to ``n_elements``, more than ``max_elements``."""
+        if self.max_elements is not None and n_elements > self.max_elements:
+            raise SizeLimitError(
+                f"growth in step {step} (t = {t_new:g} s) would take the mesh to {n_elements} "
+                f"elements, more than max_elements = {self.max_elements}", elements=n_elements,
+                limit=self.max_elements)
 
     def _finished(self, begin, trial, flow, t_old, t_new, relaxation, tally):
         """The state at the end of the step from ``begin`` whose last solve is ``trial``:
