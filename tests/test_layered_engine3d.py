@@ -75,6 +75,9 @@ def test_layered_3d_simulation_refuses_what_it_does_not_support():
         _vertical_run(THREE_LAYERS, hd.Propagation(5e6), mesh=tilted)
     with pytest.raises(InputError, match="natural_fractures"):
         _vertical_run(THREE_LAYERS, natural_fractures=hd.mesh.rectangle([3.0, 0, 0], [1, 0, 0], [0, 0, 1], 1, 1, 1, 1))
+    with pytest.raises(InputError, match="void layer"):  # the fracture above the free surface
+        _vertical_run(LayeredMedium([-2.0], [0.0, G], [NU, NU]))
     stressed = LayeredMedium([1.0, -1.0], [G, G, G], [NU, NU, NU], in_situ_stress=np.zeros((3, 2, 2)))
     with pytest.raises(InputError, match="in_situ_stress must hold 3x3"):
         _vertical_run(stressed)
+

@@ -1,6 +1,7 @@
 """3D half-space (a void top layer, ref. Sec. 3.4.1 with gamma = 0): the independent
 reference of tests/_mindlin.py (Mindlin's point force, Gauss quadrature by reciprocity)
-checked on its own, and the layered rectangle kernels checked against it."""
+checked on its own: Kelvin near the source and at depth, a traction-free surface,
+equilibrium, reciprocity, and the DD quadrature against tests/kelvin_reference.py."""
 import numpy as np
 import pytest
 
