@@ -43,8 +43,10 @@ METHODS = ("auto", "direct", "tree")
 #: 0.01-0.1 ``eps`` times the largest induced stress (measured, benchmarks/bench_fields.py).
 DEFAULT_STRESS_EPS = 1e-5
 #: ``method="auto"`` compresses when (points x elements) reaches this and both counts
-#: exceed twice the leaf size.
-AUTO_TREE_PAIRS = 2_000_000
+#: exceed twice the leaf size. Measured (benchmarks/bench_fields.py, RESULTS.md): the
+#: H-matrix build (ACA + recompression + storage) costs 1.6-1.8x the exact sum's CPU up to
+#: 8.5e7 pairs (35,570 points x 2,400 elements), so the exact sum is the default there.
+AUTO_TREE_PAIRS = 100_000_000
 #: Admissibility ``min(diam) <= eta * dist`` and leaf size of both cluster trees. Stricter
 #: than the operator's 3: the field must stay within ~1e-7 of its largest component at
 #: ``DEFAULT_STRESS_EPS`` (measured 1.4e-6 in 2D with 3, benchmarks/RESULTS.md).
