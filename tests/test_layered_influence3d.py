@@ -77,7 +77,7 @@ def test_stress_at_matches_the_operator_and_the_mean_stress():
 TABLE_3_1_FREE_SURFACE = 1.6930  # ref. Table 3.1, W / W(gamma = 1) at gamma = 0 (40 elements in 2D)
 
 
-@pytest.mark.slow  # ~10 min on 2 shared cores: 84 rectangles 1 h below the surface need 4 x 4 sub-squares
+@pytest.mark.slow  # 30 s warm on 2 shared cores (84 rectangles near the surface: 4 x 4 sub-squares each)
 def test_long_strip_reproduces_the_plane_strain_result():
     """Ref. Sec. 3.4.2 in 3D: a horizontal strip crack of width 2h, 20h long, at depth h
     below a free surface (gamma = 0, nu = 0.1, uniform pressure): the opening volume of
