@@ -4,6 +4,10 @@ Square operators (d x d blocks, one cluster tree) and rectangular matrices (a ro
 and a column tree of different points, d_r x d_c blocks: e.g. the stress at target
 points induced by the DDs of elements, :mod:`hmatddm.fields`) are built and applied by
 the same code; the near-field extraction (preconditioners) exists for square ones.
+
+Length (over ~400 lines): the one public compressed-matrix class (build for square and
+rectangular generators, products, near field, preconditioner hooks, statistics); its
+numerical pieces live in ``cluster_tree``, ``block_tree``, ``aca`` and ``storage``.
 """
 
 import math
