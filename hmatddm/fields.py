@@ -15,18 +15,23 @@ a local DD and rotated to the global frame (ref. Eq. 2.57). Two ways to apply it
 * ``"direct"``: the exact sum over all elements, parallel over a fixed split of the points
   (the result does not depend on the thread count), each pair's DD contracted before the
   one rotation;
-* ``"tree"``: a rectangular H-matrix of the generic engine (:mod:`hmatddm.hmatrix`: a
-  cluster tree of the points, one of the elements, whole-element ACA of the far blocks
-  to ``eps``), then one matvec. For one evaluation (:func:`induced`, behind
-  ``hd.stress_at``) the matrix is that of the given DDs (one column per element, the
-  ranks of the contracted sum); :class:`StressField` without DDs keeps the matrix of
-  unit DD components for further DDs on the same points and elements.
+* ``"tree"``: the block tree of a rectangular H-matrix of the generic engine
+  (:mod:`hmatddm.hmatrix`: a cluster tree of the points, one of the elements,
+  whole-element ACA of the far blocks). For one evaluation of given DDs (:func:`induced`,
+  behind ``hd.stress_at``) the matrix has one column per element (the ranks of the
+  contracted sum) and is applied to ones without being stored
+  (:func:`hmatddm.hmatrix.product.build_free_product`: each far block's ACA at
+  ``ACA_TOLERANCE_FACTOR * eps``, ``U (V^T 1)`` added at once); :class:`StressField`
+  without DDs builds and keeps the matrix of unit DD components (ACA, recompression to
+  ``eps``) for further DDs on the same points and elements.
 """
 import time
+import warnings
 from typing import NamedTuple
 
 import numpy as np
 from numba import njit, prange
+from numba.core.errors import NumbaPerformanceWarning
 
 from ._validation import finite_array, finite_scalar
 from .errors import InputError
@@ -43,15 +48,18 @@ METHODS = ("auto", "direct", "tree")
 #: 0.01-0.1 ``eps`` times the largest induced stress (measured, benchmarks/bench_fields.py).
 DEFAULT_STRESS_EPS = 1e-5
 #: ``method="auto"`` compresses when (points x elements) reaches this and both counts
-#: exceed twice the leaf size. Measured (benchmarks/bench_fields.py, RESULTS.md): the
-#: H-matrix build (ACA + recompression + storage) costs 1.6-1.8x the exact sum's CPU up to
-#: 8.5e7 pairs (35,570 points x 2,400 elements), so the exact sum is the default there.
-AUTO_TREE_PAIRS = 100_000_000
+#: exceed twice the leaf size. Measured (benchmarks/bench_fields.py, RESULTS.md "One-shot
+#: product"): the one-shot product of given DDs costs the exact sum's CPU at ~2.4e6 pairs
+#: in 3D (4,447 points x 540 elements), 0.55x at 1.9e7; in 2D it wins from 3e6 pairs.
+AUTO_TREE_PAIRS = 4_000_000
 #: Admissibility ``min(diam) <= eta * dist`` and leaf size of both cluster trees. Stricter
 #: than the operator's 3: the field must stay within ~1e-7 of its largest component at
 #: ``DEFAULT_STRESS_EPS`` (measured 1.4e-6 in 2D with 3, benchmarks/RESULTS.md).
 FIELD_ETA = 1.0
 FIELD_LEAF_SIZE = 64
+#: Far blocks of the one-shot product with fewer points or elements than this are summed
+#: exactly (ranks of the six components are 30-60: the ACA does not pay below).
+FIELD_MIN_ACA = 64
 _DIRECT_CHUNKS = 64  # fixed split of the point range in the direct sum
 
 
@@ -203,7 +211,7 @@ def _contribution(sources, point, j, n_out, work3, work2, value):
     _components(work3, work2, dd.shape[0], l0, l1, l2, frame, n_out, sources.poisson_ratio, value)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, parallel=True)  # see _KERNEL_NOTE
 def field_block(data, rows, cols, out):
     """Block generator kernel of the points x elements matrix (see
     :class:`hmatddm.hmatrix.BlockGenerator`): ``out[n_out * a + c, d * b + q]`` =
@@ -231,7 +239,7 @@ def field_block(data, rows, cols, out):
                     out[n_out * a + c, dim * b + q] = value[c]
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, parallel=True)  # see _KERNEL_NOTE
 def contribution_block(data, rows, cols, out):
     """Block generator kernel of the points x elements matrix of given DDs, one column
     per element: ``out[n_out * a + c, b]`` = component ``c`` at point ``rows[a]`` of
@@ -270,6 +278,14 @@ def direct_sum(sources, out):
                 _contribution(sources, points[t], j, n_out, work3, work2, value)
                 for c in range(n_out):
                     out[t, c] += value[c]
+
+
+# _KERNEL_NOTE: the block kernels hold no prange, but compiled with parallel=True (numba's
+# parfor pipeline) they run ~3x faster per pair than with the default pipeline, like the
+# exact sum (measured on the bench_fields.py 3D scene, 64-point blocks: 1.04 -> 0.36 s
+# CPU); numba's warning that nothing was parallelised is silenced below.
+warnings.filterwarnings("ignore", message=r"(?s).*The keyword argument 'parallel=True' was specified but no",
+                        category=NumbaPerformanceWarning)
 
 
 # ---------------------------------------------------------------------------- fields
@@ -313,8 +329,10 @@ class StressField:
         with its DD), so ``eps`` bounds each block's error relative to what its elements
         actually induce, and its ranks are those of the contracted sum (about a third).
 
-    With ``"tree"`` the H-matrix is built once here (its build is most of the cost) and
-    each call is one matvec; ``"direct"`` sums the kernels at every call.
+    With ``"tree"`` and no ``dd`` the H-matrix is built once here (its build is most of
+    the cost) and each call is one matvec; with ``dd`` the one-shot product
+    (:func:`hmatddm.hmatrix.product.build_free_product`, nothing stored) is computed here
+    and each call returns it; ``"direct"`` sums the kernels at every call.
     ``field(dd)`` returns the (M, n_out) components; ``field.info`` says what was done.
     """
 
@@ -343,22 +361,41 @@ class StressField:
         self.hmatrix = None
         started = time.perf_counter()
         self.info = {"method": method, "eps": self.eps, "points": m, "elements": n}
-        if method == "tree":
+        self._product = None
+        if method == "tree" and self.contracted:
+            # one evaluation: the build-free product (ACA per far block, U (V^T 1) added
+            # at once, nothing stored), computed here; the call returns it
+            self._product = self._build_free()
+        elif method == "tree":
             self.hmatrix = self._build()
             self.info.update(self._tree_info())
         else:
             self.info.update(n_far=0, n_near=1, pairs_exact=m * n, pairs_compressed=0)
         self.info["build_seconds"] = time.perf_counter() - started
 
-    def _build(self):
-        from .hmatrix import BlockGenerator, HMatrix
+    def _generator(self):
+        from .hmatrix import BlockGenerator
 
         mesh = self.mesh
         kernel, col_dof = (contribution_block, 1) if self.contracted else (field_block, mesh.dim)
-        generator = BlockGenerator(kernel, self.sources, self.points, 0.0, self.n_out, col_points=mesh.centers,
-                                   col_radii=mesh.radii, col_dof=col_dof)
-        return HMatrix.build(generator, eps=self.eps, eta=FIELD_ETA, leaf_size=FIELD_LEAF_SIZE,
+        return BlockGenerator(kernel, self.sources, self.points, 0.0, self.n_out, col_points=mesh.centers,
+                              col_radii=mesh.radii, col_dof=col_dof)
+
+    def _build(self):
+        from .hmatrix import HMatrix
+
+        return HMatrix.build(self._generator(), eps=self.eps, eta=FIELD_ETA, leaf_size=FIELD_LEAF_SIZE,
                              factor_dtype=np.float64)
+
+    def _build_free(self):
+        from .hmatrix.aca import ACA_TOLERANCE_FACTOR
+        from .hmatrix.product import build_free_product
+
+        generator = self._generator()
+        values, counts = build_free_product(generator, np.ones(self.mesh.n_elements), ACA_TOLERANCE_FACTOR * self.eps,
+                                            eta=FIELD_ETA, leaf_size=FIELD_LEAF_SIZE, min_aca_elements=FIELD_MIN_ACA)
+        self.info.update(counts, build_free=True)
+        return values.reshape(len(self.points), self.n_out)
 
     def _tree_info(self):
         h = self.hmatrix
@@ -386,6 +423,8 @@ class StressField:
         sources = self.sources if dd is None else self.sources._replace(dd=_dd_array(self.mesh, dd))
         if m == 0:
             out = np.zeros((0, self.n_out))
+        elif self._product is not None:
+            out = self._product.copy()
         elif self.hmatrix is not None:
             x = np.ones(self.mesh.n_elements) if self.contracted else sources.dd.reshape(-1)
             out = self.hmatrix.matvec(x).reshape(m, self.n_out)
@@ -439,4 +478,4 @@ def induced(mesh, material, dd, points, quantity, singular_correction="none", me
 
 
 __all__ = ["StressField", "as_tensors", "FieldSources", "field_sources", "field_block", "contribution_block", "direct_sum", "induced", "refuse_singular", "n_components",
-           "DEFAULT_STRESS_EPS", "AUTO_TREE_PAIRS", "FIELD_ETA", "FIELD_LEAF_SIZE", "METHODS", "QUANTITIES"]
+           "DEFAULT_STRESS_EPS", "AUTO_TREE_PAIRS", "FIELD_ETA", "FIELD_LEAF_SIZE", "FIELD_MIN_ACA", "METHODS", "QUANTITIES"]

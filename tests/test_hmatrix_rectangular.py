@@ -95,3 +95,56 @@ def test_block_generator_column_geometry_comes_whole():
     with pytest.raises(InputError, match="col_dof"):
         BlockGenerator(field_kernel, (targets, sources), targets, 0.0, 3, col_points=sources, col_radii=0.0,
                        col_dof=0)
+
+
+def _product_case(kind, dim):
+    if kind == "rectangular":
+        from hmatddm.hmatrix.example_kernels import field_generator as make
+
+        targets, sources = scene(dim, 900, 260, seed=dim)
+        return make(targets, sources), dict(eta=2.0, leaf_size=32, col_leaf_size=16)
+    from hmatddm.hmatrix.example_kernels import tensor_generator
+
+    points = np.random.default_rng(dim).uniform(-5.0, 5.0, (700, dim))
+    return tensor_generator(points), dict(eta=2.0, leaf_size=32)
+
+
+@pytest.mark.parametrize("kind", ["rectangular", "square"])
+@pytest.mark.parametrize("dim", [2, 3])
+def test_build_free_product_equals_the_built_matvec_and_the_dense_product(kind, dim):
+    """The one-shot product (hmatrix.product, no storage) runs the ACA of the build on
+    the same block tree: at the ACA tolerance of the build (ACA_TOLERANCE_FACTOR * eps,
+    before recompression) it is within eps of the dense product, and of the built
+    H-matrix's matvec; exact blocks only (min_aca_elements above every block) give the
+    dense product to rounding."""
+    from hmatddm.hmatrix.aca import ACA_TOLERANCE_FACTOR
+    from hmatddm.hmatrix.product import build_free_product
+
+    generator, options = _product_case(kind, dim)
+    dense = generator.to_dense()
+    x = np.random.default_rng(2).normal(size=dense.shape[1])
+    exact = dense @ x
+    eps = 1e-6
+    y, info = build_free_product(generator, x, ACA_TOLERANCE_FACTOR * eps, **options)
+    assert info["n_far"] > 0 and info["pairs_compressed"] > 0
+    assert np.linalg.norm(y - exact) <= eps * np.linalg.norm(exact)
+    built = HMatrix.build(generator, eps=eps, factor_dtype=np.float64, **options)
+    assert np.linalg.norm(y - built.matvec(x)) <= 2.0 * eps * np.linalg.norm(exact)
+    # ACA at a looser eps: error bounded by it, and larger than at the tight one
+    loose, _ = build_free_product(generator, x, 1e-3, **options)
+    assert np.linalg.norm(y - exact) < np.linalg.norm(loose - exact) <= 1e-3 * np.linalg.norm(exact)
+    everything_exact, info = build_free_product(generator, x, 1e-3, min_aca_elements=10**6, **options)
+    assert info["pairs_compressed"] == 0
+    np.testing.assert_allclose(everything_exact, exact, rtol=0, atol=1e-12 * np.abs(exact).max())
+
+
+def test_build_free_product_refuses_bad_input():
+    from hmatddm.hmatrix.product import build_free_product
+
+    generator, options = _product_case("rectangular", 2)
+    with pytest.raises(InputError, match="x must have"):
+        build_free_product(generator, np.ones(3), 1e-4, **options)
+    with pytest.raises(InputError, match="eps"):
+        build_free_product(generator, np.ones(generator.shape[1]), 2.0, **options)
+    with pytest.raises(InputError, match="BlockGenerator"):
+        build_free_product(object(), np.ones(3), 1e-4)
