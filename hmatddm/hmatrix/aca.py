@@ -30,6 +30,9 @@ d_r = d_c = d); it has m = d_r*m_e rows and n = d_c*n_e columns and is approxima
 U V^T with U (m x k) and V (n x k). A pivot is a d_r x d_c block. The ACA and the recompression work on the transposed
 factors (``ut`` k x m, ``vt`` k x n, one vector per contiguous row) so that every
 inner loop is contiguous.
+
+Length (over ~400 lines): the one ACA loop used in production and its numba helpers
+(pivoting on tensor blocks, re-pivoting, recompression), which must compile together.
 """
 
 import numpy as np

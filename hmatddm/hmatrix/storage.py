@@ -15,6 +15,9 @@ d_c, a square one the same tree and d for both):
 * for the matvec, the row space is split into the leaf clusters ("segments"); each
   segment lists (CSR) the dense and low-rank blocks whose rows cover it, so threads
   own whole segments of y and never race.
+
+Length (over ~400 lines): the numba build driver, products and near-field extraction all
+read one flat layout of blocks; keeping them together keeps that layout in one place.
 """
 
 import time

@@ -54,6 +54,10 @@ closed-form kernel of :mod:`hmatddm.kernels.line2d`); in any other layer, the
 transmitted and reflected pairs minus the source layer's whole-plane (Kelvin) field,
 because the callers add the closed-form kernel of the source's material at every
 receiver. So with equal layers the complementary stress is exactly zero.
+
+Length (over ~400 lines): the derivative tables of the Hansen potentials (checked by
+``_derive_images2d``), the tracer of images through interfaces and the quadrature are
+numba code that compiles as one unit; splitting them would spread one derivation.
 """
 import math
 from typing import NamedTuple

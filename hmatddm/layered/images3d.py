@@ -47,6 +47,10 @@ Derivatives. Horizontal derivatives (up to order 5) of ``F`` and ``L`` come from
 truncated bivariate Taylor series; ``D F = -sigma L``, ``D L = sigma / r``, so every
 derivative with a vertical part is a derivative of ``1/r``, whose Taylor coefficients
 follow a three-term recurrence (any order).
+
+Length (over ~400 lines): the 3D derivative tables of the Hansen potentials (checked by
+``_derive_images3d``), the tracer of images through interfaces and the rectangle quadrature
+are numba code that compiles as one unit; splitting them would spread one derivation.
 """
 import math
 from typing import NamedTuple
