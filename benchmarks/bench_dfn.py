@@ -23,7 +23,10 @@ cannot hold it open (``contact="all"``, as in the ``dfn-3cluster`` scene).
 
 What is recorded per step (printed as a table, saved as ``dfn_records.json`` in --out):
 wall time of the step and its parts (coupled solve incl. operator builds, operator
-builds alone, growth/encounter logic, remote-failure stress evaluation, checkpoint),
+builds alone, growth/encounter logic, the whole remote-failure check, checkpoint), CPU
+time (``time.process_time``, all threads) of the step and of the remote-failure check,
+the remote-failure checks and the targets whose stress they evaluated (the others are
+cleared by the stress bound of :mod:`hmatddm.field_bound`),
 peak RSS (``resource.getrusage(...).ru_maxrss``), active elements (total, natural
 activated), natural elements failed by remote failure, nonlinear and GMRES iterations,
 and the memory a dense run would need: ``N_active^2 * 9 * 8`` bytes for the DDM matrix
@@ -183,10 +186,13 @@ def build_simulation(scene, backend="hmatrix", checkpoint_dir=None):
 # ---------------------------------------------------------------------------------------
 
 class PartTimer:
-    """Accumulates wall time per named part; ``wrap`` patches ``owner.name`` for a run."""
+    """Accumulates wall and CPU time (``time.process_time``: all threads of this process)
+    per named part; ``wrap`` patches ``owner.name`` for a run."""
 
     def __init__(self):
         self.seconds = {}
+        self.cpu = {}
+        self.counts = {}
         self._patches = []
 
     def wrap(self, owner, name, part):
@@ -194,14 +200,27 @@ class PartTimer:
         timer = self
 
         def timed(*args, **kwargs):
-            start = time.perf_counter()
+            start, start_cpu = time.perf_counter(), time.process_time()
             try:
                 return original(*args, **kwargs)
             finally:
                 timer.seconds[part] = timer.seconds.get(part, 0.0) + time.perf_counter() - start
+                timer.cpu[part] = timer.cpu.get(part, 0.0) + time.process_time() - start_cpu
 
         self._patches.append((owner, name, original))
         setattr(owner, name, timed)
+
+    def count(self, owner, name, what, amount):
+        """Patch ``owner.name`` to add ``amount(args)`` to ``counts[what]`` at each call."""
+        original = getattr(owner, name)
+        timer = self
+
+        def counted(*args, **kwargs):
+            timer.counts[what] = timer.counts.get(what, 0) + int(amount(args))
+            return original(*args, **kwargs)
+
+        self._patches.append((owner, name, original))
+        setattr(owner, name, counted)
 
     def restore(self):
         for owner, name, original in reversed(self._patches):
@@ -209,8 +228,11 @@ class PartTimer:
         self._patches.clear()
 
     def take(self):
+        """(wall, cpu) seconds per part and the counts since the last call."""
         seconds, self.seconds = self.seconds, {}
-        return seconds
+        cpu, self.cpu = self.cpu, {}
+        counts, self.counts = self.counts, {}
+        return seconds, cpu, counts
 
 
 PARTS = ("solve", "operator", "grow", "remote_stress", "checkpoint")
@@ -224,7 +246,10 @@ def instrumented():
     timer.wrap(growing_operator_module.GrowingOperator, "build", "operator")  # H-matrix / dense builds
     timer.wrap(growth_pass_module, "grow", "grow")       # tips, new elements, encounters
     timer.wrap(sim_class, "save_checkpoint", "checkpoint")
-    timer.wrap(natural_module.NaturalNetwork, "induced_stress", "remote_stress")
+    # the whole remote-failure check (screening, stress at the targets kept, Coulomb test)
+    timer.wrap(growth_pass_module, "remote_failures", "remote_stress")
+    timer.count(natural_module.NaturalNetwork, "induced_stress", "targets_evaluated", lambda args: len(args[4]))
+    timer.count(growth_pass_module, "remote_failures", "remote_checks", lambda args: 1)
     try:
         yield timer
     finally:
@@ -267,7 +292,7 @@ def run(scene, backend="hmatrix", end_time=None, checkpoint_dir=None, keep_centr
     with instrumented() as timer:
         timer.take()
         while sim.state.time < end_time - 1e-9 * sim.time_step:
-            step_start = time.perf_counter()
+            step_start, step_cpu = time.perf_counter(), time.process_time()
             t_next = sim.state.time + sim.time_step
             try:
                 record = sim.step()
@@ -278,13 +303,13 @@ def run(scene, backend="hmatrix", end_time=None, checkpoint_dir=None, keep_centr
                 if verbose:
                     print(f"# stopped: {error}", flush=True)
                 break
-            wall = time.perf_counter() - step_start
-            parts = timer.take()
+            wall, cpu = time.perf_counter() - step_start, time.process_time() - step_cpu
+            parts, parts_cpu, counts = timer.take()
             s = sim.state
             n_active = int(s.mesh.n_elements)
             n_targets = int(np.count_nonzero(s.intact))
             row = dict(
-                time=float(record["time"]), wall_seconds=wall, n_active=n_active,
+                time=float(record["time"]), wall_seconds=wall, cpu_seconds=cpu, n_active=n_active,
                 n_hydraulic=int(np.count_nonzero(s.origin == 0)), natural_active=int(record["natural_active"]),
                 natural_failed=int(record["natural_failed"]), natural_intact=n_targets,
                 n_total=n_active + n_targets,
@@ -297,7 +322,10 @@ def run(scene, backend="hmatrix", end_time=None, checkpoint_dir=None, keep_centr
                 peak_rss_bytes=_peak_rss(), load=_load(),
                 dense_matrix_bytes=float(n_active) ** 2 * 9 * 8,
                 dense_stress_bytes=float(n_targets) * n_active * 18 * 8,
-                **{f"{part}_seconds": float(parts.get(part, 0.0)) for part in PARTS})
+                remote_checks=int(counts.get("remote_checks", 0)),
+                targets_evaluated=int(counts.get("targets_evaluated", 0)),
+                **{f"{part}_seconds": float(parts.get(part, 0.0)) for part in PARTS},
+                **{f"{part}_cpu_seconds": float(parts_cpu.get(part, 0.0)) for part in PARTS})
             row["operator_stats"] = _operator_stats(sim)
             if keep_centres:
                 row["centres"] = _sorted_centres(s.mesh)
@@ -329,14 +357,16 @@ def _sorted_centres(mesh):
 
 
 def _row_header():
-    return (f"{'t':>4} {'wall':>7} {'solve':>7} {'op':>6} {'grow':>6} {'remote':>7} {'ckpt':>5} "
+    return (f"{'t':>4} {'wall':>7} {'cpu':>7} {'solve':>7} {'op':>6} {'grow':>6} {'remote':>7} {'rem cpu':>7} "
+            f"{'checks':>6} {'evaluated':>9} {'ckpt':>5} "
             f"{'N_act':>6} {'nat_act':>7} {'nat_fail':>8} {'intact':>7} {'NL':>4} {'GMRES':>6} "
             f"{'RSS GB':>7} {'dense GB':>9} {'load':>5}")
 
 
 def _row_line(r):
-    return (f"{r['time']:4.0f} {r['wall_seconds']:7.2f} {r['solve_seconds']:7.2f} {r['operator_seconds']:6.2f} "
-            f"{r['grow_seconds']:6.2f} {r['remote_stress_seconds']:7.2f} "
+    return (f"{r['time']:4.0f} {r['wall_seconds']:7.2f} {r['cpu_seconds']:7.2f} {r['solve_seconds']:7.2f} "
+            f"{r['operator_seconds']:6.2f} {r['grow_seconds']:6.2f} {r['remote_stress_seconds']:7.2f} "
+            f"{r['remote_stress_cpu_seconds']:7.2f} {r['remote_checks']:6d} {r['targets_evaluated']:9d} "
             f"{r['checkpoint_seconds']:5.2f} {r['n_active']:6d} {r['natural_active']:7d} {r['natural_failed']:8d} "
             f"{r['natural_intact']:7d} {r['nonlinear_iterations']:4d} {r['linear_iterations']:6d} "
             f"{r['peak_rss_bytes'] / 1e9:7.2f} {(r['dense_matrix_bytes'] + r['dense_stress_bytes']) / 1e9:9.2f} "
@@ -350,6 +380,7 @@ def summary(rows, total_seconds, error=None):
     last = rows[-1]
     out = dict(steps=len(rows), end_time_reached=last["time"], total_seconds=total_seconds,
                step_seconds=float(sum(r["wall_seconds"] for r in rows)),
+               step_cpu_seconds=float(sum(r["cpu_seconds"] for r in rows)),
                peak_rss_bytes=max(r["peak_rss_bytes"] for r in rows),
                n_active_max=max(r["n_active"] for r in rows), n_total=last["n_total"],
                natural_active=last["natural_active"], natural_failed_max=max(r["natural_failed"] for r in rows),
@@ -361,6 +392,7 @@ def summary(rows, total_seconds, error=None):
                mean_load=float(np.mean([r["load"] for r in rows])), error=error)
     for part in PARTS:
         out[f"{part}_seconds"] = float(sum(r[f"{part}_seconds"] for r in rows))
+        out[f"{part}_cpu_seconds"] = float(sum(r[f"{part}_cpu_seconds"] for r in rows))
     return out
 
 
@@ -402,6 +434,17 @@ def remote_check(sim, original_kernel=True):
         out["original_seconds"] = 2.0 * (time.perf_counter() - start)
         out["direct_vs_original"] = float(np.max(np.abs(exact - reference)) / np.max(np.abs(reference)))
     out["stress_eps"] = fields_module.DEFAULT_STRESS_EPS
+    # the screened check (the run's): with no memory, and with the margins the run left
+    full = sim.network.remote_failure(mesh, dd, mat, sim.far_field_stress, s.intact, "average")
+    for name, network in (("fresh", natural_module.NaturalNetwork(sim.network.mesh, sim.network.properties)),
+                          ("memory", sim.network)):
+        info = {}
+        start, start_cpu = time.perf_counter(), time.process_time()
+        failed = network.remote_failure(mesh, dd, mat, sim.far_field_stress, s.intact, "average", screen=True,
+                                        info=info)[0]
+        out[f"screened_{name}"] = dict(seconds=time.perf_counter() - start, cpu_seconds=time.process_time() - start_cpu,
+                                       evaluated=info["evaluated"], targets=info["targets"],
+                                       same_failures=bool(np.array_equal(failed, full[0])))
     return out
 
 
@@ -518,12 +561,16 @@ def _print_summary(name, s):
         print(f"no step completed ({s.get('error')})")
         return
     print(f"reached t = {s['end_time_reached']:g} s in {s['total_seconds']:.1f} s wall "
-          f"(steps {s['step_seconds']:.1f} s), peak RSS {s['peak_rss_bytes'] / gb:.2f} GB, "
+          f"(steps {s['step_seconds']:.1f} s wall, {s['step_cpu_seconds']:.1f} s CPU), peak RSS {s['peak_rss_bytes'] / gb:.2f} GB, "
           f"mean load {s['mean_load']:.2f}")
     print(f"elements: active max {s['n_active_max']}, total {s['n_total']}, natural activated "
           f"{s['natural_active']}, natural failed {s['natural_failed_last']} (max {s['natural_failed_max']})")
     print(f"iterations: nonlinear {s['nonlinear_iterations']}, GMRES {s['linear_iterations']}")
-    print("time per part (s): " + ", ".join(f"{p} {s[p + '_seconds']:.1f}" for p in PARTS))
+    print("time per part, wall / CPU (s): " + ", ".join(f"{p} {s[p + '_seconds']:.1f} / {s[p + '_cpu_seconds']:.1f}"
+                                                       for p in PARTS))
+    share = s["remote_stress_seconds"] / max(s["step_seconds"], 1e-300)
+    share_cpu = s["remote_stress_cpu_seconds"] / max(s["step_cpu_seconds"], 1e-300)
+    print(f"remote-failure share of the steps: {100 * share:.1f}% wall, {100 * share_cpu:.1f}% CPU")
     print(f"dense would need: matrix {s['dense_matrix_bytes_max'] / gb:.3f} GB + natural-target stress "
           f"{s['dense_stress_bytes_max'] / gb:.2f} GB")
     if s.get("error"):
@@ -607,6 +654,11 @@ def main(argv=None):
                   f"{check['direct_seconds']:.2f} s, original kernel "
                   f"{check.get('original_seconds', float('nan')):.2f} s; "
                   f"default error {check['default_error']:.1e} of the largest stress (eps {check['stress_eps']:g})")
+            for name in ("fresh", "memory"):
+                c = check[f"screened_{name}"]
+                print(f"screened check ({name}): {c['evaluated']} of {c['targets']} targets evaluated, "
+                      f"{c['seconds']:.2f} s wall, {c['cpu_seconds']:.2f} s CPU, same failures as the full check: "
+                      f"{c['same_failures']}")
         all_rows[backend] = rows
         last_sim = sim
     if args.reduced:

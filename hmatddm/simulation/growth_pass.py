@@ -65,8 +65,10 @@ def remote_failures(simulation, state, events):
     sim = simulation
     if sim.network is None or not sim.remote_failure or not np.any(state.intact):
         return None
+    # screened: only the targets that the stress bound leaves able to fail are evaluated
     failed, _, _, pore_change = sim.network.remote_failure(state.mesh, state.dd, sim.material, sim.far_field_stress,
-                                                           state.intact, sim.operator_settings.singular_correction)
+                                                           state.intact, sim.operator_settings.singular_correction,
+                                                           screen=True)
     index = np.flatnonzero(failed)
     if index.size == 0:
         return None

@@ -17,12 +17,16 @@ Remote failure (ref. Sec. 5.3): the stress the active elements induce on every i
 natural element, plus the far field and the undrained pore-pressure change
 ``dp = -B d sigma_m`` (ref. Eq. 5.18), is checked against Coulomb's criterion.
 """
+import time
+
 import numpy as np
 from scipy.spatial import cKDTree
 
 from ..errors import InputError
+from ..field_bound import stress_bound
 from ..fracture.crossing import NaturalFractureProperties, crosses
-from ..mesh import Mesh3D, check_mesh
+from ..material import Elastic
+from ..mesh import Mesh2D, Mesh3D, check_mesh
 from ..operators import NEAR_SINGULAR_FRACTION
 from ..solve import stress_at
 
@@ -67,6 +71,9 @@ class NaturalNetwork:
         self.p0, self.p1, self.vertical_half = plan_segments(mesh)
         self.tree = cKDTree(mesh.centers)
         self.reach = 2.0 * float(mesh.radii.max())
+        #: :class:`ScreenMemory` of the last screened remote-failure check (a cache: a
+        #: check finds the same failures with or without it)
+        self.screen_memory = None
 
     def encounter(self, candidate_mesh, index, hinge, intact):
         """The intact natural element cut by candidate ``index`` (hinged at ``hinge``),
@@ -99,20 +106,30 @@ class NaturalNetwork:
         stress_tip = frame @ far_field @ frame.T
         return crosses(tips_k1, tips_k2, tips_theta, phi, stress_tip, rock_toughness, self.properties)
 
-    def induced_stress(self, active_mesh, dd, material, targets, singular_correction="average"):
+    def induced_stress(self, active_mesh, dd, material, targets, singular_correction="average", info=None,
+                       method="auto"):
         """Stress (len(targets), d, d) the active elements induce at the centres of the
         natural elements ``targets`` (:func:`hmatddm.stress_at`). Targets within half an
         element size of an active element's edge are near misses (stress ~1/gap),
         averaged like the DDM operator's collocation points."""
         near = NEAR_SINGULAR_FRACTION if singular_correction == "average" else 0.0
         return stress_at(active_mesh, material, dd, self.mesh.centers[targets],
-                         singular_correction=singular_correction, near_fraction=near)
+                         singular_correction=singular_correction, near_fraction=near, info=info, method=method)
 
-    def remote_failure(self, active_mesh, dd, material, far_field, intact, singular_correction="average"):
+    def remote_failure(self, active_mesh, dd, material, far_field, intact, singular_correction="average",
+                       screen=False, info=None):
         """Coulomb check on the intact elements (ref. Sec. 5.3).
 
         Returns ``(failed, normal, shear, pore_pressure_change)`` over the natural
         elements (zeros where not intact).
+
+        ``screen``: evaluate the induced stress (exact sum) only at the targets that may
+        fail; the others keep zeros like the elements that are not intact. ``failed``,
+        and the values where it is True, are those of the full check (see
+        :class:`ScreenMemory`). Only in a homogeneous medium with constant elements
+        (elsewhere every target is evaluated). ``info`` (dict or None) receives
+        ``targets``, ``evaluated``, ``screen_seconds``, ``memory`` (whether the last
+        check's margins were used) and the stress evaluation's ``stress`` info.
         """
         n = self.mesh.n_elements
         failed = np.zeros(n, dtype=bool)
@@ -120,26 +137,164 @@ class NaturalNetwork:
         shear_stress = np.zeros(n)
         pore_change = np.zeros(n)
         targets = np.flatnonzero(intact)
-        if targets.size == 0:
-            return failed, normal_stress, shear_stress, pore_change
-        stress = self.induced_stress(active_mesh, dd, material, targets, singular_correction)
-        if self.properties.skempton > 0.0:
-            # mean of the induced stress (ref. Eqs 5.24-5.28), from the same evaluation: in
-            # 2D plane strain sigma_zz = nu (sigma_xx + sigma_yy) joins the trace
-            trace = np.trace(stress, axis1=1, axis2=2)
-            mean = trace / 3.0 if stress.shape[1] == 3 else (1.0 + material.poisson_ratio) * trace / 3.0
-            pore_change[targets] = -self.properties.skempton * mean
-        stress = stress + far_field
-        normals = self.mesh.normals[targets]
-        traction = np.einsum("mij,mj->mi", stress, normals)
-        sigma_n = np.sum(traction * normals, axis=1)
-        tau = np.linalg.norm(traction - sigma_n[:, None] * normals, axis=1)
-        props = self.properties
-        strength = props.cohesion - props.friction * (sigma_n + props.pore_pressure + pore_change[targets])
-        failed[targets] = (tau >= strength) | (sigma_n + props.pore_pressure + pore_change[targets]
-                                               >= props.tensile_strength)
-        normal_stress[targets], shear_stress[targets] = sigma_n, tau
+        started = time.perf_counter()
+        screened = screen and targets.size > 0 and _screenable(active_mesh, material)
+        cleared = None
+        if screened:
+            near = NEAR_SINGULAR_FRACTION if singular_correction == "average" else 0.0
+            memory = self.screen_memory
+            if memory is None or not memory.holds(active_mesh, material, far_field, near):
+                memory = ScreenMemory.start(self, active_mesh, material, far_field, near)
+            cleared, cleared_margin = memory.clear(active_mesh, material, dd, self.mesh.centers[targets], targets)
+            evaluate = targets[~cleared]
+        else:
+            evaluate = targets
+        stress_info = {}
+        if info is not None:
+            info.update(targets=int(targets.size), evaluated=int(evaluate.size), memory=bool(screened and memory.used),
+                        screen_seconds=time.perf_counter() - started, stress=stress_info)
+        if evaluate.size:
+            # the exact sum when screening: a target's value does not depend on which others
+            # are evaluated (with "auto" the count would choose the method)
+            stress = self.induced_stress(active_mesh, dd, material, evaluate, singular_correction, info=stress_info,
+                                         method="direct" if screened else "auto")
+            if self.properties.skempton > 0.0:
+                pore_change[evaluate] = -self.properties.skempton * _mean_stress(stress, material)
+            stress = stress + far_field
+            normal_stress[evaluate], shear_stress[evaluate] = _normal_and_shear(stress, self.mesh.normals[evaluate])
+            failed[evaluate] = _coulomb(self.properties, normal_stress[evaluate], shear_stress[evaluate],
+                                        pore_change[evaluate])
+        if screened:
+            margin = np.full(n, -np.inf)
+            margin[targets[cleared]] = cleared_margin
+            if evaluate.size:
+                margin[evaluate] = failure_margin(self.properties, material, stress, self.mesh.normals[evaluate],
+                                                  active_mesh.dim, pore_change[evaluate])
+            self.screen_memory = memory.after(active_mesh, dd, margin)
         return failed, normal_stress, shear_stress, pore_change
+
+
+class ScreenMemory:
+    """What the last screened remote-failure check of a :class:`NaturalNetwork` knew:
+    the active elements and DDs it saw, and for every natural element a margin: an
+    induced-stress change (Frobenius norm) it can take from that state without failing.
+
+    A check with DDs ``dd`` bounds, at each target, the change of the induced stress
+    since the last check (:func:`hmatddm.field_bound.stress_bound` of the DD changes,
+    the new elements' DDs whole) and evaluates the stress only where the bound reaches
+    the margin. The margins then become: the evaluated targets' own
+    (:func:`failure_margin` at their exact stress), the others' less the bound. A first
+    check (or one whose elements are not the last one's plus appended ones, or another
+    material, far field or correction) starts from the far field alone: margin = what
+    the far field leaves, change = the whole induced stress. The bound is rigorous, so
+    a target left out cannot fail: the check finds what the full one finds.
+    """
+
+    def __init__(self, centers, frames, sizes, dd, margin, key, used):
+        self.centers, self.frames, self.sizes, self.dd = centers, frames, sizes, dd
+        self.margin, self.key, self.used = margin, key, used
+
+    @staticmethod
+    def _key(material, far_field, near):
+        return (type(material), float(material.shear_modulus), float(material.poisson_ratio),
+                np.asarray(far_field, dtype=float).tobytes(), float(near))
+
+    @classmethod
+    def start(cls, network, active_mesh, material, far_field, near):
+        """No elements seen yet: each natural element's margin under the far field."""
+        dim = active_mesh.dim
+        margin = failure_margin(network.properties, material, far_field, network.mesh.normals, dim)
+        empty = np.zeros((0, dim))
+        return cls(empty, np.zeros((0, dim, dim)), np.zeros((0, 2)), empty, margin,
+                   cls._key(material, far_field, near), used=False)
+
+    def holds(self, active_mesh, material, far_field, near):
+        """Whether ``active_mesh`` extends the elements seen (same first ones) in the same
+        material, far field and singular-point correction."""
+        n0 = self.centers.shape[0]
+        if self._key(material, far_field, near) != self.key or active_mesh.n_elements < n0 \
+                or active_mesh.dim != self.centers.shape[1]:
+            return False
+        return bool(np.array_equal(active_mesh.centers[:n0], self.centers)
+                    and np.array_equal(active_mesh.frames[:n0], self.frames)
+                    and np.array_equal(_sizes(active_mesh)[:n0], self.sizes))
+
+    def clear(self, active_mesh, material, dd, points, targets):
+        """``(cleared, margin)``: the targets whose induced stress cannot have changed by
+        their margin since the last check, and their margin left."""
+        n0 = self.centers.shape[0]
+        change = np.array(dd, dtype=float).reshape(active_mesh.n_elements, active_mesh.dim)
+        change[:n0] -= self.dd
+        margin = self.margin[targets]
+        bound = stress_bound(active_mesh, material, change, points, self.key[4], limit=margin)
+        cleared = bound < margin
+        return cleared, margin[cleared] - bound[cleared]
+
+    def after(self, active_mesh, dd, margin):
+        """The memory of a check of ``active_mesh`` with ``dd`` that left ``margin``."""
+        dd = np.array(dd, dtype=float).reshape(active_mesh.n_elements, active_mesh.dim)
+        return ScreenMemory(np.array(active_mesh.centers), np.array(active_mesh.frames), _sizes(active_mesh), dd,
+                            margin, self.key, used=True)
+
+
+def _sizes(mesh):
+    """(N, 2) the half sizes of the elements (2D: the half length twice)."""
+    if isinstance(mesh, Mesh3D):
+        return np.column_stack([mesh.half_a, mesh.half_b])
+    return np.column_stack([mesh.half_length, mesh.half_length])
+
+
+def _screenable(mesh, material):
+    """Whether :func:`hmatddm.field_bound.stress_bound` applies: constant elements in a
+    homogeneous medium."""
+    return isinstance(material, Elastic) and isinstance(mesh, (Mesh2D, Mesh3D)) and getattr(mesh, "n_nodes", 1) == 1
+
+
+def _mean_stress(stress, material):
+    """Mean of induced stress tensors (M, d, d) (ref. Eqs 5.24-5.28): in 2D plane strain
+    sigma_zz = nu (sigma_xx + sigma_yy) joins the trace."""
+    trace = np.trace(stress, axis1=1, axis2=2)
+    return trace / 3.0 if stress.shape[1] == 3 else (1.0 + material.poisson_ratio) * trace / 3.0
+
+
+def _normal_and_shear(stress, normals):
+    """Normal stress and shear traction magnitude of stress tensors (M, d, d) on planes of
+    unit ``normals`` (M, d)."""
+    traction = np.einsum("mij,mj->mi", stress, normals)
+    sigma_n = np.sum(traction * normals, axis=1)
+    return sigma_n, np.linalg.norm(traction - sigma_n[:, None] * normals, axis=1)
+
+
+def _coulomb(props, sigma_n, tau, pore_change):
+    """Coulomb's criterion or the tensile one (ref. Sec. 5.3), with the undrained pore
+    pressure change ``pore_change`` (ref. Eq. 5.18)."""
+    effective = sigma_n + props.pore_pressure + pore_change
+    return (tau >= props.cohesion - props.friction * effective) | (effective >= props.tensile_strength)
+
+
+def failure_margin(properties, material, stress, normals, dim, pore_change=0.0):
+    """(M,) the induced-stress change (Frobenius norm) that natural elements of unit
+    ``normals`` (M, d) can take from ``stress`` (the far field (d, d), or total stress
+    tensors (M, d, d)) and ``pore_change`` without failing (ref. Sec. 5.3): with
+    ``|d sigma|_F < margin`` neither Coulomb's criterion nor the tensile one can hold.
+
+    A change of norm ``S`` changes the normal stress and the shear traction by at most
+    ``S`` each, and the undrained pore pressure ``-B sigma_m`` (ref. Eq. 5.18) by at most
+    ``B f S`` (``f`` = sqrt(3)/3 in 3D; (1 + nu) sqrt(2)/3 in 2D plane strain); so
+    ``tau + S < c - mu (sigma_n + p + dp) - |mu| (1 + B f) S`` and
+    ``sigma_n + p + dp + (1 + B f) S < T`` keep the element intact. Negative where
+    ``stress`` fails it already.
+    """
+    props = properties
+    stress = np.asarray(stress, dtype=float)
+    if stress.ndim == 2:
+        stress = np.broadcast_to(stress, (len(normals),) + stress.shape)
+    sigma_n, tau = _normal_and_shear(stress, normals)
+    effective = sigma_n + props.pore_pressure + pore_change
+    pore = props.skempton * (np.sqrt(3.0) / 3.0 if dim == 3 else (1.0 + material.poisson_ratio) * np.sqrt(2.0) / 3.0)
+    shear = (props.cohesion - props.friction * effective - tau) / (1.0 + abs(props.friction) * (1.0 + pore))
+    tensile = (props.tensile_strength - effective) / (1.0 + pore)
+    return np.minimum(shear, tensile)
 
 
 def natural_network(mesh, natural_fractures, properties=None):
