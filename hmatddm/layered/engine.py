@@ -193,9 +193,13 @@ def tip_criterion(tips, tip_materials, layers, medium, propagation):
     return replace(tips, grows=grows)
 
 
-def split_new_elements(grown, parent, rows, medium):
+def split_new_elements(grown, parent, rows, medium, mesh=None):
     """New tip elements cut where they cross interfaces (pieces keep the parent tip);
-    pieces in a void layer (beyond a free surface) are dropped."""
+    pieces in a void layer (beyond a free surface) are dropped, and so is a piece that
+    lands on an element of ``mesh`` (the current mesh) or on an earlier piece: a tip
+    growing up to an interface and the tip of a piece already cut there, beside it,
+    reach the same cell only after the cut (the candidates differed before it).
+    ``(None, None, None)`` when no piece is left."""
     if grown.dim == 3:
         split, index = split_rectangles(grown, medium)
     else:
@@ -206,4 +210,27 @@ def split_new_elements(grown, parent, rows, medium):
     if not np.all(solid) and np.any(solid):
         keep = np.flatnonzero(solid)
         split, index = split.subset(keep), index[keep]
+    keep = _new_cells(split, mesh)
+    if keep.size == 0:
+        return None, None, None
+    if keep.size < split.n_elements:
+        split, index = split.subset(keep), index[keep]
     return split, parent[index], rows[index]
+
+
+def _new_cells(pieces, mesh):
+    """Indices of the pieces whose centre is farther than half their smaller size from
+    every centre of ``mesh`` and from every earlier kept piece (the rule of
+    :func:`hmatddm.fracture.new_elements`, applied after the cut)."""
+    from scipy.spatial import cKDTree
+
+    size = np.minimum(pieces.half_a, pieces.half_b) if pieces.dim == 3 else pieces.half_length
+    keep = np.ones(pieces.n_elements, dtype=bool)
+    if mesh is not None and mesh.n_elements:
+        distance, _ = cKDTree(mesh.centers).query(pieces.centers)
+        keep &= distance > 0.5 * size
+    chosen = []
+    for m in np.flatnonzero(keep):
+        if all(np.linalg.norm(pieces.centers[m] - pieces.centers[q]) > 0.5 * size[m] for q in chosen):
+            chosen.append(m)
+    return np.asarray(chosen, dtype=np.int64)

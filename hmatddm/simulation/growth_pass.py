@@ -44,7 +44,9 @@ def grow(simulation, state, edges, faces, drained, events):
     grown, parent, rows = candidates
     # cut at interfaces (3D: also between equal layers, the 3D kernels refuse straddling rectangles)
     if sim.medium is not None and (mesh.dim == 3 or not layered_engine.uniform(sim.medium)):
-        grown, parent, rows = layered_engine.split_new_elements(grown, parent, rows, sim.medium)
+        grown, parent, rows = layered_engine.split_new_elements(grown, parent, rows, sim.medium, mesh)
+        if grown is None:
+            return None
     grown, parent, rows, junctions = stop_at_other_fractures(mesh, edges, tips, grown, parent, rows, state.origin,
                                                              events)
     if grown is None:
