@@ -7,10 +7,9 @@ The stress at M points from N elements is a points x elements matrix applied to 
 row ``n_out * t + c`` is component ``c`` of the stress at point ``t`` (3D: xx, yy, zz, xy,
 xz, yz; 2D plane strain: xx, yy, xy; or the mean stress alone, ``n_out = 1``), column
 ``d * j + q`` the global DD component ``q`` of element ``j`` (or, for given DDs, one
-column per element: what it induces with its DD). Its entries come from the
-per-pair kernels of :mod:`hmatddm.kernels` (``local_stress_corrected`` of
-:mod:`~hmatddm.kernels.rectangle3d` and :mod:`~hmatddm.kernels.line2d`), contracted with
-a local DD and rotated to the global frame (ref. Eq. 2.57). Two ways to apply it:
+column per element: what it induces with its DD). Its entries come from
+:mod:`hmatddm.field_kernels` (the per-pair kernels of :mod:`hmatddm.kernels`, contracted
+with a local DD and rotated to the global frame, ref. Eq. 2.57). Two ways to apply it:
 
 * ``"direct"``: the exact sum over all elements, parallel over a fixed split of the points
   (the result does not depend on the thread count), each pair's DD contracted before the
@@ -26,17 +25,12 @@ a local DD and rotated to the global frame (ref. Eq. 2.57). Two ways to apply it
   ``eps``) for further DDs on the same points and elements.
 """
 import time
-import warnings
-from typing import NamedTuple
 
 import numpy as np
-from numba import njit, prange
-from numba.core.errors import NumbaPerformanceWarning
 
 from ._validation import finite_array, finite_scalar
 from .errors import InputError
-from .kernels.line2d import local_stress_corrected as _segment_local_stress
-from .kernels.rectangle3d import local_stress_corrected as _rectangle_local_stress
+from .field_kernels import FieldSources, contribution_block, direct_sum, field_block, field_sources
 from .material import Elastic
 from .mesh import Mesh2D, Mesh3D, check_mesh
 
@@ -60,232 +54,11 @@ FIELD_LEAF_SIZE = 64
 #: Far blocks of the one-shot product with fewer points or elements than this are summed
 #: exactly (ranks of the six components are 30-60: the ACA does not pay below).
 FIELD_MIN_ACA = 64
-_DIRECT_CHUNKS = 64  # fixed split of the point range in the direct sum
 
 
 def n_components(dim, quantity):
     """Values per point: 6 (3D) or 3 (2D) stress components, 1 for the mean stress."""
     return 1 if quantity == "mean" else (6 if dim == 3 else 3)
-
-
-# ---------------------------------------------------------------------------- kernels
-
-class FieldSources(NamedTuple):
-    """What the field kernels read (numba reads the fields by name): the target
-    ``points`` (M, dim), the elements (``centers``, ``frames`` with the local axes as
-    rows, half sizes ``half_a``, ``half_b``; in 2D both are the half length), the
-    material, the singular-point treatment: ``singular_shift`` (0: NaN at singular
-    points, else the averaging offset of ref. Sec. 6.2.3) and ``near_fraction``, and the
-    global DDs ``dd`` (N, dim) that :func:`contribution_block` folds into its columns."""
-
-    points: np.ndarray
-    centers: np.ndarray
-    frames: np.ndarray
-    half_a: np.ndarray
-    half_b: np.ndarray
-    shear_modulus: float
-    poisson_ratio: float
-    singular_shift: float
-    near_fraction: float
-    dd: np.ndarray
-
-
-def field_sources(mesh, material, points, singular_correction="none", near_fraction=0.0, dd=None):
-    """The :class:`FieldSources` of ``mesh`` seen from ``points`` (contiguous float64
-    arrays: one compiled specialisation of each kernel, whatever slicing or
-    concatenation produced the mesh)."""
-    half_a, half_b = (mesh.half_length, mesh.half_length) if mesh.dim == 2 else (mesh.half_a, mesh.half_b)
-    arrays = (np.ascontiguousarray(a, dtype=np.float64) for a in (points, mesh.centers, mesh.frames, half_a, half_b))
-    dd = np.zeros((mesh.n_elements, mesh.dim)) if dd is None else dd
-    return FieldSources(*arrays, float(material.shear_modulus), float(material.poisson_ratio),
-                        1e-3 if singular_correction == "average" else 0.0, float(near_fraction),
-                        np.ascontiguousarray(dd, dtype=np.float64))
-
-
-@njit(cache=True, inline="always")
-def _may_touch_boundary(x1, x2, x3, a, b, distance):
-    """False when the local point is certainly farther than ``distance`` from the
-    rectangle's boundary (a bounding test, so that the far pairs skip the nearest
-    boundary point search of ``local_stress_corrected``)."""
-    if abs(x3) > distance:
-        return False
-    u = abs(x1)
-    v = abs(x2)
-    if u > a + distance or v > b + distance:
-        return False
-    return abs(u - a) <= distance or abs(v - b) <= distance
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _local_response(sources, point, j, work3, work2):
-    """Local stress of element ``j`` at ``point`` per unit local DD component
-    (``work3[k]`` in 3D, ``work2[k]`` in 2D): the kernels' ``local_stress_corrected``
-    (points on an edge or end, or within ``near_fraction`` of the element's smaller half
-    size of one, are averaged across it when ``singular_shift > 0``, else NaN)."""
-    centers = sources.centers
-    frame = sources.frames[j]
-    g = sources.shear_modulus
-    nu = sources.poisson_ratio
-    if centers.shape[1] == 3:
-        dx = point[0] - centers[j, 0]
-        dy = point[1] - centers[j, 1]
-        dz = point[2] - centers[j, 2]
-        x1 = frame[0, 0] * dx + frame[0, 1] * dy + frame[0, 2] * dz
-        x2 = frame[1, 0] * dx + frame[1, 1] * dy + frame[1, 2] * dz
-        x3 = frame[2, 0] * dx + frame[2, 1] * dy + frame[2, 2] * dz
-        a = sources.half_a[j]
-        b = sources.half_b[j]
-        near = sources.near_fraction * min(a, b)
-        if near > 0.0 and not _may_touch_boundary(x1, x2, x3, a, b, near):
-            near = 0.0
-        _rectangle_local_stress(x1, x2, x3, a, b, g, nu, sources.singular_shift, work3, near)
-    else:
-        dx = point[0] - centers[j, 0]
-        dy = point[1] - centers[j, 1]
-        a = sources.half_a[j]
-        _segment_local_stress(frame[0, 0] * dx + frame[0, 1] * dy, frame[1, 0] * dx + frame[1, 1] * dy, a, g, nu,
-                              sources.singular_shift, work2, sources.near_fraction * a)
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _components(work3, work2, dim, l0, l1, l2, frame, n_out, nu, out):
-    """``out[:n_out]``: the global components of the stress of local DD ``(l0, l1, l2)``
-    (``l2`` unused in 2D) from the local responses: ``s = sum_k l_k work[k]``, rotated
-    ``F^T s F`` (``frame`` rows are the local axes, ref. Eq. 2.57), or the mean stress
-    ``tr(s)/3`` (2D plane strain: ``(1 + nu) tr(s) / 3``, since ``s_zz = nu tr(s)``)."""
-    if dim == 3:
-        s00 = l0 * work3[0, 0, 0] + l1 * work3[1, 0, 0] + l2 * work3[2, 0, 0]
-        s11 = l0 * work3[0, 1, 1] + l1 * work3[1, 1, 1] + l2 * work3[2, 1, 1]
-        s22 = l0 * work3[0, 2, 2] + l1 * work3[1, 2, 2] + l2 * work3[2, 2, 2]
-        if n_out == 1:
-            out[0] = (s00 + s11 + s22) / 3.0
-            return
-        s01 = l0 * work3[0, 0, 1] + l1 * work3[1, 0, 1] + l2 * work3[2, 0, 1]
-        s02 = l0 * work3[0, 0, 2] + l1 * work3[1, 0, 2] + l2 * work3[2, 0, 2]
-        s12 = l0 * work3[0, 1, 2] + l1 * work3[1, 1, 2] + l2 * work3[2, 1, 2]
-        t00 = s00 * frame[0, 0] + s01 * frame[1, 0] + s02 * frame[2, 0]
-        t01 = s00 * frame[0, 1] + s01 * frame[1, 1] + s02 * frame[2, 1]
-        t02 = s00 * frame[0, 2] + s01 * frame[1, 2] + s02 * frame[2, 2]
-        t10 = s01 * frame[0, 0] + s11 * frame[1, 0] + s12 * frame[2, 0]
-        t11 = s01 * frame[0, 1] + s11 * frame[1, 1] + s12 * frame[2, 1]
-        t12 = s01 * frame[0, 2] + s11 * frame[1, 2] + s12 * frame[2, 2]
-        t20 = s02 * frame[0, 0] + s12 * frame[1, 0] + s22 * frame[2, 0]
-        t21 = s02 * frame[0, 1] + s12 * frame[1, 1] + s22 * frame[2, 1]
-        t22 = s02 * frame[0, 2] + s12 * frame[1, 2] + s22 * frame[2, 2]
-        out[0] = frame[0, 0] * t00 + frame[1, 0] * t10 + frame[2, 0] * t20
-        out[1] = frame[0, 1] * t01 + frame[1, 1] * t11 + frame[2, 1] * t21
-        out[2] = frame[0, 2] * t02 + frame[1, 2] * t12 + frame[2, 2] * t22
-        out[3] = frame[0, 0] * t01 + frame[1, 0] * t11 + frame[2, 0] * t21
-        out[4] = frame[0, 0] * t02 + frame[1, 0] * t12 + frame[2, 0] * t22
-        out[5] = frame[0, 1] * t02 + frame[1, 1] * t12 + frame[2, 1] * t22
-        return
-    s00 = l0 * work2[0, 0, 0] + l1 * work2[1, 0, 0]
-    s11 = l0 * work2[0, 1, 1] + l1 * work2[1, 1, 1]
-    if n_out == 1:
-        out[0] = (1.0 + nu) * (s00 + s11) / 3.0
-        return
-    s01 = l0 * work2[0, 0, 1] + l1 * work2[1, 0, 1]
-    t00 = s00 * frame[0, 0] + s01 * frame[1, 0]
-    t01 = s00 * frame[0, 1] + s01 * frame[1, 1]
-    t10 = s01 * frame[0, 0] + s11 * frame[1, 0]
-    t11 = s01 * frame[0, 1] + s11 * frame[1, 1]
-    out[0] = frame[0, 0] * t00 + frame[1, 0] * t10
-    out[1] = frame[0, 1] * t01 + frame[1, 1] * t11
-    out[2] = frame[0, 0] * t01 + frame[1, 0] * t11
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _contribution(sources, point, j, n_out, work3, work2, value):
-    """``value[:n_out]``: the components at ``point`` of element ``j`` with its global DD
-    ``sources.dd[j]``, contracted in the local frame before the one rotation."""
-    frame = sources.frames[j]
-    dd = sources.dd[j]
-    _local_response(sources, point, j, work3, work2)
-    l0 = frame[0, 0] * dd[0] + frame[0, 1] * dd[1]
-    l1 = frame[1, 0] * dd[0] + frame[1, 1] * dd[1]
-    l2 = 0.0
-    if dd.shape[0] == 3:
-        l0 += frame[0, 2] * dd[2]
-        l1 += frame[1, 2] * dd[2]
-        l2 = frame[2, 0] * dd[0] + frame[2, 1] * dd[1] + frame[2, 2] * dd[2]
-    _components(work3, work2, dd.shape[0], l0, l1, l2, frame, n_out, sources.poisson_ratio, value)
-
-
-@njit(cache=True, nogil=True, parallel=True)  # see _KERNEL_NOTE
-def field_block(data, rows, cols, out):
-    """Block generator kernel of the points x elements matrix (see
-    :class:`hmatddm.hmatrix.BlockGenerator`): ``out[n_out * a + c, d * b + q]`` =
-    component ``c`` at point ``rows[a]`` from a unit global DD component ``q`` of
-    element ``cols[b]``. ``data``: :class:`FieldSources`; ``n_out`` (6, 3 or 1) is read
-    from the shape of ``out``."""
-    points = data.points
-    dim = data.centers.shape[1]
-    n_out = out.shape[0] // rows.shape[0]
-    nu = data.poisson_ratio
-    work3 = np.empty((3, 3, 3))
-    work2 = np.empty((2, 2, 2))
-    value = np.empty(6)
-    for a in range(rows.shape[0]):
-        point = points[rows[a]]
-        for b in range(cols.shape[0]):
-            j = cols[b]
-            frame = data.frames[j]
-            _local_response(data, point, j, work3, work2)
-            for q in range(dim):
-                # local components of the unit global DD q: column q of the frame
-                _components(work3, work2, dim, frame[0, q], frame[1, q], frame[dim - 1, q], frame, n_out, nu,
-                            value)
-                for c in range(n_out):
-                    out[n_out * a + c, dim * b + q] = value[c]
-
-
-@njit(cache=True, nogil=True, parallel=True)  # see _KERNEL_NOTE
-def contribution_block(data, rows, cols, out):
-    """Block generator kernel of the points x elements matrix of given DDs, one column
-    per element: ``out[n_out * a + c, b]`` = component ``c`` at point ``rows[a]`` of
-    element ``cols[b]`` with its DD ``data.dd[cols[b]]``; the field is this matrix
-    times a vector of ones."""
-    n_out = out.shape[0] // rows.shape[0]
-    work3 = np.empty((3, 3, 3))
-    work2 = np.empty((2, 2, 2))
-    value = np.empty(6)
-    for a in range(rows.shape[0]):
-        point = data.points[rows[a]]
-        for b in range(cols.shape[0]):
-            _contribution(data, point, cols[b], n_out, work3, work2, value)
-            for c in range(n_out):
-                out[n_out * a + c, b] = value[c]
-
-
-@njit(cache=True, parallel=True)
-def direct_sum(sources, out):
-    """``out[t] = sum_j`` (stress at point ``t`` of element ``j`` with its global DD
-    ``sources.dd[j]``), exact, ``n_out = out.shape[1]``. Each pair contracts its DD
-    before the one rotation; parallel over a fixed split of the points, the sum over
-    ``j`` in element order (the result does not depend on the thread count)."""
-    points = sources.points
-    m = points.shape[0]
-    n_out = out.shape[1]
-    n_chunks = min(_DIRECT_CHUNKS, m)
-    for chunk in prange(n_chunks):
-        work3 = np.empty((3, 3, 3))
-        work2 = np.empty((2, 2, 2))
-        value = np.empty(6)
-        for t in range(chunk * m // n_chunks, (chunk + 1) * m // n_chunks):
-            for c in range(n_out):
-                out[t, c] = 0.0
-            for j in range(sources.frames.shape[0]):
-                _contribution(sources, points[t], j, n_out, work3, work2, value)
-                for c in range(n_out):
-                    out[t, c] += value[c]
-
-
-# _KERNEL_NOTE: the block kernels hold no prange, but compiled with parallel=True (numba's
-# parfor pipeline) they run ~3x faster per pair than with the default pipeline, like the
-# exact sum (measured on the bench_fields.py 3D scene, 64-point blocks: 1.04 -> 0.36 s
-# CPU); numba's warning that nothing was parallelised is silenced below.
-warnings.filterwarnings("ignore", message=r"(?s).*The keyword argument 'parallel=True' was specified but no",
-                        category=NumbaPerformanceWarning)
 
 
 # ---------------------------------------------------------------------------- fields
