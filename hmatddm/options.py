@@ -14,9 +14,11 @@ DEFAULT_LEAF_SIZE = 32  # 64 costs ~25% more memory at N=100k in 3D (8.4 GB vs 6
 CONTACT_MODES = ("natural", "all", "none")      # hmatddm.coupled.contact: which elements may close
 
 SCHEMES = ("fixed-width", "fracture-compliance", "fully-coupled", "krylov")  # hmatddm.coupled.schemes
+STOPPING_RULES = ("change", "contraction")    # SchemeSettings.stopping
 SCHEME_DEFAULTS = dict(scheme="krylov", omega=1.0, relaxation=1.0, min_relaxation=1.0 / 256.0,
                        tolerance_pressure=1e-6, tolerance_opening=1e-6, max_iterations=400, linear_rtol=1e-9,
-                       linear_restart=100, linear_maxiter=20, relaxation_growth=None)  # SchemeSettings
+                       linear_restart=100, linear_maxiter=20, relaxation_growth=None, stopping="contraction",
+                       first_linear_rtol=1e-6)  # SchemeSettings
 
 CRITERIA = ("mcs", "energy")                    # hmatddm.fracture.growth.Propagation
 TURNING = ("none", "plan", "any")

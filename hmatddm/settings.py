@@ -15,7 +15,7 @@ from numbers import Integral, Real
 
 from .errors import InputError
 from .options import (BACKENDS, CONTACT_MODES, CRITERIA, DEFAULT_EPS, DEFAULT_ETA, DEFAULT_LEAF_SIZE, FRONTS,
-                      SCHEME_DEFAULTS, SCHEMES, SINGULAR_CORRECTIONS, TURNING)
+                      SCHEME_DEFAULTS, SCHEMES, SINGULAR_CORRECTIONS, STOPPING_RULES, TURNING)
 
 REQUIRED = object()  # marker: the key has no default
 ABSENT = object()    # marker: optional key without a default (left out of the echo when not given)
@@ -231,6 +231,12 @@ SCHEME = {  # -> hmatddm.coupled.schemes.SchemeSettings (ref. Sec. 4.5)
     "linear_rtol": Setting("number", SCHEME_DEFAULTS["linear_rtol"], **_UNIT_INTERVAL),
     "linear_restart": Setting("integer", SCHEME_DEFAULTS["linear_restart"], low=1),
     "linear_maxiter": Setting("integer", SCHEME_DEFAULTS["linear_maxiter"], low=1),
+    "stopping": Setting("choice", SCHEME_DEFAULTS["stopping"], choices=STOPPING_RULES,
+                        doc="change: stop when the change between iterates is below the tolerances; "
+                            "contraction: also when the next change, extrapolated from the last two, is"),
+    "first_linear_rtol": Setting("number", SCHEME_DEFAULTS["first_linear_rtol"], **_UNIT_INTERVAL,
+                                 doc="GMRES relative residual of the first nonlinear iteration of a solve "
+                                     "(coupled schemes; at least linear_rtol)"),
 }
 
 MATERIAL = {  # -> hmatddm.material.Elastic

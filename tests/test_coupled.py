@@ -10,9 +10,9 @@ from hmatddm.coupled.schemes import _CoupledLinearSystem
 from hmatddm.flow import LeakOff, LubricationModel, fracture_compliance
 
 
-def _problem(mesh, backend="dense", dt=1.0, height=1.0, rate=5e-4, leak=0.0):
+def _problem(mesh, backend="dense", dt=1.0, height=1.0, rate=5e-4, leak=0.0, viscosity=1e-3):
     mat = hd.Elastic(10e9, 0.25)
-    fluid = hd.Fluid(viscosity=1e-3, compressibility=4.5e-10)
+    fluid = hd.Fluid(viscosity=viscosity, compressibility=4.5e-10)
     faces = topology.element_faces(mesh, height=height)
     areas = mesh.areas * (height if mesh.dim == 2 else 1.0)
     flow = LubricationModel(areas=areas, normals=mesh.normals, faces=faces, fluid=fluid,
@@ -102,3 +102,48 @@ def test_scaling_makes_the_coupled_matrix_well_conditioned():
     scaled = np.column_stack([system.operator @ e for e in np.eye(full.shape[0])])
     assert np.linalg.cond(full) > 1e12
     assert np.linalg.cond(scaled) < 1e3
+
+
+
+@pytest.mark.parametrize("scheme", ["krylov", "fully-coupled"])
+def test_contraction_stopping_matches_the_change_rule_within_the_tolerance(scheme):
+    # the default rule (stop on the extrapolated next change, first GMRES solve at
+    # first_linear_rtol) against the plain one (change between iterates, every GMRES solve
+    # at linear_rtol), both at the default tolerance 1e-6, and against a tight solve. A thin
+    # fluid (K-vertex-like) contracts fast: the contraction rule saves an iteration there.
+    mesh = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 8.0, 8.0, 8, 8)
+    tight = SchemeSettings(scheme="krylov", tolerance_pressure=1e-10, tolerance_opening=1e-10, linear_rtol=1e-12,
+                           stopping="change")
+    problem, dd0, p0 = _problem(mesh, rate=1e-2, viscosity=1e-5)
+    dd_ref, p_ref, _ = solve_step(problem, tight, dd0, p0, 1.0)
+    results = {}
+    for stopping, first in (("change", 1e-12), ("contraction", 1e-6)):
+        problem, dd0, p0 = _problem(mesh, rate=1e-2, viscosity=1e-5)
+        settings = SchemeSettings(scheme=scheme, linear_rtol=1e-12, stopping=stopping, first_linear_rtol=first,
+                                  max_iterations=3000)
+        results[stopping] = solve_step(problem, settings, dd0, p0, 1.0)
+    (dd_c, p_c, info_c), (dd_s, p_s, info_s) = results["contraction"], results["change"]
+    tolerance = 1e-6 / info_s["relaxation"]  # a relaxed iteration stops within about tol/alpha
+    for dd, p in ((dd_c, p_c), (dd_s, p_s)):
+        np.testing.assert_allclose(p, p_ref, atol=tolerance * np.abs(p_ref).max())
+        np.testing.assert_allclose(dd, dd_ref, atol=tolerance * np.abs(dd_ref).max())
+    np.testing.assert_allclose(p_c, p_s, atol=tolerance * np.abs(p_ref).max())
+    assert info_c["nonlinear_iterations"] <= info_s["nonlinear_iterations"]
+    if scheme == "krylov":
+        assert info_c["nonlinear_iterations"] == info_s["nonlinear_iterations"] - 1
+        assert info_c["linear_iterations"] < info_s["linear_iterations"]
+
+
+def test_contraction_rule_needs_a_fast_contraction():
+    from hmatddm.coupled.schemes import _converged
+
+    assert _converged("change", 0.9, []) and _converged("contraction", 0.9, [])
+    assert not _converged("contraction", 100.0, [])           # no rate yet
+    assert _converged("contraction", 100.0, [1e6])            # rate 1e-4: next change 0.01 tolerance
+    assert _converged("contraction", 100.0, [1e5])            # rate 1e-3: 0.1 tolerance, x3 safety
+    assert not _converged("contraction", 100.0, [2e4])        # rate 5e-3: 0.5 tolerance, x3 safety: no
+    assert not _converged("contraction", 100.0, [2e6, 1e6])   # the rate before was 0.5: slow
+    assert not _converged("contraction", 1.5, [2.0])          # rate 0.75 > 1/2: too slow to extrapolate
+    assert not _converged("change", 100.0, [1e6])
+    with pytest.raises(hd.errors.InputError, match="stopping"):
+        SchemeSettings(stopping="guess")

@@ -97,6 +97,8 @@ The format, annotated (``=`` values are the defaults unless marked REQUIRED)::
     linear_rtol = 1e-9             # GMRES relative residual, (0, 1)
     linear_restart = 100           # GMRES Krylov dimension, >= 1
     linear_maxiter = 20            # GMRES restart cycles, >= 1
+    stopping = "contraction"       # "contraction" (also stop on the extrapolated next change) or "change"
+    first_linear_rtol = 1e-6       # GMRES relative residual of a solve's first iteration, (0, 1)
     initial_pressure = 10e6        # Pa, fluid pressure at t = 0 (default 0)
     initial_opening = 1e-5         # m, >= 0, opening of the initial elements
     # minimum_width = 1e-5         # m, > 0, width floor of the flow (default initial_opening)

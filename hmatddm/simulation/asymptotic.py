@@ -31,7 +31,6 @@ from dataclasses import replace
 
 import numpy as np
 
-from .. import topology
 from ..coupled import ElasticSolver, StepProblem, solve_step
 from ..coupled.contact import ContactRows
 from ..errors import ConvergenceError, InputError
@@ -39,6 +38,7 @@ from ..flow import fracture_compliance
 from ..fracture.front import CHANNEL, EMPTY, FILLED, TIP, FrontField, PlanarGrid, fill, front_radii, level_set
 from ..fracture.tip_asymptote import TipAsymptote
 from .records import StepTally, step_record
+from .step_solve import mesh_topology
 from .state import NewElements, StepStart
 
 logger = logging.getLogger(__name__)
@@ -54,6 +54,7 @@ class PrescribedOpening:
     :class:`~hmatddm.coupled.contact.ContactRows`); ``k`` the element's own stiffness."""
 
     frozen = 0
+    active_set = False  # fixed rows: no active-set update (and no residual matvec) per iterate
 
     def __init__(self, prescribed, width, normals, stiffness):
         n, d = normals.shape
@@ -130,8 +131,7 @@ class AsymptoticFront:
         ``(trial with the solution, info, flow model)``. The elastic solver (and its inverse
         of the modified rows) is kept across the front iterations of one operator."""
         mesh = trial.mesh
-        edges = topology.element_edges(mesh, sim.height)
-        faces = topology.element_faces(mesh, edges)
+        _, faces = mesh_topology(mesh, sim.height)
         flow = sim.flow_model(mesh, faces)
         op = sim.operator(mesh)
         if self._solver is None or self._solver.operator is not op:

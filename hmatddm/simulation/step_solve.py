@@ -37,6 +37,29 @@ def contact_law(simulation, origin):
     return ContactLaw(enabled, friction, cohesion)
 
 
+class _MeshTopology:
+    """The edges and flow faces of the last mesh asked for: a step's first solve works on
+    the mesh of the previous step's last one, and the asymptotic front's iterations on one
+    mesh until it grows (the mesh is immutable; a new mesh is a new object)."""
+
+    def __init__(self):
+        self.entry = (None, None, None)  # (mesh, height, (edges, faces)), replaced at once (threads)
+
+    def __call__(self, mesh, height):
+        cached_mesh, cached_height, value = self.entry
+        if cached_mesh is not mesh or cached_height != height:
+            edges = topology.element_edges(mesh, height)
+            value = (edges, topology.element_faces(mesh, edges))
+            self.entry = (mesh, height, value)
+        return value
+
+
+mesh_topology = _MeshTopology()
+"""``mesh_topology(mesh, height)``: ``(edges, faces)`` of ``mesh``
+(:func:`hmatddm.topology.element_edges`, :func:`~hmatddm.topology.element_faces`), kept for
+the last mesh."""
+
+
 def drained(simulation, mesh, faces, origin):
     """Remotely failed elements that no fluid path connects to an injection point."""
     failed = origin == Origin.FAILED
@@ -60,8 +83,8 @@ def solve(simulation, trial, start, t_old, t_new, relaxation):
     ``info`` is :func:`hmatddm.coupled.solve_step`'s plus ``contact_frozen`` and
     ``drained`` (the remotely failed elements no fluid reaches)."""
     sim, mesh = simulation, trial.mesh
-    edges = topology.element_edges(mesh, sim.height)
-    faces = with_links(topology.element_faces(mesh, edges), trial.extra_faces)
+    edges, faces = mesh_topology(mesh, sim.height)
+    faces = with_links(faces, trial.extra_faces)
     flow = sim.flow_model(mesh, faces)
     elastic = ElasticSolver(sim.operator(mesh), rtol=sim.settings.linear_rtol)
     contact, fixed_pressure, pressure_guess = None, None, trial.pressure
