@@ -33,7 +33,7 @@ POINT_DD_CONSTANT_2D = 3.2
 #: A cluster of elements counts whole at distances of at least this many diameters (its
 #: bound then overestimates each element's term by at most (1 + 1/SEPARATION)^p).
 SEPARATION = 3.0
-_LEAF_SIZE = 4
+_LEAF_SIZE = 8
 _CHUNKS = 64
 
 
@@ -59,20 +59,22 @@ def _element_distance(point, center, frame, a, b):
 
 
 @njit(cache=True, parallel=True)
-def _bound(points, centers, frames, half_a, half_b, weight, near, permutation, start, stop, left, right, box_min,
-           box_max, cumulative, power, limit, out):
-    """``out[t]``: sum over elements of ``weight / distance^power`` at ``points[t]``,
-    clusters far enough counted whole; ``inf`` within ``near`` of an element. The
-    descent of a point stops once its sum passes ``limit[t]`` (what is known then: the
-    bound exceeds the limit)."""
-    m = points.shape[0]
-    dim = points.shape[1]
+def _bound(query_min, query_max, exact, centers, frames, half_a, half_b, radii, weight, near, permutation, start, stop,
+           left, right, box_min, box_max, cumulative, power, limit, out):
+    """``out[t]``: sum over elements of ``weight / distance^power`` over the query box
+    ``t`` (``query_min[t]`` to ``query_max[t]``; a point when ``exact``, and then the
+    distance to each element is exact, else to its bounding box), clusters far enough
+    counted whole; ``inf`` within ``near`` of an element. The descent of a query stops
+    once its sum passes ``limit[t]`` (what is known then: the bound exceeds the limit)."""
+    m = query_min.shape[0]
+    dim = query_min.shape[1]
     n_chunks = min(_CHUNKS, m)
     separation2 = SEPARATION * SEPARATION
     for chunk in prange(n_chunks):
         stack = np.empty(2 * start.shape[0] + 2, np.int64)
         for t in range(chunk * m // n_chunks, (chunk + 1) * m // n_chunks):
-            point = points[t]
+            q_low = query_min[t]
+            q_high = query_max[t]
             total = 0.0
             stack[0] = 0
             top = 1
@@ -84,8 +86,7 @@ def _bound(points, centers, frames, half_a, half_b, weight, near, permutation, s
                 for k in range(dim):
                     low = box_min[c, k]
                     high = box_max[c, k]
-                    x = point[k]
-                    gap = low - x if x < low else (x - high if x > high else 0.0)
+                    gap = max(low - q_high[k], q_low[k] - high, 0.0)
                     gap2 += gap * gap
                     diameter2 += (high - low) * (high - low)
                 if gap2 > 0.0 and gap2 >= separation2 * diameter2:
@@ -97,7 +98,15 @@ def _bound(points, centers, frames, half_a, half_b, weight, near, permutation, s
                 else:
                     for k in range(start[c], stop[c]):
                         j = permutation[k]
-                        d = _element_distance(point, centers[j], frames[j], half_a[j], half_b[j])
+                        if exact:
+                            d = _element_distance(q_low, centers[j], frames[j], half_a[j], half_b[j])
+                        else:
+                            d2 = 0.0
+                            for i in range(dim):
+                                gap = max(centers[j, i] - radii[j] - q_high[i], q_low[i] - centers[j, i] - radii[j],
+                                          0.0)
+                                d2 += gap * gap
+                            d = np.sqrt(d2)
                         if d <= near[j]:
                             total = np.inf
                             break
@@ -105,7 +114,7 @@ def _bound(points, centers, frames, half_a, half_b, weight, near, permutation, s
             out[t] = total
 
 
-def stress_bound(mesh, material, dd, points, near_fraction=0.0, limit=None):
+def stress_bound(mesh, material, dd, points, near_fraction=0.0, limit=None, point_tree=None):
     """(M,) upper bounds of the Frobenius norm of the stress tensor that the global DDs
     ``dd`` (N, d) of the constant elements of ``mesh`` induce at ``points`` (M, d) in
     the homogeneous ``material`` (:class:`hmatddm.Elastic`); ``inf`` at points within
@@ -113,7 +122,12 @@ def stress_bound(mesh, material, dd, points, near_fraction=0.0, limit=None):
     ``singular_correction="average"`` averages) or on it.
 
     ``limit`` (M,) or None: a point's sum may stop as soon as it passes its limit (the
-    result then only says that the bound exceeds the limit).
+    result then only says that the bound exceeds the limit); points whose limit is
+    ``-inf`` are not needed (their result is meaningless).
+    ``point_tree`` (a :func:`hmatddm.hmatrix.cluster_tree.cluster_tree` of ``points``,
+    e.g. kept across calls on the same points) with ``limit``: each leaf's box is bounded
+    first, as a whole; where that stays below the smallest limit of its needed points,
+    it is their bound, and only the other leaves' points are bounded one by one.
     """
     points = np.ascontiguousarray(points, dtype=np.float64)
     m = points.shape[0]
@@ -141,11 +155,33 @@ def stress_bound(mesh, material, dd, points, near_fraction=0.0, limit=None):
     tree = cluster_tree(mesh.centers, mesh.radii, _LEAF_SIZE)
     cumulative = np.concatenate(([0.0], np.cumsum(weight[tree.permutation])))
     limit = np.full(m, np.inf) if limit is None else np.ascontiguousarray(limit, dtype=np.float64)
-    as_float = (np.ascontiguousarray(a, dtype=np.float64) for a in
-                (mesh.centers, mesh.frames, half_a, half_b, weight, near))
-    _bound(points, *as_float, tree.permutation, tree.start, tree.stop, tree.left, tree.right,
-           np.ascontiguousarray(tree.bbox_min), np.ascontiguousarray(tree.bbox_max), cumulative, float(dim), limit,
-           out)
+    elements = tuple(np.ascontiguousarray(a, dtype=np.float64) for a in
+                     (mesh.centers, mesh.frames, half_a, half_b, mesh.radii, weight, near))
+    clusters = (tree.permutation, tree.start, tree.stop, tree.left, tree.right, np.ascontiguousarray(tree.bbox_min),
+                np.ascontiguousarray(tree.bbox_max), cumulative, float(dim))
+    alone = np.arange(m)
+    if point_tree is not None:
+        leaves = point_tree.leaves()
+        sizes = point_tree.stop[leaves] - point_tree.start[leaves]
+        members = point_tree.permutation[point_tree.start[leaves[0]]:point_tree.stop[leaves[-1]]]
+        leaf_of = np.repeat(np.arange(leaves.size), sizes)
+        leaf_limit = np.full(leaves.size, np.inf)
+        needed = limit[members] > -np.inf
+        np.minimum.at(leaf_limit, leaf_of[needed], limit[members][needed])
+        kept = np.flatnonzero(np.bincount(leaf_of[needed], minlength=leaves.size) > 0)
+        leaf_bound = np.full(leaves.size, np.inf)
+        part = np.empty(kept.size)
+        _bound(np.ascontiguousarray(point_tree.bbox_min[leaves[kept]]),
+               np.ascontiguousarray(point_tree.bbox_max[leaves[kept]]), False, *elements, *clusters, leaf_limit[kept],
+               part)
+        leaf_bound[kept] = part
+        cleared = leaf_bound < leaf_limit
+        out[members] = np.where(cleared[leaf_of], leaf_bound[leaf_of], np.inf)
+        alone = members[~cleared[leaf_of] & needed]
+    if alone.size:
+        values = np.empty(alone.size)
+        _bound(points[alone], points[alone], True, *elements, *clusters, limit[alone], values)
+        out[alone] = values
     return out
 
 

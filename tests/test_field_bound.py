@@ -82,6 +82,18 @@ def test_bound_is_above_the_exact_stress_and_not_far_above(dim):
     limited = stress_bound(mesh, mat, dd, points, near_fraction=0.5, limit=limit)
     assert np.array_equal(limited >= limit, bound >= limit)
     assert np.array_equal(limited[bound < limit], bound[bound < limit])
+    # leaves of a cluster tree of the points bounded whole first: still above the exact
+    # stress wherever it is below the limit; -inf marks points not needed
+    from hmatddm.hmatrix.cluster_tree import cluster_tree
+
+    limit = np.where(np.arange(len(points)) % 5 == 0, -np.inf, 10.0 * np.median(bound[finite]))
+    grouped = stress_bound(mesh, mat, dd, points, near_fraction=0.5, limit=limit,
+                           point_tree=cluster_tree(points, 0.0, 16))
+    below = (grouped < limit) & finite
+    assert np.count_nonzero(below) > 50
+    assert np.all(grouped[below] >= exact[below[finite]])
+    needed = limit > -np.inf
+    assert np.all((grouped < limit)[needed] <= (bound < limit)[needed])  # a leaf bound is never tighter
 
 
 def test_points_on_or_near_an_element_have_no_bound():

@@ -31,6 +31,10 @@ from ..operators import NEAR_SINGULAR_FRACTION
 from ..solve import stress_at
 
 
+#: Natural element centres per leaf of :meth:`NaturalNetwork.target_tree`.
+TARGET_LEAF_SIZE = 32
+
+
 def plan_segments(mesh):
     """Plan-view (x, y) end points of every element: the segment itself in 2D, the
     horizontal mid-line of a (vertical) rectangle in 3D, and the vertical half size."""
@@ -74,6 +78,16 @@ class NaturalNetwork:
         #: :class:`ScreenMemory` of the last screened remote-failure check (a cache: a
         #: check finds the same failures with or without it)
         self.screen_memory = None
+        self._target_tree = None
+
+    def target_tree(self):
+        """Cluster tree of the natural element centres (the remote-failure targets), built
+        at the first call (its leaves are bounded whole by the screened check)."""
+        if self._target_tree is None:
+            from ..hmatrix.cluster_tree import cluster_tree
+
+            self._target_tree = cluster_tree(self.mesh.centers, 0.0, TARGET_LEAF_SIZE)
+        return self._target_tree
 
     def encounter(self, candidate_mesh, index, hinge, intact):
         """The intact natural element cut by candidate ``index`` (hinged at ``hinge``),
@@ -145,7 +159,7 @@ class NaturalNetwork:
             memory = self.screen_memory
             if memory is None or not memory.holds(active_mesh, material, far_field, near):
                 memory = ScreenMemory.start(self, active_mesh, material, far_field, near)
-            cleared, cleared_margin = memory.clear(active_mesh, material, dd, self.mesh.centers[targets], targets)
+            cleared, cleared_margin = memory.clear(active_mesh, material, dd, self, targets)
             evaluate = targets[~cleared]
         else:
             evaluate = targets
@@ -219,14 +233,18 @@ class ScreenMemory:
                     and np.array_equal(active_mesh.frames[:n0], self.frames)
                     and np.array_equal(_sizes(active_mesh)[:n0], self.sizes))
 
-    def clear(self, active_mesh, material, dd, points, targets):
-        """``(cleared, margin)``: the targets whose induced stress cannot have changed by
-        their margin since the last check, and their margin left."""
+    def clear(self, active_mesh, material, dd, network, targets):
+        """``(cleared, margin)``: the ``targets`` (natural elements of ``network``) whose
+        induced stress cannot have changed by their margin since the last check, and
+        their margin left."""
         n0 = self.centers.shape[0]
         change = np.array(dd, dtype=float).reshape(active_mesh.n_elements, active_mesh.dim)
         change[:n0] -= self.dd
+        limit = np.full(network.mesh.n_elements, -np.inf)  # -inf: not a target
+        limit[targets] = self.margin[targets]
+        bound = stress_bound(active_mesh, material, change, network.mesh.centers, self.key[4], limit=limit,
+                             point_tree=network.target_tree())[targets]
         margin = self.margin[targets]
-        bound = stress_bound(active_mesh, material, change, points, self.key[4], limit=margin)
         cleared = bound < margin
         return cleared, margin[cleared] - bound[cleared]
 
