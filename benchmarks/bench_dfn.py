@@ -42,7 +42,9 @@ element centres (every centre of one run within 1 mm of a centre of the other).
 
 At the end of a run the remote-failure stress evaluation of the final state is timed
 three ways (``remote_check``): the default of :func:`hmatddm.stress_at` (compressed far
-field), the exact direct sum, and the per-DD-component kernel the engine used before.
+field), the exact direct sum, and the per-DD-component kernel the engine used before; then
+the screened check the run uses (``NaturalNetwork.remote_failure(screen=True)``), with no
+memory and with the margins the run left, against the full check's failures.
 
 ``OMP_WAIT_POLICY=PASSIVE`` is set (unless already set) before numba loads; see below.
 
