@@ -80,3 +80,40 @@ def test_screen_needs_a_homogeneous_medium_of_constant_elements():
     assert _screenable(hd.mesh.line([-5, 0], [5, 0], 20), mat)
     assert not _screenable(hd.mesh.line([-5, 0], [5, 0], 20, element_order=1), mat)
     assert not _screenable(hd.mesh.line([-5, 0], [5, 0], 20), object())
+
+
+def test_a_run_with_remote_failures_is_the_same_screened_or_not(monkeypatch):
+    # the scene of test_contact.py: a weak, critically stressed natural fracture fails
+    # remotely next to a pressurised crack; the run screens its checks, the reference
+    # evaluates every target at every check
+    def run():
+        mat = hd.Elastic(10e9, 0.25)
+        hf = hd.mesh.line([-2.0, 0.0], [2.0, 0.0], 8)
+        a = np.deg2rad(30.0)
+        center, tangent = np.array([3.0, 0.6]), np.array([np.cos(a), np.sin(a)])
+        far_nf = hd.mesh.line([-30.0, 20.0], [30.0, 20.0], 40, fracture_id=1)  # far: cleared by the bound
+        nf = hd.mesh.concatenate([hd.mesh.line(center - 1.0 * tangent, center + 1.0 * tangent, 4), far_nf])
+        props = NaturalFractureProperties(friction=0.3, cohesion=0.0, tensile_strength=0.0, toughness=0.5e6,
+                                          critical_radius=0.005, pore_pressure=5e6, skempton=0.5)
+        sim = hd.Simulation(hf, mat, hd.Fluid(1e-3, 1e-9), [hd.Cluster((0, 0), 1e-3, 0.0)],
+                            far_field_stress=np.diag([-14e6, -9e6]), time_step=1.0, initial_pressure=9.5e6,
+                            initial_opening=1e-4, backend="dense", natural_fractures=nf, natural=props,
+                            singular_correction="average", alpha=1.0)
+        return sim, sim.run(3.0)
+
+    screened, records = run()
+    checks = []
+    original = NaturalNetwork.remote_failure
+
+    def unscreened(self, *args, screen=False, info=None, **kwargs):
+        checks.append(screen)
+        return original(self, *args, screen=False, info=info, **kwargs)
+
+    monkeypatch.setattr(NaturalNetwork, "remote_failure", unscreened)
+    reference, reference_records = run()
+    assert checks and all(checks)  # the run screens
+    assert records[-1]["natural_failed"] > 0 and screened.network.screen_memory is not None
+    assert [r["natural_failed"] for r in records] == [r["natural_failed"] for r in reference_records]
+    np.testing.assert_array_equal(screened.state.origin, reference.state.origin)
+    np.testing.assert_array_equal(screened.state.pressure, reference.state.pressure)
+    np.testing.assert_array_equal(screened.state.dd, reference.state.dd)
