@@ -235,3 +235,55 @@ def test_the_production_build_loop_gives_the_factors_of_aca_tensor():
         assert rank == s.lowrank_rank[b]
         reference = u @ v.T
         assert np.linalg.norm(stored_u @ stored_v.T - reference) <= 1e-12 * np.linalg.norm(reference)
+
+
+def near_full_rank_field_block(seed):
+    """A far block of the rectangular field kernel (3 rows per target, 2 columns per
+    source) whose ACA needs nearly every row element: 28 targets in a cube x 32 sources
+    in a cube 2.5 cube-halves away (an eta ~ 1-2 block of the rectangular H-matrix)."""
+    from hmatddm.hmatrix.example_kernels import field_kernel
+
+    rng = np.random.default_rng(seed)
+    targets = rng.uniform(-1.0, 1.0, (28, 3))
+    sources = rng.uniform(-1.0, 1.0, (32, 3)) + np.array([2.5, 0.0, 0.0])
+    data = (targets, sources)
+    rows, cols = np.arange(28, dtype=np.int64), np.arange(32, dtype=np.int64)
+    block = np.empty((84, 64))
+    field_kernel(data, rows, cols, block)
+    return data, rows, cols, block
+
+
+@pytest.mark.parametrize("seed", [0, 5])
+@pytest.mark.parametrize("eps", [1e-4, 1e-6])
+def test_a_block_the_aca_cannot_compress_is_exact_not_approximate(seed, eps):
+    """Issue 17: on blocks where the ACA pivots on every row element, a 3 x 2 pivot
+    leaves a part of the visited rows that later crosses never recover; the loop used
+    to stop at rank 58 of 64 with a block error of 4e-3 (seed 0) and 9e-3 (seed 5)
+    whatever eps. It now gives up there and the block comes back exact (dense)."""
+    from hmatddm.hmatrix.aca import aca_compressed
+    from hmatddm.hmatrix.example_kernels import field_kernel
+
+    data, rows, cols, block = near_full_rank_field_block(seed)
+    u, v, rank = aca_tensor(field_kernel, data, rows, cols, 3, eps, 2)
+    assert relative_error(u, v, block) <= eps
+    ut, vt, compressed_rank = aca_compressed(field_kernel, data, rows, cols, 3, 2, eps)
+    if compressed_rank >= 0:  # stored low rank: it must meet eps
+        assert relative_error(ut.T, vt.T, block) <= 1.2 * eps
+    else:  # flagged for dense storage
+        assert ut.shape == (0, 84) and vt.shape == (0, 64)
+
+
+def test_giving_up_leaves_ordinary_low_rank_blocks_alone():
+    """The same kernel on a well separated block (4x farther): an ordinary low-rank ACA,
+    not given up, within eps, rank far below min(m, n)."""
+    from hmatddm.hmatrix.aca import _aca_loop, aca_gave_up
+    from hmatddm.hmatrix.example_kernels import field_kernel
+
+    data, rows, cols, _ = near_full_rank_field_block(0)
+    sources = data[1] + np.array([8.0, 0.0, 0.0])
+    block = np.empty((84, 64))
+    field_kernel((data[0], sources), rows, cols, block)
+    _, _, ints = _aca_loop(field_kernel, (data[0], sources), rows, cols, 3, 2, 1e-6)
+    assert not aca_gave_up(ints)
+    u, v, rank = aca_tensor(field_kernel, (data[0], sources), rows, cols, 3, 1e-6, 2)
+    assert rank < 40 and relative_error(u, v, block) <= 3e-6

@@ -23,6 +23,22 @@ pivot has visited (the unvisited ones farthest, in cluster-tree order, from ever
 visited one) must be small; a probe that fails becomes the next pivot and the
 iteration goes on.
 
+Blocks the ACA cannot compress: once every row element (or every column element) has
+been a pivot, the ACA has evaluated as many entries as the block holds, and pivoting
+on elements again is where its accuracy broke down: a d_r x d_c pivot with d_r > d_c,
+or a weak direction left in the residual, leaves a part of the visited rows that the
+re-pivots (chosen from the last residual columns) stopped finding, and the loop ended
+on "no residual left where I look" (rectangular 3D field blocks of 28 x 32 elements
+stopped at rank 58-62 of 64 with a block error of 1e-6 - 1e-2 whatever eps). So the
+ACA only ends normally through a passed stopping test and convergence check (or on a
+zero block); an end without them after every row or every column element was a pivot
+makes it GIVE UP by design: it stops and flags the block (:func:`aca_gave_up`), and the
+callers store and apply the block exactly (dense); the kernel fill costs no more
+entries than the ACA already spent. Full rank min(m, n) is exact in exact arithmetic
+and goes through the check like convergence. (Giving up also on rank min(m, n), or
+on a converged block with no unvisited element left to check, was tried: those
+blocks were within eps after recompression, and storing them dense cost memory.)
+
 Conventions: a block is given by its row elements (m_e of them, d_r unknowns each)
 and column elements (n_e, d_c unknowns each: a rectangular matrix, e.g. stress
 components at points x DD components of elements, has d_r != d_c; a square operator
@@ -145,9 +161,9 @@ def _best_row_element(residual_cols, visited, d):
 def _next_pivot_row(residual_cols, visited, d, revisit, negligible):
     """Row element of the next pivot: the unvisited one with the largest residual in
     the m x d_c residual columns; when every row element was a pivot once (and
-    ``revisit``), the one with the largest residual if it exceeds ``negligible``: a
-    d_r x d_c pivot with d_c < d_r (or a weak direction left by :func:`_add_cross`)
-    captures only part of a row element's rows. -1 when there is none."""
+    ``revisit``), the one with the largest residual if it exceeds ``negligible`` (a
+    d_r x d_c pivot with d_c < d_r, or a weak direction left by :func:`_add_cross`,
+    captures only part of a row element's rows). -1 when there is none."""
     row, _ = _best_row_element(residual_cols, visited, d)
     if row < 0 and revisit:
         row, norm2 = _best_row_element(residual_cols, np.zeros(visited.shape[0], dtype=np.bool_), d)
@@ -305,7 +321,7 @@ REQUEST_ROW = 1  # evaluate the d_r rows of row element `index` into `rows` (d_r
 REQUEST_COL = 2  # evaluate the d_c columns of column element `index` into `cols` (m x d_c)
 
 # Slots of the integer state array.
-_PHASE, _RANK, _FAILURES, _PROBE, _ROW, _COL, _ROW_HOP, _COL_HOP, _CHECKS, _CHECK_INDEX = range(10)
+_PHASE, _RANK, _FAILURES, _PROBE, _ROW, _COL, _ROW_HOP, _COL_HOP, _CHECKS, _CHECK_INDEX, _GAVE_UP = range(11)
 _PHASE_PIVOT_ROW, _PHASE_PIVOT_COL, _PHASE_PROBE_COL, _PHASE_CHECK_ROW, _PHASE_CHECK_COL = 0, 1, 2, 3, 4
 # Slots of the float state array.
 _SCALE, _NORM2, _EPS = range(3)
@@ -333,6 +349,45 @@ def _next_check(row_visited, col_visited, ints):
                 ints[_PHASE] = _PHASE_CHECK_COL
                 return REQUEST_COL, col
     return REQUEST_DONE, 0
+
+
+# Why the ACA gave up (ints[_GAVE_UP]; 0: it did not).
+GAVE_UP_NO_PIVOT = 1  # ended unconverged after every row or column element was a pivot
+
+
+@njit(cache=True, nogil=True)
+def _give_up(ints, reason):
+    """Stop and flag the block for exact (dense) storage (see the module docstring);
+    ``reason`` (> 0, kept in the state for diagnostics): GAVE_UP_* below."""
+    ints[_GAVE_UP] = reason
+    return REQUEST_DONE, 0
+
+
+@njit(cache=True, nogil=True)
+def _stop(ints, row_visited, col_visited):
+    """End of the ACA other than through a passed convergence check: it gives up when
+    some pivots were found and every row or every column element was a pivot (the
+    block was not converged where it had been sampled whole); otherwise (zero block,
+    zero rows left) it is done."""
+    if ints[_RANK] > 0 and (_all(row_visited) or _all(col_visited)):
+        return _give_up(ints, GAVE_UP_NO_PIVOT)
+    return REQUEST_DONE, 0
+
+
+@njit(cache=True, nogil=True)
+def _all(flags):
+    for flag in flags:
+        if not flag:
+            return False
+    return True
+
+
+@njit(cache=True, nogil=True)
+def aca_gave_up(ints):
+    """True when the ACA of this state gave up on its block: every row or column
+    element was a pivot before convergence, or the rank reached min(m, n). The factors
+    are then NOT an approximation of the block: evaluate it exactly instead."""
+    return ints[_GAVE_UP] != 0
 
 
 # Explicit signatures of the state-machine steps: with them the kernel-specific build
@@ -364,7 +419,7 @@ def aca_start(n_row_elements, n_col_elements, row_dof, col_dof, eps):
     n = n_col_elements * col_dof
     d = max(row_dof, col_dof)
     capacity = min(min(m, n) + d, 4 * d)
-    ints = np.zeros(10, dtype=np.int64)
+    ints = np.zeros(11, dtype=np.int64)
     ints[_ROW_HOP] = _coprime_hop(n_row_elements)
     ints[_COL_HOP] = _coprime_hop(n_col_elements)
     ints[_PHASE] = _PHASE_PIVOT_ROW
@@ -388,6 +443,10 @@ def aca_advance(ut, vt, rows, cols, row_visited, col_visited, ints, floats):
     the stopping test passes, the convergence check requests its probes (see
     CHECK_PROBES): a probe row with a large residual becomes the next pivot row, a
     probe column with a large residual gives the next pivot row (its largest residual).
+    When the ACA ends without a passed stopping test and check after every row or
+    every column element was a pivot (the pivots ran out, or only zero residuals were
+    left where pivots were), it gives up (REQUEST_DONE with :func:`aca_gave_up` true;
+    module docstring). Full rank is checked like convergence.
     Returns (ut, vt, request, index); ut, vt may have been reallocated to grow.
     """
     d = rows.shape[0]  # unknowns per row element
@@ -416,7 +475,8 @@ def aca_advance(ut, vt, rows, cols, row_visited, col_visited, ints, floats):
             # residual entry again (blocks with few column elements, e.g. 18 x 2 DDs)
             col, largest = _best_element(rows, np.zeros(col_visited.shape[0], dtype=np.bool_), dc)
         if col < 0:
-            return ut, vt, REQUEST_DONE, 0
+            request, index = _stop(ints, row_visited, col_visited)
+            return ut, vt, request, index
         if largest > NEGLIGIBLE * floats[_SCALE]:
             col_visited[col] = True
             ints[_COL] = col
@@ -424,11 +484,10 @@ def aca_advance(ut, vt, rows, cols, row_visited, col_visited, ints, floats):
             return ut, vt, REQUEST_COL, col
         # Zero residual row: probe an unvisited column for a row that has a residual.
         ints[_FAILURES] += 1
-        if ints[_FAILURES] >= MAX_FAILED_PIVOTS:
-            return ut, vt, REQUEST_DONE, 0
         probe = _next_unvisited(col_visited, ints[_PROBE], ints[_COL_HOP])
-        if probe < 0:
-            return ut, vt, REQUEST_DONE, 0
+        if ints[_FAILURES] >= MAX_FAILED_PIVOTS or probe < 0:
+            request, index = _stop(ints, row_visited, col_visited)
+            return ut, vt, request, index
         ints[_PROBE] = probe
         ints[_PHASE] = _PHASE_PROBE_COL
         return ut, vt, REQUEST_COL, probe
@@ -444,7 +503,8 @@ def aca_advance(ut, vt, rows, cols, row_visited, col_visited, ints, floats):
         ints[_CHECKS] = 0  # the check failed: pivot on this column's largest residual row
         row = _next_pivot_row(cols, row_visited, d, rank < max_rank, NEGLIGIBLE * floats[_SCALE])
         if row < 0:
-            return ut, vt, REQUEST_DONE, 0
+            request, index = _stop(ints, row_visited, col_visited)
+            return ut, vt, request, index
         row_visited[row] = True
         ints[_ROW] = row
         ints[_PHASE] = _PHASE_PIVOT_ROW
@@ -461,7 +521,8 @@ def aca_advance(ut, vt, rows, cols, row_visited, col_visited, ints, floats):
             if row < 0 and rank < max_rank:
                 row = _next_pivot_row(cols, row_visited, d, True, NEGLIGIBLE * floats[_SCALE])
         if row < 0:
-            return ut, vt, REQUEST_DONE, 0
+            request, index = _stop(ints, row_visited, col_visited)
+            return ut, vt, request, index
         row_visited[row] = True
         ints[_ROW] = row
         ints[_PHASE] = _PHASE_PIVOT_ROW
@@ -479,14 +540,14 @@ def aca_advance(ut, vt, rows, cols, row_visited, col_visited, ints, floats):
     ints[_RANK] = rank
     floats[_NORM2] = max(floats[_NORM2] + update_norm2 + cross, 0.0)
     ints[_FAILURES] = 0
-    if rank >= max_rank:
-        return ut, vt, REQUEST_DONE, 0
-    if update_norm2 <= floats[_EPS] ** 2 * floats[_NORM2]:
+    if rank >= max_rank or update_norm2 <= floats[_EPS] ** 2 * floats[_NORM2]:
+        # converged, or full rank (exact in exact arithmetic: the check measures it)
         request, index = _next_check(row_visited, col_visited, ints)
         return ut, vt, request, index
     row = _next_pivot_row(cols, row_visited, d, True, NEGLIGIBLE * floats[_SCALE])
     if row < 0:
-        return ut, vt, REQUEST_DONE, 0
+        request, index = _stop(ints, row_visited, col_visited)
+        return ut, vt, request, index
     row_visited[row] = True
     ints[_ROW] = row
     ints[_PHASE] = _PHASE_PIVOT_ROW
@@ -520,19 +581,31 @@ def aca_tensor(kernel, data, row_elements, col_elements, dof, eps, col_dof=0):
     the last update satisfies ||U_k V_k^T||_F <= eps ||S_k||_F (the norm of the
     approximation S_k is updated incrementally, cross terms included) and the
     convergence check passes (unvisited probe rows and columns with a residual
-    below CHECK_FACTOR * eps ||S_k||_F, extrapolated to the block), when the rank
-    reaches min(m, n), or when every row or column element has been used.
+    below CHECK_FACTOR * eps ||S_k||_F, extrapolated to the block). When it gives up
+    (every row or column element used before convergence, or rank min(m, n): see
+    the module docstring) the block is evaluated exactly and returned as an exact
+    factorisation (U = block, V = identity, or U = identity, V = block^T; rank
+    min(m, n)), as the build stores it dense.
 
     Returns (U, V, rank) with U (m x rank), V (n x rank); rank 0 for a zero block.
     """
-    ut, vt, ints = _aca_loop(kernel, data, row_elements, col_elements, dof, col_dof if col_dof > 0 else dof, eps)
+    col_dof = col_dof if col_dof > 0 else dof
+    ut, vt, ints = _aca_loop(kernel, data, row_elements, col_elements, dof, col_dof, eps)
+    if aca_gave_up(ints):
+        m, n = dof * row_elements.shape[0], col_dof * col_elements.shape[0]
+        block = np.empty((m, n))
+        kernel(data, row_elements, col_elements, block)
+        if m <= n:
+            return np.eye(m), np.ascontiguousarray(block.T), m
+        return block, np.eye(n), n
     return aca_result(ut, vt, ints)
 
 
 @njit(nogil=True)
 def _aca_loop(kernel, data, row_elements, col_elements, row_dof, col_dof, eps):
     """Drive the ACA state machine (aca_start / aca_advance) to the end, evaluating the
-    requested row and column elements with ``kernel``; returns (ut, vt, ints)."""
+    requested row and column elements with ``kernel``; returns (ut, vt, ints). When
+    ``aca_gave_up(ints)`` the factors are no approximation: use the exact block."""
     ut, vt, rows, cols, row_visited, col_visited, ints, floats, request, index = aca_start(
         row_elements.shape[0], col_elements.shape[0], row_dof, col_dof, eps)
     while request != REQUEST_DONE:
@@ -550,9 +623,12 @@ def aca_compressed(kernel, data, row_elements, col_elements, row_dof, col_dof, e
     :func:`aca_tensor` at ``ACA_TOLERANCE_FACTOR * eps``, recompressed at ``eps``.
 
     Returns the TRANSPOSED factors (U'^T, V'^T) with ``rank`` rows in use, and the rank
-    (the build driver, hmatrix/storage.py, calls exactly this function).
+    (the build driver, hmatrix/storage.py, calls exactly this function); rank -1 (and
+    empty factors) when the ACA gave up: the block is to be stored dense.
     """
     ut, vt, ints = _aca_loop(kernel, data, row_elements, col_elements, row_dof, col_dof, ACA_TOLERANCE_FACTOR * eps)
+    if aca_gave_up(ints):
+        return np.zeros((0, ut.shape[1])), np.zeros((0, vt.shape[1])), -1
     return recompress_transposed(ut, vt, ints[_RANK], eps)
 
 

@@ -14,7 +14,7 @@ import numpy as np
 from numba import njit, types
 
 from ..errors import InputError
-from .aca import _RANK, _aca_loop
+from .aca import _RANK, _aca_loop, aca_gave_up
 from .block_tree import block_tree
 from .cluster_tree import cluster_tree
 from .generator import BlockGenerator
@@ -29,7 +29,7 @@ def _apply_blocks(kernel, data, row_permutation, col_permutation, row_dof, col_d
     Compiled per kernel data type by :func:`product_driver` (the kernel arrives as a
     first-class function, as in the build driver of hmatrix/storage.py, so the compiled
     driver is cached on disk). Admissible blocks: ``_aca_loop`` at ``eps``, then
-    ``y += U (V^T x)``; the others, and those whose ACA rank does not pay
+    ``y += U (V^T x)``; the others, those the ACA gave up on, and those whose ACA rank does not pay
     (``rank (m + n) >= m n``, which the build stores dense too): kernel fill of the
     block, then ``y += B x``.
     """
@@ -46,7 +46,7 @@ def _apply_blocks(kernel, data, row_permutation, col_permutation, row_dof, col_d
                 xb[col_dof * c + q] = x[col_dof * cols[c] + q]
         if admissible[b]:
             ut, vt, ints = _aca_loop(kernel, data, rows, cols, row_dof, col_dof, eps)
-        if admissible[b] and ints[_RANK] * (m + n) < m * n:
+        if admissible[b] and not aca_gave_up(ints) and ints[_RANK] * (m + n) < m * n:
             for k in range(ints[_RANK]):
                 s = 0.0
                 for c in range(n):

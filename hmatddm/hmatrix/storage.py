@@ -140,8 +140,9 @@ def _build_blocks(kernel, data, row_permutation, col_permutation, row_dof, col_d
     Inadmissible blocks are filled by the kernel straight into
     ``dense_values[dense_offset[b]:]`` (the final array). Admissible blocks get
     :func:`~hmatddm.hmatrix.aca.aca_compressed` (ACA plus recompression, the function
-    the ACA tests call); their factors (or, when the rank does not pay, their exact
-    dense values) are appended to batch-local buffers returned at the end.
+    the ACA tests call); their factors (or, when the rank does not pay or the ACA gave
+    up on the block, rank -1, their exact dense values) are appended to batch-local
+    buffers returned at the end.
     Returns (rank per block, stored-dense flag per block, U values, V values, dense
     values of the far blocks stored dense), factors in batch order.
     """
@@ -164,8 +165,8 @@ def _build_blocks(kernel, data, row_permutation, col_permutation, row_dof, col_d
             kernel(data, rows, cols, target)
             continue
         ut, vt, rank = aca_compressed(kernel, data, rows, cols, row_dof, col_dof, eps)
-        ranks[b] = rank
-        if rank * (m + n) >= m * n:
+        ranks[b] = rank if rank >= 0 else min(m, n)
+        if rank < 0 or rank * (m + n) >= m * n:
             stored_dense[b] = True
             far_dense = _reserve(far_dense, far_used, m * n)
             target = far_dense[far_used:far_used + m * n].reshape((m, n))
