@@ -226,11 +226,12 @@ def sampled_smooth_error(mesh, data, y, n_rows=300, chunk=10):
     return float(np.linalg.norm(y[index] - exact) / np.linalg.norm(exact))
 
 
-def memory_case(n, eps=1e-4, leaf_size=32, near_dtype="float64", geometry="planar"):
+def memory_case(n, eps=1e-4, leaf_size=32, near_dtype="float64", geometry="planar", boxes="axis"):
     """Planar crack (or cloud, fractures-first tree as ElasticityOperator builds it) of N elements: where the H-matrix memory goes (near-field dense
     blocks, far blocks stored dense, low-rank factors, index), build wall and CPU time,
     peak RSS and the sampled smooth-field error, with the near field stored as
-    ``near_dtype``. Returns a dict (run in a fresh process by --memory-study)."""
+    ``near_dtype``, admissibility on ``boxes`` ("axis" or "oriented"). Returns a dict (run in a fresh process by
+    --memory-study)."""
     import hmatddm as hd
     from _common import peak_rss_bytes
     from hmatddm.hmatrix import BlockGenerator, HMatrix
@@ -245,12 +246,13 @@ def memory_case(n, eps=1e-4, leaf_size=32, near_dtype="float64", geometry="plana
         load = float(f.read().split()[0])
     t0, c0 = time.perf_counter(), time.process_time()
     h = HMatrix.build(generator, eps=eps, eta=3.0, leaf_size=leaf_size, near_dtype=np.dtype(near_dtype),
-                      groups=groups)
+                      groups=groups, boxes=boxes)
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     s = h.storage
     near = int(sum(s.dense_offset[b + 1] - s.dense_offset[b] for b in np.flatnonzero(s.dense_is_near)))
     item = s.dense_values.itemsize
-    row = dict(geometry=geometry, n=mesh.n_elements, eps=eps, leaf_size=leaf_size, near_dtype=str(np.dtype(near_dtype)),
+    row = dict(geometry=geometry, boxes=boxes, n=mesh.n_elements, eps=eps, leaf_size=leaf_size,
+               near_dtype=str(np.dtype(near_dtype)), n_admissible=int(s.admissible_kind.size),
                build_s=wall, build_cpu_s=cpu, load_before=load, memory_mb=s.memory_bytes / 2**20,
                near_mb=near * item / 2**20, far_dense_mb=(s.dense_values.size - near) * item / 2**20,
                lowrank_mb=(s.u_values.nbytes + s.v_values.nbytes) / 2**20, index_mb=s.index_bytes / 2**20,
@@ -269,10 +271,10 @@ def memory_case(n, eps=1e-4, leaf_size=32, near_dtype="float64", geometry="plana
 def memory_table(rows):
     from _common import markdown_table
 
-    header = ["geometry", "N", "eps", "leaf", "near field", "build wall / CPU (s)", "load", "H memory (MB)", "near field (MB)",
+    header = ["geometry", "boxes", "N", "eps", "leaf", "near field", "build wall / CPU (s)", "load", "H memory (MB)", "near field (MB)",
               "far dense (MB)", "low-rank (MB)", "KB / element", "mean / max rank", "peak RSS (MB)",
               "smooth-field error (sampled)"]
-    body = [[r.get("geometry", "planar"), r["n"], f"{r['eps']:.0e}", r["leaf_size"], r["near_dtype"], f"{r['build_s']:.1f} / {r['build_cpu_s']:.1f}",
+    body = [[r.get("geometry", "planar"), r.get("boxes", "axis"), r["n"], f"{r['eps']:.0e}", r["leaf_size"], r["near_dtype"], f"{r['build_s']:.1f} / {r['build_cpu_s']:.1f}",
              f"{r['load_before']:.1f}", f"{r['memory_mb']:.0f}", f"{r['near_mb']:.0f}", f"{r['far_dense_mb']:.0f}",
              f"{r['lowrank_mb']:.0f}", f"{r['kb_per_element']:.1f}", f"{r['mean_rank']:.1f} / {r['max_rank']}",
              f"{r['peak_rss_mb']:.0f}", f"{r['smooth_error']:.1e}"] for r in rows if "failed" not in r]
@@ -282,7 +284,8 @@ def memory_table(rows):
 def memory_slopes(rows):
     """Log-log slopes of build CPU time and memory against N per (geometry, eps, leaf, near dtype)."""
     out = {}
-    variant = lambda r: (r.get("geometry", "planar"), r["eps"], r["leaf_size"], r["near_dtype"])  # noqa: E731
+    variant = lambda r: (r.get("geometry", "planar") + ("" if r.get("boxes", "axis") == "axis" else " oriented"),  # noqa: E731
+                         r["eps"], r["leaf_size"], r["near_dtype"])
     for key in sorted({variant(r) for r in rows if "failed" not in r}):
         sel = sorted((r for r in rows if "failed" not in r and variant(r) == key), key=lambda r: r["n"])
         if len(sel) >= 2:
@@ -293,9 +296,9 @@ def memory_slopes(rows):
     return out
 
 
-def spawn_memory(n, eps, leaf_size, near_dtype, geometry="planar"):
+def spawn_memory(n, eps, leaf_size, near_dtype, geometry="planar", boxes="axis"):
     cmd = [sys.executable, os.path.abspath(__file__), "--memory-case", json.dumps(
-        dict(n=n, eps=eps, leaf_size=leaf_size, near_dtype=near_dtype, geometry=geometry))]
+        dict(n=n, eps=eps, leaf_size=leaf_size, near_dtype=near_dtype, geometry=geometry, boxes=boxes))]
     print("  running", cmd[-1], flush=True)
     result = subprocess.run(cmd, capture_output=True, text=True, cwd=HERE)
     if result.returncode != 0:
@@ -464,7 +467,8 @@ def main():
     parser.add_argument("--memory-study", default=None, metavar="N,N,...",
                         help="memory per element by kind (near field, low rank) and its growth, then exit")
     parser.add_argument("--variants", default="1e-4:32:float64,1e-4:32:float32",
-                        help="memory study: comma-separated eps:leaf:near_dtype[:geometry] (geometry planar or cloud)")
+                        help="memory study: comma-separated eps:leaf:near_dtype[:geometry[:boxes]] (geometry planar or "
+                             "cloud; boxes axis or oriented: admissibility on axis-aligned or oriented cluster boxes)")
     parser.add_argument("--memory-case", default=None, help=argparse.SUPPRESS)
     args = parser.parse_args()
     sys.path.insert(0, HERE)
@@ -478,8 +482,9 @@ def main():
         rows = []
         for n in (int(v) for v in args.memory_study.split(",")):
             for variant in args.variants.split(","):
-                eps, leaf, near_dtype, geometry = (variant + ":planar").split(":")[:4]
-                rows.append(spawn_memory(n, float(eps), int(leaf), near_dtype, geometry))
+                parts = variant.split(":")
+                eps, leaf, near_dtype, geometry, boxes = parts + ["planar", "axis"][len(parts) - 3:]
+                rows.append(spawn_memory(n, float(eps), int(leaf), near_dtype, geometry, boxes))
                 print(json.dumps(rows[-1]), flush=True)
         os.makedirs(OUT, exist_ok=True)
         with open(os.path.join(OUT, "hmatrix_memory.json"), "w") as f:

@@ -92,7 +92,7 @@ class HMatrix(LinearOperator):
     # ------------------------------------------------------------------ construction
     @classmethod
     def build(cls, generator, eps=1e-4, eta=3.0, leaf_size=64, factor_dtype=None, check_finite=False, groups=None,
-              col_leaf_size=None, near_dtype=np.float64):
+              col_leaf_size=None, near_dtype=np.float64, boxes="axis"):
         """Cluster, partition and compress the matrix of ``generator``.
 
         Parameters
@@ -123,6 +123,10 @@ class HMatrix(LinearOperator):
         groups : (N,) int array, optional
             Group of each element (e.g. its fracture): clusters are split between
             whole groups first (see :func:`~hmatddm.hmatrix.cluster_tree.cluster_tree`).
+        boxes : "axis" (default) or "oriented"
+            Admissibility on axis-aligned bounding boxes, or also on the clusters'
+            principal-axis boxes (thin boxes of tilted or vertical fractures at any
+            strike; see :mod:`~hmatddm.hmatrix.block_tree`).
         col_leaf_size : int >= 1, optional
             Leaf size of the column tree of a rectangular generator (default
             ``leaf_size``); the row tree is built on ``generator.points``, the column
@@ -143,7 +147,7 @@ class HMatrix(LinearOperator):
         col_tree = tree
         if generator.rectangular:
             col_tree = cluster_tree(generator.col_points, generator.col_radii, int(col_leaf_size))
-        blocks = block_tree(tree, float(eta), col_tree=col_tree)
+        blocks = block_tree(tree, float(eta), col_tree=col_tree, boxes=boxes)
         try:
             storage = assemble(generator, tree, blocks, float(eps), factor_dtype=dtype, col_tree=col_tree,
                                near_dtype=near_dtype)
