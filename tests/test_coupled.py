@@ -147,3 +147,19 @@ def test_contraction_rule_needs_a_fast_contraction():
     assert not _converged("change", 100.0, [1e6])
     with pytest.raises(hd.errors.InputError, match="stopping"):
         SchemeSettings(stopping="guess")
+
+
+def test_a_loose_first_solve_is_never_accepted():
+    # a guess whose residual is already below first_linear_rtol comes back unchanged from
+    # the first GMRES solve (change 0): it must still be checked at linear_rtol
+    mesh = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 8.0, 8.0, 8, 8)
+    problem, dd0, p0 = _problem(mesh, rate=1e-2, viscosity=1e-5)
+    tight = SchemeSettings(scheme="krylov", tolerance_pressure=1e-10, tolerance_opening=1e-10, linear_rtol=1e-12,
+                           stopping="change")
+    dd_ref, p_ref, _ = solve_step(problem, tight, dd0, p0, 1.0)
+    problem, _, _ = _problem(mesh, rate=1e-2, viscosity=1e-5)
+    loose = SchemeSettings(scheme="krylov", linear_rtol=1e-12, first_linear_rtol=0.5)
+    dd, p, info = solve_step(problem, loose, 1.01 * dd_ref, 1.001 * p_ref, 1.0)
+    assert info["nonlinear_iterations"] >= 2
+    np.testing.assert_allclose(p, p_ref, atol=1e-6 * np.abs(p_ref).max())
+    np.testing.assert_allclose(dd, dd_ref, atol=1e-6 * np.abs(dd_ref).max())

@@ -28,7 +28,9 @@ contract ~200-1000x per iteration: the accepted iterate differs from the one ``"
 accepts an iteration later by less than the tolerance, and a solve takes two iterations
 instead of three. The first
 iteration of a solve starts far from the fixed point and only feeds the next one, whose
-change is checked: its GMRES asks ``first_linear_rtol`` (at least ``linear_rtol``).
+change is checked: its GMRES asks ``first_linear_rtol`` (at least ``linear_rtol``), and
+its iterate is never accepted (a guess whose residual is already below that tolerance
+comes back unchanged: the next iteration checks it at ``linear_rtol``).
 
 Segregated schemes relax (ref. Eq. 4.47) with ``alpha``; when an iteration diverges
 or does not converge, ``alpha`` is halved and the step restarted (ref. Fig. 4.10).
@@ -361,7 +363,11 @@ def solve_step(problem, settings, dd_guess, p_guess, relaxation):
                 contact_changes += changed
                 # the change in units of the tolerances
                 change = max(change_p / settings.tolerance_pressure, change_u / settings.tolerance_opening)
-                if _converged(settings.stopping, change, history) and changed == 0:
+                # a loosely solved first iteration may return its guess (its residual already
+                # below first_linear_rtol): only a full-accuracy iterate can be accepted
+                loose = iteration == 0 and iterate is _coupled_iteration and \
+                    settings.first_linear_rtol > settings.linear_rtol
+                if not loose and _converged(settings.stopping, change, history) and changed == 0:
                     info = dict(nonlinear_iterations=counters["nonlinear"], linear_iterations=counters["linear"],
                                 relaxation=alpha, restarts=restarts, solve_seconds=time.perf_counter() - start,
                                 contact_changes=contact_changes)
