@@ -16,15 +16,15 @@ The influence of a node's shape function is the sum of
 Kernel data: :class:`LayeredNodalSegments` (``2 n`` unknowns per element, node-major),
 served by the drivers of :mod:`hmatddm.kernels.drivers`.
 """
-from typing import NamedTuple
-
 import numpy as np
 from numba import njit
 
-from .kernels.drivers import KernelKind, influence_matrix, no_source_state, register_kind, self_block_max, stress_sum
-from .kernels.line2d_higher_order import (edge_distance, near_distance, node_point, set_node_rows, stress_nodes,
-                                          traction_nodes)
-from .layered.images2d import composite_rule, image_element_stress, subdivisions
+from .kernels.drivers import (KernelKind, finite_stress_sum, influence_matrix, kernel_record, no_source_state,
+                              register_kind, with_self_max)
+from .kernels.line2d import SEGMENT_FIELDS
+from .kernels.line2d_higher_order import (SHAPE_FIELDS, edge_distance, near_distance, node_point, set_node_rows,
+                                          stress_nodes, traction_nodes)
+from .layered.images2d import LAYERED_FIELDS, composite_rule, image_element_stress, subdivisions
 
 
 @njit(cache=True)
@@ -54,33 +54,11 @@ def image_nodes(point, receiver_layer, center, frame, a, source_layer, coefficie
                          poisson_ratio, n_images, xi, weight, _shape_values(coefficients, xi), out)
 
 
-class LayeredNodalSegments(NamedTuple):
-    """Kernel data of linear and quadratic 2D elements in a layered medium (the record
-    :mod:`hmatddm.kernels.drivers` take): :class:`hmatddm.layered.images2d.LayeredSegments`
-    plus the shape functions."""
-
-    centers: np.ndarray  #: (N, 2) element midpoints
-    frames: np.ndarray  #: (N, 2, 2) rows: unit tangent, unit normal
-    half_length: np.ndarray  #: (N,) half lengths
-    layer: np.ndarray  #: (N,) int64 layer of each element
-    interfaces: np.ndarray  #: (L - 1,) interface heights, top down
-    shear_modulus: np.ndarray  #: (L,) per layer (0: void)
-    poisson_ratio: np.ndarray  #: (L,) per layer
-    n_images: int  #: reflections per interface (ref. Fig. 3.4)
-    gauss_points: int  #: Gauss-Legendre points per sub-segment of the image quadrature (ref. Table 3.2)
-    max_subdivisions: int  #: largest number of sub-segments (:func:`hmatddm.layered.images2d.subdivisions`)
-    singular_shift: float  #: see :mod:`hmatddm.kernels.drivers` (singular points)
-    near_fraction: float  #: near-miss distance, fraction of the smaller half size
-    alpha: float  #: ref. Eq. 6.11 scaling (0: none)
-    self_max: np.ndarray  #: (N,) largest |entry| of each self block (ref. Eq. 6.11)
-    coefficients: np.ndarray  #: (n, 3) monomial coefficients of the n shape functions
-    nodes: np.ndarray  #: (n,) intrinsic coordinates of the collocation nodes
-
-
-@njit(cache=True, inline="always")
-def unknowns(data):
-    """``2 n`` unknowns per element (n nodes, global DD x, y each)."""
-    return 2 * data.nodes.shape[0]
+LayeredNodalSegments = kernel_record(
+    "LayeredNodalSegments", __name__,
+    "Kernel data of linear and quadratic 2D elements in a layered medium (the record :mod:`hmatddm.kernels.drivers` "
+    "take): :class:`hmatddm.layered.images2d.LayeredSegments` plus the shape functions.",
+    SEGMENT_FIELDS + LAYERED_FIELDS, SHAPE_FIELDS)
 
 
 @njit(cache=True)
@@ -144,7 +122,7 @@ def element_stress(data, point, point_layer, j, work, out):
         nodal += image
 
 
-register_kind(LayeredNodalSegments, KernelKind(unknowns, workspace, no_source_state, element_traction, element_stress,
+register_kind(LayeredNodalSegments, KernelKind(workspace, no_source_state, element_traction, element_stress,
                                                edge_distance))
 
 
@@ -171,11 +149,8 @@ def influence_data(mesh, medium, singular_shift, alpha, near_fraction, n_images,
     from .shape_functions import coefficients, nodes
 
     constant = _constant_data(mesh, medium, singular_shift, near_fraction, n_images, gauss_points, max_subdivisions)
-    data = LayeredNodalSegments(*constant._replace(alpha=float(alpha)), coefficients(mesh.element_order),
-                                nodes(mesh.element_order))
-    if alpha > 0.0:
-        self_block_max(data, data.self_max)
-    return data
+    return with_self_max(LayeredNodalSegments(*constant._replace(alpha=float(alpha)), coefficients(mesh.element_order),
+                                              nodes(mesh.element_order)))
 
 
 def image_count(mesh, medium, singular_shift=0.0):
@@ -203,14 +178,7 @@ def stress_at(mesh, medium, dd, points, singular_correction="none", near_fractio
     dd = np.ascontiguousarray(nodal_array("dd", dd, mesh))
     data = influence_data(mesh, medium, 1e-3 if singular_correction == "average" else 0.0, 0.0, near_fraction,
                           n_images)
-    out = stress_sum(data, points, dd, medium.layer_of(points[:, 1]).astype(np.int64))
-    bad = np.flatnonzero(~np.all(np.isfinite(out.reshape(len(points), -1)), axis=1))
-    if bad.size:
-        from .errors import InputError
-
-        raise InputError(f"points[{int(bad[0])}] lies on an element end, where the stress is singular; move it or "
-                         "pass singular_correction='average'")
-    return out
+    return finite_stress_sum(data, points, dd, medium.layer_of(points[:, 1]).astype(np.int64), "element end")
 
 
 

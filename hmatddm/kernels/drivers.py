@@ -8,8 +8,8 @@ each kind of element (:mod:`.line2d`, :mod:`.rectangle3d`, :mod:`.line2d_higher_
 element pairs, the reference's scaling of blocks larger than the self-influence
 (ref. Eq. 6.11) and the parallel assembly live here, once.
 
-Kernel data are records (``typing.NamedTuple``, read by field name inside numba; flat:
-numba's parallel loops take no nested tuples), one class per kind of element. Every
+Kernel data are flat records (``typing.NamedTuple``, read by field name inside numba),
+one class per kind of element. Every
 record has the fields
 
 * ``centers`` (N, dim): element centres;
@@ -26,12 +26,13 @@ record has the fields
 * ``self_max`` (N,): the largest |entry| of each element's self block (zeros when
   ``alpha == 0``),
 
-plus its own geometry and material. A kind of element registers six ``@njit`` functions,
-each taking its record first (:class:`KernelKind`, :func:`register_kind`):
+plus its own geometry and material (:func:`kernel_record` makes the classes). Element
+``e`` owns unknowns ``d e .. d e + d - 1`` (docs/conventions.md §2), ``d`` =
+:func:`element_unknowns`: the dimension (the frames' size) times the nodes per element
+(the length of a ``nodes`` field; one without it). A kind of element registers five
+``@njit`` functions, each taking its record first (:class:`KernelKind`,
+:func:`register_kind`):
 
-``unknowns(data) -> int``
-    Unknowns per element ``d`` (``dim`` times the nodes per element); element ``e`` owns
-    unknowns ``d e .. d e + d - 1`` (docs/conventions.md §2).
 ``workspace(data) -> tuple``
     Scratch arrays, allocated once per driver call (and per thread).
 ``source_state(data, j, work)``
@@ -48,23 +49,56 @@ each taking its record first (:class:`KernelKind`, :func:`register_kind`):
 ``edge_distance(data, i, j) -> float``
     Distance from the collocation point(s) of ``i`` to the nearest edge (end) of ``j``.
 
-The drivers are compiled once per record type and cached on disk (``cache=True``). The
-cache of a driver does not notice edits in a kind's module: delete
-``hmatddm/**/__pycache__/*.nbi|*.nbc`` after changing a kernel.
+Compiled entry points are few on purpose, as each one compiles (and LLVM optimises) the
+whole per-pair kernel it calls again: per record type only :func:`traction_block` (the
+H-matrix's block generator, with exactly the signature the H-matrix build calls it with),
+:func:`stress_block` and :func:`edge_distance`. The dense matrix, the stress at many
+points, the singular-pair test and the self-block maxima call those two from Python
+(in parallel on numba's thread count where it pays: the compiled drivers release the GIL).
+The drivers are cached on disk (``cache=True``); the cache of a driver does not notice
+edits in a kind's module: delete ``hmatddm/**/__pycache__/*.nbi|*.nbc`` after changing a
+kernel.
 """
+import inspect
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
+from typing import NamedTuple
+
+import numba
 import numpy as np
-from numba import njit, prange
+from numba import njit
 from numba.extending import overload
 
 from .correction import scale_to_self
 
+#: The fields every kernel record has, after its geometry and material: (name, type,
+#: description) as :func:`kernel_record` takes them.
+COMMON_FIELDS = (
+    ("singular_shift", float, "see :mod:`hmatddm.kernels.drivers` (singular points)"),
+    ("near_fraction", float, "near-miss distance, fraction of the smaller half size"),
+    ("alpha", float, "ref. Eq. 6.11 scaling (0: none)"),
+    ("self_max", np.ndarray, "(N,) largest |entry| of each self block (ref. Eq. 6.11)"),
+)
+#: The material fields of a homogeneous medium.
+HOMOGENEOUS_FIELDS = (("shear_modulus", float, "G (Pa)"), ("poisson_ratio", float, "nu"))
+
+
+def kernel_record(name, module, summary, fields, extra=()):
+    """A kernel data record class (``typing.NamedTuple``) named ``name``, defined in
+    ``module`` (pass ``__name__``; assign it there to the same name): its ``fields``
+    (geometry and material), then :data:`COMMON_FIELDS`, then ``extra``, each a
+    ``(name, type, description)``; the docstring is ``summary`` and the field list."""
+    every = (*fields, *COMMON_FIELDS, *extra)
+    record = NamedTuple(name, [(field, kind) for field, kind, _ in every])
+    record.__module__ = module
+    record.__doc__ = summary + "\n\nFields:\n\n" + "\n".join(f"* ``{field}``: {text}" for field, _, text in every)
+    return record
+
 
 @dataclass(frozen=True)
 class KernelKind:
-    """The six per-element functions of one kind of kernel data (see the module docstring)."""
+    """The five per-element functions of one kind of kernel data (see the module docstring)."""
 
-    unknowns: object
     workspace: object
     source_state: object
     element_traction: object
@@ -96,93 +130,72 @@ def no_source_state(data, j, work):
     return 0
 
 
-# -- the per-kind hooks: plain Python for Python callers, resolved by type inside numba --
 def element_unknowns(data):
-    """Unknowns per element of ``data``'s kind."""
-    return int(kind_of(data).unknowns(data))
-
-
-def _workspace(data):
-    return kind_of(data).workspace(data)
-
-
-def _source_state(data, j, work):
-    return kind_of(data).source_state(data, j, work)
-
-
-def _element_traction(data, i, j, state, work, block):
-    kind_of(data).element_traction(data, i, j, state, work, block)
-
-
-def _element_stress(data, point, point_layer, j, work, out):
-    kind_of(data).element_stress(data, point, point_layer, j, work, out)
-
-
-def _edge_distance(data, i, j):
-    return kind_of(data).edge_distance(data, i, j)
+    """Unknowns per element of ``data``'s kind: the dimension (the frames' size) times
+    the nodes per element (a ``nodes`` field's length; one without it)."""
+    kind_of(data)
+    return int(data.frames.shape[1]) * (len(data.nodes) if hasattr(data, "nodes") else 1)
 
 
 @overload(element_unknowns, inline="always")
 def _overload_unknowns(data):
-    function = kind_of(data).unknowns
-
-    def impl(data):
-        return function(data)
-    return impl
-
-
-@overload(_workspace, inline="always")
-def _overload_workspace(data):
-    function = kind_of(data).workspace
-
-    def impl(data):
-        return function(data)
-    return impl
+    kind_of(data)
+    if "nodes" in data.fields:
+        return lambda data: data.frames.shape[1] * data.nodes.shape[0]
+    return lambda data: data.frames.shape[1]
 
 
-@overload(_source_state, inline="always")
-def _overload_source_state(data, j, work):
-    function = kind_of(data).source_state
+def _per_kind(stub):
+    """The function of :class:`KernelKind` named as ``stub`` (less its underscore), called
+    for ``data``'s kind: plain Python for Python callers; inside numba the kind's function
+    is compiled in place (inlined), resolved by the record type. ``stub`` gives the
+    signature (the kinds' functions use the same argument names) and the docstring."""
+    name = stub.__name__.lstrip("_")
 
-    def impl(data, j, work):
-        return function(data, j, work)
-    return impl
+    def function(data, *args):
+        return getattr(kind_of(data), name)(data, *args)
 
+    def resolve(data, *args):
+        return getattr(kind_of(data), name).py_func
 
-@overload(_element_traction, inline="always")
-def _overload_element_traction(data, i, j, state, work, block):
-    function = kind_of(data).element_traction
-
-    def impl(data, i, j, state, work, block):
-        function(data, i, j, state, work, block)
-    return impl
-
-
-@overload(_element_stress, inline="always")
-def _overload_element_stress(data, point, point_layer, j, work, out):
-    function = kind_of(data).element_stress
-
-    def impl(data, point, point_layer, j, work, out):
-        function(data, point, point_layer, j, work, out)
-    return impl
+    function.__signature__ = resolve.__signature__ = inspect.signature(stub)
+    function.__name__, function.__qualname__, function.__doc__ = stub.__name__, stub.__qualname__, stub.__doc__
+    overload(function, inline="always")(resolve)
+    return function
 
 
-@overload(_edge_distance, inline="always")
-def _overload_edge_distance(data, i, j):
-    function = kind_of(data).edge_distance
-
-    def impl(data, i, j):
-        return function(data, i, j)
-    return impl
+@_per_kind
+def _workspace(data):
+    """Scratch arrays of ``data``'s kind."""
 
 
-# -- the drivers ---------------------------------------------------------------------------
+@_per_kind
+def _source_state(data, j, work):
+    """What the receivers of source ``j`` share."""
+
+
+@_per_kind
+def _element_traction(data, i, j, state, work, block):
+    """``block`` (d, d): the unscaled block of receiver ``i`` and source ``j``."""
+
+
+@_per_kind
+def _element_stress(data, point, point_layer, j, work, out):
+    """``out`` (d, dim, dim): stress at ``point`` per unit DD unknown of source ``j``."""
+
+
+@_per_kind
+def _edge_distance(data, i, j):
+    """Distance from the collocation point(s) of ``i`` to the nearest edge of ``j``."""
+
+
+# -- the compiled drivers ------------------------------------------------------------------
 @njit(cache=True)
 def _fill_receiver(data, i, cols, out, row, work, block):
     """``out[row + p, d jb + q]``: the blocks of receiver ``i`` from the sources ``cols``,
     scaled by ref. Eq. 6.11 when ``alpha > 0`` (off the diagonal); for kinds whose
     receivers share nothing about a source (rows written contiguously)."""
-    dof = element_unknowns(data)  # a constant of most kinds: the copy loops unroll
+    dof = block.shape[0]
     alpha = data.alpha
     for jb in range(cols.shape[0]):
         j = cols[jb]
@@ -199,7 +212,7 @@ def _fill_source(data, j, rows, out, column, work, block):
     """``out[d ia + p, column + q]``: the blocks of source ``j`` at the receivers ``rows``
     (its ``source_state`` made once), scaled as :func:`_fill_receiver`."""
     state = _source_state(data, j, work)
-    dof = element_unknowns(data)
+    dof = block.shape[0]
     alpha = data.alpha
     for ia in range(rows.shape[0]):
         i = rows[ia]
@@ -211,18 +224,14 @@ def _fill_source(data, j, rows, out, column, work, block):
                 out[dof * ia + p, column + q] = block[p, q]
 
 
+def _shares_source_state(data):
+    """True for kinds with a ``source_state`` (blocks are filled source by source)."""
+    return kind_of(data).source_state is not no_source_state
+
+
 def _fill_block(data, rows, cols, out, work, block):
     """``rows`` x ``cols`` into ``out``: receiver by receiver, or source by source for
     kinds with a ``source_state`` (numba picks the loop by the record type)."""
-
-
-def _fill_matrix_part(data, k, everything, out, work, block):
-    """Part ``k`` of the dense matrix: the rows of receiver ``k``, or the columns of
-    source ``k`` for kinds with a ``source_state``."""
-
-
-def _shares_source_state(data):
-    return kind_of(data).source_state is not no_source_state
 
 
 @overload(_fill_block)
@@ -240,63 +249,39 @@ def _overload_fill_block(data, rows, cols, out, work, block):
     return impl
 
 
-@overload(_fill_matrix_part)
-def _overload_fill_matrix_part(data, k, everything, out, work, block):
-    if _shares_source_state(data):
-        def impl(data, k, everything, out, work, block):
-            _fill_source(data, k, everything, out, block.shape[0] * k, work, block)
-    else:
-        def impl(data, k, everything, out, work, block):
-            _fill_receiver(data, k, everything, out, block.shape[0] * k, work, block)
-    return impl
-
-
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def traction_block(data, rows, cols, out):
     """Block generator kernel (see :class:`hmatddm.hmatrix.BlockGenerator`): ``out`` of
     shape ``(d len(rows), d len(cols))`` receives ``out[d a + p, d b + q]``, the traction
     component ``p`` at the collocation point(s) of element ``rows[a]`` for a unit global
-    DD unknown ``q`` of element ``cols[b]``."""
+    DD unknown ``q`` of element ``cols[b]``. Called with int64 ``rows``, ``cols`` and a
+    C-contiguous float64 ``out`` everywhere (one compiled version per record type)."""
     dof = element_unknowns(data)
     _fill_block(data, rows, cols, out, _workspace(data), np.empty((dof, dof)))
 
 
-@njit(cache=True, parallel=True)
-def traction_matrix(data, out):
-    """Dense assembly of the whole traction matrix ``out`` (N d, N d), parallel over
-    receivers (rows written contiguously), or over sources for kinds with a
-    ``source_state`` (made once per source)."""
+@njit(cache=True, nogil=True)
+def stress_block(data, points, point_layer, dd, out):
+    """Global stress ``out`` (M, dim, dim) at ``points`` (M, dim), in layers
+    ``point_layer`` (M,) (zeros in a homogeneous medium), induced by the DD unknowns
+    ``dd`` (N, d) of every element (direct sum)."""
     n = data.centers.shape[0]
-    dof = element_unknowns(data)
-    everything = np.arange(n)
-    for k in prange(n):
-        _fill_matrix_part(data, k, everything, out, _workspace(data), np.empty((dof, dof)))
-
-
-@njit(cache=True)
-def singular_pairs(data, rows, cols, out):
-    """``out[k]`` = True when the block of receiver ``rows[k]`` and source ``cols[k]``
-    (as :func:`traction_block` fills it) is not finite: a singular pair."""
+    dim = points.shape[1]
     dof = element_unknowns(data)
     work = _workspace(data)
-    block = np.empty((dof, dof))
-    pair = np.empty((dof, dof))
-    for k in range(rows.shape[0]):
-        _fill_source(data, cols[k], rows[k:k + 1], pair, 0, work, block)
-        out[k] = not np.all(np.isfinite(pair))
-
-
-@njit(cache=True)
-def self_block_max(data, out):
-    """``out[i]``: the largest |entry| of element ``i``'s self block (the ``self_max``
-    of ref. Eq. 6.11)."""
-    dof = element_unknowns(data)
-    work = _workspace(data)
-    block = np.empty((dof, dof))
-    for i in range(data.centers.shape[0]):
-        state = _source_state(data, i, work)
-        _element_traction(data, i, i, state, work, block)
-        out[i] = np.max(np.abs(block))
+    pair = np.empty((dof, dim, dim))
+    for m in range(points.shape[0]):
+        acc = np.zeros((dim, dim))
+        for j in range(n):
+            _element_stress(data, points[m], point_layer[m], j, work, pair)
+            for u in range(dof):
+                du = dd[j, u]
+                for a in range(dim):
+                    for b in range(dim):
+                        acc[a, b] += pair[u, a, b] * du
+        for a in range(dim):
+            for b in range(dim):
+                out[m, a, b] = acc[a, b]
 
 
 @njit(cache=True)
@@ -306,26 +291,37 @@ def edge_distance(data, i, j):
     return _edge_distance(data, i, j)
 
 
-@njit(cache=True, parallel=True)
-def stress_at_points(data, points, point_layer, dd, out):
-    """Global stress ``out`` (M, dim, dim) at ``points`` (M, dim), in layers
-    ``point_layer`` (M,) (zeros in a homogeneous medium), induced by the DD unknowns
-    ``dd`` (N, d) of every element (direct sum, parallel over points)."""
+# -- what Python calls: the drivers above, in parallel where it pays -----------------------
+def _in_parts(function, count, parts_per_thread=4):
+    """``function(start, stop)`` over consecutive ranges covering ``range(count)``: on
+    numba's thread count of threads (``parts_per_thread`` ranges each, for balance), or
+    in one call on one thread."""
+    threads = min(numba.get_num_threads(), count)
+    if threads <= 1:
+        if count:
+            function(0, count)
+        return
+    bounds = np.linspace(0, count, min(count, threads * parts_per_thread) + 1).astype(np.int64)
+    with ThreadPoolExecutor(max_workers=threads) as pool:
+        list(pool.map(function, bounds[:-1], bounds[1:]))
+
+
+def traction_matrix(data, out):
+    """Dense assembly of the whole traction matrix into ``out`` (N d, N d), a C-contiguous
+    float64 array: row bands of receivers on parallel threads, or column bands of sources
+    for kinds with a ``source_state`` (made once per source)."""
     n = data.centers.shape[0]
-    dim = points.shape[1]
     dof = element_unknowns(data)
-    for m in prange(points.shape[0]):
-        work = _workspace(data)
-        pair = np.empty((dof, dim, dim))
-        acc = np.zeros((dim, dim))
-        for j in range(n):
-            _element_stress(data, points[m], point_layer[m], j, work, pair)
-            for u in range(dof):
-                du = dd[j, u]
-                for a in range(dim):
-                    for b in range(dim):
-                        acc[a, b] += pair[u, a, b] * du
-        out[m] = acc
+    everything = np.arange(n, dtype=np.int64)
+    if _shares_source_state(data):
+        def part(start, stop):
+            band = np.empty((n * dof, (stop - start) * dof))
+            traction_block(data, everything, everything[start:stop], band)
+            out[:, start * dof:stop * dof] = band
+    else:
+        def part(start, stop):
+            traction_block(data, everything[start:stop], everything, out[start * dof:stop * dof])
+    _in_parts(part, n)
 
 
 def influence_matrix(data):
@@ -336,11 +332,51 @@ def influence_matrix(data):
     return out
 
 
+def singular_pairs(data, rows, cols, out):
+    """``out[k]`` = True when the block of receiver ``rows[k]`` and source ``cols[k]``
+    (as :func:`traction_block` fills it) is not finite: a singular pair."""
+    rows = np.asarray(rows, dtype=np.int64)
+    cols = np.asarray(cols, dtype=np.int64)
+    dof = element_unknowns(data)
+    for j in np.unique(cols):  # the pairs of one source in one call
+        pairs = np.flatnonzero(cols == j)
+        block = np.empty((dof * len(pairs), dof))
+        traction_block(data, np.ascontiguousarray(rows[pairs]), np.array([j], dtype=np.int64), block)
+        out[pairs] = ~np.all(np.isfinite(block.reshape(len(pairs), -1)), axis=1)
+
+
+def self_block_max(data, out):
+    """``out[i]``: the largest |entry| of element ``i``'s self block (the ``self_max``
+    of ref. Eq. 6.11; the Eq. 6.11 scaling never applies to a self block)."""
+    dof = element_unknowns(data)
+    block = np.empty((dof, dof))
+    for i in range(data.centers.shape[0]):
+        element = np.array([i], dtype=np.int64)
+        traction_block(data, element, element, block)
+        out[i] = np.max(np.abs(block))
+
+
+def with_self_max(data):
+    """``data`` with its ``self_max`` filled in place when ``alpha > 0`` (ref. Eq. 6.11;
+    records are built with zeros there)."""
+    if data.alpha > 0.0:
+        self_block_max(data, data.self_max)
+    return data
+
+
 def self_block_maxima(data):
     """(N,) :func:`self_block_max` as a new array."""
     out = np.empty(data.centers.shape[0])
     self_block_max(data, out)
     return out
+
+
+def stress_at_points(data, points, point_layer, dd, out):
+    """:func:`stress_block` with ``points`` (M, dim), ``point_layer`` (M,) int64, ``dd``
+    (N, d) and ``out`` (M, dim, dim) C-contiguous float64 arrays, parallel over points."""
+    def part(start, stop):
+        stress_block(data, points[start:stop], point_layer[start:stop], dd, out[start:stop])
+    _in_parts(part, len(points))
 
 
 def stress_sum(data, points, dd, point_layer=None):
@@ -351,11 +387,25 @@ def stress_sum(data, points, dd, point_layer=None):
         point_layer = np.zeros(len(points), dtype=np.int64)
     dd = np.ascontiguousarray(np.asarray(dd, dtype=np.float64).reshape(data.centers.shape[0], -1))
     out = np.zeros((len(points), points.shape[1], points.shape[1]))
-    if len(points):
-        stress_at_points(data, points, np.ascontiguousarray(point_layer, dtype=np.int64), dd, out)
+    stress_at_points(data, points, np.ascontiguousarray(point_layer, dtype=np.int64), dd, out)
     return out
 
 
-__all__ = ["KernelKind", "register_kind", "no_source_state", "kind_of", "element_unknowns",
-           "traction_block", "traction_matrix", "singular_pairs", "self_block_max", "edge_distance",
-           "stress_at_points", "influence_matrix", "self_block_maxima", "stress_sum"]
+def finite_stress_sum(data, points, dd, point_layer, edge="element edge"):
+    """:func:`stress_sum`, refusing a point where the stress is singular (on an ``edge``
+    of an element: NaN without the reference's averaging) with an
+    :class:`hmatddm.errors.InputError` naming it."""
+    out = stress_sum(data, points, dd, point_layer)
+    bad = np.flatnonzero(~np.all(np.isfinite(out.reshape(len(out), -1)), axis=1))
+    if bad.size:
+        from ..errors import InputError
+
+        raise InputError(f"points[{int(bad[0])}] lies on an {edge}, where the stress is singular; move it or pass "
+                         "singular_correction='average'")
+    return out
+
+
+__all__ = ["COMMON_FIELDS", "HOMOGENEOUS_FIELDS", "kernel_record", "KernelKind", "register_kind", "no_source_state",
+           "kind_of", "element_unknowns", "traction_block", "stress_block", "edge_distance", "traction_matrix",
+           "influence_matrix", "singular_pairs", "self_block_max", "with_self_max", "self_block_maxima", "stress_at_points",
+           "stress_sum", "finite_stress_sum"]

@@ -19,12 +19,10 @@ caller passes a ``near`` distance (see :func:`element_traction`). The loops over
 pairs are :mod:`hmatddm.kernels.drivers`; :class:`Segments` is the kernel data.
 """
 import math
-from typing import NamedTuple
-
 import numpy as np
 from numba import njit
 
-from .drivers import KernelKind, no_source_state, register_kind
+from .drivers import HOMOGENEOUS_FIELDS, KernelKind, kernel_record, no_source_state, register_kind
 
 _INV_4PI = 1.0 / (4.0 * math.pi)
 
@@ -156,24 +154,12 @@ def rotate_to_global(frame, local, out):
                 out[q, i, j] = acc
 
 
-class Segments(NamedTuple):
-    """Kernel data of constant 2D elements (the record :mod:`.drivers` take)."""
-
-    centers: np.ndarray  #: (N, 2) element midpoints
-    frames: np.ndarray  #: (N, 2, 2) rows: unit tangent, unit normal
-    half_length: np.ndarray  #: (N,) half lengths a
-    shear_modulus: float
-    poisson_ratio: float
-    singular_shift: float  #: see :mod:`hmatddm.kernels.drivers` (singular points)
-    near_fraction: float  #: near-miss distance, fraction of the smaller half size
-    alpha: float  #: ref. Eq. 6.11 scaling (0: none)
-    self_max: np.ndarray  #: (N,) largest |entry| of each self block (ref. Eq. 6.11)
-
-
-@njit(cache=True, inline="always")
-def unknowns(data):
-    """Two unknowns per element (global DD x, y)."""
-    return 2
+#: The geometry fields of every record of 2D segments (:func:`.drivers.kernel_record`).
+SEGMENT_FIELDS = (("centers", np.ndarray, "(N, 2) element midpoints"),
+                  ("frames", np.ndarray, "(N, 2, 2) rows: unit tangent, unit normal"),
+                  ("half_length", np.ndarray, "(N,) half lengths a"))
+Segments = kernel_record("Segments", __name__, "Kernel data of constant 2D elements (the record :mod:`.drivers` take).",
+                         SEGMENT_FIELDS + HOMOGENEOUS_FIELDS)
 
 
 @njit(cache=True)
@@ -237,5 +223,4 @@ def mean_stress_pair(point, center, frame, a, shear_modulus, poisson_ratio, out)
         out[q] = frame[0, q] * m0 + frame[1, q] * m1
 
 
-register_kind(Segments, KernelKind(unknowns, workspace, no_source_state, element_traction, element_stress,
-                                   edge_distance))
+register_kind(Segments, KernelKind(workspace, no_source_state, element_traction, element_stress, edge_distance))

@@ -34,13 +34,12 @@ Kernel data: :class:`NodalSegments` (the loops over element pairs are
 for node ``k`` and global component ``q`` (docs/conventions.md §2).
 """
 import math
-from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
-from .drivers import KernelKind, no_source_state, register_kind
-from .line2d import on_tip, rotate_to_global, tip_distance
+from .drivers import HOMOGENEOUS_FIELDS, KernelKind, kernel_record, no_source_state, register_kind
+from .line2d import SEGMENT_FIELDS, on_tip, rotate_to_global, tip_distance
 
 _INV_4PI = 1.0 / (4.0 * math.pi)
 
@@ -252,26 +251,12 @@ def near_distance(near_fraction, a_receiver, a_source, nodes):
     return near_fraction * (1.0 - outer) * min(a_receiver, a_source)
 
 
-class NodalSegments(NamedTuple):
-    """Kernel data of linear and quadratic 2D elements (the record :mod:`.drivers` take)."""
-
-    centers: np.ndarray  #: (N, 2) element midpoints
-    frames: np.ndarray  #: (N, 2, 2) rows: unit tangent, unit normal
-    half_length: np.ndarray  #: (N,) half lengths a
-    shear_modulus: float
-    poisson_ratio: float
-    singular_shift: float  #: see :mod:`hmatddm.kernels.drivers` (singular points)
-    near_fraction: float  #: near-miss distance, fraction of the smaller half size
-    alpha: float  #: ref. Eq. 6.11 scaling (0: none)
-    self_max: np.ndarray  #: (N,) largest |entry| of each self block (ref. Eq. 6.11)
-    coefficients: np.ndarray  #: (n, 3) monomial coefficients of the n shape functions
-    nodes: np.ndarray  #: (n,) intrinsic coordinates of the collocation nodes
-
-
-@njit(cache=True, inline="always")
-def unknowns(data):
-    """``2 n`` unknowns per element (n nodes, global DD x, y each)."""
-    return 2 * data.nodes.shape[0]
+#: The shape-function fields of every record of nodal segments (after the common ones).
+SHAPE_FIELDS = (("coefficients", np.ndarray, "(n, 3) monomial coefficients of the n shape functions"),
+                ("nodes", np.ndarray, "(n,) intrinsic coordinates of the collocation nodes"))
+NodalSegments = kernel_record("NodalSegments", __name__,
+                              "Kernel data of linear and quadratic 2D elements (the record :mod:`.drivers` take).",
+                              SEGMENT_FIELDS + HOMOGENEOUS_FIELDS, SHAPE_FIELDS)
 
 
 @njit(cache=True)
@@ -335,5 +320,4 @@ def edge_distance(data, i, j):
     return best
 
 
-register_kind(NodalSegments, KernelKind(unknowns, workspace, no_source_state, element_traction, element_stress,
-                                        edge_distance))
+register_kind(NodalSegments, KernelKind(workspace, no_source_state, element_traction, element_stress, edge_distance))

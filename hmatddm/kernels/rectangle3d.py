@@ -29,12 +29,11 @@ Sign convention: DD = u(+) - u(-), + being the side ``n = e1 x e2`` points to; a
 (DD . n > 0) induces compression on the element itself (docs/conventions.md §1).
 """
 import math
-from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
-from .drivers import KernelKind, no_source_state, register_kind
+from .drivers import HOMOGENEOUS_FIELDS, KernelKind, kernel_record, no_source_state, register_kind
 
 _INV_8PI = 1.0 / (8.0 * math.pi)
 
@@ -299,25 +298,14 @@ def stress_pair(point, center, frame, a, b, shear_modulus, poisson_ratio, singul
                 out[q, i, j] = acc
 
 
-class Rectangles(NamedTuple):
-    """Kernel data of constant 3D rectangles (the record :mod:`.drivers` take)."""
-
-    centers: np.ndarray  #: (N, 3) element centres
-    frames: np.ndarray  #: (N, 3, 3) rows: e1, e2, normal e1 x e2
-    half_a: np.ndarray  #: (N,) half sides along e1
-    half_b: np.ndarray  #: (N,) half sides along e2
-    shear_modulus: float
-    poisson_ratio: float
-    singular_shift: float  #: see :mod:`hmatddm.kernels.drivers` (singular points)
-    near_fraction: float  #: near-miss distance, fraction of the smaller half size
-    alpha: float  #: ref. Eq. 6.11 scaling (0: none)
-    self_max: np.ndarray  #: (N,) largest |entry| of each self block (ref. Eq. 6.11)
-
-
-@njit(cache=True, inline="always")
-def unknowns(data):
-    """Three unknowns per element (global DD x, y, z)."""
-    return 3
+#: The geometry fields of every record of rectangles (:func:`.drivers.kernel_record`).
+RECTANGLE_FIELDS = (("centers", np.ndarray, "(N, 3) element centres"),
+                    ("frames", np.ndarray, "(N, 3, 3) rows: e1, e2, normal e1 x e2"),
+                    ("half_a", np.ndarray, "(N,) half sides along e1"),
+                    ("half_b", np.ndarray, "(N,) half sides along e2"))
+Rectangles = kernel_record("Rectangles", __name__,
+                           "Kernel data of constant 3D rectangles (the record :mod:`.drivers` take).",
+                           RECTANGLE_FIELDS + HOMOGENEOUS_FIELDS)
 
 
 @njit(cache=True)
@@ -374,5 +362,4 @@ def mean_stress_pair(point, center, frame, a, b, shear_modulus, poisson_ratio, o
         out[q] = frame[0, q] * m0 + frame[1, q] * m1 + frame[2, q] * m2
 
 
-register_kind(Rectangles, KernelKind(unknowns, workspace, no_source_state, element_traction, element_stress,
-                                     edge_distance))
+register_kind(Rectangles, KernelKind(workspace, no_source_state, element_traction, element_stress, edge_distance))

@@ -60,13 +60,12 @@ Length (over ~400 lines): the derivative tables of the Hansen potentials (checke
 numba code that compiles as one unit; splitting them would spread one derivation.
 """
 import math
-from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
 from ..kernels import line2d
-from ..kernels.drivers import KernelKind, register_kind
+from ..kernels.drivers import KernelKind, kernel_record, register_kind
 
 _INV_4PI = 1.0 / (4.0 * math.pi)
 
@@ -612,31 +611,19 @@ def _level_rule(n_gauss, max_level):
     return xi, w, start
 
 
-class LayeredSegments(NamedTuple):
-    """Kernel data of constant 2D elements in a layered medium (the record
-    :mod:`hmatddm.kernels.drivers` take; built by
-    :func:`hmatddm.layered.influence2d.influence_data`)."""
-
-    centers: np.ndarray  #: (N, 2) element midpoints
-    frames: np.ndarray  #: (N, 2, 2) rows: unit tangent, unit normal
-    half_length: np.ndarray  #: (N,) half lengths
-    layer: np.ndarray  #: (N,) int64 layer of each element
-    interfaces: np.ndarray  #: (L - 1,) interface heights, top down
-    shear_modulus: np.ndarray  #: (L,) per layer (0: void)
-    poisson_ratio: np.ndarray  #: (L,) per layer
-    n_images: int  #: reflections per interface (ref. Fig. 3.4)
-    gauss_points: int  #: Gauss-Legendre points per sub-segment of the image quadrature (ref. Table 3.2)
-    max_subdivisions: int  #: largest number of sub-segments (:func:`hmatddm.layered.images2d.subdivisions`)
-    singular_shift: float  #: see :mod:`hmatddm.kernels.drivers` (singular points)
-    near_fraction: float  #: near-miss distance, fraction of the smaller half size
-    alpha: float  #: ref. Eq. 6.11 scaling (0: none)
-    self_max: np.ndarray  #: (N,) largest |entry| of each self block (ref. Eq. 6.11)
-
-
-@njit(cache=True, inline="always")
-def unknowns(data):
-    """Two unknowns per element (global DD x, y)."""
-    return 2
+#: The medium fields of every record of 2D segments in a layered medium (after the geometry).
+LAYERED_FIELDS = (
+    ("layer", np.ndarray, "(N,) int64 layer of each element"),
+    ("interfaces", np.ndarray, "(L - 1,) interface heights, top down"),
+    ("shear_modulus", np.ndarray, "(L,) per layer (0: void)"),
+    ("poisson_ratio", np.ndarray, "(L,) per layer"),
+    ("n_images", int, "reflections per interface (ref. Fig. 3.4)"),
+    ("gauss_points", int, "Gauss-Legendre points per sub-segment of the image quadrature (ref. Table 3.2)"),
+    ("max_subdivisions", int, "largest number of sub-segments (:func:`hmatddm.layered.images2d.subdivisions`)"))
+LayeredSegments = kernel_record(
+    "LayeredSegments", __name__,
+    "Kernel data of constant 2D elements in a layered medium (the record :mod:`hmatddm.kernels.drivers` take; built "
+    "by :func:`hmatddm.layered.influence2d.influence_data`).", line2d.SEGMENT_FIELDS + LAYERED_FIELDS)
 
 
 @njit(cache=True)
@@ -731,5 +718,5 @@ def element_stress(data, point, point_layer, j, work, out):
                     out[q, i, k] += image[0, q, i, k]
 
 
-register_kind(LayeredSegments, KernelKind(unknowns, workspace, source_state, element_traction, element_stress,
+register_kind(LayeredSegments, KernelKind(workspace, source_state, element_traction, element_stress,
                                           line2d.edge_distance))

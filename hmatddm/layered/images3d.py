@@ -776,12 +776,6 @@ def _level(n_sub):
 
 
 @njit(cache=True)
-def unknowns(data):
-    """Three unknowns per element (global DD x, y, z)."""
-    return 3
-
-
-@njit(cache=True)
 def workspace(data):
     """Scratch: local stress (3, 3, 3), image stress (3, 3, 3), gradient (3, 3, 3, 3), the
     Kelvin scratch (2, 3, 3, 1) and the one-order :func:`Workspace`."""
@@ -881,5 +875,5 @@ def element_stress(data, point, point_layer, j, work, out):
                     out[q, i, k] += image[q, i, k]
 
 
-register_kind(LayeredRectangles, KernelKind(unknowns, workspace, source_state, element_traction, element_stress,
+register_kind(LayeredRectangles, KernelKind(workspace, source_state, element_traction, element_stress,
                                             rectangle3d.edge_distance))

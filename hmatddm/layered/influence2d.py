@@ -5,7 +5,7 @@ served by the drivers of :mod:`hmatddm.kernels.drivers`)."""
 import numpy as np
 
 from ..errors import InputError
-from ..kernels.drivers import self_block_max, stress_sum, traction_block
+from ..kernels.drivers import finite_stress_sum, traction_block, with_self_max
 from ..mesh import Mesh2D
 from . import images2d
 from .medium import MAX_IMAGES
@@ -95,14 +95,11 @@ def influence_data(mesh, medium, singular_shift, alpha, near_fraction, n_images)
     for ref. Eq. 6.11."""
     layers = element_layers(mesh, medium)
     interfaces, g, nu = medium.arrays()
-    data = images2d.LayeredSegments(mesh.centers, mesh.frames, mesh.half_length, layers, interfaces, g, nu,
-                                    n_images=int(n_images), gauss_points=int(medium.gauss_points),
-                                    max_subdivisions=int(MAX_SUBDIVISIONS), singular_shift=float(singular_shift),
-                                    near_fraction=float(near_fraction), alpha=float(alpha),
-                                    self_max=np.zeros(mesh.n_elements))
-    if alpha > 0.0:
-        self_block_max(data, data.self_max)
-    return data
+    return with_self_max(images2d.LayeredSegments(
+        mesh.centers, mesh.frames, mesh.half_length, layers, interfaces, g, nu, n_images=int(n_images),
+        gauss_points=int(medium.gauss_points), max_subdivisions=int(MAX_SUBDIVISIONS),
+        singular_shift=float(singular_shift), near_fraction=float(near_fraction), alpha=float(alpha),
+        self_max=np.zeros(mesh.n_elements)))
 
 
 def with_images(data, n_images):
@@ -161,9 +158,4 @@ def stress_at(mesh, medium, dd, points, singular_correction="none", near_fractio
         n_images = choose_images(mesh, medium, data)
     data = with_images(data, n_images)
     point_layer = medium.layer_of(points[:, 1]).astype(np.int64)
-    out = stress_sum(data, points, dd, point_layer)
-    bad = np.flatnonzero(~np.all(np.isfinite(out.reshape(len(points), -1)), axis=1))
-    if bad.size:
-        raise InputError(f"points[{int(bad[0])}] lies on an element end, where the stress is singular; move it or "
-                         "pass singular_correction='average'")
-    return out
+    return finite_stress_sum(data, points, dd, point_layer, "element end")

@@ -7,7 +7,7 @@ import numpy as np
 
 from .._validation import finite_array
 from ..errors import InputError
-from ..kernels.drivers import self_block_max, stress_sum
+from ..kernels.drivers import finite_stress_sum, with_self_max
 from . import images3d
 from .influence2d import choose_images as _choose_images
 from .influence2d import layers_of_extents, with_images
@@ -37,14 +37,11 @@ def influence_data(mesh, medium, singular_shift, alpha, near_fraction, n_images)
     with ``n_images`` images; ``alpha > 0`` fills ``self_max`` for ref. Eq. 6.11."""
     layers = element_layers(mesh, medium)
     interfaces, g, nu = medium.arrays()
-    data = images3d.LayeredRectangles(mesh.centers, mesh.frames, mesh.half_a, mesh.half_b, layers, interfaces, g, nu,
-                                      n_images=int(n_images), gauss_points=int(medium.gauss_points),
-                                      max_subdivisions=int(MAX_SUBDIVISIONS), singular_shift=float(singular_shift),
-                                      near_fraction=float(near_fraction), alpha=float(alpha),
-                                      self_max=np.zeros(mesh.n_elements))
-    if alpha > 0.0:
-        self_block_max(data, data.self_max)
-    return data
+    return with_self_max(images3d.LayeredRectangles(
+        mesh.centers, mesh.frames, mesh.half_a, mesh.half_b, layers, interfaces, g, nu, n_images=int(n_images),
+        gauss_points=int(medium.gauss_points), max_subdivisions=int(MAX_SUBDIVISIONS),
+        singular_shift=float(singular_shift), near_fraction=float(near_fraction), alpha=float(alpha),
+        self_max=np.zeros(mesh.n_elements)))
 
 
 def choose_images(mesh, medium, data, max_samples=24, max_sources=400):
@@ -74,12 +71,7 @@ def stress_at(mesh, medium, dd, points, singular_correction="none", near_fractio
     if mesh.dim != 3:
         raise InputError("influence3d.stress_at takes a Mesh3D")
     points, dd, data = _prepared(mesh, medium, dd, points, singular_correction, near_fraction, n_images)
-    out = stress_sum(data, points, dd, medium.layer_of(points[:, 2]).astype(np.int64))
-    bad = np.flatnonzero(~np.all(np.isfinite(out.reshape(len(points), -1)), axis=1))
-    if bad.size:
-        raise InputError(f"points[{int(bad[0])}] lies on an element edge, where the stress is singular; move it or "
-                         "pass singular_correction='average'")
-    return out
+    return finite_stress_sum(data, points, dd, medium.layer_of(points[:, 2]).astype(np.int64))
 
 
 def mean_stress_at(mesh, medium, dd, points, singular_correction="none", near_fraction=0.0, n_images=None):
