@@ -5,6 +5,10 @@ the cost of accuracy as the elements shrink.
     python benchmarks/bench_radial.py --quick      # h = 2 and 1.5 m only, to 20 s (under a minute)
     python benchmarks/bench_radial.py --report     # tables and plots again from the saved JSON
     python benchmarks/bench_radial.py --case '{"case": "K", "h": 1.0, "backend": "hmatrix"}'   # one run, JSON
+    # issue 17: the h = 0.5 m K-vertex run with its CPU split, and with the plain iteration of before
+    python benchmarks/bench_radial.py --case '{"case": "K-vertex", "h": 0.5, "backend": "hmatrix", "parts": true}'
+    python benchmarks/bench_radial.py --case '{"case": "K-vertex", "h": 0.5, "backend": "hmatrix",
+        "scheme_options": {"stopping": "change", "first_linear_rtol": 1e-9}}'
 
 Two studies, printed as markdown tables and saved (JSON in benchmarks/out/, PNG in benchmarks/):
 
@@ -105,26 +109,77 @@ def closed_form(case, t, h):
     return radius, width, pressure, "K-vertex"
 
 
-def run_case(case, h, backend, t_end, scheme="krylov", front="element"):
-    """One simulation; returns a dict with the per-step history and the final errors."""
+def cpu_parts():
+    """Process CPU seconds spent in the main costs of a run, by name (a dict filled while
+    the run goes): wrappers around the H build, the border blocks and products of the grown
+    mesh, the coupled GMRES and its parts, the flow LU and the mesh topology. Nested: "coupled
+    GMRES" includes the matvecs and the preconditioner, "grown-mesh matvec" the H matvec."""
+    import functools
+
+    import hmatddm.coupled.schemes as schemes
+    import hmatddm.extended_operator as extended
+    import hmatddm.hmatrix.hmatrix as hmatrix
+    import hmatddm.simulation.growing_operator as growing
+    import hmatddm.topology as topology
+
+    parts = {}
+
+    def wrap(owner, name, key):
+        function = getattr(owner, name)
+
+        @functools.wraps(function)
+        def timed(*args, **kwargs):
+            begin = time.process_time()
+            try:
+                return function(*args, **kwargs)
+            finally:
+                parts[key] = parts.get(key, 0.0) + time.process_time() - begin
+
+        setattr(owner, name, timed)
+
+    wrap(growing.GrowingOperator, "build", "H builds")
+    wrap(extended.ExtendedElasticityOperator, "_border_blocks", "border blocks")
+    wrap(schemes, "gmres", "coupled GMRES")
+    wrap(hmatrix.HMatrix, "_matvec", "H matvec")
+    wrap(extended.ExtendedElasticityOperator, "_matvec", "grown-mesh matvec")
+    wrap(extended.ExtendedElasticityOperator, "_block_triangular", "block-triangular preconditioner")
+    wrap(schemes._CoupledLinearSystem, "compliance_preconditioner", "flow LU")
+    wrap(topology, "element_edges", "topology")
+    wrap(topology, "element_faces", "topology")
+    return parts
+
+
+def run_case(case, h, backend, t_end, scheme="krylov", front="element", scheme_options=None, parts=False):
+    """One simulation; returns a dict with the per-step history and the final errors.
+    ``scheme_options``: further :class:`hmatddm.coupled.SchemeSettings` fields (e.g.
+    ``{"stopping": "change", "first_linear_rtol": 1e-9}``, the plain iteration of before
+    issue 17); ``parts``: add ``cpu_parts`` (:func:`cpu_parts`)."""
     import hmatddm as hd
     from _common import peak_rss_bytes
 
     params = CASES[case]
+    costs = cpu_parts() if parts else None
+    cpu = time.process_time()
     start = time.perf_counter()
+    settings = scheme
+    if scheme_options:
+        from hmatddm.coupled import SchemeSettings
+
+        settings = SchemeSettings(scheme=scheme, **scheme_options)
     material = hd.Elastic(SHEAR_MODULUS, POISSON)
     mesh = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 3 * h, 3 * h, 3, 3)
     sim = hd.Simulation(mesh, material, hd.Fluid(params["viscosity"], COMPRESSIBILITY),
                         [hd.Cluster((0, 0, 0), RATE, WELLBORE)], far_field_stress=np.diag([0, 0, -S_HMIN]),
                         time_step=1.0, propagation=hd.Propagation(toughness=params["toughness"], front=front),
                         initial_pressure=INITIAL_PRESSURE, initial_opening=params["initial_opening"],
-                        backend=backend, scheme=scheme)
+                        backend=backend, scheme=settings)
     failure = None
     try:
         records = sim.run(t_end)
     except hd.HmatddmError as error:  # ConvergenceError and friends: report, do not hide
         records, failure = sim.records, f"{type(error).__name__}: {error}"
     wall = time.perf_counter() - start
+    cpu = time.process_time() - cpu
     state = sim.state
     width = np.sum(state.dd * state.mesh.normals, axis=1)
     injection = int(sim.injection_elements[0])
@@ -133,10 +188,14 @@ def run_case(case, h, backend, t_end, scheme="krylov", front="element"):
     history = {k: [r[k] for r in records] for k in keys}
     history["front_circularity"] = [r.get("front_circularity") for r in records]
     history["net_pressure"] = [r["wellbore_pressure"][0] - S_HMIN for r in records]
-    row = dict(case=case, h=h, backend=backend, scheme=scheme, front=front, t_end=t_end, wall_s=wall,
+    row = dict(case=case, h=h, backend=backend, scheme=scheme, front=front, t_end=t_end, wall_s=wall, cpu_s=cpu,
                peak_rss_mb=peak_rss_bytes() / 2**20, history=history, failure=failure,
                centre_width=float(width[injection]), final_elements=int(state.mesh.n_elements),
                operator_builds=int(sim.operator_builds))
+    if scheme_options:
+        row["scheme_options"] = dict(scheme_options)
+    if costs is not None:
+        row["cpu_parts"] = dict(costs)
     if records:
         add_reference(row)
         t = np.array(history["time"])
@@ -544,7 +603,8 @@ def main():
 
             preconditioners.TWO_LEVEL_MIN_ELEMENTS = int(spec["two_level_from"])
         print(json.dumps(run_case(spec["case"], float(spec["h"]), spec["backend"], float(spec.get("t_end", 50.0)),
-                                  spec.get("scheme", "krylov"), spec.get("front", "element"))))
+                                  spec.get("scheme", "krylov"), spec.get("front", "element"),
+                                  spec.get("scheme_options"), bool(spec.get("parts", False)))))
         return
     from _common import machine, markdown_table
 
