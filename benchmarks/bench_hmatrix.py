@@ -4,6 +4,7 @@
     python benchmarks/bench_hmatrix.py --quick         # N = 1k, 4k only, short eps sweep
     python benchmarks/bench_hmatrix.py --case planar --n 10000 --eps 1e-4   # one case, JSON
     python benchmarks/bench_hmatrix.py --tree-study 4000   # cloud: principal-axis vs fractures-first tree
+    python benchmarks/bench_hmatrix.py --rank-study 4000   # cloud: far-block ranks by kind (same/two fractures) and level
     python benchmarks/bench_hmatrix.py --memory-study 10000,40000 --variants 1e-4:32:float64,1e-4:16:float32
                                                        # planar: where the memory goes, growth exponents
 
@@ -205,6 +206,48 @@ def tree_study(n, leaf_size=32):
                         near_mb=st["near_field_bytes"] / 2**20, max_rank=st["max_rank"], mean_rank=st["mean_rank"],
                         smooth_error=error))
         print(json.dumps(out[-1]), flush=True)
+    return out
+
+
+def rank_study(n, eps=1e-4, leaf_size=32):
+    """Cloud of N elements (fractures-first tree, as ElasticityOperator builds it): rank and
+    memory of the admissible blocks by kind (both clusters on the same fracture, on two
+    different fractures, or a cluster holding several fractures) and row-cluster level.
+    Returns a list of dicts, one per (kind, level)."""
+    import hmatddm as hd
+    from hmatddm.hmatrix import BlockGenerator, HMatrix
+    from hmatddm.hmatrix.storage import KIND_DENSE, KIND_LOWRANK
+    from hmatddm.kernels.drivers import traction_block
+    from hmatddm.operators import influence_data
+
+    mesh = cloud(n)
+    data = influence_data(mesh, hd.Elastic(shear_modulus=10e9, poisson_ratio=0.25))
+    generator = BlockGenerator(kernel=traction_block, data=data, points=mesh.centers, radii=mesh.radii, dof=3)
+    h = HMatrix.build(generator, eps=eps, eta=3.0, leaf_size=leaf_size, groups=mesh.fracture_id)
+    s, t = h.storage, h.tree
+    fracture = mesh.fracture_id[t.permutation]
+    one = np.array([fracture[t.start[c]:t.stop[c]].min() == fracture[t.start[c]:t.stop[c]].max()
+                    for c in range(t.n_clusters)])
+    table = {}
+    for b, (r, c) in enumerate(zip(h.blocks.admissible_rows, h.blocks.admissible_cols)):
+        kind = ("several fractures" if not (one[r] and one[c]) else
+                "same fracture" if fracture[t.start[r]] == fracture[t.start[c]] else "two fractures")
+        m, k_cols = 3 * int(t.stop[r] - t.start[r]), 3 * int(t.stop[c] - t.start[c])
+        rank, size = 0, 0
+        if s.admissible_kind[b] == KIND_LOWRANK:
+            rank = int(s.lowrank_rank[s.admissible_index[b]])
+            size = rank * (m + k_cols) * s.u_values.itemsize
+        elif s.admissible_kind[b] == KIND_DENSE:
+            rank, size = min(m, k_cols), m * k_cols * s.dense_values.itemsize
+        row = table.setdefault((kind, int(t.level[r])), dict(kind=kind, level=int(t.level[r]), blocks=0, max_rank=0,
+                                                              rank_sum=0, mb=0.0))
+        row["blocks"] += 1
+        row["max_rank"] = max(row["max_rank"], rank)
+        row["rank_sum"] += rank
+        row["mb"] += size / 2**20
+    out = [dict(r, mean_rank=r["rank_sum"] / r["blocks"]) for _, r in sorted(table.items())]
+    for r in out:
+        print(json.dumps(r), flush=True)
     return out
 
 
@@ -469,6 +512,8 @@ def main():
     parser.add_argument("--variants", default="1e-4:32:float64,1e-4:32:float32",
                         help="memory study: comma-separated eps:leaf:near_dtype[:geometry[:boxes]] (geometry planar or "
                              "cloud; boxes axis or oriented: admissibility on axis-aligned or oriented cluster boxes)")
+    parser.add_argument("--rank-study", type=int, default=None, metavar="N",
+                        help="cloud of N elements: rank and memory of far blocks by kind and level, then exit")
     parser.add_argument("--memory-case", default=None, help=argparse.SUPPRESS)
     args = parser.parse_args()
     sys.path.insert(0, HERE)
@@ -497,6 +542,9 @@ def main():
         return
     if args.tree_study:
         tree_study(args.tree_study)
+        return
+    if args.rank_study:
+        rank_study(args.rank_study)
         return
     if args.case:
         print(json.dumps(run_case(args.case, args.n, args.eps, args.dense_limit, args.solve_limit,
