@@ -278,12 +278,18 @@ def layered_table(results):
 
 
 def layered_plot(results, path):
-    fig, ax = plt.subplots(figsize=(7, 4.5))
-    for (gamma, r), colour in zip(results.items(), ("C0", "C1", "C3", "C2")):
-        ax.plot(r["time"], r["height"], "-o", color=colour, ms=3, label=f"height, gamma = {gamma}")
-        ax.plot(r["time"], r["length"], "--s", color=colour, ms=3, label=f"length, gamma = {gamma}")
+    """Height and length against time, one colour per gamma; line widths and markers
+    differ so that coinciding histories stay visible."""
+    fig, ax = plt.subplots(figsize=(8, 5))
+    styles = zip(("C0", "C1", "C3", "C2"), (5.0, 3.0, 1.3, 1.0), ("o", "s", "^", "v"), (9, 6, 4, 3))
+    for (gamma, r), (colour, width, marker, size) in zip(results.items(), styles):
+        ax.plot(r["time"], r["height"], "-", marker=marker, color=colour, lw=width, ms=size, alpha=0.8,
+                label=f"height, gamma = {gamma}")
+        ax.plot(r["time"], r["length"], "--", marker=marker, color=colour, lw=width, ms=size, alpha=0.8,
+                label=f"length, gamma = {gamma}")
     ax.axhline(6.0, color="grey", lw=0.8)
-    ax.text(0.2, 6.1, "middle layer thickness (6 m)", color="grey", fontsize=8)
+    ax.annotate("middle layer thickness (6 m)", (0.02, 6.0), xycoords=("axes fraction", "data"),
+                xytext=(0, 3), textcoords="offset points", color="grey", fontsize=8)
     ax.set(xlabel="time s", ylabel="m", title="layered-3d: height (z extent) and length (y extent)")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, ncol=2)
