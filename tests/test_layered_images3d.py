@@ -35,17 +35,30 @@ def _total(y, receiver_layer, shape, source_layer, medium, n_images, dz=0.0):
 
 
 def test_base_function_derivatives_are_harmonic_and_closed_form():
-    """Horizontal Taylor series of F and L against closed forms, and the Laplacian of
-    the recurrence's derivatives of 1/r (to high vertical order) vanishing."""
+    """Horizontal derivatives of F and L against closed forms and central differences,
+    and the Laplacian of the recurrence's derivatives of 1/r (to high vertical order)
+    vanishing."""
     r1, r2, r3 = 0.3, -0.4, 0.7
     r = np.sqrt(r1 * r1 + r2 * r2 + r3 * r3)
     sf, sl = np.zeros((6, 6)), np.zeros((6, 6))
-    images3d.horizontal_derivatives(r1, r2, r3, sf, sl, np.zeros((4, 6, 6)))
+    images3d.base_derivatives(r1, r2, r3, sf, sl, np.zeros((6, 6, 4)), np.zeros((4, 6)))
     assert sf[0, 0] == pytest.approx(r - r3 * np.log(r + r3), rel=1e-14)
     assert sf[1, 0] == pytest.approx(r1 / (r + r3), rel=1e-13)  # d1 F (ref. Eq. 3.24 gauge +1)
     assert sl[0, 1] == pytest.approx(r2 / (r * (r + r3)), rel=1e-13)
     assert sf[2, 0] + sf[0, 2] == pytest.approx(1.0 / r, rel=1e-12)  # = -d33 F
     assert sl[2, 0] + sl[0, 2] == pytest.approx(r3 / r ** 3, rel=1e-12)  # = -d3 (1/r)
+    h = 1e-4  # d1^a d2^b of order 5 from order 4 by a central difference of each variable
+    for var in range(2):
+        step = np.array([h, 0.0]) if var == 0 else np.array([0.0, h])
+        plus, minus = (np.zeros((6, 6)) for _ in range(2))
+        sfp, sfm = np.zeros((6, 6)), np.zeros((6, 6))
+        images3d.base_derivatives(r1 + step[0], r2 + step[1], r3, sfp, plus, np.zeros((6, 6, 4)), np.zeros((4, 6)))
+        images3d.base_derivatives(r1 - step[0], r2 - step[1], r3, sfm, minus, np.zeros((6, 6, 4)), np.zeros((4, 6)))
+        for a in range(5):
+            b = 4 - a
+            da, db = (a + 1, b) if var == 0 else (a, b + 1)
+            assert sl[da, db] == pytest.approx((plus[a, b] - minus[a, b]) / (2 * h), rel=1e-6, abs=1e-6)
+            assert sf[da, db] == pytest.approx((sfp[a, b] - sfm[a, b]) / (2 * h), rel=1e-6, abs=1e-6)
     q = np.zeros((6, 6, 24))
     images3d.inverse_distance_derivatives(r1, r2, r3, q)
     # (d11 + d22)^2 = d3^4 on harmonic functions; d3 L = 1/r, d3^2 F = -1/r

@@ -120,44 +120,44 @@ def _apply(coef, power, h, dh, src, dsrc, dst, ddst, n_orders):
 
 
 @njit(cache=True)
-def trace(t, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, pair_layer, pair_z, pair_eps,
-          pair_coef, pair_dcoef):
-    """Image pairs of a unit point force at height ``t`` in ``source_layer``.
+def trace_potentials(t, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, original, parity, pair_layer,
+                     pair_z, pair_eps, pair_sigma, pair_coef, pair_dcoef):
+    """Reflect and transmit the potentials of a unit point force at height ``t`` in
+    ``source_layer`` through the interfaces (ref. Fig. 3.4, Eqs 3.25-3.28): 2D pairs
+    (``pair_coef`` (C, 2, 2, O)) and 3D triples ((C, 3, 3, O), the third potential
+    reflected by ``c3`` and transmitted by ``c6``) alike.
 
-    Fills ``pair_layer[k]`` (layer the pair lives in), ``pair_z[k]`` (height it
-    emanates from), ``pair_eps[k] = dz/dt`` (+-1) and ``pair_coef[k, f, j, n]``
-    (``A`` of potential ``j`` for a force along ``f`` = 0: x, 1: y; ``n``: order of
-    ``D``), ``pair_dcoef`` = dA/dt. Returns the number of pairs (the original excluded,
-    pairs whose coefficients vanish pruned).
-    """
+    ``original[e]`` (2, F, J): the source's coefficients of ``D^0`` travelling up
+    (``e = 0``) and down (``e = 1``); ``parity[f]``: sign of force ``f``'s potentials
+    under mirroring in a horizontal plane (times ``(-1)^n`` for ``D^n``). Fills
+    ``pair_layer[k]`` (layer the potentials live in), ``pair_z[k]`` (height they emanate
+    from), ``pair_eps[k] = dz/dt`` (+-1), ``pair_sigma[k]`` (direction of travel: +1
+    upward), ``pair_coef[k, f, j, n]`` (coefficient of ``D^n`` of potential ``j`` for a
+    force along ``f``) and ``pair_dcoef`` = d/dt. Returns their number (the original
+    excluded)."""
     n_layers = shear_modulus.shape[0]
+    n_f = pair_coef.shape[1]
+    n_j = pair_coef.shape[2]
     n_orders = pair_coef.shape[3]
     cap = pair_coef.shape[0]
-    # work queue: incident pairs (the original twice, up and down) then every new pair
+    # work queue: the original twice (up and down), then every new image
     q_layer = np.empty(cap + 2, dtype=np.int64)
     q_dir = np.empty(cap + 2, dtype=np.int64)
     q_ref = np.empty(cap + 2, dtype=np.int64)
     q_z = np.empty(cap + 2)
     q_eps = np.empty(cap + 2)
-    q_coef = np.zeros((cap + 2, 2, 2, n_orders))
-    q_dcoef = np.zeros((cap + 2, 2, 2, n_orders))
-    g_s = shear_modulus[source_layer]
-    delta_s = 1.0 / (3.0 - 4.0 * poisson_ratio[source_layer])
-    k_2d = _INV_4PI / (g_s * (1.0 + delta_s))
+    q_coef = np.zeros((cap + 2, n_f, n_j, n_orders))
+    q_dcoef = np.zeros((cap + 2, n_f, n_j, n_orders))
     for e in range(2):
         q_layer[e] = source_layer
         q_dir[e] = 1 if e == 0 else -1
         q_ref[e] = 0
         q_z[e] = t
         q_eps[e] = 1.0
-        q_coef[e, 0, 0, 0] = k_2d        # Phi_11 (force x1)
-        q_coef[e, 0, 1, 0] = -k_2d       # Phi_12 = -Phi_11
-        q_coef[e, 1, 0, 0] = k_2d        # Phi_31 (force x3)
-        q_coef[e, 1, 1, 0] = k_2d        # Phi_32 = Phi_31
+        q_coef[e, :, :, 0] = original[e]
     n_queue = 2
-    n_out = 0
-    mirrored = np.empty((2, 2, n_orders))
-    dmirrored = np.empty((2, 2, n_orders))
+    mirrored = np.empty((n_f, n_j, n_orders))
+    dmirrored = np.empty((n_f, n_j, n_orders))
     i = 0
     while i < n_queue:
         layer = q_layer[i]
@@ -176,19 +176,20 @@ def trace(t, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, p
         gamma = g2 / g1
         c1 = (gamma - 1.0) / (gamma + d1)                 # ref. Eq. 3.28
         c2 = (gamma * d2 - d1) / (gamma * d2 + 1.0)
+        c3 = (1.0 - gamma) / (1.0 + gamma)                # (3D; zero only where c1 is)
         c4 = 1.0 - c1
         c5 = 1.0 - c2
+        c6 = 1.0 + c3
         if q_ref[i] < n_images and (c1 != 0.0 or c2 != 0.0):
             k = n_queue
-            for f in range(2):
-                parity = 1.0 if f == 0 else -1.0       # Phi_11 even in r3, Phi_31 odd
-                for j in range(2):
+            for f in range(n_f):
+                for j in range(n_j):
                     for n in range(n_orders):
-                        sign = parity if n % 2 == 0 else -parity
+                        sign = parity[f] if n % 2 == 0 else -parity[f]
                         mirrored[f, j, n] = sign * q_coef[i, f, j, n]
                         dmirrored[f, j, n] = sign * q_dcoef[i, f, j, n]
-            # the mirrored pair emanates from z' = 2d - z (dz'/dt = -dz/dt, below)
-            for f in range(2):
+            # the mirrored potentials emanate from z' = 2d - z (dz'/dt = -dz/dt, below)
+            for f in range(n_f):
                 # ref. Eq. 3.26
                 _apply(2.0 * d1 * c1, 1, h, dh, mirrored[f, 0], dmirrored[f, 0], q_coef[k, f, 0], q_dcoef[k, f, 0],
                        n_orders)
@@ -198,6 +199,9 @@ def trace(t, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, p
                 _apply(c1, 0, h, dh, mirrored[f, 0], dmirrored[f, 0], q_coef[k, f, 1], q_dcoef[k, f, 1], n_orders)
                 _apply(-2.0 * d1 * c1, 1, h, dh, mirrored[f, 1], dmirrored[f, 1], q_coef[k, f, 1],
                        q_dcoef[k, f, 1], n_orders)
+                if n_j == 3:
+                    _apply(c3, 0, h, dh, mirrored[f, 2], dmirrored[f, 2], q_coef[k, f, 2], q_dcoef[k, f, 2],
+                           n_orders)
             q_layer[k] = layer
             q_dir[k] = -direction
             q_ref[k] = q_ref[i] + 1
@@ -206,13 +210,16 @@ def trace(t, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, p
             n_queue += 1
         if g2 > 0.0:
             k = n_queue
-            for f in range(2):
+            for f in range(n_f):
                 # ref. Eq. 3.27, but T12 = +2 (d1 c4 - d2 c5) h D: the reference prints a minus
                 # sign, which breaks the interface conditions (_derive_images2d.py derives +)
                 _apply(c4, 0, h, dh, q_coef[i, f, 0], q_dcoef[i, f, 0], q_coef[k, f, 0], q_dcoef[k, f, 0], n_orders)
                 _apply(2.0 * (d1 * c4 - d2 * c5), 1, h, dh, q_coef[i, f, 1], q_dcoef[i, f, 1], q_coef[k, f, 0],
                        q_dcoef[k, f, 0], n_orders)
                 _apply(c5, 0, h, dh, q_coef[i, f, 1], q_dcoef[i, f, 1], q_coef[k, f, 1], q_dcoef[k, f, 1], n_orders)
+                if n_j == 3:
+                    _apply(c6, 0, h, dh, q_coef[i, f, 2], q_dcoef[i, f, 2], q_coef[k, f, 2], q_dcoef[k, f, 2],
+                           n_orders)
             q_layer[k] = far
             q_dir[k] = direction
             q_ref[k] = q_ref[i]
@@ -220,14 +227,38 @@ def trace(t, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, p
             q_eps[k] = q_eps[i]
             n_queue += 1
         i += 1
+    n_out = 0
     for k in range(2, n_queue):
         pair_layer[n_out] = q_layer[k]
         pair_z[n_out] = q_z[k]
         pair_eps[n_out] = q_eps[k]
+        pair_sigma[n_out] = float(q_dir[k])
         pair_coef[n_out] = q_coef[k]
         pair_dcoef[n_out] = q_dcoef[k]
         n_out += 1
     return n_out
+
+
+@njit(cache=True)
+def trace(t, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, pair_layer, pair_z, pair_eps,
+          pair_coef, pair_dcoef):
+    """Image pairs of a unit point force at height ``t`` in ``source_layer``
+    (:func:`trace_potentials`): ``pair_coef[k, f, j, n]`` is ``A`` of potential ``j``
+    for a force along ``f`` = 0: x, 1: y (``n``: order of ``D``), of the kernels of
+    ref. Eq. 3.23 (``Phi_11 = -Phi_12``, ``Phi_31 = Phi_32``; ``Phi_11`` even in ``r3``,
+    ``Phi_31`` odd)."""
+    g_s = shear_modulus[source_layer]
+    delta_s = 1.0 / (3.0 - 4.0 * poisson_ratio[source_layer])
+    k_2d = _INV_4PI / (g_s * (1.0 + delta_s))
+    original = np.empty((2, 2, 2))
+    for e in range(2):
+        original[e, 0, 0] = k_2d        # Phi_11 (force x1)
+        original[e, 0, 1] = -k_2d       # Phi_12 = -Phi_11
+        original[e, 1, 0] = k_2d        # Phi_31 (force x3)
+        original[e, 1, 1] = k_2d        # Phi_32 = Phi_31
+    return trace_potentials(t, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, original,
+                            np.array([1.0, -1.0]), pair_layer, pair_z, pair_eps, np.empty(pair_z.shape[0]), pair_coef,
+                            pair_dcoef)
 
 
 # -- stress of one pair ------------------------------------------------------------------

@@ -43,10 +43,11 @@ derivative of the point-force stress, exactly as in :mod:`.images2d`, and the
 bookkeeping (complementary = every image pair in the source's layer; transmitted minus
 the source material's whole-space field elsewhere) is the same.
 
-Derivatives. Horizontal derivatives (up to order 5) of ``F`` and ``L`` come from
-truncated bivariate Taylor series; ``D F = -sigma L``, ``D L = sigma / r``, so every
-derivative with a vertical part is a derivative of ``1/r``, whose Taylor coefficients
-follow a three-term recurrence (any order).
+Derivatives. ``D F = -sigma L``, ``D L = sigma / r``, so every derivative with a vertical
+part is a derivative of ``1/r``, whose Taylor coefficients follow a three-term recurrence
+(any order). Horizontal derivatives (up to order 5) of ``F`` and ``L`` come from
+one-variable Taylor series along x of the closed forms of ``d1 F``, ``d2 F``, ``d1 L``,
+``d2 L`` and from Laplace's equation (both are harmonic) for the higher ``d2`` powers.
 
 Length (over ~400 lines): the 3D derivative tables of the Hansen potentials (checked by
 ``_derive_images3d``), the tracer of images through interfaces and the rectangle quadrature
@@ -60,11 +61,9 @@ from numba import njit
 
 from ..kernels import rectangle3d
 from ..kernels.drivers import KernelKind, register_kind
-from .images2d import _apply, _lame, gauss_legendre, trace_capacity
+from .images2d import _lame, gauss_legendre, trace_capacity, trace_potentials
 
 _INV_8PI = 1.0 / (8.0 * math.pi)
-#: Order of the horizontal Taylor series of ``F`` and ``L``.
-_SERIES = 5
 
 
 # -- tracing the image triples (ref. Fig. 3.4) ------------------------------------------------
@@ -85,181 +84,82 @@ def _original(coef, delta, shear_modulus, sigma, scale):
 @njit(cache=True)
 def trace(t, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, pair_layer, pair_z, pair_eps,
           pair_sigma, pair_coef, pair_dcoef):
-    """Image triples of a unit point force at height ``t`` in ``source_layer``.
-
-    Fills ``pair_layer[k]``, ``pair_z[k]`` (height the triple emanates from),
-    ``pair_eps[k] = dz/dt``, ``pair_sigma[k]`` (gauge = direction of travel: +1 upward,
-    receivers above ``z``) and ``pair_coef[k, f, j, n]`` (coefficient of ``D^n`` of the
-    base function of potential ``j`` for a force along ``f``), ``pair_dcoef`` = d/dt.
-    Returns the number of triples (the original excluded)."""
-    n_layers = shear_modulus.shape[0]
-    n_orders = pair_coef.shape[3]
-    cap = pair_coef.shape[0]
-    q_layer = np.empty(cap + 2, dtype=np.int64)
-    q_dir = np.empty(cap + 2, dtype=np.int64)
-    q_ref = np.empty(cap + 2, dtype=np.int64)
-    q_z = np.empty(cap + 2)
-    q_eps = np.empty(cap + 2)
-    q_coef = np.zeros((cap + 2, 3, 3, n_orders))
-    q_dcoef = np.zeros((cap + 2, 3, 3, n_orders))
+    """Image triples of a unit point force at height ``t`` in ``source_layer``
+    (:func:`.images2d.trace_potentials`): ``pair_sigma[k]`` is the triple's gauge (its
+    direction of travel: +1 upward, receivers above ``z``), ``pair_coef[k, f, j, n]`` the
+    coefficient of ``D^n`` of the base function of potential ``j`` for a force along
+    ``f``. Returns the number of triples (the original excluded)."""
     delta_s = 1.0 / (3.0 - 4.0 * poisson_ratio[source_layer])
+    original = np.zeros((2, 3, 3, 1))
     for e in range(2):
-        q_layer[e] = source_layer
-        q_dir[e] = 1 if e == 0 else -1
-        q_ref[e] = 0
-        q_z[e] = t
-        q_eps[e] = 1.0
-        _original(q_coef[e], delta_s, shear_modulus[source_layer], float(q_dir[e]), 1.0)
-    n_queue = 2
-    mirrored = np.empty((3, 3, n_orders))
-    dmirrored = np.empty((3, 3, n_orders))
-    i = 0
-    while i < n_queue:
-        layer = q_layer[i]
-        direction = q_dir[i]
-        far = layer - 1 if direction > 0 else layer + 1
-        if far < 0 or far >= n_layers:
-            i += 1
-            continue
-        d = interfaces[layer - 1] if direction > 0 else interfaces[layer]
-        h = q_z[i] - d
-        dh = q_eps[i]
-        g1 = shear_modulus[layer]
-        g2 = shear_modulus[far]
-        d1 = 1.0 / (3.0 - 4.0 * poisson_ratio[layer])
-        d2 = 1.0 / (3.0 - 4.0 * poisson_ratio[far])
-        gamma = g2 / g1
-        c1 = (gamma - 1.0) / (gamma + d1)                 # ref. Eq. 3.28
-        c2 = (gamma * d2 - d1) / (gamma * d2 + 1.0)
-        c3 = (1.0 - gamma) / (1.0 + gamma)
-        c4 = 1.0 - c1
-        c5 = 1.0 - c2
-        c6 = 1.0 + c3
-        if q_ref[i] < n_images and (c1 != 0.0 or c2 != 0.0 or c3 != 0.0):
-            k = n_queue
-            for f in range(3):
-                for j in range(3):
-                    for n in range(n_orders):
-                        sign = 1.0 if n % 2 == 0 else -1.0
-                        mirrored[f, j, n] = sign * q_coef[i, f, j, n]
-                        dmirrored[f, j, n] = sign * q_dcoef[i, f, j, n]
-            for f in range(3):
-                # ref. Eq. 3.26 (the mirrored triple emanates from z' = 2d - z)
-                _apply(2.0 * d1 * c1, 1, h, dh, mirrored[f, 0], dmirrored[f, 0], q_coef[k, f, 0], q_dcoef[k, f, 0],
-                       n_orders)
-                _apply(c2, 0, h, dh, mirrored[f, 1], dmirrored[f, 1], q_coef[k, f, 0], q_dcoef[k, f, 0], n_orders)
-                _apply(-4.0 * d1 * d1 * c1, 2, h, dh, mirrored[f, 1], dmirrored[f, 1], q_coef[k, f, 0],
-                       q_dcoef[k, f, 0], n_orders)
-                _apply(c1, 0, h, dh, mirrored[f, 0], dmirrored[f, 0], q_coef[k, f, 1], q_dcoef[k, f, 1], n_orders)
-                _apply(-2.0 * d1 * c1, 1, h, dh, mirrored[f, 1], dmirrored[f, 1], q_coef[k, f, 1],
-                       q_dcoef[k, f, 1], n_orders)
-                _apply(c3, 0, h, dh, mirrored[f, 2], dmirrored[f, 2], q_coef[k, f, 2], q_dcoef[k, f, 2], n_orders)
-            q_layer[k] = layer
-            q_dir[k] = -direction
-            q_ref[k] = q_ref[i] + 1
-            q_z[k] = 2.0 * d - q_z[i]
-            q_eps[k] = -q_eps[i]
-            n_queue += 1
-        if g2 > 0.0:
-            k = n_queue
-            for f in range(3):
-                # ref. Eq. 3.27 with T12 = +2 (d1 c4 - d2 c5) h D (see the module docstring)
-                _apply(c4, 0, h, dh, q_coef[i, f, 0], q_dcoef[i, f, 0], q_coef[k, f, 0], q_dcoef[k, f, 0], n_orders)
-                _apply(2.0 * (d1 * c4 - d2 * c5), 1, h, dh, q_coef[i, f, 1], q_dcoef[i, f, 1], q_coef[k, f, 0],
-                       q_dcoef[k, f, 0], n_orders)
-                _apply(c5, 0, h, dh, q_coef[i, f, 1], q_dcoef[i, f, 1], q_coef[k, f, 1], q_dcoef[k, f, 1], n_orders)
-                _apply(c6, 0, h, dh, q_coef[i, f, 2], q_dcoef[i, f, 2], q_coef[k, f, 2], q_dcoef[k, f, 2], n_orders)
-            q_layer[k] = far
-            q_dir[k] = direction
-            q_ref[k] = q_ref[i]
-            q_z[k] = q_z[i]
-            q_eps[k] = q_eps[i]
-            n_queue += 1
-        i += 1
-    n_out = 0
-    for k in range(2, n_queue):
-        pair_layer[n_out] = q_layer[k]
-        pair_z[n_out] = q_z[k]
-        pair_eps[n_out] = q_eps[k]
-        pair_sigma[n_out] = float(q_dir[k])
-        pair_coef[n_out] = q_coef[k]
-        pair_dcoef[n_out] = q_dcoef[k]
-        n_out += 1
-    return n_out
+        _original(original[e], delta_s, shear_modulus[source_layer], 1.0 if e == 0 else -1.0, 1.0)
+    return trace_potentials(t, source_layer, interfaces, shear_modulus, poisson_ratio, n_images,
+                            np.ascontiguousarray(original[:, :, :, 0]),
+                            np.ones(3), pair_layer, pair_z, pair_eps, pair_sigma, pair_coef, pair_dcoef)
 
 
 # -- derivatives of the base functions -----------------------------------------------------
 @njit(cache=True)
-def _series_mul(x, y, out):
-    """Truncated product of bivariate Taylor series (``[i, j]``, ``i + j <= order``)."""
-    m = x.shape[0] - 1
-    out[:] = 0.0
-    for i1 in range(m + 1):
-        for j1 in range(m + 1 - i1):
-            xv = x[i1, j1]
-            if xv == 0.0:
-                continue
-            for i2 in range(m + 1 - i1 - j1):
-                for j2 in range(m + 1 - i1 - j1 - i2):
-                    out[i1 + i2, j1 + j2] += xv * y[i2, j2]
+def _axis_series(r1, r3, r, m, ser):
+    """Taylor coefficients (``k < m``) in ``t`` at ``(r1 + t, r2, r3)``, gauge +1, ``U = R + r3``:
+    ``ser[0] = R``, ``ser[1] = 1/R``, ``ser[2] = V = 1/U``, ``ser[3] = W = V/R``."""
+    rs, ir, v, w = ser[0], ser[1], ser[2], ser[3]
+    u0 = r + r3
+    rs[0] = r
+    ir[0] = 1.0 / r
+    v[0] = 1.0 / u0
+    for k in range(1, m):
+        s = 2.0 * r1 if k == 1 else (1.0 if k == 2 else 0.0)  # R^2 = r^2 + 2 r1 t + t^2
+        for i in range(1, k):
+            s -= rs[i] * rs[k - i]
+        rs[k] = s / (2.0 * r)
+        s_ir = 0.0
+        s_v = 0.0
+        for i in range(1, k + 1):
+            s_ir += rs[i] * ir[k - i]
+            s_v += rs[i] * v[k - i]  # U_i = R_i for i >= 1
+        ir[k] = -s_ir / r
+        v[k] = -s_v / u0
+    for k in range(m):
+        s = 0.0
+        for i in range(k + 1):
+            s += v[i] * ir[k - i]
+        w[k] = s
 
 
 @njit(cache=True)
-def horizontal_derivatives(r1, r2, r3, sf, sl, scratch):
-    """``sf[a, b] = d1^a d2^b F``, ``sl[a, b] = d1^a d2^b L`` of gauge +1 at ``(r1, r2, r3)``,
-    ``r3 >= 0`` (away from the singular half-line), ``a + b <= 5``; ``scratch``: (4, 6, 6)."""
-    w = scratch[0]
-    power = scratch[1]
-    tmp = scratch[2]
-    acc = scratch[3]
-    rr = r1 * r1 + r2 * r2 + r3 * r3
-    r = math.sqrt(rr)
-    w[:] = 0.0
-    w[1, 0] = 2.0 * r1 / rr
-    w[0, 1] = 2.0 * r2 / rr
-    w[2, 0] = 1.0 / rr
-    w[0, 2] = 1.0 / rr
-    # R = r sqrt(1 + w); its increment R - r
-    acc[:] = 0.0
-    power[:] = w
-    binom = 0.5
-    for k in range(1, _SERIES + 1):
-        for i in range(_SERIES + 1):
-            for j in range(_SERIES + 1 - i):
-                acc[i, j] += r * binom * power[i, j]
-        binom *= (0.5 - k) / (k + 1.0)
-        if k < _SERIES:
-            _series_mul(power, w, tmp)
-            power[:] = tmp
-    u0 = r + r3
-    # log(u0 + (R - r)) = log u0 + log(1 + v), v = (R - r)/u0
-    for i in range(_SERIES + 1):
-        for j in range(_SERIES + 1 - i):
-            w[i, j] = acc[i, j] / u0
-    sl[:] = 0.0
-    power[:] = w
-    for k in range(1, _SERIES + 1):
-        c = 1.0 / k if k % 2 == 1 else -1.0 / k
-        for i in range(_SERIES + 1):
-            for j in range(_SERIES + 1 - i):
-                sl[i, j] += c * power[i, j]
-        if k < _SERIES:
-            _series_mul(power, w, tmp)
-            power[:] = tmp
-    sl[0, 0] = math.log(u0)
-    fi = 1.0
-    for i in range(_SERIES + 1):
-        if i > 0:
-            fi *= i
-        fj = 1.0
-        for j in range(_SERIES + 1 - i):
-            if j > 0:
-                fj *= j
-            f = acc[i, j] - r3 * sl[i, j]
-            if i == 0 and j == 0:
-                f += r
-            sf[i, j] = fi * fj * f
-            sl[i, j] = fi * fj * sl[i, j]
+def base_derivatives(r1, r2, r3, sf, sl, q, ser):
+    """Derivatives of the gauge +1 base functions at ``(r1, r2, r3)``, ``r3 >= 0`` (away
+    from the singular half-line): ``q[a, b, c] = d1^a d2^b d3^c (1/r)`` (all of ``q``'s
+    shape, :func:`inverse_distance_derivatives`), ``sf[a, b] = d1^a d2^b F`` and
+    ``sl[a, b] = d1^a d2^b L`` for ``a + b <= 5``. Along x from one-variable Taylor series
+    of the closed forms ``d1 F = r1 / U``, ``d1 L = r1 / (R U)``, ``d2 F = r2 / U``,
+    ``d2 L = r2 / (R U)`` (``U = r + r3``, no cancelling terms); the other horizontal
+    derivatives from Laplace's equation, ``d2^2 F = -d1^2 F + 1/r``,
+    ``d2^2 L = -d1^2 L - d3 (1/r)`` (``F`` and ``L`` are harmonic; ``ser``: (4, 6) scratch)."""
+    inverse_distance_derivatives(r1, r2, r3, q)
+    r = math.sqrt(r1 * r1 + r2 * r2 + r3 * r3)
+    _axis_series(r1, r3, r, 5, ser)
+    v = ser[2]
+    w = ser[3]
+    sf[0, 0] = r - r3 * math.log(r + r3)
+    sl[0, 0] = math.log(r + r3)
+    fact = 1.0  # (a - 1)!
+    for a in range(1, 6):
+        if a > 1:
+            fact *= a - 1
+        sf[a, 0] = fact * (r1 * v[a - 1] + (v[a - 2] if a >= 2 else 0.0))
+        sl[a, 0] = fact * (r1 * w[a - 1] + (w[a - 2] if a >= 2 else 0.0))
+    fact = 1.0  # a!
+    for a in range(5):
+        if a > 0:
+            fact *= a
+        sf[a, 1] = fact * r2 * v[a]
+        sl[a, 1] = fact * r2 * w[a]
+    for b in range(2, 6):
+        for a in range(6 - b):
+            sf[a, b] = -sf[a + 2, b - 2] + q[a, b - 2, 0]
+            sl[a, b] = -sl[a + 2, b - 2] - q[a, b - 2, 1]
 
 
 @njit(cache=True)
@@ -269,7 +169,10 @@ def inverse_distance_derivatives(r1, r2, r3, q):
     ``n r^2 t_k + (2n - 1) sum_i r_i t_(k - e_i) + (n - 1) sum_i t_(k - 2 e_i) = 0``
     (here on the unit vector, then scaled)."""
     r = math.sqrt(r1 * r1 + r2 * r2 + r3 * r3)
-    x = (r1 / r, r2 / r, r3 / r)
+    inv = 1.0 / r
+    x0 = r1 * inv
+    x1 = r2 * inv
+    x2 = r3 * inv
     ha = q.shape[0]
     nc = q.shape[2]
     for c in range(nc):
@@ -281,53 +184,62 @@ def inverse_distance_derivatives(r1, r2, r3, q):
                     continue
                 s = 0.0
                 if a >= 1:
-                    s += (2 * n - 1) * x[0] * q[a - 1, b, c]
+                    s += x0 * q[a - 1, b, c]
                 if b >= 1:
-                    s += (2 * n - 1) * x[1] * q[a, b - 1, c]
+                    s += x1 * q[a, b - 1, c]
                 if c >= 1:
-                    s += (2 * n - 1) * x[2] * q[a, b, c - 1]
+                    s += x2 * q[a, b, c - 1]
+                s *= 2 * n - 1
+                t = 0.0
                 if a >= 2:
-                    s += (n - 1) * q[a - 2, b, c]
+                    t += q[a - 2, b, c]
                 if b >= 2:
-                    s += (n - 1) * q[a, b - 2, c]
+                    t += q[a, b - 2, c]
                 if c >= 2:
-                    s += (n - 1) * q[a, b, c - 2]
-                q[a, b, c] = -s / n
+                    t += q[a, b, c - 2]
+                q[a, b, c] = -(s + (n - 1) * t) / n
     # t_k / r^(n+1) * a! b! c!
-    fc = 1.0
+    fc = inv
     for c in range(nc):
         if c > 0:
-            fc *= c
-        fa = 1.0
+            fc *= c * inv
+        fa = fc
         for a in range(ha):
             if a > 0:
-                fa *= a
-            fb = 1.0
+                fa *= a * inv
+            fb = fa
             for b in range(ha - a):
                 if b > 0:
-                    fb *= b
-                q[a, b, c] *= fa * fb * fc / r ** (a + b + c + 1)
-
-
-@njit(cache=True, inline="always")
-def _base(kind, a, b, c, sf, sl, q):
-    """``d1^a d2^b d3^c`` of ``F`` (kind 0) or ``L`` (kind 1), gauge +1."""
-    if kind == 0:
-        if c == 0:
-            return sf[a, b]
-        if c == 1:
-            return -sl[a, b]
-        return -q[a, b, c - 2]
-    if c == 0:
-        return sl[a, b]
-    return q[a, b, c - 1]
+                    fb *= b * inv
+                q[a, b, c] *= fb
 
 
 @njit(cache=True)
-def _potential_table(coef, n_orders, sigma, max_order, sf, sl, q, table):
-    """``table[f, j, a, b, c] = d1^a d2^b d3^c phi_j`` of force ``f`` (``a + b + c <= max_order``)
-    for the triple ``coef`` of gauge ``sigma`` (derivatives of gauge +1 taken at the
-    flipped point, hence ``sigma^(c + n)``)."""
+def _base_table(sigma, n_c, sf, sl, q, base):
+    """``base[kind, a, b, c] = d1^a d2^b d3^c`` of ``F`` (kind 0) or ``L`` (kind 1) of
+    gauge ``sigma`` (``a + b <= 5``, ``c < n_c``), from the gauge +1 derivatives at the
+    flipped point: ``sigma^c`` times ``sf``/``sl``/``q`` (``d3 F = -L``, ``d3 L = 1/r``)."""
+    for a in range(6):
+        for b in range(6 - a):
+            sign = 1.0
+            for c in range(n_c):
+                if c == 0:
+                    base[0, a, b, 0] = sf[a, b]
+                    base[1, a, b, 0] = sl[a, b]
+                else:
+                    if sigma < 0.0:
+                        sign = -sign
+                    base[0, a, b, c] = -sign * (sl[a, b] if c == 1 else q[a, b, c - 2])
+                    base[1, a, b, c] = sign * q[a, b, c - 1]
+
+
+@njit(cache=True)
+def _potential_table(coef, base, order, table):
+    """``table[f, j, a, b, c] = d1^a d2^b d3^c phi_j`` of force ``f`` for the triple
+    ``coef`` (``phi_j = sum_n coef[f, j, n] D^n`` of its base function ``d1 F``, ``d2 F``
+    or ``L``): the orders the stress needs, ``a + b + c = order`` (and ``order + 1`` for
+    ``phi_2``, the only one with the ``s`` term of ref. Eq. 3.22)."""
+    n_orders = coef.shape[2]
     for f in range(3):
         for j in range(3):
             if f == 2 and j == 2:
@@ -338,52 +250,38 @@ def _potential_table(coef, n_orders, sigma, max_order, sf, sl, q, table):
                 kind, ia, ib = 0, 1, 0
             else:
                 kind, ia, ib = 0, 0, 1
-            for a in range(max_order + 1):
-                for b in range(max_order + 1 - a):
-                    for c in range(max_order + 1 - a - b):
+            n0 = 0
+            while n0 < n_orders and coef[f, j, n0] == 0.0:
+                n0 += 1
+            n1 = n_orders
+            while n1 > n0 and coef[f, j, n1 - 1] == 0.0:
+                n1 -= 1
+            top = order + 1 if j == 1 else order
+            for o in range(order, top + 1):
+                for a in range(o + 1):
+                    for b in range(o + 1 - a):
+                        c = o - a - b
                         s = 0.0
-                        for n in range(n_orders):
-                            cn = coef[f, j, n]
-                            if cn != 0.0:
-                                v = cn * _base(kind, a + ia, b + ib, c + n, sf, sl, q)
-                                s += v if (c + n) % 2 == 0 or sigma > 0.0 else -v
+                        for n in range(n0, n1):
+                            s += coef[f, j, n] * base[kind, a + ia, b + ib, c + n]
                         table[f, j, a, b, c] = s
 
 
 @njit(cache=True)
-def _displacement_gradient(table, f, da, db, dc, scale, s, delta, out):
-    """``out[i, k] += scale * d_k u_i`` of force ``f`` from the potential derivatives
-    ``table`` shifted by ``(da, db, dc)`` (ref. Eq. 3.22, ``s`` the height above the
-    triple's point)."""
-    for i in range(3):
-        for k in range(3):
-            a = da + (1 if i == 0 else 0) + (1 if k == 0 else 0)
-            b = db + (1 if i == 1 else 0) + (1 if k == 1 else 0)
-            c = dc + (1 if i == 2 else 0) + (1 if k == 2 else 0)
-            v = table[f, 0, a, b, c] - table[f, 1, a, b, c] - 2.0 * delta * s * table[f, 1, a, b, c + 1]
-            if k == 2:
-                v -= 2.0 * delta * table[f, 1, a, b, c]
-            if i == 2:
-                v += 2.0 * table[f, 1, a, b, c]
-            if i == 0:  # M_1 = phi3,2
-                v += table[f, 2, a - (1 if i == 0 else 0), b + 1, c]
-            elif i == 1:  # M_2 = -phi3,1
-                v -= table[f, 2, a + 1, b - 1, c]
-            out[i, k] += scale * v
-
-
-@njit(cache=True)
 def Workspace(n_orders):
-    """Scratch arrays of :func:`_pair_stress_gradient` for triples of up to ``n_orders``."""
-    return (np.empty((6, 6)), np.empty((6, 6)), np.empty((4, 6, 6)), np.empty((6, 6, n_orders + 4)),
-            np.zeros((3, 3, 6, 6, 6)), np.zeros((3, 3, 6, 6, 6)), np.empty((3, 3)))
+    """Scratch arrays of :func:`_pair_stress_gradient` for triples of up to ``n_orders``:
+    ``sf, sl`` (6, 6), the series (4, 6), ``q`` (6, 6, n_orders + 4), the base table
+    (2, 6, 6, n_orders + 5) and the potential tables (3, 3, 6, 6, 6)."""
+    return (np.empty((6, 6)), np.empty((6, 6)), np.empty((4, 6)), np.empty((6, 6, n_orders + 4)),
+            np.empty((2, 6, 6, n_orders + 5)), np.zeros((3, 3, 6, 6, 6)), np.zeros((3, 3, 6, 6, 6)))
 
 
 @njit(cache=True)
-def _pair_tables(r1, r2, r3, sigma, coef, dcoef, work):
-    """Fill ``work``'s potential tables (derivatives up to order 4, of ``dcoef`` up to 3)
-    of the triple at the receiver ``r`` (relative to the triple's point)."""
-    sf, sl, scratch, q, table, dtable, grad = work
+def _pair_tables(r1, r2, r3, sigma, coef, dcoef, order, work):
+    """Fill ``work``'s potential tables of the triple at the receiver ``r`` (relative to
+    the triple's point): ``coef`` at ``order`` (3 for the stress, 2 for the displacement),
+    ``dcoef`` one lower."""
+    sf, sl, ser, q, base, table, dtable = work
     n_orders = coef.shape[2]
     used = 1
     for f in range(3):
@@ -392,43 +290,77 @@ def _pair_tables(r1, r2, r3, sigma, coef, dcoef, work):
                 if coef[f, j, n] != 0.0 or dcoef[f, j, n] != 0.0:
                     used = n + 1
                     break
-    rho3 = sigma * r3
-    horizontal_derivatives(r1, r2, rho3, sf, sl, scratch)
-    inverse_distance_derivatives(r1, r2, rho3, q[:, :, :used + 3])
-    _potential_table(coef, used, sigma, 4, sf, sl, q, table)
-    _potential_table(dcoef, used, sigma, 3, sf, sl, q, dtable)
+    n_c = order + used + 1
+    base_derivatives(r1, r2, sigma * r3, sf, sl, q[:, :, :n_c - 1], ser)
+    _base_table(sigma, n_c, sf, sl, q, base)
+    _potential_table(coef, base, order, table)
+    _potential_table(dcoef, base, order - 1, dtable)
+
+
+@njit(cache=True)
+def _stress(table, f, da, db, dc, scale, s, delta, shear_modulus, lame, out):
+    """``out[i, k] += scale *`` the stress of force ``f`` from the potential derivatives
+    ``table`` shifted by ``(da, db, dc)``: ref. Eq. 3.22's displacement, with harmonic
+    potentials (so ``div u = 2 (1 - delta) phi2,33``),
+    ``sigma_ik = G (2 phi1,ik - 2 phi2,ik - 4 delta s phi2,ik3 + 2 (1 - delta)
+    (delta_k3 phi2,i3 + delta_i3 phi2,k3) + eps_ij3 phi3,jk + eps_kj3 phi3,ji)
+    + 2 lambda (1 - delta) delta_ik phi2,33`` (``s`` the height above the triple's point)."""
+    t0 = table[f, 0]
+    t1 = table[f, 1]
+    t2 = table[f, 2]
+    g = shear_modulus
+    w = 2.0 * (1.0 - delta)
+    d33 = w * t1[da, db, dc + 2]
+    for i in range(3):
+        for k in range(i, 3):
+            a = da + (1 if i == 0 else 0) + (1 if k == 0 else 0)
+            b = db + (1 if i == 1 else 0) + (1 if k == 1 else 0)
+            c = dc + (1 if i == 2 else 0) + (1 if k == 2 else 0)
+            v = 2.0 * (t0[a, b, c] - t1[a, b, c]) - 4.0 * delta * s * t1[a, b, c + 1]
+            if k == 2:
+                v += w * t1[da + (1 if i == 0 else 0), db + (1 if i == 1 else 0), dc + (1 if i == 2 else 0) + 1]
+                if i == 2:
+                    v += w * t1[da, db, dc + 2]
+            if i == 0 and k == 0:
+                v += 2.0 * t2[da + 1, db + 1, dc]
+            elif i == 1 and k == 1:
+                v -= 2.0 * t2[da + 1, db + 1, dc]
+            elif i == 0 and k == 1:
+                v += t2[da, db + 2, dc] - t2[da + 2, db, dc]
+            elif i == 0 and k == 2:
+                v += t2[da, db + 1, dc + 1]
+            elif i == 1 and k == 2:
+                v -= t2[da + 1, db, dc + 1]
+            v *= g
+            if i == k:
+                v += lame * d33
+            out[i, k] += scale * v
+            if i != k:
+                out[k, i] += scale * v
 
 
 @njit(cache=True)
 def _pair_stress_gradient(r1, r2, r3, eps, sigma, coef, dcoef, delta, shear_modulus, lame, out, work):
     """``out[f, q, i, k] +=`` derivative along the source coordinate ``q`` of the stress
     ``(i, k)`` at the receiver ``r`` (relative to the triple's point) of a unit force
-    along ``f``; ``delta``, moduli: the receiver layer's; ``eps = dz/dt``."""
-    _pair_tables(r1, r2, r3, sigma, coef, dcoef, work)
-    table = work[4]
-    dtable = work[5]
-    grad = work[6]
+    along ``f``; ``delta``, moduli: the receiver layer's; ``eps = dz/dt``. Horizontal
+    source derivatives are minus receiver derivatives; the vertical one differentiates
+    the coefficients (``dcoef``), the triple's height ``z`` and ``s = y3 - z``."""
+    _pair_tables(r1, r2, r3, sigma, coef, dcoef, 3, work)
+    table = work[5]
+    dtable = work[6]
     for f in range(3):
-        for qq in range(3):
-            grad[:] = 0.0
-            if qq < 2:
-                _displacement_gradient(table, f, 1 if qq == 0 else 0, 1 if qq == 1 else 0, 0, -1.0, r3, delta, grad)
-            else:
-                _displacement_gradient(dtable, f, 0, 0, 0, 1.0, r3, delta, grad)
-                _displacement_gradient(table, f, 0, 0, 1, -eps, r3, delta, grad)
-                for i in range(3):
-                    for k in range(3):
-                        a = (1 if i == 0 else 0) + (1 if k == 0 else 0)
-                        b = (1 if i == 1 else 0) + (1 if k == 1 else 0)
-                        c = (1 if i == 2 else 0) + (1 if k == 2 else 0)
-                        grad[i, k] += 2.0 * delta * eps * table[f, 1, a, b, c + 1]
-            trace_strain = grad[0, 0] + grad[1, 1] + grad[2, 2]
-            for i in range(3):
-                for k in range(3):
-                    v = shear_modulus * (grad[i, k] + grad[k, i])
-                    if i == k:
-                        v += lame * trace_strain
-                    out[f, qq, i, k] += v
+        _stress(table, f, 1, 0, 0, -1.0, r3, delta, shear_modulus, lame, out[f, 0])
+        _stress(table, f, 0, 1, 0, -1.0, r3, delta, shear_modulus, lame, out[f, 1])
+        _stress(dtable, f, 0, 0, 0, 1.0, r3, delta, shear_modulus, lame, out[f, 2])
+        _stress(table, f, 0, 0, 1, -eps, r3, delta, shear_modulus, lame, out[f, 2])
+        t1 = table[f, 1]
+        for i in range(3):
+            for k in range(3):
+                a = (1 if i == 0 else 0) + (1 if k == 0 else 0)
+                b = (1 if i == 1 else 0) + (1 if k == 1 else 0)
+                c = (1 if i == 2 else 0) + (1 if k == 2 else 0)
+                out[f, 2, i, k] += 4.0 * shear_modulus * delta * eps * t1[a, b, c + 1]
 
 
 @njit(cache=True)
@@ -453,9 +385,9 @@ def _displacement(table, f, da, db, dc, scale, s, delta, out):
 def _pair_displacement_gradient(r1, r2, r3, eps, sigma, coef, dcoef, delta, out, work):
     """``out[f, q, i] +=`` derivative along the source coordinate ``q`` of the
     displacement ``u_i`` at the receiver ``r`` of a unit force along ``f``."""
-    _pair_tables(r1, r2, r3, sigma, coef, dcoef, work)
-    table = work[4]
-    dtable = work[5]
+    _pair_tables(r1, r2, r3, sigma, coef, dcoef, 2, work)
+    table = work[5]
+    dtable = work[6]
     for f in range(3):
         _displacement(table, f, 1, 0, 0, -1.0, r3, delta, out[f, 0])
         _displacement(table, f, 0, 1, 0, -1.0, r3, delta, out[f, 1])
@@ -472,10 +404,10 @@ def _pair_displacement_gradient(r1, r2, r3, eps, sigma, coef, dcoef, delta, out,
 def _contract(gradient, normal, shear_modulus, lame, weight, out):
     """``out[b, i, k] += weight *`` stress of a unit DD density along global ``b`` on a
     plane of ``normal``: ``M_pq = lame (b.n) delta_pq + G (b_p n_q + b_q n_p)`` applied
-    to ``gradient[p, q, i, k]``."""
+    to ``gradient[p, q, i, k]`` (any number of ``k``)."""
     for b in range(3):
         for i in range(3):
-            for k in range(3):
+            for k in range(gradient.shape[3]):
                 acc = 0.0
                 for p in range(3):
                     for q in range(3):
@@ -557,20 +489,9 @@ def image_point_stress(y, receiver_layer, x, source_layer, normal, interfaces, s
 @njit(cache=True)
 def _contract_vector(gradient, normal, shear_modulus, lame, out):
     """``out[b, i] =`` the moment contraction (see :func:`_contract`) of ``gradient[p, q, i]``."""
-    for b in range(3):
-        for i in range(3):
-            acc = 0.0
-            for p in range(3):
-                for q in range(3):
-                    m = 0.0
-                    if p == b:
-                        m += shear_modulus * normal[q]
-                    if q == b:
-                        m += shear_modulus * normal[p]
-                    if p == q:
-                        m += lame * normal[b]
-                    acc += m * gradient[p, q, i]
-            out[b, i] = acc
+    contracted = np.zeros((3, 3, 1))
+    _contract(gradient.reshape((3, 3, 3, 1)), normal, shear_modulus, lame, 1.0, contracted)
+    out[:] = contracted[:, :, 0]
 
 
 @njit(cache=True)
@@ -620,12 +541,9 @@ def trace_points(heights, source_layer, interfaces, shear_modulus, poisson_ratio
     """The image triples of source points at ``heights`` (P,): ``(n_pairs (P,), layer,
     z, eps, sigma (P, C), coef, dcoef (P, C, 3, 3, O))``."""
     cap, n_orders = trace_capacity(source_layer, shear_modulus, n_images)
-    n_points = heights.shape[0]
-    traced = (np.zeros(n_points, dtype=np.int64), np.empty((n_points, cap), dtype=np.int64),
-              np.empty((n_points, cap)), np.empty((n_points, cap)), np.empty((n_points, cap)),
-              np.zeros((n_points, cap, 3, 3, n_orders)), np.zeros((n_points, cap, 3, 3, n_orders)))
+    traced = _traced_buffer(heights.shape[0], cap, n_orders)
     n_pairs, layer, z, eps, sigma, coef, dcoef = traced
-    for g in range(n_points):
+    for g in range(heights.shape[0]):
         n_pairs[g] = trace(heights[g], source_layer, interfaces, shear_modulus, poisson_ratio, n_images, layer[g],
                            z[g], eps[g], sigma[g], coef[g], dcoef[g])
     return traced
@@ -657,11 +575,12 @@ def square_rule(n_gauss, n_sub):
 
 
 @njit(cache=True)
-def rectangle_distance(y, center, frame, a, b):
-    """Distance from ``y`` to the rectangle (centre, frame rows e1 e2 n, half sides a b)."""
-    d0 = y[0] - center[0]
-    d1 = y[1] - center[1]
-    d2 = y[2] - center[2]
+def _distance(y0, y1, y2, center, frame, a, b):
+    """Distance from the point ``(y0, y1, y2)`` to the rectangle (centre, frame rows e1 e2
+    n, half sides a b)."""
+    d0 = y0 - center[0]
+    d1 = y1 - center[1]
+    d2 = y2 - center[2]
     x1 = frame[0, 0] * d0 + frame[0, 1] * d1 + frame[0, 2] * d2
     x2 = frame[1, 0] * d0 + frame[1, 1] * d1 + frame[1, 2] * d2
     x3 = frame[2, 0] * d0 + frame[2, 1] * d1 + frame[2, 2] * d2
@@ -671,30 +590,64 @@ def rectangle_distance(y, center, frame, a, b):
 
 
 @njit(cache=True)
-def subdivisions(y, receiver_layer, center, frame, a, b, source_layer, interfaces, max_sub):
-    """Sub-squares per side so that each is at most half as large as the distance from
-    the receiver to the nearest singular point of the integrand: the rectangle's mirror
-    images in the interfaces bounding the source's and the receiver's layers, and the
-    rectangle itself when the receiver is in another layer."""
+def rectangle_distance(y, center, frame, a, b):
+    """Distance from ``y`` to the rectangle (centre, frame rows e1 e2 n, half sides a b)."""
+    return _distance(y[0], y[1], y[2], center, frame, a, b)
+
+
+@njit(cache=True)
+def nearest_singularity(y, receiver_layer, center, frame, a, b, source_layer, interfaces):
+    """Distance from the receiver ``y`` to the nearest singular point of the image
+    integrand: the rectangle's mirror images in the interfaces bounding the source's and
+    the receiver's layers (the distance of the mirrored receiver to the rectangle), and
+    the rectangle itself when the receiver is in another layer."""
     dmin = np.inf
     if receiver_layer != source_layer:
         dmin = rectangle_distance(y, center, frame, a, b)
     n_if = interfaces.shape[0]
-    mirrored = np.empty(3)
-    mframe = frame.copy()
-    for r in range(3):
-        mframe[r, 2] = -frame[r, 2]
     for layer in (source_layer, receiver_layer):
         for k in (layer - 1, layer):
             if 0 <= k < n_if:
-                mirrored[0] = center[0]
-                mirrored[1] = center[1]
-                mirrored[2] = 2.0 * interfaces[k] - center[2]
-                dmin = min(dmin, rectangle_distance(y, mirrored, mframe, a, b))
+                dmin = min(dmin, _distance(y[0], y[1], 2.0 * interfaces[k] - y[2], center, frame, a, b))
+    return dmin
+
+
+@njit(cache=True)
+def subdivisions(y, receiver_layer, center, frame, a, b, source_layer, interfaces, max_sub):
+    """Sub-squares per side so that each is at most half as large as the distance from
+    the receiver to the nearest singular point of the integrand (:func:`nearest_singularity`)."""
+    return _sub_count(nearest_singularity(y, receiver_layer, center, frame, a, b, source_layer, interfaces), a, b,
+                      max_sub)
+
+
+@njit(cache=True)
+def _sub_count(dmin, a, b, max_sub):
     if dmin <= 0.0:
         return max_sub
     n = int(math.ceil(4.0 * max(a, b) / dmin))
     return min(max(n, 1), max_sub)
+
+
+#: Relative error of the image stress of a rectangle that :func:`far_order` allows when it
+#: lowers the Gauss order for a distant receiver (what ``gauss_points = 4`` leaves near
+#: images, at 4 to 8 half sides: 5e-6).
+FAR_TOL = 1e-6
+
+
+@njit(cache=True)
+def far_order(ratio, n_max, tol):
+    """Gauss points per side (at most ``n_max``) for a square of half side ``a`` whose
+    nearest singular point is ``ratio a`` away: the smallest ``n`` with
+    ``40 n ratio^(-2n) <= tol`` (default :data:`FAR_TOL`). That expression bounds the
+    measured relative error of the ``n x n`` Gauss rule on the image stress of horizontal, vertical and tilted
+    squares below a free surface, ``C_n ratio^(-2n)`` with ``C_n`` = 12, 32, 62, 103 for
+    ``n`` = 1-4 (``ratio`` 8-128; the error of a Gauss rule on a function regular within
+    a distance ``d`` falls like ``(a / d)^(2n)``). Thresholds at :data:`FAR_TOL`: 4 points
+    from ratio 10.6, 3 from 22.3, 2 from 95."""
+    for n in range(1, n_max):
+        if 40.0 * n * ratio ** (-2.0 * n) <= tol:
+            return n
+    return n_max
 
 
 @njit(cache=True)
@@ -718,11 +671,39 @@ def _integrate(y, receiver_layer, center, frame, a, b, source_layer, shear_modul
 
 
 @njit(cache=True)
-def _heights(center, frame, a, b, xi, eta):
-    t = np.empty(xi.shape[0])
-    for g in range(xi.shape[0]):
-        t[g] = center[2] + xi[g] * a * frame[0, 2] + eta[g] * b * frame[1, 2]
-    return t
+def _trace_range(center, frame, a, b, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, xi, eta, lo,
+                 hi, traced):
+    """Trace the points ``lo .. hi - 1`` of the rule ``(xi, eta)`` into ``traced``, once
+    per distinct height (a horizontal rectangle is traced once, a vertical one once per
+    row)."""
+    n_pairs, layer, z, eps, sigma, coef, dcoef = traced
+    for g in range(lo, hi):
+        t = center[2] + xi[g] * a * frame[0, 2] + eta[g] * b * frame[1, 2]
+        same = -1
+        for k in range(lo, g):
+            if center[2] + xi[k] * a * frame[0, 2] + eta[k] * b * frame[1, 2] == t:
+                same = k
+                break
+        if same < 0:
+            n_pairs[g] = trace(t, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, layer[g], z[g],
+                               eps[g], sigma[g], coef[g], dcoef[g])
+        else:
+            n = n_pairs[same]
+            n_pairs[g] = n
+            layer[g, :n] = layer[same, :n]
+            z[g, :n] = z[same, :n]
+            eps[g, :n] = eps[same, :n]
+            sigma[g, :n] = sigma[same, :n]
+            coef[g, :n] = coef[same, :n]
+            dcoef[g, :n] = dcoef[same, :n]
+
+
+@njit(cache=True)
+def _traced_buffer(n_points, cap, n_orders):
+    """Room for the triples of ``n_points`` source points (see :func:`trace_points`)."""
+    return (np.zeros(n_points, dtype=np.int64), np.empty((n_points, cap), dtype=np.int64),
+            np.empty((n_points, cap)), np.empty((n_points, cap)), np.empty((n_points, cap)),
+            np.empty((n_points, cap, 3, 3, n_orders)), np.empty((n_points, cap, 3, 3, n_orders)))
 
 
 @njit(cache=True)
@@ -731,19 +712,28 @@ def image_rectangle_stress(y, receiver_layer, center, frame, a, b, source_layer,
     """Complementary stress ``out[b, i, k]`` at ``y`` of a unit global DD ``b`` on the
     rectangle, by ``n_gauss^2`` points on each of ``n_sub^2`` sub-squares."""
     xi, eta, wt = square_rule(n_gauss, n_sub)
-    traced = trace_points(_heights(center, frame, a, b, xi, eta), source_layer, interfaces, shear_modulus,
-                          poisson_ratio, n_images)
+    cap, n_orders = trace_capacity(source_layer, shear_modulus, n_images)
+    traced = _traced_buffer(xi.shape[0], cap, n_orders)
+    _trace_range(center, frame, a, b, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, xi, eta, 0,
+                 xi.shape[0], traced)
     out[:] = 0.0
     _integrate(y, receiver_layer, center, frame, a, b, source_layer, shear_modulus, poisson_ratio, xi, eta, wt,
-               traced, 0, out, np.empty((3, 3, 3, 3)), Workspace(traced[5].shape[-1]), Workspace(1),
-               np.zeros((2, 3, 3, 1)))
+               traced, 0, out, np.empty((3, 3, 3, 3)), Workspace(n_orders), Workspace(1), np.zeros((2, 3, 3, 1)))
+
+
+@njit(cache=True)
+def _image_order(y, receiver_layer, center, frame, a, b, source_layer, interfaces, gauss_points, max_sub, far_tol):
+    """``(n_gauss, n_sub)`` of the image quadrature of a rectangle at ``y``: sub-squares
+    by :func:`subdivisions` rounded up to a power of two, and, on one square,
+    :func:`far_order` points per side."""
+    dmin = nearest_singularity(y, receiver_layer, center, frame, a, b, source_layer, interfaces)
+    n_sub = 2 ** _level(_sub_count(dmin, a, b, max_sub))
+    if n_sub == 1:
+        return far_order(dmin / max(a, b), gauss_points, far_tol), 1
+    return gauss_points, n_sub
 
 
 # -- constant rectangles: the kernel data and the per-pair functions of the drivers ---------------
-#: Sub-square levels (2^level per side) whose traced triples a source keeps.
-_CACHED_LEVELS = 2
-
-
 class LayeredRectangles(NamedTuple):
     """Kernel data of constant rectangles in a layered medium (the record
     :mod:`hmatddm.kernels.drivers` take; built by
@@ -759,12 +749,13 @@ class LayeredRectangles(NamedTuple):
     shear_modulus: np.ndarray  #: (L,) per layer (0: void)
     poisson_ratio: np.ndarray  #: (L,) per layer
     n_images: int  #: reflections per interface (ref. Fig. 3.4)
-    gauss_points: int  #: Gauss-Legendre points per side of a sub-square of the image quadrature
+    gauss_points: int  #: Gauss-Legendre points per side of a sub-square near images (fewer far away: :func:`far_order`)
     max_subdivisions: int  #: largest number of sub-squares per side (:func:`subdivisions`)
     singular_shift: float  #: see :mod:`hmatddm.kernels.drivers` (singular points)
     near_fraction: float  #: near-miss distance, fraction of the smaller half size
     alpha: float  #: ref. Eq. 6.11 scaling (0: none)
     self_max: np.ndarray  #: (N,) largest |entry| of each self block (ref. Eq. 6.11)
+    far_tol: float = FAR_TOL  #: error allowed to :func:`far_order` (0: ``gauss_points`` everywhere)
 
 
 @njit(cache=True)
@@ -776,42 +767,63 @@ def _level(n_sub):
 
 
 @njit(cache=True)
+def _cached_rules(n_gauss):
+    """The rules a source keeps traced, stacked ``(xi, eta, w, start)``: slot ``s < n_gauss``
+    is one square with ``s + 1`` points per side (far receivers, :func:`far_order`), slot
+    ``n_gauss`` is 2 x 2 sub-squares of ``n_gauss`` points per side."""
+    start = np.zeros(n_gauss + 2, dtype=np.int64)
+    for s in range(n_gauss):
+        start[s + 1] = start[s] + (s + 1) ** 2
+    start[n_gauss + 1] = start[n_gauss] + 4 * n_gauss ** 2
+    xi = np.empty(start[-1])
+    eta = np.empty(start[-1])
+    wt = np.empty(start[-1])
+    for s in range(n_gauss + 1):
+        x, e, w = square_rule(s + 1, 1) if s < n_gauss else square_rule(n_gauss, 2)
+        xi[start[s]:start[s + 1]] = x
+        eta[start[s]:start[s + 1]] = e
+        wt[start[s]:start[s + 1]] = w
+    return xi, eta, wt, start
+
+
+@njit(cache=True)
 def workspace(data):
     """Scratch: local stress (3, 3, 3), image stress (3, 3, 3), gradient (3, 3, 3, 3), the
-    Kelvin scratch (2, 3, 3, 1) and the one-order :func:`Workspace`."""
-    return np.empty((3, 3, 3)), np.zeros((3, 3, 3)), np.empty((3, 3, 3, 3)), np.zeros((2, 3, 3, 1)), Workspace(1)
+    Kelvin scratch (2, 3, 3, 1), the :func:`Workspace` of order 1 and of the largest order
+    of any source layer's triples, the tracer's room per layer ``(cap, n_orders)`` and the
+    :func:`_cached_rules`."""
+    n_layers = data.shear_modulus.shape[0]
+    room = np.zeros((n_layers, 2), dtype=np.int64)
+    n_orders = 1
+    if data.interfaces.shape[0] > 0:
+        for layer in range(n_layers):
+            if data.shear_modulus[layer] > 0.0:
+                room[layer, 0], room[layer, 1] = trace_capacity(layer, data.shear_modulus, data.n_images)
+                n_orders = max(n_orders, room[layer, 1])
+    return (np.empty((3, 3, 3)), np.zeros((3, 3, 3)), np.empty((3, 3, 3, 3)), np.zeros((2, 3, 3, 1)), Workspace(1),
+            Workspace(n_orders), room, _cached_rules(data.gauss_points))
 
 
 @njit(cache=True)
 def source_state(data, j, work):
-    """What the receivers of source ``j`` share: the rules of the cached levels (2^level
-    sub-squares per side) and their image triples (traced when a receiver first needs a
-    level)."""
+    """What the receivers of source ``j`` share: room for the image triples at the points
+    of the cached rules, traced when a receiver first needs a rule."""
+    room = work[6]
+    start = work[7][3]
     ls = data.layer[j]
-    center = data.centers[j]
-    frame = data.frames[j]
-    a = data.half_a[j]
-    b = data.half_b[j]
-    rules = []
-    traced_levels = []
-    for level in range(_CACHED_LEVELS):
-        xi, eta, wt = square_rule(data.gauss_points, 2 ** level)
-        rules.append((xi, eta, wt))
-        traced_levels.append(trace_points(_heights(center, frame, a, b, xi[:0], eta[:0]), ls, data.interfaces,
-                                          data.shear_modulus, data.poisson_ratio, data.n_images))
-    is_traced = np.zeros(_CACHED_LEVELS, dtype=np.bool_)
-    n_orders = trace_capacity(ls, data.shear_modulus, data.n_images)[1]
-    return rules, traced_levels, is_traced, Workspace(n_orders)
+    return _traced_buffer(start[-1], max(room[ls, 0], 1), max(room[ls, 1], 1)), np.zeros(start.shape[0] - 1,
+                                                                                         dtype=np.bool_)
 
 
 @njit(cache=True)
 def element_traction(data, i, j, state, work, block):
     """``block`` (3, 3): traction at the centre of element ``i`` (its normal) for a unit
     global DD of rectangle ``j``: closed form of the source layer's material (with the
-    closed-form kernel's singular and near-miss handling) plus images, the source's
-    traced triples reused across receivers."""
-    rules, traced_levels, is_traced, ws = state
-    local, image, gradient, kelvin, ws1 = work
+    closed-form kernel's singular and near-miss handling) plus images (:func:`_image_order`),
+    the source's traced triples reused across receivers."""
+    traced, is_traced = state
+    local, image, gradient, kelvin, ws1, ws, room, rules = work
+    xi, eta, wt, start = rules
     g = data.shear_modulus
     nu = data.poisson_ratio
     interfaces = data.interfaces
@@ -829,19 +841,20 @@ def element_traction(data, i, j, state, work, block):
                               near)
     if interfaces.shape[0] > 0:
         lr = data.layer[i]
-        level = _level(subdivisions(point, lr, center, frame, a, b, ls, interfaces, data.max_subdivisions))
+        n_gauss, n_sub = _image_order(point, lr, center, frame, a, b, ls, interfaces, data.gauss_points,
+                                      data.max_subdivisions, data.far_tol)
         image[:] = 0.0
-        if level < _CACHED_LEVELS:
-            xi, eta, wt = rules[level]
-            if not is_traced[level]:
-                traced_levels[level] = trace_points(_heights(center, frame, a, b, xi, eta), ls, interfaces, g, nu,
-                                                    data.n_images)
-                is_traced[level] = True
-            _integrate(point, lr, center, frame, a, b, ls, g, nu, xi, eta, wt, traced_levels[level], 0, image,
+        if n_sub <= 2:
+            slot = n_gauss - 1 if n_sub == 1 else data.gauss_points
+            lo, hi = start[slot], start[slot + 1]
+            if not is_traced[slot]:
+                _trace_range(center, frame, a, b, ls, interfaces, g, nu, data.n_images, xi, eta, lo, hi, traced)
+                is_traced[slot] = True
+            _integrate(point, lr, center, frame, a, b, ls, g, nu, xi[lo:hi], eta[lo:hi], wt[lo:hi], traced, lo, image,
                        gradient, ws, ws1, kelvin)
         else:
-            image_rectangle_stress(point, lr, center, frame, a, b, ls, interfaces, g, nu, data.n_images,
-                                   data.gauss_points, 2 ** level, image)
+            image_rectangle_stress(point, lr, center, frame, a, b, ls, interfaces, g, nu, data.n_images, n_gauss,
+                                   n_sub, image)
         for p in range(3):
             for q in range(3):
                 block[p, q] += image[q, p, 0] * normal[0] + image[q, p, 1] * normal[1] + image[q, p, 2] * normal[2]
@@ -853,22 +866,24 @@ def element_stress(data, point, point_layer, j, work, out):
     for a unit global DD ``q`` of rectangle ``j``, closed form plus images (the
     quadrature of :func:`element_traction`). A point within ``near_fraction`` smaller
     half sides of an edge counts as on it."""
-    local, image, gradient, kelvin, ws1 = work
+    local, image = work[0], work[1]
     g = data.shear_modulus
     nu = data.poisson_ratio
     if g[point_layer] <= 0.0:
         out[:] = 0.0
         return
     ls = data.layer[j]
+    center = data.centers[j]
+    frame = data.frames[j]
     a = data.half_a[j]
     b = data.half_b[j]
-    rectangle3d.stress_pair(point, data.centers[j], data.frames[j], a, b, g[ls], nu[ls], data.singular_shift, out,
-                            local, data.near_fraction * min(a, b))
+    rectangle3d.stress_pair(point, center, frame, a, b, g[ls], nu[ls], data.singular_shift, out, local,
+                            data.near_fraction * min(a, b))
     if data.interfaces.shape[0] > 0:
-        level = _level(subdivisions(point, point_layer, data.centers[j], data.frames[j], a, b, ls, data.interfaces,
-                                    data.max_subdivisions))
-        image_rectangle_stress(point, point_layer, data.centers[j], data.frames[j], a, b, ls, data.interfaces, g, nu,
-                               data.n_images, data.gauss_points, 2 ** level, image)
+        n_gauss, n_sub = _image_order(point, point_layer, center, frame, a, b, ls, data.interfaces,
+                                      data.gauss_points, data.max_subdivisions, data.far_tol)
+        image_rectangle_stress(point, point_layer, center, frame, a, b, ls, data.interfaces, g, nu, data.n_images,
+                               n_gauss, n_sub, image)
         for q in range(3):
             for i in range(3):
                 for k in range(3):

@@ -44,9 +44,10 @@ def influence_data(mesh, medium, singular_shift, alpha, near_fraction, n_images)
         self_max=np.zeros(mesh.n_elements)))
 
 
-def choose_images(mesh, medium, data, max_samples=24, max_sources=400):
+def choose_images(mesh, medium, data, max_samples=12, max_sources=120):
     """The number of images (see :func:`hmatddm.layered.influence2d.choose_images`,
-    same criterion, with the 3D kernels)."""
+    same criterion, with the 3D kernels, on fewer samples: a 3D pair with many images
+    costs milliseconds)."""
     return _choose_images(mesh, medium, data, max_samples, max_sources)
 
 
