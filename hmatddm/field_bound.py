@@ -27,6 +27,8 @@ corrected value there is not the integral above.
 import numpy as np
 from numba import njit, prange
 
+from .kernels.rectangle3d import rectangle_distance
+
 #: ``C3``, ``C2`` above, with a margin over the measured maxima (9.80 and sqrt(10)).
 POINT_DD_CONSTANT_3D = 10.0
 POINT_DD_CONSTANT_2D = 3.2
@@ -41,15 +43,7 @@ _CHUNKS = 64
 def _element_distance(point, center, frame, a, b):
     """Distance from ``point`` to the rectangle (3D) or segment (2D, ``b`` unused)."""
     if point.shape[0] == 3:
-        dx = point[0] - center[0]
-        dy = point[1] - center[1]
-        dz = point[2] - center[2]
-        x1 = frame[0, 0] * dx + frame[0, 1] * dy + frame[0, 2] * dz
-        x2 = frame[1, 0] * dx + frame[1, 1] * dy + frame[1, 2] * dz
-        x3 = frame[2, 0] * dx + frame[2, 1] * dy + frame[2, 2] * dz
-        u = max(abs(x1) - a, 0.0)
-        v = max(abs(x2) - b, 0.0)
-        return np.sqrt(u * u + v * v + x3 * x3)
+        return rectangle_distance(point, center, frame, a, b)
     dx = point[0] - center[0]
     dy = point[1] - center[1]
     x = frame[0, 0] * dx + frame[0, 1] * dy

@@ -363,3 +363,24 @@ def mean_stress_pair(point, center, frame, a, b, shear_modulus, poisson_ratio, o
 
 
 register_kind(Rectangles, KernelKind(workspace, no_source_state, element_traction, element_stress, edge_distance))
+
+
+@njit(cache=True)
+def distance_to_rectangle(y0, y1, y2, center, frame, a, b):
+    """Distance from the point ``(y0, y1, y2)`` to the rectangle (centre, frame rows e1 e2
+    n, half sides a b)."""
+    d0 = y0 - center[0]
+    d1 = y1 - center[1]
+    d2 = y2 - center[2]
+    x1 = frame[0, 0] * d0 + frame[0, 1] * d1 + frame[0, 2] * d2
+    x2 = frame[1, 0] * d0 + frame[1, 1] * d1 + frame[1, 2] * d2
+    x3 = frame[2, 0] * d0 + frame[2, 1] * d1 + frame[2, 2] * d2
+    o1 = max(abs(x1) - a, 0.0)
+    o2 = max(abs(x2) - b, 0.0)
+    return math.sqrt(o1 * o1 + o2 * o2 + x3 * x3)
+
+
+@njit(cache=True)
+def rectangle_distance(y, center, frame, a, b):
+    """Distance from ``y`` to the rectangle (centre, frame rows e1 e2 n, half sides a b)."""
+    return distance_to_rectangle(y[0], y[1], y[2], center, frame, a, b)

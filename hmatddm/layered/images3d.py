@@ -60,6 +60,7 @@ import numpy as np
 from numba import njit
 
 from ..kernels import rectangle3d
+from ..kernels.rectangle3d import distance_to_rectangle as _distance, rectangle_distance  # noqa: F401 (re-export)
 from ..kernels.drivers import KernelKind, register_kind
 from .images2d import _lame, gauss_legendre, trace_capacity, trace_potentials
 
@@ -572,27 +573,6 @@ def square_rule(n_gauss, n_sub):
             eta[i * m + j] = xi1[j]
             wt[i * m + j] = w1[i] * w1[j]
     return xi, eta, wt
-
-
-@njit(cache=True)
-def _distance(y0, y1, y2, center, frame, a, b):
-    """Distance from the point ``(y0, y1, y2)`` to the rectangle (centre, frame rows e1 e2
-    n, half sides a b)."""
-    d0 = y0 - center[0]
-    d1 = y1 - center[1]
-    d2 = y2 - center[2]
-    x1 = frame[0, 0] * d0 + frame[0, 1] * d1 + frame[0, 2] * d2
-    x2 = frame[1, 0] * d0 + frame[1, 1] * d1 + frame[1, 2] * d2
-    x3 = frame[2, 0] * d0 + frame[2, 1] * d1 + frame[2, 2] * d2
-    o1 = max(abs(x1) - a, 0.0)
-    o2 = max(abs(x2) - b, 0.0)
-    return math.sqrt(o1 * o1 + o2 * o2 + x3 * x3)
-
-
-@njit(cache=True)
-def rectangle_distance(y, center, frame, a, b):
-    """Distance from ``y`` to the rectangle (centre, frame rows e1 e2 n, half sides a b)."""
-    return _distance(y[0], y[1], y[2], center, frame, a, b)
 
 
 @njit(cache=True)
