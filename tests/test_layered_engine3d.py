@@ -73,8 +73,11 @@ def test_layered_3d_simulation_refuses_what_it_does_not_support():
                                        np.array([0.3]))
     with pytest.raises(InputError, match="no horizontal edge"):
         _vertical_run(THREE_LAYERS, hd.Propagation(5e6), mesh=tilted)
-    with pytest.raises(InputError, match="natural_fractures"):
-        _vertical_run(THREE_LAYERS, natural_fractures=hd.mesh.rectangle([3.0, 0, 0], [1, 0, 0], [0, 0, 1], 1, 1, 1, 1))
+    # natural fractures are cut at the interfaces (tests/test_layered_natural.py), unless they cannot be
+    across = hd.Mesh3D.from_rectangles(np.array([[3.0, 0.0, 1.0]]), e1[None], e2[None], np.array([0.3]),
+                                       np.array([0.3]))
+    with pytest.raises(InputError, match="natural_fractures: element 0 crosses the interface at z = 1"):
+        _vertical_run(THREE_LAYERS, natural_fractures=across)
     with pytest.raises(InputError, match="void layer"):  # the fracture above the free surface
         _vertical_run(LayeredMedium([-2.0], [0.0, G], [NU, NU]))
     stressed = LayeredMedium([1.0, -1.0], [G, G, G], [NU, NU, NU], in_situ_stress=np.zeros((3, 2, 2)))

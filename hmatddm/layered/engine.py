@@ -3,6 +3,26 @@
 criteria, self compliance), per-element in-situ stress and toughness, and new tip
 elements cut at the interfaces, so that a fracture grows from one layer into the next.
 
+Natural fractures (ref. Ch. 5) run as in uniform rock, with the layers:
+
+* their mesh is cut at the interfaces like new tip elements (:func:`natural_fracture_mesh`:
+  in 3D always, in 2D where the layers differ), so a network drawn without regard to the
+  layers is accepted; an element that cannot be cut (3D, no horizontal edge), lies along
+  an interface between different layers, or lies in a void layer is refused by name;
+* remote failure (ref. Sec. 5.3) evaluates the induced stress at the intact elements with
+  the image terms (the layered :func:`hmatddm.stress_at`, direct sum, with the number of
+  images of the run's operator), adds the in-situ stress of each element's layer and
+  takes Poisson's ratio of its layer for the undrained pore-pressure change (2D); the
+  rigorous screen of :mod:`hmatddm.field_bound` holds for a homogeneous kernel only, so
+  it is used where all layers have the same moduli (the images vanish: the medium's
+  stress is the homogeneous one) and every target is evaluated otherwise
+  (:func:`remote_failure_setting`);
+* the crossing criterion (ref. Sec. 5.2) uses the in-situ stress and the rock toughness
+  of the layer where the tip meets the natural fracture (:func:`crossing_setting`); the
+  stress intensity factors come from the layered solution with the tip layer's moduli,
+  so the images act on the decision through them (the near-tip field of ref. Eqs 5.6-5.8
+  is that of a crack tip inside one layer).
+
 The vertical axis is the last coordinate (``y`` in 2D, ``z`` in 3D; docs/conventions.md
 §3). In 3D a new rectangle that crosses an interface is cut along it into two
 rectangles, which needs one of its edges to be horizontal (vertical, horizontal and
@@ -47,9 +67,6 @@ def check_simulation(mesh, medium, natural_fractures, propagation):
     if medium.in_situ_stress is not None and medium.in_situ_stress.shape[1] != mesh.dim:
         raise InputError(f"material.in_situ_stress must hold {mesh.dim}x{mesh.dim} tensors for a {mesh.dim}D run, "
                          f"got {medium.in_situ_stress.shape[1]}x{medium.in_situ_stress.shape[2]}")
-    if natural_fractures is not None:
-        raise InputError("natural_fractures: not supported with a LayeredMedium yet (remote failure and the "
-                         "crossing criterion evaluate stresses with a homogeneous material)")
     if propagation is not None and propagation.front != "element":
         raise InputError("propagation.front: a LayeredMedium supports front = 'element' only, so far")
     void = np.flatnonzero(np.asarray(medium.shear_modulus)[element_layers(mesh, medium)] == 0.0)
@@ -71,6 +88,76 @@ def check_simulation(mesh, medium, natural_fractures, propagation):
                 raise InputError(f"mesh: element {inclined[0]} has no horizontal edge, so new elements grown from "
                                  f"it could not be cut along an interface into rectangles; with a LayeredMedium "
                                  f"and propagation, give every 3D element a horizontal edge (e1 or e2 with z = 0)")
+
+
+def natural_fracture_mesh(mesh, natural_fractures, medium):
+    """The natural-fracture mesh of a layered run: ``natural_fractures`` cut at the
+    interfaces (:func:`hmatddm.layered.split_at_interfaces`; in 3D always, the 3D kernels
+    refuse a straddling rectangle; in 2D only where the layers differ, as new tip elements
+    are), each piece keeping its fracture id. InputError naming ``natural_fractures`` for
+    higher-order elements, a 3D element crossing an interface without a horizontal edge,
+    an element along an interface between different layers or in a void layer. A mesh of
+    another type than ``mesh`` is returned as it is (the engine refuses it)."""
+    if type(natural_fractures) is not type(mesh):
+        return natural_fractures
+    if getattr(natural_fractures, "element_order", 0) != 0:
+        raise InputError("natural_fractures: a LayeredMedium simulation needs constant elements (element_order 0)")
+    if mesh.dim == 3 or not uniform(medium):
+        if mesh.dim == 3:
+            try:
+                natural_fractures, _ = split_rectangles(natural_fractures, medium)
+            except InputError as error:  # an element without a horizontal edge: name the field
+                raise InputError(str(error).replace("mesh:", "natural_fractures:", 1)) from None
+        else:
+            from .influence2d import split_at_interfaces
+
+            natural_fractures, _ = split_at_interfaces(natural_fractures, medium)
+    from .influence2d import layers_of_extents
+
+    if mesh.dim == 3:
+        low, high = _vertical_extent(natural_fractures)
+        tol = _CROSSING_TOL * np.maximum(natural_fractures.half_a, natural_fractures.half_b)
+    else:
+        p0, p1 = natural_fractures.endpoints
+        low, high = np.minimum(p0[:, 1], p1[:, 1]), np.maximum(p0[:, 1], p1[:, 1])
+        tol = _CROSSING_TOL * natural_fractures.half_length
+    layers_of_extents(medium, low, high, tol, natural_fractures.fracture_id, noun="natural_fractures element")
+    return natural_fractures
+
+
+def remote_failure_setting(network_mesh, medium, far_field_stress):
+    """``(material, far_field, poisson_ratio)`` of the remote-failure check of the natural
+    elements ``network_mesh`` (ref. Sec. 5.3): the :class:`hmatddm.Elastic` of the layers
+    where they all have the same moduli (no images: the screened check applies), else
+    the medium; the in-situ stress of each element's layer (M, d, d) where the medium
+    gives one, else ``far_field_stress``; Poisson's ratio of each element's layer (M,)."""
+    layers = element_layers(network_mesh, medium)
+    material = medium.material(0) if medium.is_homogeneous else medium
+    far_field = far_field_stress if medium.in_situ_stress is None else medium.in_situ_stress[layers]
+    return material, far_field, np.asarray(medium.poisson_ratio)[layers]
+
+
+def crossing_setting(medium, height, far_field_stress, toughness):
+    """``(far_field, rock_toughness)`` of the crossing criterion (ref. Sec. 5.2) where a
+    tip meets a natural fracture at ``height``: the in-situ stress and toughness of that
+    layer where the medium gives them, else ``far_field_stress`` and ``toughness``."""
+    layer = int(medium.layer_of(height))
+    if medium.in_situ_stress is not None:
+        far_field_stress = medium.in_situ_stress[layer]
+    if medium.toughness is not None:
+        toughness = medium.toughness[layer]
+    return far_field_stress, toughness
+
+
+def induced_stress(mesh, medium, dd, points, singular_correction, near_fraction, n_images):
+    """Stress (M, d, d) the DDs ``dd`` of the constant elements ``mesh`` induce at
+    ``points`` in ``medium`` with ``n_images`` images (None: the medium's choice), by
+    the direct layered sum of :mod:`.influence2d` / :mod:`.influence3d`."""
+    if mesh.dim == 3:
+        from .influence3d import stress_at
+    else:
+        from .influence2d import stress_at
+    return stress_at(mesh, medium, dd, points, singular_correction, near_fraction, n_images)
 
 
 def _has_horizontal_edge(mesh):

@@ -72,9 +72,14 @@ def meet_natural_fractures(simulation, state, edges, faces, tips, grown, parent,
             kept.append(k)
             continue
         target, point = hit
+        far_field, toughness = simulation.far_field_stress, simulation.propagation.toughness
+        if simulation.medium is not None:  # the layer where the tip meets it (hmatddm.layered.engine)
+            from ..layered.engine import crossing_setting
+
+            far_field, toughness = crossing_setting(simulation.medium, hinge[-1] if mesh.dim == 3 else point[-1],
+                                                    far_field, toughness)
         if network.decide_crossing(tips.k_1[row], tips.k_2[row], tips.theta[row], edges.ahead[tip, tips.edge[row]],
-                                   mesh.normals[tip], target, simulation.far_field_stress,
-                                   simulation.propagation.toughness):
+                                   mesh.normals[tip], target, far_field, toughness):
             events.natural_crossed += 1
             kept.append(k)
             continue

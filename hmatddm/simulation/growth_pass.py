@@ -67,10 +67,16 @@ def remote_failures(simulation, state, events):
     sim = simulation
     if sim.network is None or not sim.remote_failure or not np.any(state.intact):
         return None
+    material, far_field, layered = sim.material, sim.far_field_stress, {}
+    if sim.medium is not None:  # images, and each natural element's layer (hmatddm.layered.engine)
+        from ..layered import engine as layered_engine
+
+        material, far_field, nu = layered_engine.remote_failure_setting(sim.network.mesh, sim.medium, far_field)
+        layered = dict(poisson_ratio=nu, n_images=sim.base_operator.stats.get("n_images"))
     # screened: only the targets that the stress bound leaves able to fail are evaluated
-    failed, _, _, pore_change = sim.network.remote_failure(state.mesh, state.dd, sim.material, sim.far_field_stress,
-                                                           state.intact, sim.operator_settings.singular_correction,
-                                                           screen=True)
+    failed, _, _, pore_change = sim.network.remote_failure(state.mesh, state.dd, material, far_field, state.intact,
+                                                           sim.operator_settings.singular_correction, screen=True,
+                                                           **layered)
     index = np.flatnonzero(failed)
     if index.size == 0:
         return None

@@ -16,6 +16,12 @@ They join the active system when fluid reaches them:
 Remote failure (ref. Sec. 5.3): the stress the active elements induce on every intact
 natural element, plus the far field and the undrained pore-pressure change
 ``dp = -B d sigma_m`` (ref. Eq. 5.18), is checked against Coulomb's criterion.
+
+In a :class:`hmatddm.LayeredMedium` the same machinery runs with the layers
+(:mod:`hmatddm.layered.engine`): the induced stress includes the image terms, the far
+field and Poisson's ratio are those of each natural element's layer, and the crossing
+criterion takes the in-situ stress and toughness of the layer where the tip meets the
+natural fracture.
 """
 import time
 
@@ -25,6 +31,7 @@ from scipy.spatial import cKDTree
 from ..errors import InputError
 from ..field_bound import stress_bound
 from ..fracture.crossing import NaturalFractureProperties, crosses
+from ..layered.medium import LayeredMedium
 from ..material import Elastic
 from ..mesh import Mesh2D, Mesh3D, check_mesh
 from ..operators import NEAR_SINGULAR_FRACTION
@@ -110,7 +117,9 @@ class NaturalNetwork:
         return best, start + best_s * (end - start)
 
     def decide_crossing(self, tips_k1, tips_k2, tips_theta, ahead, normal, element, far_field, rock_toughness):
-        """True to cross natural element ``element`` (tip frame: ``ahead``, ``normal``)."""
+        """True to cross natural element ``element`` (tip frame: ``ahead``, ``normal``);
+        ``far_field`` and ``rock_toughness``: those where the tip meets it (in a layered
+        medium, of that layer: :func:`hmatddm.layered.engine.crossing_setting`)."""
         tangent = self.p1[element] - self.p0[element]
         tangent = tangent / np.linalg.norm(tangent)
         if len(ahead) > 2:  # the natural fracture's plan-view direction, in 3D
@@ -121,27 +130,41 @@ class NaturalNetwork:
         return crosses(tips_k1, tips_k2, tips_theta, phi, stress_tip, rock_toughness, self.properties)
 
     def induced_stress(self, active_mesh, dd, material, targets, singular_correction="average", info=None,
-                       method="auto"):
+                       method="auto", n_images=None):
         """Stress (len(targets), d, d) the active elements induce at the centres of the
         natural elements ``targets`` (:func:`hmatddm.stress_at`). Targets within half an
         element size of an active element's edge are near misses (stress ~1/gap),
-        averaged like the DDM operator's collocation points."""
+        averaged like the DDM operator's collocation points. ``material`` a
+        :class:`hmatddm.LayeredMedium`: the direct layered sum with ``n_images`` images
+        (None: the medium's choice; ``method`` and ``info`` do not apply)."""
         near = NEAR_SINGULAR_FRACTION if singular_correction == "average" else 0.0
+        if isinstance(material, LayeredMedium):
+            from ..layered.engine import induced_stress
+
+            return induced_stress(active_mesh, material, dd, self.mesh.centers[targets], singular_correction, near,
+                                  n_images)
         return stress_at(active_mesh, material, dd, self.mesh.centers[targets],
                          singular_correction=singular_correction, near_fraction=near, info=info, method=method)
 
     def remote_failure(self, active_mesh, dd, material, far_field, intact, singular_correction="average",
-                       screen=False, info=None):
+                       screen=False, info=None, poisson_ratio=None, n_images=None):
         """Coulomb check on the intact elements (ref. Sec. 5.3).
 
         Returns ``(failed, normal, shear, pore_pressure_change)`` over the natural
         elements (zeros where not intact).
 
+        ``material``: an :class:`hmatddm.Elastic` or a :class:`hmatddm.LayeredMedium`
+        (the induced stress with the image terms, ``n_images`` of them, see
+        :meth:`induced_stress`); ``far_field``: the (d, d) in-situ stress, or one per
+        natural element (M, d, d) (a layered medium's per layer); ``poisson_ratio`` (M,)
+        or None (the material's): per natural element, for the 2D mean stress.
+
         ``screen``: evaluate the induced stress (exact sum) only at the targets that may
         fail; the others keep zeros like the elements that are not intact. ``failed``,
         and the values where it is True, are those of the full check (see
         :class:`ScreenMemory`). Only in a homogeneous medium with constant elements
-        (elsewhere every target is evaluated). ``info`` (dict or None) receives
+        (elsewhere every target is evaluated; see
+        :func:`hmatddm.layered.engine.remote_failure_setting` for layers). ``info`` (dict or None) receives
         ``targets``, ``evaluated``, ``screen_seconds``, ``memory`` (whether the last
         check's margins were used) and the stress evaluation's ``stress`` info.
         """
@@ -171,10 +194,11 @@ class NaturalNetwork:
             # the exact sum when screening: a target's value does not depend on which others
             # are evaluated (with "auto" the count would choose the method)
             stress = self.induced_stress(active_mesh, dd, material, evaluate, singular_correction, info=stress_info,
-                                         method="direct" if screened else "auto")
+                                         method="direct" if screened else "auto", n_images=n_images)
+            nu = material.poisson_ratio if poisson_ratio is None else np.asarray(poisson_ratio)[evaluate]
             if self.properties.skempton > 0.0:
-                pore_change[evaluate] = -self.properties.skempton * _mean_stress(stress, material)
-            stress = stress + far_field
+                pore_change[evaluate] = -self.properties.skempton * _mean_stress(stress, nu)
+            stress = stress + (far_field if np.ndim(far_field) == 2 else np.asarray(far_field)[evaluate])
             normal_stress[evaluate], shear_stress[evaluate] = _normal_and_shear(stress, self.mesh.normals[evaluate])
             failed[evaluate] = _coulomb(self.properties, normal_stress[evaluate], shear_stress[evaluate],
                                         pore_change[evaluate])
@@ -268,11 +292,11 @@ def _screenable(mesh, material):
     return isinstance(material, Elastic) and isinstance(mesh, (Mesh2D, Mesh3D)) and getattr(mesh, "n_nodes", 1) == 1
 
 
-def _mean_stress(stress, material):
+def _mean_stress(stress, poisson_ratio):
     """Mean of induced stress tensors (M, d, d) (ref. Eqs 5.24-5.28): in 2D plane strain
-    sigma_zz = nu (sigma_xx + sigma_yy) joins the trace."""
+    sigma_zz = nu (sigma_xx + sigma_yy) joins the trace (``poisson_ratio``: nu, scalar or (M,))."""
     trace = np.trace(stress, axis1=1, axis2=2)
-    return trace / 3.0 if stress.shape[1] == 3 else (1.0 + material.poisson_ratio) * trace / 3.0
+    return trace / 3.0 if stress.shape[1] == 3 else (1.0 + poisson_ratio) * trace / 3.0
 
 
 def _normal_and_shear(stress, normals):

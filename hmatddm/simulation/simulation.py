@@ -86,7 +86,9 @@ class Simulation:
         Natural-fracture elements (same dimension as ``mesh``). Intact ones are stress
         targets; they join the system when the fluid reaches them (ref. Ch. 5, see
         :mod:`hmatddm.simulation.natural`). Use ``singular_correction="average"`` and
-        ``alpha=1.0`` (ref. Sec. 6.2.3) when elements meet at intersections.
+        ``alpha=1.0`` (ref. Sec. 6.2.3) when elements meet at intersections. With a
+        LayeredMedium they are cut at the interfaces (3D; 2D where the layers differ) and
+        feel the layers (:mod:`hmatddm.layered.engine`).
     natural : NaturalFractureProperties or None
         Their strength and the crossing criterion (default properties if None).
     remote_failure : bool
@@ -132,6 +134,8 @@ class Simulation:
             from ..layered import engine as layered_engine
 
             layered_engine.check_simulation(mesh, material, natural_fractures, propagation)
+            if natural_fractures is not None:  # cut at the interfaces (hmatddm.layered.engine)
+                natural_fractures = layered_engine.natural_fracture_mesh(mesh, natural_fractures, material)
         elif not isinstance(material, Elastic):
             raise InputError(f"material must be an hmatddm.Elastic or hmatddm.LayeredMedium, got "
                              f"{type(material).__name__}")
