@@ -236,3 +236,46 @@ def _run_3d(material, natural):
                         initial_pressure=3.5e6, initial_opening=1e-4, backend="dense",
                         singular_correction="average", alpha=1.0, natural_fractures=natural, natural=props)
     return sim, sim.run(4.0)
+
+
+@pytest.mark.slow  # the 3D layered kernels compile cold in minutes; the run itself takes seconds
+def test_equal_layers_reproduce_the_homogeneous_3d_run_with_natural_fractures():
+    """The natural fracture crosses both interfaces: the layered run cuts it there, so the
+    homogeneous run is given the same pieces."""
+    medium = LayeredMedium([1.0, -1.0], [G] * 3, [NU] * 3)
+    natural = hd.mesh.rectangle([1.75, 0.0, 0.0], [0, 1, 0], [0, 0, 1], 2.0, 3.0, 2, 3, fracture_id=5)
+    pieces, _ = split_at_interfaces(natural, medium)
+    homogeneous, records_h = _run_3d(hd.Elastic(G, NU), pieces)
+    layered, records_l = _run_3d(medium, natural)
+    np.testing.assert_array_equal(layered.network.mesh.centers, pieces.centers)
+    assert sum(r["natural_deflected"] + r["natural_crossed"] for r in records_h) >= 1
+    assert _events(records_l) == _events(records_h)
+    np.testing.assert_array_equal(layered.state.origin, homogeneous.state.origin)
+    scale = np.abs(homogeneous.state.dd).max()
+    assert np.max(np.abs(layered.state.dd - homogeneous.state.dd)) <= 1e-10 * scale
+
+
+@pytest.mark.slow  # the 3D layered kernels compile cold in minutes; the run itself takes seconds
+def test_3d_remote_failure_sees_the_stiffer_layers_as_the_layered_stress_says(monkeypatch):
+    """Stiffer bounding layers (gamma = 2): the natural fracture is cut at both interfaces,
+    and the first remote-failure check's normal stress on every intact element is the
+    layered stress at its centre (hd.stress_at with the medium) plus the far field."""
+    calls = _spy(monkeypatch, "remote_failure")
+    medium = LayeredMedium([1.0, -1.0], [2 * G, G, 2 * G], [NU] * 3, images=1)
+    natural = hd.mesh.rectangle([1.75, 0.0, 0.0], [0, 1, 0], [0, 0, 1], 2.0, 3.0, 2, 3, fracture_id=5)
+    sim, records = _run_3d(medium, natural)
+    assert sim.network.mesh.n_elements == 10 and sum(r["natural_deflected"] for r in records) >= 1
+    (mesh, dd, *_), (failed, normal, shear, _) = calls[0]
+    nf = sim.network.mesh
+    intact = normal != 0.0
+    assert np.count_nonzero(intact) >= 6
+    total = hd.stress_at(mesh, medium, dd, nf.centers, singular_correction="average", near_fraction=0.5) \
+        + np.diag([-8e6, -3e6, -12e6])
+    traction = np.einsum("mij,mj->mi", total, nf.normals)
+    sigma_n = np.sum(traction * nf.normals, axis=1)
+    tau = np.linalg.norm(traction - sigma_n[:, None] * nf.normals, axis=1)
+    np.testing.assert_allclose(normal[intact], sigma_n[intact], rtol=1e-12)
+    np.testing.assert_allclose(shear[intact], tau[intact], rtol=1e-10, atol=1e-9 * np.abs(total).max())
+    homogeneous = hd.stress_at(mesh, hd.Elastic(G, NU), dd, nf.centers, singular_correction="average",
+                               near_fraction=0.5)
+    assert np.abs(total - homogeneous - np.diag([-8e6, -3e6, -12e6]))[intact].max() > 1e-3 * np.abs(total).max()
