@@ -101,7 +101,7 @@ def test_the_toughness_of_the_layer_where_the_tip_meets_the_natural_fracture_dec
 
 
 # -- remote failure (ref. Sec. 5.3) -------------------------------------------------------
-def _remote_run(material, pore_pressure=2e6, end_time=1.0):
+def _remote_run(material, pore_pressure=2e6, end_time=1.0, **options):
     """A pressurised crack along y = 0 next to a natural fracture at 30 degrees that spans
     y = 0.1 .. 1.1 (the scene of tests/test_simulation_natural.py)."""
     hf = hd.mesh.line([-2.0, 0.0], [2.0, 0.0], 8)
@@ -113,8 +113,8 @@ def _remote_run(material, pore_pressure=2e6, end_time=1.0):
     sim = hd.Simulation(hf, material, hd.Fluid(1e-3, 1e-9), [hd.Cluster((0, 0), 1e-3, 0.0)],
                         far_field_stress=np.diag([-14e6, -9e6]), time_step=1.0, initial_pressure=9.5e6,
                         initial_opening=1e-4, backend="dense", natural_fractures=nf, natural=props,
-                        singular_correction="average", alpha=1.0)
-    return sim, sim.run(end_time)
+                        singular_correction="average", alpha=1.0, **options)
+    return sim, None if end_time is None else sim.run(end_time)
 
 
 def test_equal_layers_fail_remotely_as_the_homogeneous_run():
@@ -168,6 +168,19 @@ def test_layers_change_the_remote_failure_as_coulomb_says_by_hand(monkeypatch, m
     assert np.min(np.abs(tau - strength)) > 1e-3 * np.abs(total).max()  # not a tie
     np.testing.assert_allclose(normal, sigma_n, rtol=1e-12)
     np.testing.assert_allclose(pore_change, dp, rtol=1e-12)
+
+
+def test_a_layered_run_with_natural_fractures_resumes_to_the_same_numbers(tmp_path):
+    """The network cut at the interface and its remote failures survive a checkpoint."""
+    whole, records = _remote_run(THREE_LAYERS, end_time=3.0)
+    assert records[0]["natural_failed"] >= 1
+    _remote_run(THREE_LAYERS, end_time=1.0, checkpoint_dir=tmp_path)
+    resumed = _remote_run(THREE_LAYERS, end_time=None, checkpoint_dir=tmp_path)[0]
+    resumed_records = resumed.run(3.0, resume=True)
+    assert [r["step"] for r in resumed_records] == [r["step"] for r in records]
+    assert _events(resumed_records) == _events(records)
+    np.testing.assert_array_equal(resumed.state.dd, whole.state.dd)
+    np.testing.assert_array_equal(resumed.state.failed, whole.state.failed)
 
 
 # -- natural-fracture meshes and the interfaces ----------------------------------------------
