@@ -292,3 +292,20 @@ def test_3d_remote_failure_sees_the_stiffer_layers_as_the_layered_stress_says(mo
     homogeneous = hd.stress_at(mesh, hd.Elastic(G, NU), dd, nf.centers, singular_correction="average",
                                near_fraction=0.5)
     assert np.abs(total - homogeneous - np.diag([-8e6, -3e6, -12e6]))[intact].max() > 1e-3 * np.abs(total).max()
+
+
+def test_the_network_check_takes_each_elements_layer_when_called_directly():
+    """NaturalNetwork.remote_failure with a LayeredMedium and no per-element values: the
+    Poisson's ratio of each target's layer, as the engine passes it."""
+    hf = hd.mesh.line([-2.0, 0.0], [2.0, 0.0], 8)
+    dd = hd.solve(hd.ElasticityOperator(hf, THREE_LAYERS, backend="dense"), -2e6 * hf.normals)
+    nf = split_at_interfaces(hd.mesh.line([3.0, -0.4], [3.0, 1.0], 4), THREE_LAYERS)[0]
+    props = hd.NaturalFractureProperties(friction=0.3, pore_pressure=2e6, skempton=0.5)
+    intact = np.ones(nf.n_elements, bool)
+    direct = NaturalNetwork(nf, props).remote_failure(hf, dd, THREE_LAYERS, np.diag([-14e6, -9e6]), intact)
+    nu = np.array(THREE_LAYERS.poisson_ratio)[THREE_LAYERS.layer_of(nf.centers[:, 1])]
+    assert len(set(nu)) == 2
+    given = NaturalNetwork(nf, props).remote_failure(hf, dd, THREE_LAYERS, np.diag([-14e6, -9e6]), intact,
+                                                     poisson_ratio=nu)
+    for a, b in zip(direct, given):
+        np.testing.assert_array_equal(a, b)

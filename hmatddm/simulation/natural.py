@@ -157,7 +157,8 @@ class NaturalNetwork:
         (the induced stress with the image terms, ``n_images`` of them, see
         :meth:`induced_stress`); ``far_field``: the (d, d) in-situ stress, or one per
         natural element (M, d, d) (a layered medium's per layer); ``poisson_ratio`` (M,)
-        or None (the material's): per natural element, for the 2D mean stress.
+        or None (the material's, of each element's layer): per natural element, for the
+        2D mean stress.
 
         ``screen``: evaluate the induced stress (exact sum) only at the targets that may
         fail; the others keep zeros like the elements that are not intact. ``failed``,
@@ -195,7 +196,12 @@ class NaturalNetwork:
             # are evaluated (with "auto" the count would choose the method)
             stress = self.induced_stress(active_mesh, dd, material, evaluate, singular_correction, info=stress_info,
                                          method="direct" if screened else "auto", n_images=n_images)
-            nu = material.poisson_ratio if poisson_ratio is None else np.asarray(poisson_ratio)[evaluate]
+            if poisson_ratio is not None:
+                nu = np.asarray(poisson_ratio)[evaluate]
+            elif isinstance(material, LayeredMedium):  # the layer of each target
+                nu = np.asarray(material.poisson_ratio)[material.layer_of(self.mesh.centers[evaluate, -1])]
+            else:
+                nu = material.poisson_ratio
             if self.properties.skempton > 0.0:
                 pore_change[evaluate] = -self.properties.skempton * _mean_stress(stress, nu)
             stress = stress + (far_field if np.ndim(far_field) == 2 else np.asarray(far_field)[evaluate])
