@@ -176,6 +176,7 @@ def test_run_check_validates_natural_fracture_scenes(tiny, capsys):
     assert json.loads(captured.out)["network"]["friction_coefficient"] == 0.3
 
 
+@pytest.mark.slow  # end to end (issue 18 item 8); the crossing itself: tests/test_crossing.py
 def test_crossing_scene_runs_and_reports_the_crossing(tmp_path, capsys):
     out = tmp_path / "x"
     assert cli.main(["run", "crossing", "--out", str(out), "--quiet", "--set", "numerics.end_time=25"]) == cli.EXIT_OK

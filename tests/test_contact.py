@@ -214,6 +214,7 @@ def test_activated_natural_elements_never_interpenetrate_and_obey_coulomb():
         assert key in records[-1]
 
 
+@pytest.mark.slow  # two network runs end to end (issue 18 item 8); the dense run is checked by the test above
 def test_network_run_dense_and_hmatrix_take_the_same_path():
     dense, dense_records = _network_run("dense", end_time=12.0)
     fast, fast_records = _network_run("hmatrix", end_time=12.0)

@@ -134,7 +134,10 @@ def dfn_scene():
     return mesh, dd, natural.centers
 
 
-@pytest.mark.parametrize("eps", [1e-4, 1e-6])
+# the DFN scene's tree evaluations at a second eps, for three eps and on 1 and 2 threads are
+# slow (issue 18 item 8); tree against direct at eps 1e-4 here and the two smaller scenes below
+# stay in the default set
+@pytest.mark.parametrize("eps", [1e-4, pytest.param(1e-6, marks=pytest.mark.slow)])
 def test_tree_matches_direct_on_dfn_scene(material, dfn_scene, eps):
     mesh, dd, points = dfn_scene
     exact = hd.stress_at(mesh, material, dd, points, singular_correction="average", method="direct")
@@ -149,6 +152,7 @@ def test_tree_matches_direct_on_dfn_scene(material, dfn_scene, eps):
     assert np.max(np.abs(approx_mean - exact_mean)) <= eps * np.max(np.abs(exact_mean))
 
 
+@pytest.mark.slow
 def test_tree_error_follows_eps(material, dfn_scene):
     mesh, dd, points = dfn_scene
     exact = hd.stress_at(mesh, material, dd, points, method="direct")
@@ -173,6 +177,7 @@ def test_tree_coplanar_targets_and_zero_dd(material):
     assert np.max(np.abs(approx - exact)) <= 1e-6 * np.max(np.abs(exact))
 
 
+@pytest.mark.slow
 def test_results_do_not_depend_on_thread_count(material, dfn_scene):
     numba = pytest.importorskip("numba")
     mesh, dd, points = dfn_scene

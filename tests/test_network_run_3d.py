@@ -32,15 +32,23 @@ def _simulation(backend):
 
 @pytest.fixture(scope="module")
 def runs():
+    """run(backend): (simulation, records) of the run to t = 8 s, computed once per backend."""
     out = {}
-    for backend in ("dense", "hmatrix"):
-        sim = _simulation(backend)
-        out[backend] = (sim, sim.run(8.0))
-    return out
+
+    def run(backend):
+        if backend not in out:
+            sim = _simulation(backend)
+            out[backend] = (sim, sim.run(8.0))
+        return out[backend]
+
+    return run
 
 
+# the hmatrix run and the comparison of both are slow (issue 18 item 8): the dense run
+# stays in the default set, and tests/test_contact.py compares the backends on a 2D network
+@pytest.mark.slow
 def test_dense_and_hmatrix_follow_the_same_path_through_the_network(runs):
-    (dense, dense_records), (fast, fast_records) = runs["dense"], runs["hmatrix"]
+    (dense, dense_records), (fast, fast_records) = runs("dense"), runs("hmatrix")
     assert [r["n_elements"] for r in dense_records] == [r["n_elements"] for r in fast_records]
     assert [r["natural_active"] for r in dense_records] == [r["natural_active"] for r in fast_records]
     assert dense_records[-1]["natural_active"] > 0  # the fractures reached the network
@@ -51,11 +59,13 @@ def test_dense_and_hmatrix_follow_the_same_path_through_the_network(runs):
                                atol=1e-6 * np.abs(dense.state.dd).max())
 
 
-def test_no_coincident_elements_and_no_interpenetration(runs):
-    for sim, records in runs.values():
-        centers = np.round(sim.state.mesh.centers, 6)
-        assert len(np.unique(centers, axis=0)) == len(centers)
-        opening = np.sum(sim.state.dd * sim.state.mesh.normals, axis=1)
-        largest = np.abs(sim.state.dd).max()
-        assert opening.min() > -2e-3 * largest  # the contact band is 1e-3 of the largest DD
-        assert all(np.isfinite(r["max_opening"]) for r in records)
+@pytest.mark.parametrize("backend", ["dense", pytest.param("hmatrix", marks=pytest.mark.slow)])
+def test_no_coincident_elements_and_no_interpenetration(runs, backend):
+    sim, records = runs(backend)
+    assert records[-1]["natural_active"] > 0  # the fractures reached the network
+    centers = np.round(sim.state.mesh.centers, 6)
+    assert len(np.unique(centers, axis=0)) == len(centers)
+    opening = np.sum(sim.state.dd * sim.state.mesh.normals, axis=1)
+    largest = np.abs(sim.state.dd).max()
+    assert opening.min() > -2e-3 * largest  # the contact band is 1e-3 of the largest DD
+    assert all(np.isfinite(r["max_opening"]) for r in records)

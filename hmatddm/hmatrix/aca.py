@@ -314,8 +314,9 @@ def _squared_norm(array):
 # aca_advance consumes the rows or columns just evaluated and says what to evaluate
 # next. Only the small loop _aca_loop calls the kernel (aca_tensor for tests and
 # explicit blocks, aca_compressed for the H-matrix build); the build driver
-# (storage.build_driver) receives the kernel as a first-class function of a fixed
-# signature, so the driver with this loop in it is cached on disk per data type.
+# (storage.build_driver) receives the kernel and these steps as first-class functions
+# of fixed signatures, so the driver with this loop in it is small and cached on disk
+# per data type.
 REQUEST_DONE = 0
 REQUEST_ROW = 1  # evaluate the d_r rows of row element `index` into `rows` (d_r x n)
 REQUEST_COL = 2  # evaluate the d_c columns of column element `index` into `cols` (m x d_c)
@@ -391,9 +392,9 @@ def aca_gave_up(ints):
 
 
 # Explicit signatures of the state-machine steps: with them the kernel-specific build
-# driver can take these compiled functions as first-class function arguments and
-# call them through pointers instead of linking (and re-optimising) their code,
-# which cuts the per-kernel compile from ~2 s to ~0.3 s.
+# and product drivers take these compiled functions as first-class function arguments
+# and call them through pointers instead of linking (and re-optimising) their code,
+# which cuts the cold compile per kernel data type from ~10 s to ~3 s of CPU.
 _MATRIX = types.float64[:, ::1]
 _FLAGS = types.boolean[::1]
 _INTS = types.int64[::1]
@@ -590,7 +591,7 @@ def aca_tensor(kernel, data, row_elements, col_elements, dof, eps, col_dof=0):
     Returns (U, V, rank) with U (m x rank), V (n x rank); rank 0 for a zero block.
     """
     col_dof = col_dof if col_dof > 0 else dof
-    ut, vt, ints = _aca_loop(kernel, data, row_elements, col_elements, dof, col_dof, eps)
+    ut, vt, ints = _aca_loop(kernel, data, row_elements, col_elements, dof, col_dof, eps, aca_start, aca_advance)
     if aca_gave_up(ints):
         m, n = dof * row_elements.shape[0], col_dof * col_elements.shape[0]
         block = np.empty((m, n))
@@ -601,19 +602,42 @@ def aca_tensor(kernel, data, row_elements, col_elements, dof, eps, col_dof=0):
     return aca_result(ut, vt, ints)
 
 
+@njit(cache=True, nogil=True)
+def _all_finite(array):
+    for x in array.ravel():
+        if not np.isfinite(x):
+            return False
+    return True
+
+
 @njit(nogil=True)
-def _aca_loop(kernel, data, row_elements, col_elements, row_dof, col_dof, eps):
-    """Drive the ACA state machine (aca_start / aca_advance) to the end, evaluating the
-    requested row and column elements with ``kernel``; returns (ut, vt, ints). When
-    ``aca_gave_up(ints)`` the factors are no approximation: use the exact block."""
-    ut, vt, rows, cols, row_visited, col_visited, ints, floats, request, index = aca_start(
+def _aca_loop(kernel, data, row_elements, col_elements, row_dof, col_dof, eps, start, advance):
+    """Drive the ACA state machine (``start`` = :func:`aca_start`, ``advance`` =
+    :func:`aca_advance`) to the end, evaluating the requested row and column elements
+    with ``kernel``; returns (ut, vt, ints). When ``aca_gave_up(ints)`` the factors are
+    no approximation: use the exact block.
+
+    The steps are arguments so that the compiled build and product drivers
+    (hmatrix/storage.py, hmatrix/product.py) can pass them as first-class functions:
+    called through pointers, their code is compiled once and cached instead of being
+    linked and re-optimised into every kernel-specific driver (~10 s of compile per
+    kernel data type before, ~3 s now). Python callers (:func:`aca_tensor`,
+    :func:`aca_compressed`) pass the dispatchers themselves. A call through a pointer
+    cannot raise, so NaN/inf kernel entries are refused here, before the pivot SVD
+    would (the same LinAlgError as that SVD raises).
+    """
+    ut, vt, rows, cols, row_visited, col_visited, ints, floats, request, index = start(
         row_elements.shape[0], col_elements.shape[0], row_dof, col_dof, eps)
     while request != REQUEST_DONE:
         if request == REQUEST_ROW:
             kernel(data, row_elements[index:index + 1], col_elements, rows)
+            finite = _all_finite(rows)
         else:
             kernel(data, row_elements, col_elements[index:index + 1], cols)
-        ut, vt, request, index = aca_advance(ut, vt, rows, cols, row_visited, col_visited, ints, floats)
+            finite = _all_finite(cols)
+        if not finite:
+            raise np.linalg.LinAlgError("Array must not contain infs or NaNs.")
+        ut, vt, request, index = advance(ut, vt, rows, cols, row_visited, col_visited, ints, floats)
     return ut, vt, ints
 
 
@@ -622,14 +646,24 @@ def aca_compressed(kernel, data, row_elements, col_elements, row_dof, col_dof, e
     """What the H-matrix build stores for an admissible block: the ACA of
     :func:`aca_tensor` at ``ACA_TOLERANCE_FACTOR * eps``, recompressed at ``eps``.
 
-    Returns the TRANSPOSED factors (U'^T, V'^T) with ``rank`` rows in use, and the rank
-    (the build driver, hmatrix/storage.py, calls exactly this function); rank -1 (and
-    empty factors) when the ACA gave up: the block is to be stored dense.
+    Returns the TRANSPOSED factors (U'^T, V'^T) with ``rank`` rows in use, and the rank;
+    rank -1 (and empty factors) when the ACA gave up: the block is to be stored dense.
+    The build driver (hmatrix/storage.py) calls :func:`_aca_compressed`, this function
+    with the steps given as first-class functions.
     """
-    ut, vt, ints = _aca_loop(kernel, data, row_elements, col_elements, row_dof, col_dof, ACA_TOLERANCE_FACTOR * eps)
+    return _aca_compressed(kernel, data, row_elements, col_elements, row_dof, col_dof, eps, aca_start, aca_advance,
+                           recompress_state)
+
+
+@njit(nogil=True)
+def _aca_compressed(kernel, data, row_elements, col_elements, row_dof, col_dof, eps, start, advance, recompress):
+    """:func:`aca_compressed` with the ACA steps (:func:`aca_start`, :func:`aca_advance`)
+    and the recompression (:func:`recompress_state`) as arguments (see :func:`_aca_loop`)."""
+    ut, vt, ints = _aca_loop(kernel, data, row_elements, col_elements, row_dof, col_dof, ACA_TOLERANCE_FACTOR * eps,
+                             start, advance)
     if aca_gave_up(ints):
         return np.zeros((0, ut.shape[1])), np.zeros((0, vt.shape[1])), -1
-    return recompress_transposed(ut, vt, ints[_RANK], eps)
+    return recompress(ut, vt, ints, eps)
 
 
 @njit(cache=True, nogil=True, fastmath=FAST)

@@ -18,17 +18,18 @@ from .aca import _RANK, _aca_loop, aca_gave_up
 from .block_tree import block_tree
 from .cluster_tree import cluster_tree
 from .generator import BlockGenerator
-from .storage import _batches, _run_parallel
+from .storage import ACA_STEP_TYPES, ACA_STEPS, _batches, _run_parallel
 
 
 def _apply_blocks(kernel, data, row_permutation, col_permutation, row_dof, col_dof, eps, row_start, row_stop,
-                  col_start, col_stop, admissible, x, n_rows):
+                  col_start, col_stop, admissible, x, n_rows, start, advance):
     """Apply a batch of blocks (tree-position element ranges) to ``x`` (original column
     order); returns the batch's part of ``A x`` (``n_rows`` values, original row order).
 
     Compiled per kernel data type by :func:`product_driver` (the kernel arrives as a
     first-class function, as in the build driver of hmatrix/storage.py, so the compiled
-    driver is cached on disk). Admissible blocks: ``_aca_loop`` at ``eps``, then
+    driver is cached on disk; the ACA steps ``start``, ``advance`` = aca.aca_start,
+    aca.aca_advance arrive as first-class functions too, see storage.build_driver). Admissible blocks: ``_aca_loop`` at ``eps``, then
     ``y += U (V^T x)``; the others, those the ACA gave up on, and those whose ACA rank does not pay
     (``rank (m + n) >= m n``, which the build stores dense too): kernel fill of the
     block, then ``y += B x``.
@@ -45,7 +46,7 @@ def _apply_blocks(kernel, data, row_permutation, col_permutation, row_dof, col_d
             for q in range(col_dof):
                 xb[col_dof * c + q] = x[col_dof * cols[c] + q]
         if admissible[b]:
-            ut, vt, ints = _aca_loop(kernel, data, rows, cols, row_dof, col_dof, eps)
+            ut, vt, ints = _aca_loop(kernel, data, rows, cols, row_dof, col_dof, eps, start, advance)
         if admissible[b] and not aca_gave_up(ints) and ints[_RANK] * (m + n) < m * n:
             for k in range(ints[_RANK]):
                 s = 0.0
@@ -83,7 +84,7 @@ def product_driver(data):
         kernel_type = types.FunctionType(types.none(data_type, index, index, types.float64[:, ::1]))
         signature = types.float64[::1](kernel_type, data_type, index, index, types.int64, types.int64, types.float64,
                                        index, index, index, index, types.boolean[::1], types.float64[::1],
-                                       types.int64)
+                                       types.int64, *ACA_STEP_TYPES[:2])
         driver = njit(signature, cache=True, nogil=True)(_apply_blocks)
         _DRIVERS[data_type] = driver
     return driver
@@ -147,7 +148,7 @@ def build_free_product(generator, x, eps, eta=3.0, leaf_size=64, col_leaf_size=N
 
     def run(ids):
         return driver(kernel, data, tree.permutation, col_tree.permutation, d, dc, float(eps), row_start[ids],
-                      row_stop[ids], col_start[ids], col_stop[ids], admissible[ids], x, n_rows)
+                      row_stop[ids], col_start[ids], col_stop[ids], admissible[ids], x, n_rows, *ACA_STEPS[:2])
 
     y = np.zeros(n_rows)
     try:

@@ -28,7 +28,8 @@ import numba
 import numpy as np
 from numba import njit, prange, types
 
-from .aca import FAST, aca_compressed
+from .aca import (ACA_ADVANCE_SIGNATURE, ACA_START_SIGNATURE, FAST, RECOMPRESS_STATE_SIGNATURE, _aca_compressed,
+                  aca_advance, aca_start, recompress_state)
 
 # Block kinds recorded for every admissible block.
 KIND_LOWRANK = 0
@@ -131,16 +132,18 @@ class BlockStorage:
 
 
 def _build_blocks(kernel, data, row_permutation, col_permutation, row_dof, col_dof, eps, row_start, row_stop,
-                  col_start, col_stop, admissible, dense_offset, dense_values):
+                  col_start, col_stop, admissible, dense_offset, dense_values, start, advance, recompress):
     """Assemble a batch of blocks (tree-position element ranges) sequentially.
 
-    Compiled per kernel data type by :func:`build_driver` (the kernel arrives as a
-    first-class function, so the compiled driver is cached on disk).
+    Compiled per kernel data type by :func:`build_driver` (the kernel and the ACA steps
+    ``start``, ``advance``, ``recompress`` = aca.aca_start, aca.aca_advance,
+    aca.recompress_state arrive as first-class functions, so the compiled driver is
+    small and cached on disk).
 
     Inadmissible blocks are filled by the kernel straight into
     ``dense_values[dense_offset[b]:]`` (the final array). Admissible blocks get
     :func:`~hmatddm.hmatrix.aca.aca_compressed` (ACA plus recompression, the function
-    the ACA tests call); their factors (or, when the rank does not pay or the ACA gave
+    the ACA tests call, here with its steps as arguments); their factors (or, when the rank does not pay or the ACA gave
     up on the block, rank -1, their exact dense values) are appended to batch-local
     buffers returned at the end.
     Returns (rank per block, stored-dense flag per block, U values, V values, dense
@@ -164,7 +167,7 @@ def _build_blocks(kernel, data, row_permutation, col_permutation, row_dof, col_d
             target = dense_values[dense_offset[b]:dense_offset[b] + m * n].reshape((m, n))
             kernel(data, rows, cols, target)
             continue
-        ut, vt, rank = aca_compressed(kernel, data, rows, cols, row_dof, col_dof, eps)
+        ut, vt, rank = _aca_compressed(kernel, data, rows, cols, row_dof, col_dof, eps, start, advance, recompress)
         ranks[b] = rank if rank >= 0 else min(m, n)
         if rank < 0 or rank * (m + n) >= m * n:
             stored_dense[b] = True
@@ -183,6 +186,10 @@ def _build_blocks(kernel, data, row_permutation, col_permutation, row_dof, col_d
 
 
 _DRIVERS = {}
+# The ACA steps given to the compiled drivers (here and hmatrix/product.py), and their types.
+ACA_STEPS = (aca_start, aca_advance, recompress_state)
+ACA_STEP_TYPES = tuple(types.FunctionType(signature) for signature in (ACA_START_SIGNATURE, ACA_ADVANCE_SIGNATURE,
+                                                                       RECOMPRESS_STATE_SIGNATURE))
 
 
 def build_driver(data):
@@ -190,9 +197,13 @@ def build_driver(data):
 
     The kernel argument is typed as a first-class function ``none(data, int64[::1],
     int64[::1], float64[:, ::1])`` rather than as its dispatcher, so the signature
-    holds no Python object and numba caches the compiled driver (``cache=True``): the
-    ~2 s compile is paid once per data type, not once per process. Call it with the
-    kernel dispatcher as first argument; numba compiles the kernel for that signature.
+    holds no Python object and numba caches the compiled driver (``cache=True``): its
+    compile is paid once per data type, not once per process. The ACA steps and the
+    recompression are first-class function arguments too (:data:`ACA_STEPS`; see
+    aca._aca_loop): called through pointers, their code is compiled once for all types
+    instead of being linked into (and re-optimised with) every driver, which cuts the
+    per-type compile from ~10 s to ~3 s of CPU. Call it with the kernel dispatcher as
+    first argument and ``*ACA_STEPS`` last; numba compiles the kernel for its signature.
     """
     data_type = numba.typeof(data)
     driver = _DRIVERS.get(data_type)
@@ -202,7 +213,7 @@ def build_driver(data):
         outputs = types.Tuple((index, types.boolean[::1], types.float64[::1], types.float64[::1],
                                types.float64[::1]))
         signature = outputs(kernel_type, data_type, index, index, types.int64, types.int64, types.float64, index,
-                            index, index, index, types.boolean[::1], index, types.float64[::1])
+                            index, index, index, types.boolean[::1], index, types.float64[::1], *ACA_STEP_TYPES)
         driver = njit(signature, cache=True, nogil=True)(_build_blocks)
         _DRIVERS[data_type] = driver
     return driver
@@ -335,7 +346,7 @@ def assemble(generator, tree, blocks, eps, n_threads=None, factor_dtype=np.float
     def far_batch(ids):
         return driver(kernel, data, permutation, col_permutation, d, dc, float(eps), far_rows_start[ids],
                       far_rows_stop[ids], far_cols_start[ids], far_cols_stop[ids], np.ones(ids.size, dtype=np.bool_),
-                      no_offsets[ids], empty)
+                      no_offsets[ids], empty, *ACA_STEPS)
 
     started = time.perf_counter()
     far_cost = (far_rows_stop - far_rows_start + far_cols_stop - far_cols_start).astype(np.float64)
@@ -394,12 +405,12 @@ def assemble(generator, tree, blocks, eps, n_threads=None, factor_dtype=np.float
         if dense_values.dtype == np.float64:
             return driver(kernel, data, permutation, col_permutation, d, dc, float(eps), near_rows_start[ids],
                           near_rows_stop[ids], near_cols_start[ids], near_cols_stop[ids],
-                          np.zeros(ids.size, dtype=np.bool_), near_offset[ids], dense_values)
+                          np.zeros(ids.size, dtype=np.bool_), near_offset[ids], dense_values, *ACA_STEPS)
         local = np.concatenate(([0], np.cumsum(near_size[ids]))).astype(np.int64)
         buffer = np.empty(local[-1])  # the kernel fills float64; the store holds the rounded values
         driver(kernel, data, permutation, col_permutation, d, dc, float(eps), near_rows_start[ids],
                near_rows_stop[ids], near_cols_start[ids], near_cols_stop[ids], np.zeros(ids.size, dtype=np.bool_),
-               local[:-1], buffer)
+               local[:-1], buffer, *ACA_STEPS)
         _round_into(buffer, local, dense_values, near_offset[ids])
         return None
 
