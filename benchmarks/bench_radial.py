@@ -184,7 +184,7 @@ def run_case(case, h, backend, t_end, scheme="krylov", front="element", scheme_o
     width = np.sum(state.dd * state.mesh.normals, axis=1)
     injection = int(sim.injection_elements[0])
     keys = ("time", "n_elements", "radius", "max_opening", "nonlinear_iterations", "linear_iterations",
-            "solve_seconds", "operator_builds")
+            "solve_seconds", "operator_builds", "growth_passes")
     history = {k: [r[k] for r in records] for k in keys}
     history["front_circularity"] = [r.get("front_circularity") for r in records]
     history["net_pressure"] = [r["wellbore_pressure"][0] - S_HMIN for r in records]

@@ -15,7 +15,7 @@ from numbers import Integral, Real
 
 from .errors import InputError
 from .options import (BACKENDS, CONTACT_MODES, CRITERIA, DEFAULT_EPS, DEFAULT_ETA, DEFAULT_LEAF_SIZE, FRONTS,
-                      SCHEME_DEFAULTS, SCHEMES, SINGULAR_CORRECTIONS, STOPPING_RULES, TURNING)
+                      GROWTH_CHECKS, SCHEME_DEFAULTS, SCHEMES, SINGULAR_CORRECTIONS, STOPPING_RULES, TURNING)
 
 REQUIRED = object()  # marker: the key has no default
 ABSENT = object()    # marker: optional key without a default (left out of the echo when not given)
@@ -237,6 +237,9 @@ SCHEME = {  # -> hmatddm.coupled.schemes.SchemeSettings (ref. Sec. 4.5)
     "first_linear_rtol": Setting("number", SCHEME_DEFAULTS["first_linear_rtol"], **_UNIT_INTERVAL,
                                  doc="GMRES relative residual of the first nonlinear iteration of a solve "
                                      "(coupled schemes; at least linear_rtol)"),
+    "growth_check": Setting("choice", SCHEME_DEFAULTS["growth_check"], choices=GROWTH_CHECKS,
+                            doc="element front: first: decide a growth pass on a solve's first (loose) iterate "
+                                "and converge only the mesh the step keeps; converged: on the converged solve"),
 }
 
 MATERIAL = {  # -> hmatddm.material.Elastic

@@ -163,3 +163,45 @@ def test_a_loose_first_solve_is_never_accepted():
     assert info["nonlinear_iterations"] >= 2
     np.testing.assert_allclose(p, p_ref, atol=1e-6 * np.abs(p_ref).max())
     np.testing.assert_allclose(dd, dd_ref, atol=1e-6 * np.abs(dd_ref).max())
+
+
+@pytest.mark.parametrize("backend", ["dense", "hmatrix"])
+def test_a_provisional_solve_finishes_with_the_iterates_of_a_plain_one(backend):
+    # solve_step(provisional=True) stops after the loose first iterate; finish() continues
+    # the same iteration: the converged result is bit for bit the plain solve's, and the
+    # two infos add up to its counts. The hmatrix backend is checked against the dense one.
+    mesh = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 8.0, 8.0, 8, 8)
+    settings = SchemeSettings(scheme="krylov")
+    problem, dd0, p0 = _problem(mesh, backend=backend, rate=1e-2, viscosity=1e-5)
+    dd_plain, p_plain, info_plain = solve_step(problem, settings, dd0, p0, 1.0)
+    assert info_plain["pending"] is None
+    problem, dd0, p0 = _problem(mesh, backend=backend, rate=1e-2, viscosity=1e-5)
+    dd_first, p_first, info_first = solve_step(problem, settings, dd0, p0, 1.0, provisional=True)
+    assert info_first["pending"] is not None and info_first["nonlinear_iterations"] == 1
+    assert np.all(np.isfinite(p_first)) and not np.array_equal(p_first, p_plain)  # an iterate, not the answer
+    dd, p, info = info_first["pending"].finish()
+    assert info["pending"] is None
+    np.testing.assert_array_equal(dd, dd_plain)
+    np.testing.assert_array_equal(p, p_plain)
+    for key in ("nonlinear_iterations", "linear_iterations", "restarts"):
+        assert info_first[key] + info[key] == info_plain[key]
+    if backend == "hmatrix":
+        problem, dd0, p0 = _problem(mesh, backend="dense", rate=1e-2, viscosity=1e-5)
+        dd_dense, p_dense, _ = solve_step(problem, settings, dd0, p0, 1.0)
+        np.testing.assert_allclose(p, p_dense, atol=1e-5 * np.abs(p_dense).max())
+        np.testing.assert_allclose(dd, dd_dense, atol=1e-5 * np.abs(dd_dense).max())
+
+
+def test_a_provisional_solve_converges_at_once_without_a_loose_first_iteration():
+    # segregated schemes, or first_linear_rtol == linear_rtol: nothing to stop early
+    from hmatddm.coupled.schemes import PendingSolve
+
+    mesh = hd.mesh.line([-5, 0], [5, 0], 20)
+    problem, dd0, p0 = _problem(mesh, leak=1e-12)
+    _, _, info = solve_step(problem, SchemeSettings(scheme="krylov", first_linear_rtol=1e-9), dd0, p0, 1.0,
+                            provisional=True)
+    assert info["pending"] is None and info["nonlinear_iterations"] >= 2
+    for scheme in ("fixed-width", "fracture-compliance"):
+        assert not PendingSolve(problem, SchemeSettings(scheme=scheme), dd0, p0, 1.0).loose_first
+    with pytest.raises(hd.errors.InputError, match="growth_check"):
+        SchemeSettings(growth_check="never")

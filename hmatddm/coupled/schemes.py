@@ -76,6 +76,13 @@ class SchemeSettings:
     stopping : ``"contraction"`` or ``"change"`` (module docstring)
     first_linear_rtol : relative residual of the first GMRES solve of each attempt (coupled
         schemes; at least ``linear_rtol``)
+    growth_check : ``"first"`` or ``"converged"``: on which iterate a simulation with the
+        element front (and no natural fractures) decides a growth pass. ``"first"``: on the
+        first (loose) iterate of a coupled solve, converging it only when no element grows
+        (then checked again on the converged solution, so a step still ends on a converged
+        solve that admits no growth); the solves of the meshes a step leaves behind cost one
+        loose iteration instead of two or three (``solve_step(provisional=True)``).
+        ``"converged"``: every solve converges first (before issue 17).
     relaxation_growth : float >= 1, the factor by which a simulation raises alpha again
         (up to ``relaxation``) after a step that converged without a restart. ``None``:
         2 for the coupled schemes, whose iteration needs no relaxation (ref. Sec. 4.5.3)
@@ -97,6 +104,7 @@ class SchemeSettings:
     relaxation_growth: float = SCHEME_DEFAULTS["relaxation_growth"]
     stopping: str = SCHEME_DEFAULTS["stopping"]
     first_linear_rtol: float = SCHEME_DEFAULTS["first_linear_rtol"]
+    growth_check: str = SCHEME_DEFAULTS["growth_check"]
 
     def __post_init__(self):
         object.__setattr__(self, "scheme", SCHEME["scheme"].value("scheme", self.scheme))
@@ -104,7 +112,7 @@ class SchemeSettings:
             object.__setattr__(self, "relaxation_growth", 2.0 if self.scheme in COUPLED_SCHEMES else 1.0)
         for name in ("relaxation_growth", "omega", "relaxation", "min_relaxation", "tolerance_pressure",
                      "tolerance_opening", "linear_rtol", "max_iterations", "linear_restart", "linear_maxiter",
-                     "stopping", "first_linear_rtol"):
+                     "stopping", "first_linear_rtol", "growth_check"):
             object.__setattr__(self, name, SCHEME[name].value(name, getattr(self, name)))
 
 
@@ -330,63 +338,119 @@ def _converged(stopping, change, history):
     return rho <= 0.5 and CONTRACTION_SAFETY * change * rho / (1.0 - rho) < 1.0
 
 
-def solve_step(problem, settings, dd_guess, p_guess, relaxation):
+def solve_step(problem, settings, dd_guess, p_guess, relaxation, provisional=False):
     """Iterate one time step to convergence (ref. Eqs 4.43-4.44).
 
     Returns ``(dd, p, info)``; ``info`` has ``nonlinear_iterations`` (all attempts),
     ``linear_iterations`` (GMRES iterations), ``relaxation`` (the alpha that
-    converged), ``restarts``, ``solve_seconds`` and ``contact_changes`` (active-set
-    changes over the step). Raises ConvergenceError when even
+    converged), ``restarts``, ``solve_seconds``, ``contact_changes`` (active-set
+    changes over the step) and ``pending``. Raises ConvergenceError when even
     ``min_relaxation`` fails.
+
+    ``provisional=True`` (coupled schemes with a loose first iteration, ``first_linear_rtol
+    > linear_rtol``): return the first iterate of the attempt, which is never accepted
+    (module docstring), with ``info["pending"]`` a :class:`PendingSolve` whose ``finish()``
+    continues the very same iteration to convergence (the same iterates as without
+    ``provisional``, so the converged result is identical). A growing simulation decides on
+    this iterate whether the mesh grows (:mod:`hmatddm.simulation.step_solve`) and pays the
+    rest of the iteration only for the mesh it keeps. Otherwise ``pending`` is None and the
+    result converged.
     """
-    start = time.perf_counter()
-    iterate = _coupled_iteration if settings.scheme in COUPLED_SCHEMES else _segregated_iteration
-    counters = {"nonlinear": 0, "linear": 0}
-    alpha = relaxation
-    restarts = 0
-    contact_changes = 0
-    while True:
-        dd, p = dd_guess.copy(), p_guess.copy()
-        if problem.contact is not None:
-            problem.contact.reset()
-        history = []
-        try:
-            for iteration in range(settings.max_iterations):
-                counters["nonlinear"] += 1
-                dd_new, p_new = iterate(problem, settings, dd, p, alpha, counters, first=iteration == 0)
-                if not (np.all(np.isfinite(dd_new)) and np.all(np.isfinite(p_new))):
-                    raise _Diverged("non-finite iterate")
-                change_p = _relative_change(p_new, p)
-                change_u = _relative_change(dd_new, dd)
-                dd, p = dd_new, p_new
-                changed = problem.update_contact(dd, p)
-                contact_changes += changed
-                # the change in units of the tolerances
-                change = max(change_p / settings.tolerance_pressure, change_u / settings.tolerance_opening)
-                # a loosely solved first iteration may return its guess (its residual already
-                # below first_linear_rtol): only a full-accuracy iterate can be accepted
-                loose = iteration == 0 and iterate is _coupled_iteration and \
-                    settings.first_linear_rtol > settings.linear_rtol
-                if not loose and _converged(settings.stopping, change, history) and changed == 0:
-                    info = dict(nonlinear_iterations=counters["nonlinear"], linear_iterations=counters["linear"],
-                                relaxation=alpha, restarts=restarts, solve_seconds=time.perf_counter() - start,
-                                contact_changes=contact_changes)
-                    return dd, p, info
-                history.append(change)
-                # divergence: the change grew for 5 iterations in a row AND doubled over its
-                # recent minimum (a relaxed iteration creeps up ~1% per iteration on a
-                # plateau, which is not divergence; measured on ref. Table 4.2)
-                if (len(history) > 6 and all(history[-i] > history[-i - 1] for i in range(1, 6))
-                        and history[-1] > 2.0 * min(history[-10:])):
-                    raise _Diverged("changes grew for 5 iterations and doubled")
-                if max(change_p, change_u) > 1e6:
-                    raise _Diverged(f"relative change {max(change_p, change_u):.2e}")
-            raise _Diverged(f"no convergence in {settings.max_iterations} iterations "
-                            f"(last relative change {max(change_p, change_u):.2e})")
-        except _Diverged as reason:
-            if alpha / 2.0 < settings.min_relaxation:
-                raise ConvergenceError(
-                    f"time step did not converge with scheme {settings.scheme!r} down to relaxation "
-                    f"{alpha:g}: {reason}", iterations=counters["nonlinear"]) from None
-            alpha /= 2.0
-            restarts += 1
+    pending = PendingSolve(problem, settings, dd_guess, p_guess, relaxation)
+    return pending.run(provisional)
+
+
+class PendingSolve:
+    """The nonlinear iteration of one :func:`solve_step`, which may stop after the first
+    (loose) iterate of an attempt and be continued by :meth:`finish`."""
+
+    def __init__(self, problem, settings, dd_guess, p_guess, relaxation):
+        self.problem, self.settings = problem, settings
+        self.dd_guess, self.p_guess = dd_guess, p_guess
+        self.coupled = settings.scheme in COUPLED_SCHEMES
+        self.iterate = _coupled_iteration if self.coupled else _segregated_iteration
+        self.counters = {"nonlinear": 0, "linear": 0}
+        self.reported = {}  # the counts already reported by a provisional return
+        self.alpha = relaxation
+        self.restarts = 0
+        self.contact_changes = 0
+        self._start_attempt()
+
+    @property
+    def loose_first(self):
+        """Whether an attempt's first iterate comes from the loose GMRES (never accepted)."""
+        return self.coupled and self.settings.first_linear_rtol > self.settings.linear_rtol
+
+    def _start_attempt(self):
+        self.dd, self.p = self.dd_guess.copy(), self.p_guess.copy()
+        if self.problem.contact is not None:
+            self.problem.contact.reset()
+        self.history = []
+        self.iteration = 0
+        self.last_change = math.nan
+
+    def finish(self):
+        """``(dd, p, info)`` of the converged solve (``info`` counts the work since the
+        provisional return only, so that the two infos add up to the whole solve)."""
+        return self.run(False)
+
+    def run(self, provisional=False):
+        """Iterate (see :func:`solve_step`): ``(dd, p, info)``."""
+        return self._run(provisional and self.loose_first)
+
+    def _run(self, provisional):
+        settings, problem = self.settings, self.problem
+        self._begin = time.perf_counter()
+        while True:
+            try:
+                while self.iteration < settings.max_iterations:
+                    iteration = self.iteration
+                    self.iteration += 1
+                    self.counters["nonlinear"] += 1
+                    dd_new, p_new = self.iterate(problem, settings, self.dd, self.p, self.alpha, self.counters,
+                                                 first=iteration == 0)
+                    if not (np.all(np.isfinite(dd_new)) and np.all(np.isfinite(p_new))):
+                        raise _Diverged("non-finite iterate")
+                    change_p = _relative_change(p_new, self.p)
+                    change_u = _relative_change(dd_new, self.dd)
+                    self.dd, self.p = dd_new, p_new
+                    self.last_change = max(change_p, change_u)
+                    changed = problem.update_contact(self.dd, self.p)
+                    self.contact_changes += changed
+                    # the change in units of the tolerances
+                    change = max(change_p / settings.tolerance_pressure, change_u / settings.tolerance_opening)
+                    # a loosely solved first iteration may return its guess (its residual already
+                    # below first_linear_rtol): only a full-accuracy iterate can be accepted
+                    loose = iteration == 0 and self.loose_first
+                    if not loose and _converged(settings.stopping, change, self.history) and changed == 0:
+                        return self.dd, self.p, self._finished(pending=False)
+                    history = self.history
+                    history.append(change)
+                    # divergence: the change grew for 5 iterations in a row AND doubled over its
+                    # recent minimum (a relaxed iteration creeps up ~1% per iteration on a
+                    # plateau, which is not divergence; measured on ref. Table 4.2)
+                    if (len(history) > 6 and all(history[-i] > history[-i - 1] for i in range(1, 6))
+                            and history[-1] > 2.0 * min(history[-10:])):
+                        raise _Diverged("changes grew for 5 iterations and doubled")
+                    if max(change_p, change_u) > 1e6:
+                        raise _Diverged(f"relative change {max(change_p, change_u):.2e}")
+                    if provisional and loose:
+                        return self.dd.copy(), self.p.copy(), self._finished(pending=True)
+                raise _Diverged(f"no convergence in {settings.max_iterations} iterations "
+                                f"(last relative change {self.last_change:.2e})")
+            except _Diverged as reason:
+                if self.alpha / 2.0 < settings.min_relaxation:
+                    raise ConvergenceError(
+                        f"time step did not converge with scheme {settings.scheme!r} down to relaxation "
+                        f"{self.alpha:g}: {reason}", iterations=self.counters["nonlinear"]) from None
+                self.alpha /= 2.0
+                self.restarts += 1
+                self._start_attempt()
+
+    def _finished(self, pending):
+        counts = dict(nonlinear_iterations=self.counters["nonlinear"], linear_iterations=self.counters["linear"],
+                      restarts=self.restarts, contact_changes=self.contact_changes)
+        info = {key: value - self.reported.get(key, 0) for key, value in counts.items()}
+        self.reported.update(counts)
+        seconds = time.perf_counter() - self._begin
+        return dict(info, relaxation=self.alpha, solve_seconds=seconds, pending=self if pending else None)

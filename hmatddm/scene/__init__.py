@@ -99,6 +99,7 @@ The format, annotated (``=`` values are the defaults unless marked REQUIRED)::
     linear_maxiter = 20            # GMRES restart cycles, >= 1
     stopping = "contraction"       # "contraction" (also stop on the extrapolated next change) or "change"
     first_linear_rtol = 1e-6       # GMRES relative residual of a solve's first iteration, (0, 1)
+    growth_check = "first"         # growth pass decided on a solve's first iterate, or "converged"
     initial_pressure = 10e6        # Pa, fluid pressure at t = 0 (default 0)
     initial_opening = 1e-5         # m, >= 0, opening of the initial elements
     # minimum_width = 1e-5         # m, > 0, width floor of the flow (default initial_opening)

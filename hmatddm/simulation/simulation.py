@@ -294,11 +294,18 @@ class Simulation:
         builds = self.operator_builds
         relaxation = begin.relaxation
         max_passes = 50 if self.propagation is None else self.propagation.max_growth_passes
+        # growth decided on a solve's first iterate, converged only on the mesh the step keeps
+        provisional = (self.propagation is not None and self.network is None
+                       and self.settings.growth_check == "first")
         while True:
-            trial, info, solved = step_solve.solve(self, trial, start, t_old, t_new, relaxation)
+            trial, info, solved = step_solve.solve(self, trial, start, t_old, t_new, relaxation, provisional)
+            growth = None if tally.growth_passes >= max_passes else self._growth(trial, solved, info, tally)
+            if growth is None and info.get("pending") is not None:  # converge, then check again
+                tally.add_solve(info)
+                trial, info = step_solve.finish(trial, info)
+                growth = None if tally.growth_passes >= max_passes else self._growth(trial, solved, info, tally)
             relaxation = info["relaxation"]
             tally.add_solve(info)
-            growth = None if tally.growth_passes >= max_passes else self._growth(trial, solved, info, tally)
             if growth is None:
                 break
             tally.growth_passes += 1

@@ -75,13 +75,18 @@ def drained(simulation, mesh, faces, origin):
     return failed & ~fed
 
 
-def solve(simulation, trial, start, t_old, t_new, relaxation):
+def solve(simulation, trial, start, t_old, t_new, relaxation, provisional=False):
     """The coupled step of ``simulation`` from ``start`` (a
     :class:`~hmatddm.simulation.state.StepStart`) to ``t_new`` on the mesh of ``trial``
     (a :class:`~hmatddm.simulation.state.State`), from its DD and pressure with
     relaxation ``relaxation``: ``(trial with the solution, info, SolvedMesh)``;
     ``info`` is :func:`hmatddm.coupled.solve_step`'s plus ``contact_frozen`` and
-    ``drained`` (the remotely failed elements no fluid reaches)."""
+    ``drained`` (the remotely failed elements no fluid reaches).
+
+    ``provisional=True``: the solution may be the first (loose) iterate, with
+    ``info["pending"]`` not None; :func:`finish` converges it. The growth pass decides on
+    it whether the mesh grows; only the solve of the mesh a step keeps is converged
+    (:class:`~hmatddm.coupled.SchemeSettings` ``growth_check``)."""
     sim, mesh = simulation, trial.mesh
     edges, faces = mesh_topology(mesh, sim.height)
     faces = with_links(faces, trial.extra_faces)
@@ -101,10 +106,30 @@ def solve(simulation, trial, start, t_old, t_new, relaxation):
                           width_old=start.width, pressure_old=start.pressure,
                           leak_off_rate=flow.leak_off_rate(trial.creation_time, t_old, t_new),
                           contact=contact, fixed_pressure=fixed_pressure)
-    dd, p, info = solve_step(problem, sim.settings, trial.dd.ravel(), pressure_guess, relaxation)
-    solution = dict(dd=dd.reshape(mesh.n_elements, mesh.dim), pressure=p)
+    if provisional:
+        dd, p, info = solve_step(problem, sim.settings, trial.dd.ravel(), pressure_guess, relaxation, provisional=True)
+    else:
+        dd, p, info = solve_step(problem, sim.settings, trial.dd.ravel(), pressure_guess, relaxation)
+    info["drained"] = no_fluid
+    return _with_solution(trial, problem, dd, p, info), info, SolvedMesh(edges, faces, flow)
+
+
+def finish(trial, info):
+    """``(trial, info)`` of the converged solve whose provisional result is ``trial`` and
+    ``info`` (from :func:`solve` with ``info["pending"]``); the new ``info`` counts the
+    iterations after the provisional return."""
+    pending = info["pending"]
+    dd, p, more = pending.finish()
+    more["drained"] = info["drained"]
+    return _with_solution(trial, pending.problem, dd, p, more), more
+
+
+def _with_solution(trial, problem, dd, p, info):
+    """``trial`` holding the solution ``dd``, ``p`` of ``problem`` (and its contact
+    statuses); adds ``contact_frozen`` to ``info``."""
+    contact = problem.contact
+    solution = dict(dd=dd.reshape(trial.mesh.n_elements, trial.mesh.dim), pressure=p)
     if contact is not None:
         solution.update(contact_status=contact.status.copy(), slip_direction=contact.direction.copy())
     info["contact_frozen"] = 0 if contact is None else contact.frozen
-    info["drained"] = no_fluid
-    return replace(trial, **solution), info, SolvedMesh(edges, faces, flow)
+    return replace(trial, **solution)
