@@ -9,6 +9,9 @@ the cost of accuracy as the elements shrink.
     python benchmarks/bench_radial.py --case '{"case": "K-vertex", "h": 0.5, "backend": "hmatrix", "parts": true}'
     python benchmarks/bench_radial.py --case '{"case": "K-vertex", "h": 0.5, "backend": "hmatrix",
         "scheme_options": {"stopping": "change", "first_linear_rtol": 1e-9}}'
+    # ... and with every growth pass decided on a converged solve (before the growth_check)
+    python benchmarks/bench_radial.py --case '{"case": "K-vertex", "h": 0.5, "backend": "hmatrix", "parts": true,
+        "scheme_options": {"growth_check": "converged"}}'
 
 Two studies, printed as markdown tables and saved (JSON in benchmarks/out/, PNG in benchmarks/):
 
@@ -153,7 +156,8 @@ def run_case(case, h, backend, t_end, scheme="krylov", front="element", scheme_o
     """One simulation; returns a dict with the per-step history and the final errors.
     ``scheme_options``: further :class:`hmatddm.coupled.SchemeSettings` fields (e.g.
     ``{"stopping": "change", "first_linear_rtol": 1e-9}``, the plain iteration of before
-    issue 17); ``parts``: add ``cpu_parts`` (:func:`cpu_parts`)."""
+    issue 17; ``{"growth_check": "converged"}``, every growth pass on a converged solve, as
+    before the third issue-17 session); ``parts``: add ``cpu_parts`` (:func:`cpu_parts`)."""
     import hmatddm as hd
     from _common import peak_rss_bytes
 
