@@ -569,7 +569,6 @@ def aca_result(ut, vt, ints):
     return u_out, v_out, rank
 
 
-@njit(nogil=True)
 def aca_tensor(kernel, data, row_elements, col_elements, dof, eps, col_dof=0):
     """Partial ACA with whole-element pivots of the block rows x cols (original indices),
     ``dof`` unknowns per row element and ``col_dof`` per column element (0: ``dof``).
@@ -589,9 +588,17 @@ def aca_tensor(kernel, data, row_elements, col_elements, dof, eps, col_dof=0):
     min(m, n)), as the build stores it dense.
 
     Returns (U, V, rank) with U (m x rank), V (n x rank); rank 0 for a zero block.
+    Compiled once per data type (cached on disk, :func:`_for_data`).
     """
     col_dof = col_dof if col_dof > 0 else dof
-    ut, vt, ints = _aca_loop(kernel, data, row_elements, col_elements, dof, col_dof, eps, aca_start, aca_advance)
+    compiled = _for_data(_aca_tensor, data, (_INDEX, _INDEX, types.int64, types.int64, types.float64), 2)
+    return compiled(kernel, data, _index(row_elements), _index(col_elements), int(dof), int(col_dof), float(eps),
+                    aca_start, aca_advance)
+
+
+def _aca_tensor(kernel, data, row_elements, col_elements, dof, col_dof, eps, start, advance):
+    """:func:`aca_tensor` (njit source, compiled by :func:`_for_data`)."""
+    ut, vt, ints = _aca_loop(kernel, data, row_elements, col_elements, dof, col_dof, eps, start, advance)
     if aca_gave_up(ints):
         m, n = dof * row_elements.shape[0], col_dof * col_elements.shape[0]
         block = np.empty((m, n))
@@ -641,7 +648,6 @@ def _aca_loop(kernel, data, row_elements, col_elements, row_dof, col_dof, eps, s
     return ut, vt, ints
 
 
-@njit(nogil=True)
 def aca_compressed(kernel, data, row_elements, col_elements, row_dof, col_dof, eps):
     """What the H-matrix build stores for an admissible block: the ACA of
     :func:`aca_tensor` at ``ACA_TOLERANCE_FACTOR * eps``, recompressed at ``eps``.
@@ -649,10 +655,12 @@ def aca_compressed(kernel, data, row_elements, col_elements, row_dof, col_dof, e
     Returns the TRANSPOSED factors (U'^T, V'^T) with ``rank`` rows in use, and the rank;
     rank -1 (and empty factors) when the ACA gave up: the block is to be stored dense.
     The build driver (hmatrix/storage.py) calls :func:`_aca_compressed`, this function
-    with the steps given as first-class functions.
+    with the steps given as first-class functions; so does this function, compiled once
+    per data type (cached on disk, :func:`_for_data`).
     """
-    return _aca_compressed(kernel, data, row_elements, col_elements, row_dof, col_dof, eps, aca_start, aca_advance,
-                           recompress_state)
+    compiled = _for_data(_aca_compressed.py_func, data, (_INDEX, _INDEX, types.int64, types.int64, types.float64), 3)
+    return compiled(kernel, data, _index(row_elements), _index(col_elements), int(row_dof), int(col_dof), float(eps),
+                    aca_start, aca_advance, recompress_state)
 
 
 @njit(nogil=True)
@@ -776,3 +784,35 @@ def recompress(u, v, eps):
 def recompress_state(ut, vt, ints, eps):
     """recompress_transposed of a finished ACA state: (U'^T, V'^T, rank')."""
     return recompress_transposed(ut, vt, ints[_RANK], eps)
+
+
+# -- entry points for Python callers (tests, explicit blocks) ------------------------------
+_INDEX = types.int64[::1]
+_STEP_TYPES = (types.FunctionType(ACA_START_SIGNATURE), types.FunctionType(ACA_ADVANCE_SIGNATURE),
+               types.FunctionType(RECOMPRESS_STATE_SIGNATURE))
+_ENTRY_POINTS = {}
+
+
+def _index(elements):
+    return np.ascontiguousarray(elements, dtype=np.int64)
+
+
+def _for_data(function, data, argument_types, n_steps):
+    """``function`` (njit source taking ``(kernel, data, *argument_types, *steps)``, the
+    steps being the first ``n_steps`` of aca_start, aca_advance, recompress_state) compiled
+    for this data type with the kernel and the steps as first-class functions, like the
+    build driver (hmatrix/storage.py): cached on disk, ~3 s of cold compile per data type,
+    instead of ~10 s per kernel in every process when the kernel dispatcher is an argument
+    (numba cannot cache a function taking a dispatcher)."""
+    import numba
+
+    data_type = numba.typeof(data)
+    key = (function, data_type)
+    compiled = _ENTRY_POINTS.get(key)
+    if compiled is None:
+        kernel_type = types.FunctionType(types.none(data_type, _INDEX, _INDEX, types.float64[:, ::1]))
+        signature = (kernel_type, data_type) + tuple(argument_types) + _STEP_TYPES[:n_steps]
+        compiled = njit(signature, cache=True, nogil=True)(function)
+        _ENTRY_POINTS[key] = compiled
+    return compiled
+
