@@ -263,13 +263,17 @@ LEAK_OFF = {  # -> hmatddm.flow.fluid.LeakOff (ref. Eqs 4.25-4.26)
     "pore_pressure": Setting("number", 0.0, unit="Pa"),
 }
 
-NATURAL_FRACTURE = {  # network.* in a scene -> hmatddm.fracture.crossing.NaturalFractureProperties
-    "friction_coefficient": Setting("number", 0.25, low=0.0, doc="C (ref. Table 6.2)"),
-    "cohesion": Setting("number", 0.0, low=0.0, unit="Pa", doc="S_0"),
+#: network.* in a scene and the defaults of hmatddm.fracture.crossing.NaturalFractureProperties
+#: (one default per field: the natural-fracture runs of ref. Table 6.2).
+NATURAL_FRACTURE = {
+    "friction_coefficient": Setting("number", 0.25, low=0.0, doc="C (ref. Table 6.2: NF friction coefficient)"),
+    "cohesion": Setting("number", 0.0, low=0.0, unit="Pa", doc="S_0 (ref. Table 6.2: NF cohesion)"),
     "tensile_strength": Setting("number", 0.0, low=0.0, unit="Pa", doc="T_0"),
-    "toughness": Setting("number", 0.5e6, low=0.0, low_open=True, unit="Pa m^0.5", doc="K_Ic of the natural fractures"),
+    "toughness": Setting("number", 0.5e6, low=0.0, low_open=True, unit="Pa m^0.5",
+                         doc="K_Ic of the natural fractures (ref. Table 6.2: NF K_Ic)"),
     "critical_radius": Setting("number", 0.005, low=0.0, low_open=True, unit="m",
-                               doc="r_c of the Mohr-Coulomb crossing criterion"),
+                               doc="r_c of the Mohr-Coulomb crossing criterion (ref. Table 6.2: characteristic "
+                                   "length)"),
     "skempton": Setting("number", 0.0, low=0.0, high=1.0, doc="Skempton's B (ref. Eq. 5.18)"),
 }
 

@@ -271,6 +271,16 @@ def test_natural_fractures_validate_and_build():
         validate(only)
 
 
+def test_natural_fracture_defaults_are_those_of_the_properties_class():
+    # one default per field (hmatddm.settings.NATURAL_FRACTURE): a scene that sets no strength
+    # builds what NaturalFractureProperties() holds, the values of ref. Table 6.2
+    scene = raw()
+    scene["natural_fracture"] = [{"p0": [5.0, -10.0], "p1": [5.0, 10.0]}]
+    built = hs.build.natural_properties(validate(scene))
+    assert built == hd.NaturalFractureProperties(pore_pressure=built.pore_pressure)
+    assert (built.friction, built.cohesion, built.toughness, built.critical_radius) == (0.25, 0.0, 0.5e6, 0.005)
+
+
 def test_overrides_apply_before_validation():
     scene = hs.load_scene("kgd", overrides=["numerics.end_time=5", 'numerics.backend="dense"',
                                             "cluster[0].rate=1e-3", "output.snapshots=false"])

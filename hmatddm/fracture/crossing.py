@@ -34,7 +34,13 @@ CROSSING_CRITERIA = ("mohr-coulomb", "sif", "energy")
 
 @dataclass(frozen=True)
 class NaturalFractureProperties:
-    """Strength of the natural fractures (ref. Tables 5.1-5.2).
+    """Strength of the natural fractures (ref. Sec. 5.2-5.3).
+
+    Defaults, ranges and units are those of :data:`hmatddm.settings.NATURAL_FRACTURE`, the
+    one source that scenes (``[network]``) read too: the natural-fracture network runs of
+    ref. Table 6.2 (friction 0.25, r_c = 0.005 m, K_Ic = 0.5 MPa m^1/2, no cohesion). The
+    crossing experiments of ref. Table 5.1 use other values (friction 0.38, cohesion
+    3.2 MPa, T_0 = 0.5 MPa, r_c = 1 cm): pass them explicitly.
 
     Parameters
     ----------
@@ -49,14 +55,14 @@ class NaturalFractureProperties:
         ``dp = -B d sigma_m`` (ref. Eq. 5.18) used by the remote-failure check
     """
 
-    friction: float = 0.6
-    cohesion: float = 0.0
-    tensile_strength: float = 0.0
-    toughness: float = 0.5e6
-    critical_radius: float = 0.01
+    friction: float = NATURAL_FRACTURE["friction_coefficient"].default
+    cohesion: float = NATURAL_FRACTURE["cohesion"].default
+    tensile_strength: float = NATURAL_FRACTURE["tensile_strength"].default
+    toughness: float = NATURAL_FRACTURE["toughness"].default
+    critical_radius: float = NATURAL_FRACTURE["critical_radius"].default
     pore_pressure: float = 0.0
     crossing: str = "mohr-coulomb"
-    skempton: float = 0.0
+    skempton: float = NATURAL_FRACTURE["skempton"].default
 
     def __post_init__(self):
         for name in ("friction", "cohesion", "tensile_strength", "toughness", "critical_radius", "skempton"):
