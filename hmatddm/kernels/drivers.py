@@ -53,8 +53,11 @@ Compiled entry points are few on purpose, as each one compiles (and LLVM optimis
 whole per-pair kernel it calls again: per record type only :func:`traction_block` (the
 H-matrix's block generator, with exactly the signature the H-matrix build calls it with),
 :func:`stress_block` and :func:`edge_distance`. The dense matrix, the stress at many
-points, the singular-pair test and the self-block maxima call those two from Python
-(in parallel on numba's thread count where it pays: the compiled drivers release the GIL).
+points and the singular-pair test call those two from Python (in parallel on numba's
+thread count where it pays: the compiled drivers release the GIL); the self-block maxima
+call :func:`traction_block` through a pointer from a small compiled loop (the kernel is not
+compiled again). The loops over pairs read :func:`borrowed` arrays: numba's reference
+counts are atomic operations, and a pair's reads of the record would otherwise pay a dozen.
 The drivers are cached on disk (``cache=True``); the cache of a driver does not notice
 edits in a kind's module: delete ``hmatddm/**/__pycache__/*.nbi|*.nbc`` after changing a
 kernel.
@@ -66,8 +69,10 @@ from typing import NamedTuple
 
 import numba
 import numpy as np
-from numba import njit
-from numba.extending import overload
+from numba import njit, types
+from numba.core import cgutils
+from numba.extending import intrinsic, overload
+from numba.np.arrayobj import make_array
 
 from .correction import scale_to_self
 
@@ -190,6 +195,47 @@ def _edge_distance(data, i, j):
 
 
 # -- the compiled drivers ------------------------------------------------------------------
+def _without_reference_count(context, builder, kind, value):
+    """``value`` of numba type ``kind`` with the meminfo of every array in it (through
+    tuples and records) set to null."""
+    if isinstance(kind, types.Array):
+        array = make_array(kind)(context, builder, value=value)
+        array.meminfo = cgutils.get_null_value(array.meminfo.type)
+        return array._getvalue()
+    if isinstance(kind, types.BaseTuple):
+        for k, item in enumerate(kind.types):
+            stripped = _without_reference_count(context, builder, item, builder.extract_value(value, k))
+            value = builder.insert_value(value, stripped, k)
+    return value
+
+
+@intrinsic
+def borrowed(typingctx, value):
+    """``value`` (an array, or a tuple or record holding arrays) on the same data, without
+    reference counting: numba counts references to an array with atomic instructions
+    (~10 ns each here), and the per-pair code of a kind (record fields read, views such as
+    ``centers[i]`` passed to a kernel function, the inlined function's arguments) made about
+    twelve of them per element pair -- more time than the 2D kernel's arithmetic. numba's
+    own parallel loops hand arrays to their bodies the same way (which is why the old
+    ``prange`` dense assembly was faster than the same loop run serially). Only for values
+    whose owner outlives every use -- a compiled function's own arguments (the caller holds
+    them) -- and never returned or stored."""
+    def codegen(context, builder, signature, args):
+        return _without_reference_count(context, builder, signature.args[0], args[0])
+
+    return value(value), codegen
+
+
+@intrinsic
+def _hold(typingctx, value):
+    """Nothing, but a use of ``value``: numba releases a variable after its last use, so
+    an owner of arrays that a loop reads :func:`borrowed` must be used after the loop."""
+    def codegen(context, builder, signature, args):
+        return context.get_dummy_value()
+
+    return types.none(value), codegen
+
+
 @njit(cache=True)
 def _fill_receiver(data, i, cols, out, row, work, block):
     """``out[row + p, d jb + q]``: the blocks of receiver ``i`` from the sources ``cols``,
@@ -236,16 +282,19 @@ def _fill_block(data, rows, cols, out, work, block):
 
 @overload(_fill_block)
 def _overload_fill_block(data, rows, cols, out, work, block):
+    # every array is borrowed (:func:`borrowed`): the caller, traction_block, holds them
     if _shares_source_state(data):
         def impl(data, rows, cols, out, work, block):
-            dof = block.shape[0]
-            for jb in range(cols.shape[0]):
-                _fill_source(data, cols[jb], rows, out, dof * jb, work, block)
+            data_, rows_, cols_, out_, work_, block_ = borrowed((data, rows, cols, out, work, block))
+            dof = block_.shape[0]
+            for jb in range(cols_.shape[0]):
+                _fill_source(data_, cols_[jb], rows_, out_, dof * jb, work_, block_)
     else:
         def impl(data, rows, cols, out, work, block):
-            dof = block.shape[0]
-            for ia in range(rows.shape[0]):
-                _fill_receiver(data, rows[ia], cols, out, dof * ia, work, block)
+            data_, rows_, cols_, out_, work_, block_ = borrowed((data, rows, cols, out, work, block))
+            dof = block_.shape[0]
+            for ia in range(rows_.shape[0]):
+                _fill_receiver(data_, rows_[ia], cols_, out_, dof * ia, work_, block_)
     return impl
 
 
@@ -268,20 +317,24 @@ def stress_block(data, points, point_layer, dd, out):
     n = data.centers.shape[0]
     dim = points.shape[1]
     dof = element_unknowns(data)
-    work = _workspace(data)
-    pair = np.empty((dof, dim, dim))
-    for m in range(points.shape[0]):
+    scratch = (_workspace(data), np.empty((dof, dim, dim)))
+    # every array borrowed (:func:`borrowed`): the caller holds the arguments, ``scratch``
+    # lives until :func:`_hold` below
+    data_, points_, point_layer_, dd_, out_, work, pair = borrowed((data, points, point_layer, dd, out, scratch[0],
+                                                                    scratch[1]))
+    for m in range(points_.shape[0]):
         acc = np.zeros((dim, dim))
         for j in range(n):
-            _element_stress(data, points[m], point_layer[m], j, work, pair)
+            _element_stress(data_, points_[m], point_layer_[m], j, work, pair)
             for u in range(dof):
-                du = dd[j, u]
+                du = dd_[j, u]
                 for a in range(dim):
                     for b in range(dim):
                         acc[a, b] += pair[u, a, b] * du
         for a in range(dim):
             for b in range(dim):
-                out[m, a, b] = acc[a, b]
+                out_[m, a, b] = acc[a, b]
+    _hold(scratch)
 
 
 @njit(cache=True)
@@ -345,15 +398,45 @@ def singular_pairs(data, rows, cols, out):
         out[pairs] = ~np.all(np.isfinite(block.reshape(len(pairs), -1)), axis=1)
 
 
-def self_block_max(data, out):
-    """``out[i]``: the largest |entry| of element ``i``'s self block (the ``self_max``
-    of ref. Eq. 6.11; the Eq. 6.11 scaling never applies to a self block)."""
+def _self_block_max(kernel, data, out):
+    """:func:`self_block_max` with the block generator ``kernel`` (:func:`traction_block`)."""
+    element = np.empty(1, dtype=np.int64)
     dof = element_unknowns(data)
     block = np.empty((dof, dof))
-    for i in range(data.centers.shape[0]):
-        element = np.array([i], dtype=np.int64)
-        traction_block(data, element, element, block)
-        out[i] = np.max(np.abs(block))
+    for i in range(out.shape[0]):
+        element[0] = i
+        kernel(data, element, element, block)
+        largest = 0.0  # np.max(np.abs(block)), NaN included, without compiling numpy's reductions
+        for p in range(dof):
+            for q in range(dof):
+                value = abs(block[p, q])
+                if value > largest or value != value:
+                    largest = value
+                    if value != value:
+                        break
+            if largest != largest:
+                break
+        out[i] = largest
+
+
+_SELF_MAX_DRIVERS = {}
+
+
+def self_block_max(data, out):
+    """``out[i]`` (``out`` (N,) float64): the largest |entry| of element ``i``'s self block
+    (the ``self_max`` of ref. Eq. 6.11; the Eq. 6.11 scaling never applies to a self block).
+
+    One compiled loop per record type that calls :func:`traction_block` as a first-class
+    function (as :func:`hmatddm.hmatrix.storage.build_driver` does): the kernel is not
+    compiled again, and the loop is small and cached on disk."""
+    data_type = numba.typeof(data)
+    driver = _SELF_MAX_DRIVERS.get(data_type)
+    if driver is None:
+        index = types.int64[::1]
+        kernel_type = types.FunctionType(types.none(data_type, index, index, types.float64[:, ::1]))
+        driver = njit(types.none(kernel_type, data_type, types.float64[::1]), cache=True, nogil=True)(_self_block_max)
+        _SELF_MAX_DRIVERS[data_type] = driver
+    driver(traction_block, data, out)
 
 
 def with_self_max(data):
@@ -406,6 +489,6 @@ def finite_stress_sum(data, points, dd, point_layer, edge="element edge"):
 
 
 __all__ = ["COMMON_FIELDS", "HOMOGENEOUS_FIELDS", "kernel_record", "KernelKind", "register_kind", "no_source_state",
-           "kind_of", "element_unknowns", "traction_block", "stress_block", "edge_distance", "traction_matrix",
-           "influence_matrix", "singular_pairs", "self_block_max", "with_self_max", "self_block_maxima", "stress_at_points",
-           "stress_sum", "finite_stress_sum"]
+           "kind_of", "element_unknowns", "borrowed", "traction_block", "stress_block", "edge_distance",
+           "traction_matrix", "influence_matrix", "singular_pairs", "self_block_max", "with_self_max",
+           "self_block_maxima", "stress_at_points", "stress_sum", "finite_stress_sum"]
