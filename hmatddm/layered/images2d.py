@@ -119,6 +119,15 @@ def _apply(coef, power, h, dh, src, dsrc, dst, ddst, n_orders):
         ddst[n + power] += coef * (dhp * src[n] + hp * dsrc[n])
 
 
+#: The reflection (ref. Eq. 3.26) and transmission (Eq. 3.27) operators of
+#: :func:`trace_potentials` as rows ``(potential receiving, potential applied, power of h D)``
+#: (their coefficients are set per interface): one call of :func:`_apply` in a loop, so
+#: its loop is compiled once rather than once per term (ten copies, a quarter of the
+#: tracer's compile time).
+_REFLECTION_ROWS = np.array([[0, 0, 1], [0, 1, 0], [0, 1, 2], [1, 0, 0], [1, 1, 1], [2, 2, 0]], dtype=np.int64)
+_TRANSMISSION_ROWS = np.array([[0, 0, 0], [0, 1, 1], [1, 1, 0], [2, 2, 0]], dtype=np.int64)
+
+
 @njit(cache=True)
 def trace_potentials(t, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, original, parity, pair_layer,
                      pair_z, pair_eps, pair_sigma, pair_coef, pair_dcoef):
@@ -158,6 +167,9 @@ def trace_potentials(t, source_layer, interfaces, shear_modulus, poisson_ratio, 
     n_queue = 2
     mirrored = np.empty((n_f, n_j, n_orders))
     dmirrored = np.empty((n_f, n_j, n_orders))
+    row_coef = np.empty(6)
+    reflection_rows = 5 if n_j == 2 else 6  # the third potential (3D) has one more
+    transmission_rows = 3 if n_j == 2 else 4
     i = 0
     while i < n_queue:
         layer = q_layer[i]
@@ -189,19 +201,18 @@ def trace_potentials(t, source_layer, interfaces, shear_modulus, poisson_ratio, 
                         mirrored[f, j, n] = sign * q_coef[i, f, j, n]
                         dmirrored[f, j, n] = sign * q_dcoef[i, f, j, n]
             # the mirrored potentials emanate from z' = 2d - z (dz'/dt = -dz/dt, below)
+            # ref. Eq. 3.26, rows of _REFLECTION_ROWS
+            row_coef[0] = 2.0 * d1 * c1
+            row_coef[1] = c2
+            row_coef[2] = -4.0 * d1 * d1 * c1
+            row_coef[3] = c1
+            row_coef[4] = -2.0 * d1 * c1
+            row_coef[5] = c3
             for f in range(n_f):
-                # ref. Eq. 3.26
-                _apply(2.0 * d1 * c1, 1, h, dh, mirrored[f, 0], dmirrored[f, 0], q_coef[k, f, 0], q_dcoef[k, f, 0],
-                       n_orders)
-                _apply(c2, 0, h, dh, mirrored[f, 1], dmirrored[f, 1], q_coef[k, f, 0], q_dcoef[k, f, 0], n_orders)
-                _apply(-4.0 * d1 * d1 * c1, 2, h, dh, mirrored[f, 1], dmirrored[f, 1], q_coef[k, f, 0],
-                       q_dcoef[k, f, 0], n_orders)
-                _apply(c1, 0, h, dh, mirrored[f, 0], dmirrored[f, 0], q_coef[k, f, 1], q_dcoef[k, f, 1], n_orders)
-                _apply(-2.0 * d1 * c1, 1, h, dh, mirrored[f, 1], dmirrored[f, 1], q_coef[k, f, 1],
-                       q_dcoef[k, f, 1], n_orders)
-                if n_j == 3:
-                    _apply(c3, 0, h, dh, mirrored[f, 2], dmirrored[f, 2], q_coef[k, f, 2], q_dcoef[k, f, 2],
-                           n_orders)
+                for r in range(reflection_rows):
+                    to, of, power = _REFLECTION_ROWS[r, 0], _REFLECTION_ROWS[r, 1], _REFLECTION_ROWS[r, 2]
+                    _apply(row_coef[r], power, h, dh, mirrored[f, of], dmirrored[f, of], q_coef[k, f, to],
+                           q_dcoef[k, f, to], n_orders)
             q_layer[k] = layer
             q_dir[k] = -direction
             q_ref[k] = q_ref[i] + 1
@@ -210,16 +221,17 @@ def trace_potentials(t, source_layer, interfaces, shear_modulus, poisson_ratio, 
             n_queue += 1
         if g2 > 0.0:
             k = n_queue
+            # ref. Eq. 3.27, but T12 = +2 (d1 c4 - d2 c5) h D: the reference prints a minus
+            # sign, which breaks the interface conditions (_derive_images2d.py derives +)
+            row_coef[0] = c4
+            row_coef[1] = 2.0 * (d1 * c4 - d2 * c5)
+            row_coef[2] = c5
+            row_coef[3] = c6
             for f in range(n_f):
-                # ref. Eq. 3.27, but T12 = +2 (d1 c4 - d2 c5) h D: the reference prints a minus
-                # sign, which breaks the interface conditions (_derive_images2d.py derives +)
-                _apply(c4, 0, h, dh, q_coef[i, f, 0], q_dcoef[i, f, 0], q_coef[k, f, 0], q_dcoef[k, f, 0], n_orders)
-                _apply(2.0 * (d1 * c4 - d2 * c5), 1, h, dh, q_coef[i, f, 1], q_dcoef[i, f, 1], q_coef[k, f, 0],
-                       q_dcoef[k, f, 0], n_orders)
-                _apply(c5, 0, h, dh, q_coef[i, f, 1], q_dcoef[i, f, 1], q_coef[k, f, 1], q_dcoef[k, f, 1], n_orders)
-                if n_j == 3:
-                    _apply(c6, 0, h, dh, q_coef[i, f, 2], q_dcoef[i, f, 2], q_coef[k, f, 2], q_dcoef[k, f, 2],
-                           n_orders)
+                for r in range(transmission_rows):
+                    to, of, power = _TRANSMISSION_ROWS[r, 0], _TRANSMISSION_ROWS[r, 1], _TRANSMISSION_ROWS[r, 2]
+                    _apply(row_coef[r], power, h, dh, q_coef[i, f, of], q_dcoef[i, f, of], q_coef[k, f, to],
+                           q_dcoef[k, f, to], n_orders)
             q_layer[k] = far
             q_dir[k] = direction
             q_ref[k] = q_ref[i]

@@ -49,6 +49,16 @@ part is a derivative of ``1/r``, whose Taylor coefficients follow a three-term r
 one-variable Taylor series along x of the closed forms of ``d1 F``, ``d2 F``, ``d1 L``,
 ``d2 L`` and from Laplace's equation (both are harmonic) for the higher ``d2`` powers.
 
+Compile cost (issue 18: a cold numba cache). numba links every njit function a function
+calls into its compiled library and LLVM optimises and generates machine code for all of
+it again there, so each njit function above the per-pair stress
+(:func:`_pair_stress_gradient`) costs one more compile of everything below it: the chain is
+kept short (``_complementary_gradient``, ``image_rectangle_stress`` and ``Workspace`` are
+inlined by numba, not compiled on their own); loops LLVM would unroll into thousands of
+instructions (``_base_table``) run to array sizes; and no njit function takes a literal int
+argument where another call passes a variable (numba compiles one specialization per
+literal: ``first = np.int64(0)``). ``benchmarks/bench_layered3d_compile.py`` measures it.
+
 Length (over ~400 lines): the 3D derivative tables of the Hansen potentials (checked by
 ``_derive_images3d``), the tracer of images through interfaces and the rectangle quadrature
 are numba code that compiles as one unit; splitting them would spread one derivation.
@@ -219,19 +229,23 @@ def inverse_distance_derivatives(r1, r2, r3, q):
 def _base_table(sigma, n_c, sf, sl, q, base):
     """``base[kind, a, b, c] = d1^a d2^b d3^c`` of ``F`` (kind 0) or ``L`` (kind 1) of
     gauge ``sigma`` (``a + b <= 5``, ``c < n_c``), from the gauge +1 derivatives at the
-    flipped point: ``sigma^c`` times ``sf``/``sl``/``q`` (``d3 F = -L``, ``d3 L = 1/r``)."""
-    for a in range(6):
-        for b in range(6 - a):
-            sign = 1.0
-            for c in range(n_c):
-                if c == 0:
-                    base[0, a, b, 0] = sf[a, b]
-                    base[1, a, b, 0] = sl[a, b]
-                else:
-                    if sigma < 0.0:
-                        sign = -sign
-                    base[0, a, b, c] = -sign * (sl[a, b] if c == 1 else q[a, b, c - 2])
-                    base[1, a, b, c] = sign * q[a, b, c - 1]
+    flipped point: ``sigma^c`` times ``sf``/``sl``/``q`` (``d3 F = -L``, ``d3 L = 1/r``).
+    The bound is the array's size, not the constant 6: LLVM unrolls constant loops of this
+    copy into ~17k instructions, a third of the compile time of every caller."""
+    top = sf.shape[0]
+    flip = -1.0 if sigma < 0.0 else 1.0
+    for a in range(top):
+        for b in range(top - a):
+            base[0, a, b, 0] = sf[a, b]
+            base[1, a, b, 0] = sl[a, b]
+            sign = flip
+            if n_c > 1:
+                base[0, a, b, 1] = -sign * sl[a, b]
+                base[1, a, b, 1] = sign * q[a, b, 0]
+            for c in range(2, n_c):
+                sign *= flip
+                base[0, a, b, c] = -sign * q[a, b, c - 2]
+                base[1, a, b, c] = sign * q[a, b, c - 1]
 
 
 @njit(cache=True)
@@ -268,7 +282,7 @@ def _potential_table(coef, base, order, table):
                         table[f, j, a, b, c] = s
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def Workspace(n_orders):
     """Scratch arrays of :func:`_pair_stress_gradient` for triples of up to ``n_orders``:
     ``sf, sl`` (6, 6), the series (4, 6), ``q`` (6, 6, n_orders + 4), the base table
@@ -294,8 +308,9 @@ def _pair_tables(r1, r2, r3, sigma, coef, dcoef, order, work):
     n_c = order + used + 1
     base_derivatives(r1, r2, sigma * r3, sf, sl, q[:, :, :n_c - 1], ser)
     _base_table(sigma, n_c, sf, sl, q, base)
-    _potential_table(coef, base, order, table)
-    _potential_table(dcoef, base, order - 1, dtable)
+    lower = order - 1  # a run-time int: one compiled _potential_table for both orders
+    _potential_table(coef, base, lower + 1, table)
+    _potential_table(dcoef, base, lower, dtable)
 
 
 @njit(cache=True)
@@ -351,10 +366,11 @@ def _pair_stress_gradient(r1, r2, r3, eps, sigma, coef, dcoef, delta, shear_modu
     table = work[5]
     dtable = work[6]
     for f in range(3):
-        _stress(table, f, 1, 0, 0, -1.0, r3, delta, shear_modulus, lame, out[f, 0])
-        _stress(table, f, 0, 1, 0, -1.0, r3, delta, shear_modulus, lame, out[f, 1])
-        _stress(dtable, f, 0, 0, 0, 1.0, r3, delta, shear_modulus, lame, out[f, 2])
-        _stress(table, f, 0, 0, 1, -eps, r3, delta, shear_modulus, lame, out[f, 2])
+        # d/dx1, d/dx2 (minus the receiver's), d/dz of the coefficients, of the height: the
+        # shifts are run-time ints, so numba compiles one _stress, not one per literal shift
+        for v in range(4):
+            _stress(dtable if v == 2 else table, f, 1 if v == 0 else 0, 1 if v == 1 else 0, 1 if v == 3 else 0,
+                    -eps if v == 3 else (1.0 if v == 2 else -1.0), r3, delta, shear_modulus, lame, out[f, min(v, 2)])
         t1 = table[f, 1]
         for i in range(3):
             for k in range(3):
@@ -390,10 +406,9 @@ def _pair_displacement_gradient(r1, r2, r3, eps, sigma, coef, dcoef, delta, out,
     table = work[5]
     dtable = work[6]
     for f in range(3):
-        _displacement(table, f, 1, 0, 0, -1.0, r3, delta, out[f, 0])
-        _displacement(table, f, 0, 1, 0, -1.0, r3, delta, out[f, 1])
-        _displacement(dtable, f, 0, 0, 0, 1.0, r3, delta, out[f, 2])
-        _displacement(table, f, 0, 0, 1, -eps, r3, delta, out[f, 2])
+        for v in range(4):  # as in _pair_stress_gradient
+            _displacement(dtable if v == 2 else table, f, 1 if v == 0 else 0, 1 if v == 1 else 0, 1 if v == 3 else 0,
+                          -eps if v == 3 else (1.0 if v == 2 else -1.0), r3, delta, out[f, min(v, 2)])
         for i in range(3):
             a = 1 if i == 0 else 0
             b = 1 if i == 1 else 0
@@ -424,7 +439,7 @@ def _contract(gradient, normal, shear_modulus, lame, weight, out):
                 out[b, i, k] += weight * acc
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _complementary_gradient(y, receiver_layer, x, n_pairs, source_layer, pair_layer, pair_z, pair_eps, pair_sigma,
                             pair_coef, pair_dcoef, shear_modulus, poisson_ratio, gradient, work, work1, kelvin):
     """``gradient[f, q, i, k]`` of the complementary field at receiver ``y`` from the
@@ -686,7 +701,7 @@ def _traced_buffer(n_points, cap, n_orders):
             np.empty((n_points, cap, 3, 3, n_orders)), np.empty((n_points, cap, 3, 3, n_orders)))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def image_rectangle_stress(y, receiver_layer, center, frame, a, b, source_layer, interfaces, shear_modulus,
                            poisson_ratio, n_images, n_gauss, n_sub, out):
     """Complementary stress ``out[b, i, k]`` at ``y`` of a unit global DD ``b`` on the
@@ -694,11 +709,13 @@ def image_rectangle_stress(y, receiver_layer, center, frame, a, b, source_layer,
     xi, eta, wt = square_rule(n_gauss, n_sub)
     cap, n_orders = trace_capacity(source_layer, shear_modulus, n_images)
     traced = _traced_buffer(xi.shape[0], cap, n_orders)
-    _trace_range(center, frame, a, b, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, xi, eta, 0,
+    first = np.int64(0)  # not a literal 0: the same compiled _trace_range and _integrate as element_traction's
+    _trace_range(center, frame, a, b, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, xi, eta, first,
                  xi.shape[0], traced)
     out[:] = 0.0
     _integrate(y, receiver_layer, center, frame, a, b, source_layer, shear_modulus, poisson_ratio, xi, eta, wt,
-               traced, 0, out, np.empty((3, 3, 3, 3)), Workspace(n_orders), Workspace(1), np.zeros((2, 3, 3, 1)))
+               traced, first, out, np.empty((3, 3, 3, 3)), Workspace(n_orders), Workspace(1),
+               np.zeros((2, 3, 3, 1)))
 
 
 @njit(cache=True)
@@ -759,7 +776,7 @@ def _cached_rules(n_gauss):
     eta = np.empty(start[-1])
     wt = np.empty(start[-1])
     for s in range(n_gauss + 1):
-        x, e, w = square_rule(s + 1, 1) if s < n_gauss else square_rule(n_gauss, 2)
+        x, e, w = square_rule(s + 1 if s < n_gauss else n_gauss, 1 if s < n_gauss else 2)  # one specialization
         xi[start[s]:start[s + 1]] = x
         eta[start[s]:start[s + 1]] = e
         wt[start[s]:start[s + 1]] = w
