@@ -10,7 +10,7 @@ The influence of a node's shape function is the sum of
   integrated along the element against the node's shape function by Gauss-Legendre
   quadrature: ``gauss_points`` per sub-segment, with up to ``max_subdivisions``
   sub-segments where an image lies close to the receiver
-  (:func:`hmatddm.layered.images2d.subdivisions`); ``max_subdivisions = 1`` is the
+  (:func:`hmatddm.layered.segment_quadrature.subdivisions`); ``max_subdivisions = 1`` is the
   reference's plain rule (ref. Table 3.2: 1-3 Gauss points).
 
 Kernel data: :class:`LayeredNodalSegments` (``2 n`` unknowns per element, node-major),
@@ -24,7 +24,9 @@ from .kernels.drivers import (KernelKind, finite_stress_sum, influence_matrix, k
 from .kernels.line2d import SEGMENT_FIELDS
 from .kernels.line2d_higher_order import (SHAPE_FIELDS, edge_distance, near_distance, node_point, set_node_rows,
                                           stress_nodes, traction_nodes)
-from .layered.images2d import LAYERED_FIELDS, composite_rule, image_element_stress, subdivisions
+from .layered.images2d import image_element_stress
+from .layered.segment_quadrature import composite_rule, subdivisions
+from .layered.segments2d import LAYERED_FIELDS
 
 
 @njit(cache=True)
@@ -57,7 +59,7 @@ def image_nodes(point, receiver_layer, center, frame, a, source_layer, coefficie
 LayeredNodalSegments = kernel_record(
     "LayeredNodalSegments", __name__,
     "Kernel data of linear and quadratic 2D elements in a layered medium (the record :mod:`hmatddm.kernels.drivers` "
-    "take): :class:`hmatddm.layered.images2d.LayeredSegments` plus the shape functions.",
+    "take): :class:`hmatddm.layered.segments2d.LayeredSegments` plus the shape functions.",
     SEGMENT_FIELDS + LAYERED_FIELDS, SHAPE_FIELDS)
 
 

@@ -7,7 +7,7 @@ import hmatddm as hd
 from hmatddm.errors import InputError
 from hmatddm.kernels import line2d
 from hmatddm.kernels.drivers import traction_block
-from hmatddm.layered import LayeredMedium, images2d, split_at_interfaces
+from hmatddm.layered import LayeredMedium, images2d, segment_quadrature, split_at_interfaces
 
 
 # -- the medium -------------------------------------------------------------------------
@@ -68,7 +68,7 @@ def test_hansen_whole_plane_path_matches_closed_form_segment():
     point = np.array([2.1, -1.7])
     expected = np.empty((2, 2, 2))
     line2d.stress_pair(point, center, np.array([tangent, normal]), a, g, nu, 0.0, expected, np.empty((2, 2, 2)))
-    xi, w = images2d.composite_rule(10, 4)
+    xi, w = segment_quadrature.composite_rule(10, 4)
     got = np.zeros((2, 2, 2))
     value = np.empty((2, 2, 2))
     for x, weight in zip(xi, w):

@@ -3,7 +3,9 @@
 * :class:`LayeredMedium`: interfaces, per-layer moduli (a void layer is a free surface),
   optional per-layer in-situ stress and toughness.
 * :mod:`.images2d`: complementary (image) stress of DDs in 2D plane strain by the general
-  image method (ref. Secs 3.2-3.3), numba; loaded on first use.
+  image method (ref. Secs 3.2-3.3), numba; loaded on first use. Its parts: :mod:`.image_tracer`
+  (images through the interfaces, shared with 3D), :mod:`.segment_quadrature` (the image
+  quadrature along a segment), :mod:`.segments2d` (kernel data of constant 2D elements).
 * :mod:`.images3d`: the same for constant rectangles in 3D (any orientation), with the
   3D Hansen potentials (ref. Eq. 3.24); :mod:`.influence3d` builds their kernel data.
 * :func:`split_at_interfaces`: cut a mesh's elements where they cross interfaces (2D
@@ -15,7 +17,8 @@ from .medium import LayeredMedium
 
 
 def __getattr__(name):
-    if name in ("images2d", "influence2d", "images3d", "influence3d"):
+    if name in ("images2d", "influence2d", "images3d", "influence3d", "image_tracer", "segment_quadrature",
+                "segments2d"):
         return importlib.import_module(f"{__name__}.{name}")
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 

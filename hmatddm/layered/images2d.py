@@ -24,26 +24,11 @@ the angle drop out: ``d1^a d3^b f = i^b f^(a+b)``, ``f'' = 1/w``,
 script ``_derive_images2d.py`` derives the reflection/transmission operators below from
 the interface conditions and checks these derivatives.
 
-Reflection and transmission at an interface ``y3 = d`` of a pair emanating from ``z``
-(ref. Eqs 3.25-3.28, with ``h = z - d`` signed, ``D = d/dy3``, ``gamma = G_far/G_near``,
-``delta_1`` near side, ``delta_2`` far side): the reflected pair emanates from
-``2d - z`` and is ``R`` applied to the mirrored incident pair; the transmitted pair keeps
-``z`` and is ``T`` applied to the incident pair:
-
-    R = [[2 d1 c1 h D,  c2 - 4 d1^2 c1 h^2 D^2],     T = [[c4, 2 (d1 c4 - d2 c5) h D],
-         [c1,           -2 d1 c1 h D          ]]          [0,  c5                    ]]
-
-(ref. Eq. 3.27 prints ``-2 (d1 c4 - d2 c5)``; that sign violates the continuity of
-traction and displacement at the interface, which the ``+`` sign satisfies exactly.)
-
-The same formulas hold for a pair hitting an interface from below (flip the vertical
-axis: ``h D`` is unchanged). Applied repeatedly (ref. Fig. 3.4), each pair is a sum of
-``A[j, n] D^n`` of the source's kernel, ``A`` polynomial in the source height ``t``;
-``dA/dt`` is carried along (forward differentiation) because a displacement
-discontinuity is a force dipole: the stress at ``y`` of a unit DD density ``b`` on a
-plane of normal ``n`` at ``x`` is ``sum_pq M_pq d/dx_q sigma^(p)(y; x)`` with
-``M_pq = lambda (b.n) delta_pq + G (b_p n_q + b_q n_p)`` of the source's layer and
-``sigma^(p)`` the stress of a unit force along ``p`` (Aki & Richards, Eq. 3.20).
+Reflection and transmission of the pairs at the interfaces (ref. Eqs 3.25-3.28, Fig. 3.4)
+are :mod:`hmatddm.layered.image_tracer` (shared with 3D); the Gauss rules and the
+subdivision of the element are :mod:`hmatddm.layered.segment_quadrature`; the kernel
+record of constant elements and the per-pair functions the drivers call are
+:mod:`hmatddm.layered.segments2d`.
 
 The 2D constant displacement of ref. Sec. 3.3.1 (Eqs 3.34-3.39) is a rigid translation
 that does not depend on the source point: every DD quantity differentiates it away, so
@@ -54,201 +39,15 @@ closed-form kernel of :mod:`hmatddm.kernels.line2d`); in any other layer, the
 transmitted and reflected pairs minus the source layer's whole-plane (Kelvin) field,
 because the callers add the closed-form kernel of the source's material at every
 receiver. So with equal layers the complementary stress is exactly zero.
-
-Length (over ~400 lines): the derivative tables of the Hansen potentials (checked by
-``_derive_images2d``), the tracer of images through interfaces and the quadrature are
-numba code that compiles as one unit; splitting them would spread one derivation.
 """
 import math
 
 import numpy as np
 from numba import njit
 
-from ..kernels import line2d
-from ..kernels.drivers import KernelKind, kernel_record, register_kind
+from .image_tracer import trace_capacity, trace_potentials
 
 _INV_4PI = 1.0 / (4.0 * math.pi)
-
-
-# -- tracing the image pairs (ref. Fig. 3.4) -------------------------------------------
-@njit(cache=True)
-def trace_capacity(source_layer, shear_modulus, n_images):
-    """``(n_pairs, n_orders)``: room the tracer needs for a source in ``source_layer``
-    (counted without pruning, so an upper bound)."""
-    n_layers = shear_modulus.shape[0]
-    cap = 2
-    stack_layer = [source_layer, source_layer]
-    stack_dir = [1, -1]
-    stack_ref = [0, 0]
-    stack_order = [0, 0]
-    max_order = 0
-    while len(stack_layer) > 0:
-        layer = stack_layer.pop()
-        direction = stack_dir.pop()
-        nref = stack_ref.pop()
-        order = stack_order.pop()
-        far = layer - 1 if direction > 0 else layer + 1
-        if far < 0 or far >= n_layers:
-            continue
-        if nref < n_images:
-            cap += 1
-            max_order = max(max_order, order + 2)
-            stack_layer.append(layer)
-            stack_dir.append(-direction)
-            stack_ref.append(nref + 1)
-            stack_order.append(order + 2)
-        if shear_modulus[far] > 0.0:
-            cap += 1
-            max_order = max(max_order, order + 1)
-            stack_layer.append(far)
-            stack_dir.append(direction)
-            stack_ref.append(nref)
-            stack_order.append(order + 1)
-    return cap, max_order + 1
-
-
-@njit(cache=True)
-def _apply(coef, power, h, dh, src, dsrc, dst, ddst, n_orders):
-    """``dst += coef h^power D^power src`` and its derivative in the source height."""
-    if coef == 0.0:
-        return
-    hp = h ** power
-    dhp = power * h ** (power - 1) * dh if power > 0 else 0.0
-    for n in range(n_orders - power):
-        dst[n + power] += coef * hp * src[n]
-        ddst[n + power] += coef * (dhp * src[n] + hp * dsrc[n])
-
-
-#: The reflection (ref. Eq. 3.26) and transmission (Eq. 3.27) operators of
-#: :func:`trace_potentials` as rows ``(potential receiving, potential applied, power of h D)``
-#: (their coefficients are set per interface): one call of :func:`_apply` in a loop, so
-#: its loop is compiled once rather than once per term (ten copies, a quarter of the
-#: tracer's compile time).
-_REFLECTION_ROWS = np.array([[0, 0, 1], [0, 1, 0], [0, 1, 2], [1, 0, 0], [1, 1, 1], [2, 2, 0]], dtype=np.int64)
-_TRANSMISSION_ROWS = np.array([[0, 0, 0], [0, 1, 1], [1, 1, 0], [2, 2, 0]], dtype=np.int64)
-
-
-@njit(cache=True)
-def trace_potentials(t, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, original, parity, pair_layer,
-                     pair_z, pair_eps, pair_sigma, pair_coef, pair_dcoef):
-    """Reflect and transmit the potentials of a unit point force at height ``t`` in
-    ``source_layer`` through the interfaces (ref. Fig. 3.4, Eqs 3.25-3.28): 2D pairs
-    (``pair_coef`` (C, 2, 2, O)) and 3D triples ((C, 3, 3, O), the third potential
-    reflected by ``c3`` and transmitted by ``c6``) alike.
-
-    ``original[e]`` (2, F, J): the source's coefficients of ``D^0`` travelling up
-    (``e = 0``) and down (``e = 1``); ``parity[f]``: sign of force ``f``'s potentials
-    under mirroring in a horizontal plane (times ``(-1)^n`` for ``D^n``). Fills
-    ``pair_layer[k]`` (layer the potentials live in), ``pair_z[k]`` (height they emanate
-    from), ``pair_eps[k] = dz/dt`` (+-1), ``pair_sigma[k]`` (direction of travel: +1
-    upward), ``pair_coef[k, f, j, n]`` (coefficient of ``D^n`` of potential ``j`` for a
-    force along ``f``) and ``pair_dcoef`` = d/dt. Returns their number (the original
-    excluded)."""
-    n_layers = shear_modulus.shape[0]
-    n_f = pair_coef.shape[1]
-    n_j = pair_coef.shape[2]
-    n_orders = pair_coef.shape[3]
-    cap = pair_coef.shape[0]
-    # work queue: the original twice (up and down), then every new image
-    q_layer = np.empty(cap + 2, dtype=np.int64)
-    q_dir = np.empty(cap + 2, dtype=np.int64)
-    q_ref = np.empty(cap + 2, dtype=np.int64)
-    q_z = np.empty(cap + 2)
-    q_eps = np.empty(cap + 2)
-    q_coef = np.zeros((cap + 2, n_f, n_j, n_orders))
-    q_dcoef = np.zeros((cap + 2, n_f, n_j, n_orders))
-    for e in range(2):
-        q_layer[e] = source_layer
-        q_dir[e] = 1 if e == 0 else -1
-        q_ref[e] = 0
-        q_z[e] = t
-        q_eps[e] = 1.0
-        q_coef[e, :, :, 0] = original[e]
-    n_queue = 2
-    mirrored = np.empty((n_f, n_j, n_orders))
-    dmirrored = np.empty((n_f, n_j, n_orders))
-    row_coef = np.empty(6)
-    reflection_rows = 5 if n_j == 2 else 6  # the third potential (3D) has one more
-    transmission_rows = 3 if n_j == 2 else 4
-    i = 0
-    while i < n_queue:
-        layer = q_layer[i]
-        direction = q_dir[i]
-        far = layer - 1 if direction > 0 else layer + 1
-        if far < 0 or far >= n_layers:
-            i += 1
-            continue
-        d = interfaces[layer - 1] if direction > 0 else interfaces[layer]
-        h = q_z[i] - d
-        dh = q_eps[i]
-        g1 = shear_modulus[layer]
-        g2 = shear_modulus[far]
-        d1 = 1.0 / (3.0 - 4.0 * poisson_ratio[layer])
-        d2 = 1.0 / (3.0 - 4.0 * poisson_ratio[far])
-        gamma = g2 / g1
-        c1 = (gamma - 1.0) / (gamma + d1)                 # ref. Eq. 3.28
-        c2 = (gamma * d2 - d1) / (gamma * d2 + 1.0)
-        c3 = (1.0 - gamma) / (1.0 + gamma)                # (3D; zero only where c1 is)
-        c4 = 1.0 - c1
-        c5 = 1.0 - c2
-        c6 = 1.0 + c3
-        if q_ref[i] < n_images and (c1 != 0.0 or c2 != 0.0):
-            k = n_queue
-            for f in range(n_f):
-                for j in range(n_j):
-                    for n in range(n_orders):
-                        sign = parity[f] if n % 2 == 0 else -parity[f]
-                        mirrored[f, j, n] = sign * q_coef[i, f, j, n]
-                        dmirrored[f, j, n] = sign * q_dcoef[i, f, j, n]
-            # the mirrored potentials emanate from z' = 2d - z (dz'/dt = -dz/dt, below)
-            # ref. Eq. 3.26, rows of _REFLECTION_ROWS
-            row_coef[0] = 2.0 * d1 * c1
-            row_coef[1] = c2
-            row_coef[2] = -4.0 * d1 * d1 * c1
-            row_coef[3] = c1
-            row_coef[4] = -2.0 * d1 * c1
-            row_coef[5] = c3
-            for f in range(n_f):
-                for r in range(reflection_rows):
-                    to, of, power = _REFLECTION_ROWS[r, 0], _REFLECTION_ROWS[r, 1], _REFLECTION_ROWS[r, 2]
-                    _apply(row_coef[r], power, h, dh, mirrored[f, of], dmirrored[f, of], q_coef[k, f, to],
-                           q_dcoef[k, f, to], n_orders)
-            q_layer[k] = layer
-            q_dir[k] = -direction
-            q_ref[k] = q_ref[i] + 1
-            q_z[k] = 2.0 * d - q_z[i]
-            q_eps[k] = -q_eps[i]
-            n_queue += 1
-        if g2 > 0.0:
-            k = n_queue
-            # ref. Eq. 3.27, but T12 = +2 (d1 c4 - d2 c5) h D: the reference prints a minus
-            # sign, which breaks the interface conditions (_derive_images2d.py derives +)
-            row_coef[0] = c4
-            row_coef[1] = 2.0 * (d1 * c4 - d2 * c5)
-            row_coef[2] = c5
-            row_coef[3] = c6
-            for f in range(n_f):
-                for r in range(transmission_rows):
-                    to, of, power = _TRANSMISSION_ROWS[r, 0], _TRANSMISSION_ROWS[r, 1], _TRANSMISSION_ROWS[r, 2]
-                    _apply(row_coef[r], power, h, dh, q_coef[i, f, of], q_dcoef[i, f, of], q_coef[k, f, to],
-                           q_dcoef[k, f, to], n_orders)
-            q_layer[k] = far
-            q_dir[k] = direction
-            q_ref[k] = q_ref[i]
-            q_z[k] = q_z[i]
-            q_eps[k] = q_eps[i]
-            n_queue += 1
-        i += 1
-    n_out = 0
-    for k in range(2, n_queue):
-        pair_layer[n_out] = q_layer[k]
-        pair_z[n_out] = q_z[k]
-        pair_eps[n_out] = q_eps[k]
-        pair_sigma[n_out] = float(q_dir[k])
-        pair_coef[n_out] = q_coef[k]
-        pair_dcoef[n_out] = q_dcoef[k]
-        n_out += 1
-    return n_out
 
 
 @njit(cache=True)
@@ -273,7 +72,6 @@ def trace(t, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, p
                             pair_dcoef)
 
 
-# -- stress of one pair ------------------------------------------------------------------
 @njit(cache=True)
 def _potential_table(coef, dcoef, beta, n_orders, table, dtable):
     """``table[j, a, b] = sum_n coef[j, n] beta[a, b + n]`` (derivative d1^a d3^b of
@@ -550,216 +348,11 @@ def image_element_stress(y1, y3, receiver_layer, p0, p1, source_layer, interface
                0, out, np.empty((2, 2, 3)), Workspace(traced[4].shape[-1]), Workspace(1))
 
 
-# -- quadrature ----------------------------------------------------------------------------
-@njit(cache=True)
-def gauss_legendre(n):
-    """Nodes and weights of the ``n``-point Gauss-Legendre rule on [-1, 1] (Newton on
-    the Legendre recurrence)."""
-    x = np.empty(n)
-    w = np.empty(n)
-    for i in range(n):
-        z = math.cos(math.pi * (i + 0.75) / (n + 0.5))
-        for _ in range(100):
-            p0 = 1.0
-            p1 = 0.0
-            for k in range(1, n + 1):
-                p2 = p1
-                p1 = p0
-                p0 = ((2.0 * k - 1.0) * z * p1 - (k - 1.0) * p2) / k
-            dp = n * (z * p0 - p1) / (z * z - 1.0)
-            dz = p0 / dp
-            z -= dz
-            if abs(dz) < 1e-15:
-                break
-        x[i] = z
-        w[i] = 2.0 / ((1.0 - z * z) * dp * dp)
-    return x, w
+def __getattr__(name):
+    """``LayeredSegments`` lives in :mod:`.segments2d`; numba's on-disk cache indexes written
+    before it moved there unpickle it from here (without this they raise, not recompile)."""
+    if name == "LayeredSegments":
+        from .segments2d import LayeredSegments
 
-
-@njit(cache=True)
-def composite_rule(n_gauss, n_sub):
-    """``n_gauss`` Gauss points on each of ``n_sub`` equal sub-segments of [-1, 1]."""
-    x, w = gauss_legendre(n_gauss)
-    xi = np.empty(n_gauss * n_sub)
-    wt = np.empty(n_gauss * n_sub)
-    for s in range(n_sub):
-        lo = -1.0 + 2.0 * s / n_sub
-        for g in range(n_gauss):
-            xi[s * n_gauss + g] = lo + (x[g] + 1.0) / n_sub
-            wt[s * n_gauss + g] = w[g] / n_sub
-    return xi, wt
-
-
-@njit(cache=True)
-def _segment_distance(px, py, ax, ay, bx, by):
-    ex = bx - ax
-    ey = by - ay
-    ll = ex * ex + ey * ey
-    u = ((px - ax) * ex + (py - ay) * ey) / ll if ll > 0.0 else 0.0
-    u = min(1.0, max(0.0, u))
-    dx = px - ax - u * ex
-    dy = py - ay - u * ey
-    return math.sqrt(dx * dx + dy * dy)
-
-
-@njit(cache=True)
-def subdivisions(y1, y3, receiver_layer, p0, p1, source_layer, interfaces, max_sub):
-    """Sub-segments so that each is at most half as long as the distance from the
-    receiver to the nearest singular point of the integrand: the element's mirror
-    images in the interfaces bounding the source's and the receiver's layers, and the
-    element itself when the receiver is in another layer."""
-    length = math.sqrt((p1[0] - p0[0]) ** 2 + (p1[1] - p0[1]) ** 2)
-    dmin = np.inf
-    if receiver_layer != source_layer:
-        dmin = _segment_distance(y1, y3, p0[0], p0[1], p1[0], p1[1])
-    n_if = interfaces.shape[0]
-    for layer in (source_layer, receiver_layer):
-        for k in (layer - 1, layer):
-            if 0 <= k < n_if:
-                d = interfaces[k]
-                dmin = min(dmin, _segment_distance(y1, y3, p0[0], 2.0 * d - p0[1], p1[0], 2.0 * d - p1[1]))
-    if dmin <= 0.0:
-        return max_sub
-    n = int(math.ceil(2.0 * length / dmin))
-    return min(max(n, 1), max_sub)
-
-
-# -- constant elements: the kernel data and the per-pair functions of the drivers -----------
-#: Sub-segment levels (2^level sub-segments) whose traced pairs a source keeps.
-_CACHED_LEVELS = 4
-
-
-@njit(cache=True)
-def _level(n_sub):
-    """The smallest level with 2^level >= n_sub sub-segments."""
-    level = 0
-    while 2 ** level < n_sub:
-        level += 1
-    return level
-
-
-@njit(cache=True)
-def _level_rule(n_gauss, max_level):
-    """Composite rules of 2^level sub-segments, levels 0..max_level, stacked:
-    ``(xi, w, start)`` with level l at ``start[l]:start[l + 1]``."""
-    start = np.zeros(max_level + 2, dtype=np.int64)
-    for level in range(max_level + 1):
-        start[level + 1] = start[level] + n_gauss * 2 ** level
-    xi = np.empty(start[-1])
-    w = np.empty(start[-1])
-    for level in range(max_level + 1):
-        x, wt = composite_rule(n_gauss, 2 ** level)
-        xi[start[level]:start[level + 1]] = x
-        w[start[level]:start[level + 1]] = wt
-    return xi, w, start
-
-
-#: The medium fields of every record of 2D segments in a layered medium (after the geometry).
-LAYERED_FIELDS = (
-    ("layer", np.ndarray, "(N,) int64 layer of each element"),
-    ("interfaces", np.ndarray, "(L - 1,) interface heights, top down"),
-    ("shear_modulus", np.ndarray, "(L,) per layer (0: void)"),
-    ("poisson_ratio", np.ndarray, "(L,) per layer"),
-    ("n_images", int, "reflections per interface (ref. Fig. 3.4)"),
-    ("gauss_points", int, "Gauss-Legendre points per sub-segment of the image quadrature (ref. Table 3.2)"),
-    ("max_subdivisions", int, "largest number of sub-segments (:func:`hmatddm.layered.images2d.subdivisions`)"))
-LayeredSegments = kernel_record(
-    "LayeredSegments", __name__,
-    "Kernel data of constant 2D elements in a layered medium (the record :mod:`hmatddm.kernels.drivers` take; built "
-    "by :func:`hmatddm.layered.influence2d.influence_data`).", line2d.SEGMENT_FIELDS + LAYERED_FIELDS)
-
-
-@njit(cache=True)
-def workspace(data):
-    """Scratch: local stress (2, 2, 2), image stress (1, 2, 2, 2), gradient (2, 2, 3) and
-    the one-order :func:`Workspace`."""
-    return np.empty((2, 2, 2)), np.zeros((1, 2, 2, 2)), np.empty((2, 2, 3)), Workspace(1)
-
-
-@njit(cache=True)
-def source_state(data, j, work):
-    """What the receivers of source ``j`` share: its end points, the stacked composite
-    rules of the cached levels and their image pairs (traced when a receiver first needs
-    a level: a lone receiver traces one)."""
-    ls = data.layer[j]
-    p0 = data.centers[j] - data.half_length[j] * data.frames[j, 0]
-    p1 = data.centers[j] + data.half_length[j] * data.frames[j, 0]
-    xi, wt, start = _level_rule(data.gauss_points, _CACHED_LEVELS - 1)
-    traced = trace_points(p0, p1, ls, data.interfaces, data.shear_modulus, data.poisson_ratio, data.n_images,
-                          xi, True)
-    is_traced = np.zeros(_CACHED_LEVELS, dtype=np.bool_)
-    return p0, p1, xi, wt, start, traced, is_traced, Workspace(traced[4].shape[-1])
-
-
-@njit(cache=True, inline="always")
-def element_traction(data, i, j, state, work, block):
-    """``block`` (2, 2): traction at the centre of element ``i`` for a unit global DD of
-    constant element ``j``: closed form (source layer's material) plus images, the
-    source's traced pairs reused across receivers. Sub-segments come in powers of two
-    (:func:`subdivisions` rounded up)."""
-    p0, p1, xi, wt, start, traced, is_traced, ws = state
-    local, image, gradient, ws1 = work
-    g = data.shear_modulus
-    nu = data.poisson_ratio
-    interfaces = data.interfaces
-    half_length = data.half_length
-    ls = data.layer[j]
-    point = data.centers[i]
-    normal = data.frames[i, 1]
-    near = 0.0
-    if i != j:
-        near = data.near_fraction * min(half_length[i], half_length[j])
-    line2d.traction_pair(point, normal, data.centers[j], data.frames[j], half_length[j], g[ls], nu[ls],
-                         data.singular_shift, block, local, near)
-    if interfaces.shape[0] > 0:
-        lr = data.layer[i]
-        level = _level(subdivisions(point[0], point[1], lr, p0, p1, ls, interfaces, data.max_subdivisions))
-        image[:] = 0.0
-        if level < _CACHED_LEVELS:
-            a, b = start[level], start[level + 1]
-            if not is_traced[level]:
-                _trace_range(p0, p1, ls, interfaces, g, nu, data.n_images, xi, a, b, traced)
-                is_traced[level] = True
-            _integrate(point[0], point[1], lr, p0, p1, ls, g, nu, xi[a:b], wt[a:b], np.ones((b - a, 1)), traced, a,
-                       image, gradient, ws, ws1)
-        else:
-            x, w = composite_rule(data.gauss_points, 2 ** level)
-            image_element_stress(point[0], point[1], lr, p0, p1, ls, interfaces, g, nu, data.n_images, x, w,
-                                 np.ones((x.shape[0], 1)), image)
-        for p in range(2):
-            for q in range(2):
-                block[p, q] += image[0, q, p, 0] * normal[0] + image[0, q, p, 1] * normal[1]
-
-
-@njit(cache=True, inline="always")
-def element_stress(data, point, point_layer, j, work, out):
-    """``out[q, i, k]``: stress at ``point`` (in ``point_layer``; zero in a void layer)
-    for a unit global DD ``q`` of constant element ``j``, closed form plus images (the
-    quadrature of :func:`element_traction`). A point within ``near_fraction`` half
-    lengths of an end counts as on it."""
-    local, image, gradient, ws1 = work
-    g = data.shear_modulus
-    nu = data.poisson_ratio
-    if g[point_layer] <= 0.0:
-        out[:] = 0.0
-        return
-    ls = data.layer[j]
-    a = data.half_length[j]
-    line2d.stress_pair(point, data.centers[j], data.frames[j], a, g[ls], nu[ls], data.singular_shift, out,
-                       local, data.near_fraction * a)
-    if data.interfaces.shape[0] > 0:
-        p0 = data.centers[j] - a * data.frames[j, 0]
-        p1 = data.centers[j] + a * data.frames[j, 0]
-        level = _level(subdivisions(point[0], point[1], point_layer, p0, p1, ls, data.interfaces,
-                                    data.max_subdivisions))
-        xi, wt = composite_rule(data.gauss_points, 2 ** level)  # as the block generator
-        image_element_stress(point[0], point[1], point_layer, p0, p1, ls, data.interfaces, g, nu,
-                             data.n_images, xi, wt, np.ones((xi.shape[0], 1)), image)
-        for q in range(2):
-            for i in range(2):
-                for k in range(2):
-                    out[q, i, k] += image[0, q, i, k]
-
-
-register_kind(LayeredSegments, KernelKind(workspace, source_state, element_traction, element_stress,
-                                          line2d.edge_distance))
+        return LayeredSegments
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -72,7 +72,9 @@ from numba import njit
 from ..kernels import rectangle3d
 from ..kernels.rectangle3d import distance_to_rectangle as _distance, rectangle_distance  # noqa: F401 (re-export)
 from ..kernels.drivers import KernelKind, register_kind
-from .images2d import _lame, gauss_legendre, trace_capacity, trace_potentials
+from .image_tracer import trace_capacity, trace_potentials
+from .images2d import _lame
+from .segment_quadrature import gauss_legendre
 
 _INV_8PI = 1.0 / (8.0 * math.pi)
 
@@ -96,7 +98,7 @@ def _original(coef, delta, shear_modulus, sigma, scale):
 def trace(t, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, pair_layer, pair_z, pair_eps,
           pair_sigma, pair_coef, pair_dcoef):
     """Image triples of a unit point force at height ``t`` in ``source_layer``
-    (:func:`.images2d.trace_potentials`): ``pair_sigma[k]`` is the triple's gauge (its
+    (:func:`.image_tracer.trace_potentials`): ``pair_sigma[k]`` is the triple's gauge (its
     direction of travel: +1 upward, receivers above ``z``), ``pair_coef[k, f, j, n]`` the
     coefficient of ``D^n`` of the base function of potential ``j`` for a force along
     ``f``. Returns the number of triples (the original excluded)."""

@@ -1,13 +1,13 @@
 """Influence data of a 2D mesh of constant DD elements in a :class:`LayeredMedium`:
 element layers, the straddling check, the interface splitter and the automatic number
-of images. The kernels are :mod:`.images2d` (kernel data :class:`.images2d.LayeredSegments`,
+of images. The kernels are :mod:`.images2d` (kernel data :class:`.segments2d.LayeredSegments`,
 served by the drivers of :mod:`hmatddm.kernels.drivers`)."""
 import numpy as np
 
 from ..errors import InputError
 from ..kernels.drivers import finite_stress_sum, traction_block, with_self_max
 from ..mesh import Mesh2D
-from . import images2d
+from . import segments2d
 from .medium import MAX_IMAGES
 
 #: Largest number of sub-segments of an element for the image quadrature.
@@ -90,12 +90,12 @@ def split_at_interfaces(mesh, medium):
 
 
 def influence_data(mesh, medium, singular_shift, alpha, near_fraction, n_images):
-    """The kernel data (:class:`images2d.LayeredSegments`) of a constant-element 2D
+    """The kernel data (:class:`segments2d.LayeredSegments`) of a constant-element 2D
     ``mesh`` in ``medium`` with ``n_images`` images; ``alpha > 0`` fills ``self_max``
     for ref. Eq. 6.11."""
     layers = element_layers(mesh, medium)
     interfaces, g, nu = medium.arrays()
-    return with_self_max(images2d.LayeredSegments(
+    return with_self_max(segments2d.LayeredSegments(
         mesh.centers, mesh.frames, mesh.half_length, layers, interfaces, g, nu, n_images=int(n_images),
         gauss_points=int(medium.gauss_points), max_subdivisions=int(MAX_SUBDIVISIONS),
         singular_shift=float(singular_shift), near_fraction=float(near_fraction), alpha=float(alpha),
