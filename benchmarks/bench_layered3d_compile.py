@@ -75,8 +75,8 @@ def _child(two_d):
         from hmatddm.mesh import concatenate, line, rectangle
 
         if two_d:
-            grid = concatenate([line([0.0, -1.0], [1.0, 0.0], 2.0, 8, fracture_id=0),
-                                line([2.0, -1.5], [0.0, 1.0], 1.0, 4, fracture_id=1)])
+            grid = concatenate([line([-1.0, -1.0], [1.0, -1.0], 8, fracture_id=0),
+                                line([2.0, -2.0], [2.0, -1.0], 4, fracture_id=1)])
             medium = LayeredMedium([-0.5, -2.2], [3.0, 1.0, 2.0], [0.25, 0.25, 0.3], images=2)
         else:
             grid = concatenate([rectangle([0, 0, -1.0], [1, 0, 0], [0, 1, 0], 2.0, 2.0, 3, 3, fracture_id=0),
