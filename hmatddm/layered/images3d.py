@@ -74,7 +74,7 @@ from ..kernels.rectangle3d import distance_to_rectangle as _distance, rectangle_
 from ..kernels.drivers import KernelKind, register_kind
 from .image_tracer import trace_capacity, trace_potentials
 from .images2d import _lame
-from .segment_quadrature import gauss_legendre
+from .segment_quadrature import gauss_legendre, subdivision_level
 
 _INV_8PI = 1.0 / (8.0 * math.pi)
 
@@ -727,7 +727,7 @@ def _image_order(y, receiver_layer, center, frame, a, b, source_layer, interface
     by :func:`subdivisions` rounded up to a power of two, and, on one square,
     :func:`far_order` points per side."""
     dmin = nearest_singularity(y, receiver_layer, center, frame, a, b, source_layer, interfaces)
-    n_sub = 2 ** _level(_sub_count(dmin, a, b, max_sub))
+    n_sub = 2 ** subdivision_level(_sub_count(dmin, a, b, max_sub))
     if n_sub == 1:
         return far_order(dmin / max(a, b), gauss_points, far_tol), 1
     return gauss_points, n_sub
@@ -756,14 +756,6 @@ class LayeredRectangles(NamedTuple):
     alpha: float  #: ref. Eq. 6.11 scaling (0: none)
     self_max: np.ndarray  #: (N,) largest |entry| of each self block (ref. Eq. 6.11)
     far_tol: float = FAR_TOL  #: error allowed to :func:`far_order` (0: ``gauss_points`` everywhere)
-
-
-@njit(cache=True)
-def _level(n_sub):
-    level = 0
-    while 2 ** level < n_sub:
-        level += 1
-    return level
 
 
 @njit(cache=True)

@@ -48,6 +48,16 @@ def composite_rule(n_gauss, n_sub):
 
 
 @njit(cache=True)
+def subdivision_level(n_sub):
+    """The smallest level with 2^level >= n_sub subdivisions (of a segment in 2D, of each
+    side of a rectangle in 3D): composite rules are cached per level."""
+    level = 0
+    while 2 ** level < n_sub:
+        level += 1
+    return level
+
+
+@njit(cache=True)
 def _segment_distance(px, py, ax, ay, bx, by):
     ex = bx - ax
     ey = by - ay

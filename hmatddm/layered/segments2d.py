@@ -10,20 +10,11 @@ from numba import njit
 from ..kernels import line2d
 from ..kernels.drivers import KernelKind, kernel_record, register_kind
 from .images2d import Workspace, _integrate, _trace_range, image_element_stress, trace_points
-from .segment_quadrature import composite_rule, subdivisions
+from .segment_quadrature import composite_rule, subdivision_level, subdivisions
 
 
 #: Sub-segment levels (2^level sub-segments) whose traced pairs a source keeps.
 _CACHED_LEVELS = 4
-
-
-@njit(cache=True)
-def _level(n_sub):
-    """The smallest level with 2^level >= n_sub sub-segments."""
-    level = 0
-    while 2 ** level < n_sub:
-        level += 1
-    return level
 
 
 @njit(cache=True)
@@ -104,7 +95,7 @@ def element_traction(data, i, j, state, work, block):
                          data.singular_shift, block, local, near)
     if interfaces.shape[0] > 0:
         lr = data.layer[i]
-        level = _level(subdivisions(point[0], point[1], lr, p0, p1, ls, interfaces, data.max_subdivisions))
+        level = subdivision_level(subdivisions(point[0], point[1], lr, p0, p1, ls, interfaces, data.max_subdivisions))
         image[:] = 0.0
         if level < _CACHED_LEVELS:
             a, b = start[level], start[level + 1]
@@ -141,7 +132,7 @@ def element_stress(data, point, point_layer, j, work, out):
     if data.interfaces.shape[0] > 0:
         p0 = data.centers[j] - a * data.frames[j, 0]
         p1 = data.centers[j] + a * data.frames[j, 0]
-        level = _level(subdivisions(point[0], point[1], point_layer, p0, p1, ls, data.interfaces,
+        level = subdivision_level(subdivisions(point[0], point[1], point_layer, p0, p1, ls, data.interfaces,
                                     data.max_subdivisions))
         xi, wt = composite_rule(data.gauss_points, 2 ** level)  # as the block generator
         image_element_stress(point[0], point[1], point_layer, p0, p1, ls, data.interfaces, g, nu,
