@@ -106,10 +106,8 @@ def solve(simulation, trial, start, t_old, t_new, relaxation, provisional=False)
                           width_old=start.width, pressure_old=start.pressure,
                           leak_off_rate=flow.leak_off_rate(trial.creation_time, t_old, t_new),
                           contact=contact, fixed_pressure=fixed_pressure)
-    if provisional:
-        dd, p, info = solve_step(problem, sim.settings, trial.dd.ravel(), pressure_guess, relaxation, provisional=True)
-    else:
-        dd, p, info = solve_step(problem, sim.settings, trial.dd.ravel(), pressure_guess, relaxation)
+    dd, p, info = solve_step(problem, sim.settings, trial.dd.ravel(), pressure_guess, relaxation,
+                             provisional=provisional)
     info["drained"] = no_fluid
     return _with_solution(trial, problem, dd, p, info), info, SolvedMesh(edges, faces, flow)
 
