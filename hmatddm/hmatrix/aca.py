@@ -54,6 +54,8 @@ Length (over ~400 lines): the one ACA loop used in production and its numba help
 import numpy as np
 from numba import njit, types
 
+from .first_class import INDEX, compiled_for_data
+
 # Floating-point flags that let LLVM vectorise dot products (reassociation) while
 # keeping NaN/inf semantics, so finiteness checks stay meaningful.
 FAST = {"reassoc", "contract", "nsz", "arcp"}
@@ -591,7 +593,7 @@ def aca_tensor(kernel, data, row_elements, col_elements, dof, eps, col_dof=0):
     Compiled once per data type (cached on disk, :func:`_for_data`).
     """
     col_dof = col_dof if col_dof > 0 else dof
-    compiled = _for_data(_aca_tensor, data, (_INDEX, _INDEX, types.int64, types.int64, types.float64), 2)
+    compiled = _for_data(_aca_tensor, data, 2)
     return compiled(kernel, data, _index(row_elements), _index(col_elements), int(dof), int(col_dof), float(eps),
                     aca_start, aca_advance)
 
@@ -658,7 +660,7 @@ def aca_compressed(kernel, data, row_elements, col_elements, row_dof, col_dof, e
     with the steps given as first-class functions; so does this function, compiled once
     per data type (cached on disk, :func:`_for_data`).
     """
-    compiled = _for_data(_aca_compressed.py_func, data, (_INDEX, _INDEX, types.int64, types.int64, types.float64), 3)
+    compiled = _for_data(_aca_compressed.py_func, data, 3)
     return compiled(kernel, data, _index(row_elements), _index(col_elements), int(row_dof), int(col_dof), float(eps),
                     aca_start, aca_advance, recompress_state)
 
@@ -787,32 +789,23 @@ def recompress_state(ut, vt, ints, eps):
 
 
 # -- entry points for Python callers (tests, explicit blocks) ------------------------------
-_INDEX = types.int64[::1]
-_STEP_TYPES = (types.FunctionType(ACA_START_SIGNATURE), types.FunctionType(ACA_ADVANCE_SIGNATURE),
-               types.FunctionType(RECOMPRESS_STATE_SIGNATURE))
-_ENTRY_POINTS = {}
+#: The ACA steps the compiled drivers take as first-class functions (see aca._aca_loop), and
+#: their types.
+ACA_STEPS = (aca_start, aca_advance, recompress_state)
+ACA_STEP_TYPES = (types.FunctionType(ACA_START_SIGNATURE), types.FunctionType(ACA_ADVANCE_SIGNATURE),
+                  types.FunctionType(RECOMPRESS_STATE_SIGNATURE))
 
 
 def _index(elements):
     return np.ascontiguousarray(elements, dtype=np.int64)
 
 
-def _for_data(function, data, argument_types, n_steps):
-    """``function`` (njit source taking ``(kernel, data, *argument_types, *steps)``, the
-    steps being the first ``n_steps`` of aca_start, aca_advance, recompress_state) compiled
-    for this data type with the kernel and the steps as first-class functions, like the
-    build driver (hmatrix/storage.py): cached on disk, ~3 s of cold compile per data type,
-    instead of ~10 s per kernel in every process when the kernel dispatcher is an argument
-    (numba cannot cache a function taking a dispatcher)."""
-    import numba
-
-    data_type = numba.typeof(data)
-    key = (function, data_type)
-    compiled = _ENTRY_POINTS.get(key)
-    if compiled is None:
-        kernel_type = types.FunctionType(types.none(data_type, _INDEX, _INDEX, types.float64[:, ::1]))
-        signature = (kernel_type, data_type) + tuple(argument_types) + _STEP_TYPES[:n_steps]
-        compiled = njit(signature, cache=True, nogil=True)(function)
-        _ENTRY_POINTS[key] = compiled
-    return compiled
+def _for_data(function, data, n_steps):
+    """``function`` (njit source taking ``(kernel, data, rows, cols, row_dof, col_dof, eps,
+    *steps)``, the steps being the first ``n_steps`` of :data:`ACA_STEPS`) compiled for
+    this data type by :func:`hmatddm.hmatrix.first_class.compiled_for_data`, like the build
+    driver: cached on disk, ~3 s of cold compile per data type, instead of ~10 s per kernel
+    in every process when the kernel dispatcher is an argument."""
+    return compiled_for_data(function, data, (INDEX, INDEX, types.int64, types.int64, types.float64)
+                             + ACA_STEP_TYPES[:n_steps])
 

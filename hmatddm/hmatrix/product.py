@@ -11,14 +11,15 @@ kernel entries plus O((m + n) k) flops per far block.
 """
 import numba
 import numpy as np
-from numba import njit, types
+from numba import types
 
 from ..errors import InputError
-from .aca import _RANK, _aca_loop, aca_gave_up
+from .aca import _RANK, ACA_STEP_TYPES, ACA_STEPS, _aca_loop, aca_gave_up
 from .block_tree import block_tree
 from .cluster_tree import cluster_tree
 from .generator import BlockGenerator
-from .storage import ACA_STEP_TYPES, ACA_STEPS, _batches, _run_parallel
+from .first_class import INDEX, compiled_for_data
+from .storage import _batches, _run_parallel
 
 
 def _apply_blocks(kernel, data, row_permutation, col_permutation, row_dof, col_dof, eps, row_start, row_stop,
@@ -70,24 +71,15 @@ def _apply_blocks(kernel, data, row_permutation, col_permutation, row_dof, col_d
     return y
 
 
-_DRIVERS = {}
 _BATCHES = 64  # fixed number of batches of blocks (load balance on up to ~16 threads)
 
 
 def product_driver(data):
     """The compiled :func:`_apply_blocks` for kernel data of this type (cached on disk;
-    the kernel is typed as a first-class function, see hmatrix/storage.py build_driver)."""
-    data_type = numba.typeof(data)
-    driver = _DRIVERS.get(data_type)
-    if driver is None:
-        index = types.int64[::1]
-        kernel_type = types.FunctionType(types.none(data_type, index, index, types.float64[:, ::1]))
-        signature = types.float64[::1](kernel_type, data_type, index, index, types.int64, types.int64, types.float64,
-                                       index, index, index, index, types.boolean[::1], types.float64[::1],
-                                       types.int64, *ACA_STEP_TYPES[:2])
-        driver = njit(signature, cache=True, nogil=True)(_apply_blocks)
-        _DRIVERS[data_type] = driver
-    return driver
+    the kernel is a first-class function, :mod:`.first_class`)."""
+    return compiled_for_data(_apply_blocks, data, (INDEX, INDEX, types.int64, types.int64, types.float64, INDEX,
+                                                   INDEX, INDEX, INDEX, types.boolean[::1], types.float64[::1],
+                                                   types.int64) + ACA_STEP_TYPES[:2], types.float64[::1])
 
 
 def build_free_product(generator, x, eps, eta=3.0, leaf_size=64, col_leaf_size=None, n_threads=None,

@@ -28,8 +28,8 @@ import numba
 import numpy as np
 from numba import njit, prange, types
 
-from .aca import (ACA_ADVANCE_SIGNATURE, ACA_START_SIGNATURE, FAST, RECOMPRESS_STATE_SIGNATURE, _aca_compressed,
-                  aca_advance, aca_start, recompress_state)
+from .aca import ACA_STEP_TYPES, ACA_STEPS, FAST, _aca_compressed
+from .first_class import INDEX, compiled_for_data
 
 # Block kinds recorded for every admissible block.
 KIND_LOWRANK = 0
@@ -185,38 +185,23 @@ def _build_blocks(kernel, data, row_permutation, col_permutation, row_dof, col_d
     return ranks, stored_dense, _head(u_buffer, u_used), _head(v_buffer, v_used), _head(far_dense, far_used)
 
 
-_DRIVERS = {}
-# The ACA steps given to the compiled drivers (here and hmatrix/product.py), and their types.
-ACA_STEPS = (aca_start, aca_advance, recompress_state)
-ACA_STEP_TYPES = tuple(types.FunctionType(signature) for signature in (ACA_START_SIGNATURE, ACA_ADVANCE_SIGNATURE,
-                                                                       RECOMPRESS_STATE_SIGNATURE))
-
-
 def build_driver(data):
     """The compiled :func:`_build_blocks` for kernel data of this type (cached on disk).
 
-    The kernel argument is typed as a first-class function ``none(data, int64[::1],
-    int64[::1], float64[:, ::1])`` rather than as its dispatcher, so the signature
-    holds no Python object and numba caches the compiled driver (``cache=True``): its
-    compile is paid once per data type, not once per process. The ACA steps and the
-    recompression are first-class function arguments too (:data:`ACA_STEPS`; see
-    aca._aca_loop): called through pointers, their code is compiled once for all types
-    instead of being linked into (and re-optimised with) every driver, which cuts the
-    per-type compile from ~10 s to ~3 s of CPU. Call it with the kernel dispatcher as
-    first argument and ``*ACA_STEPS`` last; numba compiles the kernel for its signature.
+    The kernel argument is typed as a first-class function (:mod:`.first_class`) rather
+    than as its dispatcher, so numba caches the compiled driver: its compile is paid once
+    per data type, not once per process. The ACA steps and the recompression are
+    first-class function arguments too (:data:`ACA_STEPS`; see aca._aca_loop): called
+    through pointers, their code is compiled once for all types instead of being linked
+    into (and re-optimised with) every driver, which cuts the per-type compile from ~10 s
+    to ~3 s of CPU. Call it with the kernel dispatcher as first argument and
+    ``*ACA_STEPS`` last; numba compiles the kernel for its signature.
     """
-    data_type = numba.typeof(data)
-    driver = _DRIVERS.get(data_type)
-    if driver is None:
-        index = types.int64[::1]
-        kernel_type = types.FunctionType(types.none(data_type, index, index, types.float64[:, ::1]))
-        outputs = types.Tuple((index, types.boolean[::1], types.float64[::1], types.float64[::1],
-                               types.float64[::1]))
-        signature = outputs(kernel_type, data_type, index, index, types.int64, types.int64, types.float64, index,
-                            index, index, index, types.boolean[::1], index, types.float64[::1], *ACA_STEP_TYPES)
-        driver = njit(signature, cache=True, nogil=True)(_build_blocks)
-        _DRIVERS[data_type] = driver
-    return driver
+    index = INDEX
+    outputs = types.Tuple((index, types.boolean[::1], types.float64[::1], types.float64[::1], types.float64[::1]))
+    return compiled_for_data(_build_blocks, data, (index, index, types.int64, types.int64, types.float64, index,
+                                                   index, index, index, types.boolean[::1], index,
+                                                   types.float64[::1]) + ACA_STEP_TYPES, outputs)
 
 
 # Element-wise copies below avoid numba's slice assignment, whose shape-mismatch error

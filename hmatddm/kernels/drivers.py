@@ -419,24 +419,16 @@ def _self_block_max(kernel, data, out):
         out[i] = largest
 
 
-_SELF_MAX_DRIVERS = {}
-
-
 def self_block_max(data, out):
     """``out[i]`` (``out`` (N,) float64): the largest |entry| of element ``i``'s self block
     (the ``self_max`` of ref. Eq. 6.11; the Eq. 6.11 scaling never applies to a self block).
 
     One compiled loop per record type that calls :func:`traction_block` as a first-class
-    function (as :func:`hmatddm.hmatrix.storage.build_driver` does): the kernel is not
-    compiled again, and the loop is small and cached on disk."""
-    data_type = numba.typeof(data)
-    driver = _SELF_MAX_DRIVERS.get(data_type)
-    if driver is None:
-        index = types.int64[::1]
-        kernel_type = types.FunctionType(types.none(data_type, index, index, types.float64[:, ::1]))
-        driver = njit(types.none(kernel_type, data_type, types.float64[::1]), cache=True, nogil=True)(_self_block_max)
-        _SELF_MAX_DRIVERS[data_type] = driver
-    driver(traction_block, data, out)
+    function (:mod:`hmatddm.hmatrix.first_class`, as the H-matrix build does): the kernel is
+    not compiled again, and the loop is small and cached on disk."""
+    from ..hmatrix.first_class import compiled_for_data
+
+    compiled_for_data(_self_block_max, data, (types.float64[::1],), types.none)(traction_block, data, out)
 
 
 def with_self_max(data):
