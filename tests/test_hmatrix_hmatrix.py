@@ -134,13 +134,14 @@ def test_stats_are_complete_and_consistent(scalar_problems):
                 "max_rank", "eps", "eta", "leaf_size", "n_elements", "dof"):
         assert key in st
     s = h.storage
-    assert st["memory_bytes"] == s.dense_values.nbytes + s.u_values.nbytes + s.v_values.nbytes
+    factor_bytes = sum(a.nbytes for a in (s.u_values, s.v_values, s.u_fixed, s.v_fixed, s.u_scale, s.v_scale))
+    assert st["memory_bytes"] == s.dense_values.nbytes + factor_bytes == s.dense_values.nbytes + s.lowrank_bytes
     assert st["dense_bytes"] == 8 * 3000**2
     assert st["compression"] == pytest.approx(st["dense_bytes"] / st["memory_bytes"])
     assert (st["eps"], st["eta"], st["leaf_size"], st["n_elements"], st["dof"]) == (1e-4, 2.0, 32, 3000, 1)
     assert st["n_dense_blocks"] >= st["n_near_blocks"] == h.blocks.near_rows.size
     assert st["n_admissible"] == h.blocks.admissible_rows.size
-    assert st["factor_dtype"] == "float32"  # eps >= 1e-5
+    assert st["factor_dtype"] == "float32+int16"  # eps >= 1e-5: adaptive precision
     assert st["build_seconds"] > 0
     assert h.shape == (3000, 3000)
     assert h.is_finite()

@@ -36,6 +36,7 @@ from numba import njit
 from hmatddm.errors import InputError
 
 from ._threads import single_threaded_blas
+from .factor_precision import factor_columns
 
 
 def aggregates(tree, aggregate_size):
@@ -83,16 +84,17 @@ def coarse_functions(points_permuted, boundaries, n_functions):
 
 
 @njit(cache=True)
-def _project_factor(d, n_f, agg, phi, values, offset, k, start, stop):
+def _project_factor(d, n_f, agg, phi, columns, start, stop):
     """P^T F restricted to the aggregates of tree positions [start, stop), for a low-rank
-    factor F (d (stop - start) x k) stored column by column at ``values[offset:]``."""
+    factor F (d (stop - start) x k) given as its k columns (rows of ``columns``)."""
     first = agg[start]
     m = d * (stop - start)
+    k = columns.shape[0]
     out = np.zeros(((agg[stop - 1] - first + 1) * n_f * d, k))
     for q in range(k):
         for i in range(m):
             element = start + i // d
-            value = values[offset + q * m + i]
+            value = columns[q, i]
             for f in range(n_f):
                 out[((agg[element] - first) * n_f + f) * d + i % d, q] += phi[element, f] * value
     return out
@@ -101,7 +103,8 @@ def _project_factor(d, n_f, agg, phi, values, offset, k, start, stop):
 @njit(cache=True)
 def _galerkin(d, n_f, agg, phi, n_coarse, dense_row_start, dense_row_stop, dense_col_start, dense_col_stop,
               dense_offset, dense_values, lowrank_row_start, lowrank_row_stop, lowrank_col_start,
-              lowrank_col_stop, lowrank_rank, u_offset, v_offset, u_values, v_values):
+              lowrank_col_stop, lowrank_rank, u_offset, v_offset, u_values, v_values, lowrank_head, u_fixed_offset,
+              v_fixed_offset, u_fixed, v_fixed, u_scale, v_scale, rank_offset):
     """A_c = P^T A P from the stored blocks (P: agg, phi; coarse index (agg * n_f + f) * d + p)."""
     coarse = np.zeros((n_coarse, n_coarse))
     for b in range(dense_row_start.shape[0]):
@@ -135,8 +138,11 @@ def _galerkin(d, n_f, agg, phi, n_coarse, dense_row_start, dense_row_stop, dense
         r0, r1 = lowrank_row_start[b], lowrank_row_stop[b]
         c0, c1 = lowrank_col_start[b], lowrank_col_stop[b]
         ar, ac = agg[r0], agg[c0]
-        pu = _project_factor(d, n_f, agg, phi, u_values, u_offset[b], k, r0, r1)
-        pv = _project_factor(d, n_f, agg, phi, v_values, v_offset[b], k, c0, c1)
+        head, first = lowrank_head[b], rank_offset[b]
+        ut = factor_columns(u_values, u_offset[b], u_fixed, u_fixed_offset[b], u_scale, first, k, head, d * (r1 - r0))
+        vt = factor_columns(v_values, v_offset[b], v_fixed, v_fixed_offset[b], v_scale, first, k, head, d * (c1 - c0))
+        pu = _project_factor(d, n_f, agg, phi, ut, r0, r1)
+        pv = _project_factor(d, n_f, agg, phi, vt, c0, c1)
         nr, ncc = pu.shape[0], pv.shape[0]
         row0 = ar * n_f * d
         col0 = ac * n_f * d
@@ -176,7 +182,8 @@ def galerkin_coarse_matrix(hmatrix, of_position, phi):
     return _galerkin(d, n_f, of_position, np.ascontiguousarray(phi), n_coarse, s.dense_row_start,
                      s.dense_row_stop, s.dense_col_start, s.dense_col_stop, s.dense_offset, s.dense_values,
                      s.lowrank_row_start, s.lowrank_row_stop, s.lowrank_col_start, s.lowrank_col_stop,
-                     s.lowrank_rank, s.u_offset, s.v_offset, s.u_values, s.v_values)
+                     s.lowrank_rank, s.u_offset, s.v_offset, s.u_values, s.v_values, s.lowrank_head, s.u_fixed_offset,
+                     s.v_fixed_offset, s.u_fixed, s.v_fixed, s.u_scale, s.v_scale, s.rank_offset)
 
 
 class TwoLevel:

@@ -28,19 +28,30 @@ from .storage import KIND_DENSE, KIND_LOWRANK, assemble
 
 
 # Low-rank factors are stored in single precision when eps >= this (the float32
-# rounding, ~1e-7 relative, is then at most 1% of eps); double precision below.
+# rounding, ~1e-7 relative, is then at most 1% of eps), with their trailing columns in
+# 16-bit fixed point (factor_precision.py); double precision below.
 SINGLE_PRECISION_EPS = 1e-5
+#: The ``factor_dtype`` of float32 leading columns and int16 fixed-point trailing columns.
+ADAPTIVE = "adaptive"
 
 
-def _factor_dtype(factor_dtype, eps, name="factor_dtype"):
+def _factor_format(factor_dtype, eps):
+    """(dtype of the float columns, fixed point or not) for ``factor_dtype``."""
     if factor_dtype is None:
-        return np.dtype(np.float32) if eps >= SINGLE_PRECISION_EPS else np.dtype(np.float64)
+        factor_dtype = ADAPTIVE if eps >= SINGLE_PRECISION_EPS else np.float64
+    if isinstance(factor_dtype, str) and factor_dtype == ADAPTIVE:
+        return np.dtype(np.float32), True
+    return _float_dtype(factor_dtype, "factor_dtype", f"None, {ADAPTIVE!r}, float32 or float64"), False
+
+
+def _float_dtype(value, name, allowed="float32 or float64"):
     try:
-        dtype = np.dtype(factor_dtype)
+        dtype = np.dtype(value)
     except TypeError:
         dtype = None
-    if dtype not in (np.dtype(np.float32), np.dtype(np.float64)):
-        raise InputError(f"{name} must be None, float32 or float64, got {factor_dtype!r}")
+    # (``None == np.dtype(np.float64)`` is True: test for None first)
+    if dtype is None or dtype not in (np.dtype(np.float32), np.dtype(np.float64)):
+        raise InputError(f"{name} must be {allowed}, got {value!r}")
     return dtype
 
 
@@ -105,10 +116,12 @@ class HMatrix(LinearOperator):
             Admissibility ``min(diam) <= eta * dist`` of bounding boxes.
         leaf_size : int >= 1
             Largest number of elements in a leaf cluster.
-        factor_dtype : None, numpy.float32 or numpy.float64
-            Storage of the low-rank factors; None: float32 when eps >= 1e-5 (the
-            rounding is then <= 1% of eps; halves the far-field memory and matvec
-            traffic), float64 otherwise.
+        factor_dtype : None, "adaptive", numpy.float32 or numpy.float64
+            Storage of the low-rank factors. "adaptive": the leading columns of each
+            block in float32, the trailing ones (small singular values) in 16-bit
+            fixed point, within 0.25 eps of the block (:mod:`.factor_precision`;
+            0.57x the float32 memory on the planar crack at eps 1e-4). None:
+            "adaptive" when eps >= 1e-5, float64 otherwise.
         near_dtype : numpy.float64 (default) or numpy.float32
             Storage of the dense blocks (the near field: about half of the memory at
             eps 1e-4). float32 halves it; its rounding is amplified by the cancellation
@@ -140,8 +153,8 @@ class HMatrix(LinearOperator):
         _check_parameters(eps, eta, leaf_size)
         col_leaf_size = leaf_size if col_leaf_size is None else col_leaf_size
         _check_parameters(eps, eta, col_leaf_size)
-        dtype = _factor_dtype(factor_dtype, eps)
-        near_dtype = _factor_dtype(near_dtype, eps, "near_dtype")
+        dtype, fixed_point = _factor_format(factor_dtype, eps)
+        near_dtype = _float_dtype(near_dtype, "near_dtype")
         started = time.perf_counter()
         tree = cluster_tree(generator.points, generator.radii, int(leaf_size), groups=groups)
         col_tree = tree
@@ -150,7 +163,7 @@ class HMatrix(LinearOperator):
         blocks = block_tree(tree, float(eta), col_tree=col_tree, boxes=boxes)
         try:
             storage = assemble(generator, tree, blocks, float(eps), factor_dtype=dtype, col_tree=col_tree,
-                               near_dtype=near_dtype)
+                               near_dtype=near_dtype, fixed_point=fixed_point)
         except np.linalg.LinAlgError as error:  # the SVD of a pivot refuses NaN/inf
             raise InputError(f"the kernel returned NaN or inf entries (in a far-field block): {error}") from None
         seconds = time.perf_counter() - started
@@ -200,12 +213,9 @@ class HMatrix(LinearOperator):
         return dense
 
     def _factors(self, b):
-        """(U, V) of low-rank block b as float64 (views when stored in float64)."""
-        s = self.storage
-        k = s.lowrank_rank[b]
-        u = s.u_values[s.u_offset[b]:s.u_offset[b + 1]].reshape(k, -1).T.astype(np.float64, copy=False)
-        v = s.v_values[s.v_offset[b]:s.v_offset[b + 1]].reshape(k, -1).T.astype(np.float64, copy=False)
-        return u, v
+        """(U, V) of low-rank block b as float64 (fixed-point columns decoded)."""
+        ut, vt = self.storage.factors(b)
+        return ut.T, vt.T
 
     @property
     def stats(self):
@@ -229,7 +239,7 @@ class HMatrix(LinearOperator):
             "n_dense_blocks": int(s.dense_is_near.size),
             "max_rank": int(lowrank.max()) if lowrank.size else 0,
             "mean_rank": float(lowrank.mean()) if lowrank.size else 0.0,
-            "near_field_bytes": int(8 * (s.dense_offset[-1] - s.dense_offset[n_far_dense])),
+            "near_field_bytes": int(s.dense_values.itemsize * (s.dense_offset[-1] - s.dense_offset[n_far_dense])),
             "index_bytes": s.index_bytes,
             "n_clusters": int(self.tree.n_clusters),
             "n_col_clusters": int(self.col_tree.n_clusters),
@@ -240,7 +250,7 @@ class HMatrix(LinearOperator):
             "n_col_elements": int(self.n_col_elements),
             "dof": int(self.dof),
             "col_dof": int(self.col_dof),
-            "factor_dtype": str(s.u_values.dtype),
+            "factor_dtype": s.factor_format,
             "n_threads": int(numba.get_num_threads()),
         }
 
@@ -401,7 +411,8 @@ class HMatrix(LinearOperator):
         """True when every stored entry (dense blocks, U, V) is finite. O(memory)."""
         s = self.storage
         return bool(np.isfinite(s.dense_values).all() and np.isfinite(s.u_values).all()
-                    and np.isfinite(s.v_values).all())
+                    and np.isfinite(s.v_values).all() and np.isfinite(s.u_scale).all()
+                    and np.isfinite(s.v_scale).all())
 
     def __repr__(self):
         st = self.stats

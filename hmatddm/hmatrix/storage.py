@@ -10,8 +10,11 @@ d_c, a square one the same tree and d for both):
   row-major in ``dense_values[dense_offset[b]:dense_offset[b+1]]``;
 * low-rank blocks U V^T: element ranges as above, ``lowrank_rank``, U (m x k) and
   V (n x k) stored column by column (i.e. U^T and V^T row-major, so every matvec
-  loop is a long contiguous dot product or axpy) in ``u_values[u_offset[b]:...]``,
-  ``v_values[v_offset[b]:...]``;
+  loop is a long contiguous dot product or axpy): the first ``lowrank_head[b]``
+  columns in ``u_values[u_offset[b]:...]``, ``v_values[v_offset[b]:...]`` (float32
+  or float64), the trailing ones (adaptive precision, :mod:`.factor_precision`) as
+  int16 codes in ``u_fixed[u_fixed_offset[b]:...]``, ``v_fixed[v_fixed_offset[b]:...]``
+  times one scale per column, ``u_scale[rank_offset[b] + q]``, ``v_scale[...]``;
 * for the matvec, the row space is split into the leaf clusters ("segments"); each
   segment lists (CSR) the dense and low-rank blocks whose rows cover it, so threads
   own whole segments of y and never race.
@@ -29,7 +32,11 @@ import numpy as np
 from numba import njit, prange, types
 
 from .aca import ACA_STEP_TYPES, ACA_STEPS, FAST, _aca_compressed
+from .factor_precision import FIXED_POINT_SHARE, factor_columns, split_factors
 from .first_class import INDEX, compiled_for_data
+
+#: Names of the BlockStorage arrays holding low-rank factor entries.
+_FACTOR_ARRAYS = ("u_values", "v_values", "u_fixed", "v_fixed", "u_scale", "v_scale")
 
 # Block kinds recorded for every admissible block.
 KIND_LOWRANK = 0
@@ -62,6 +69,13 @@ class BlockStorage:
     rank_offset: np.ndarray
     u_values: np.ndarray
     v_values: np.ndarray
+    lowrank_head: np.ndarray
+    u_fixed_offset: np.ndarray
+    v_fixed_offset: np.ndarray
+    u_fixed: np.ndarray
+    v_fixed: np.ndarray
+    u_scale: np.ndarray
+    v_scale: np.ndarray
     segment_start: np.ndarray
     segment_dense_ptr: np.ndarray
     segment_dense_ids: np.ndarray
@@ -74,18 +88,40 @@ class BlockStorage:
     near_seconds: float = 0.0
 
     @property
+    def lowrank_bytes(self):
+        """Bytes of the low-rank factors: float columns, fixed-point columns and their scales."""
+        return int(sum(getattr(self, name).nbytes for name in _FACTOR_ARRAYS))
+
+    @property
     def memory_bytes(self):
         """Bytes of stored matrix entries (dense blocks + U + V)."""
-        return int(self.dense_values.nbytes + self.u_values.nbytes + self.v_values.nbytes)
+        return int(self.dense_values.nbytes) + self.lowrank_bytes
 
     @property
     def index_bytes(self):
         """Bytes of the bookkeeping arrays (offsets, ranges, segment lists)."""
         total = 0
         for name, value in vars(self).items():
-            if isinstance(value, np.ndarray) and name not in ("dense_values", "u_values", "v_values"):
+            if isinstance(value, np.ndarray) and name != "dense_values" and name not in _FACTOR_ARRAYS:
                 total += value.nbytes
         return int(total)
+
+    @property
+    def factor_format(self):
+        """"float64", "float32", or "float32+int16" when trailing columns are fixed point."""
+        name = str(self.u_values.dtype)
+        return name + "+int16" if self.u_fixed.size or self.v_fixed.size else name
+
+    def factors(self, b):
+        """(U^T, V^T) of low-rank block b as float64 rows (k x m, k x n)."""
+        k, head, r0 = self.lowrank_rank[b], self.lowrank_head[b], self.rank_offset[b]
+        m = self.dof * (self.lowrank_row_stop[b] - self.lowrank_row_start[b])
+        n = self.col_dof * (self.lowrank_col_stop[b] - self.lowrank_col_start[b])
+        ut = factor_columns(self.u_values, self.u_offset[b], self.u_fixed, self.u_fixed_offset[b], self.u_scale, r0,
+                            k, head, m)
+        vt = factor_columns(self.v_values, self.v_offset[b], self.v_fixed, self.v_fixed_offset[b], self.v_scale, r0,
+                            k, head, n)
+        return ut, vt
 
     def matmat_permuted(self, x):
         """y = A x for x of shape (nrhs, N_c*d_c) (transposed!) in the permuted ordering;
@@ -119,6 +155,13 @@ class BlockStorage:
             self.rank_offset,
             self.u_values,
             self.v_values,
+            self.lowrank_head,
+            self.u_fixed_offset,
+            self.v_fixed_offset,
+            self.u_fixed,
+            self.v_fixed,
+            self.u_scale,
+            self.v_scale,
             self.segment_start,
             self.segment_dense_ptr,
             self.segment_dense_ids,
@@ -302,13 +345,15 @@ class _GrowingArray:
 
 
 def assemble(generator, tree, blocks, eps, n_threads=None, factor_dtype=np.float64, col_tree=None,
-             near_dtype=np.float64):
+             near_dtype=np.float64, fixed_point=False):
     """Compress and store all blocks of ``blocks`` (a BlockTree over ``tree`` x
     ``col_tree``; default ``tree`` x ``tree``).
 
     Far blocks: whole-element ACA + recompression, in batches on ``n_threads``
     threads (default: numba's thread count); factors stored as ``factor_dtype``
-    (float64 or float32). Dense blocks are stored as ``near_dtype`` (float64, or
+    (float64 or float32); with ``fixed_point`` the trailing columns of each block go to
+    16-bit fixed point within FIXED_POINT_SHARE * eps of the block
+    (:mod:`.factor_precision`). Dense blocks are stored as ``near_dtype`` (float64, or
     float32: filled in float64 per batch, then rounded into the store). Near blocks: exact kernel fill straight into the final
     (float64) dense array. Cost: the near-field kernel entries plus, per far block,
     O((m + n) k) kernel entries and O((m + n) k^2) flops.
@@ -328,25 +373,40 @@ def assemble(generator, tree, blocks, eps, n_threads=None, factor_dtype=np.float
     no_offsets = np.zeros(n_far, dtype=np.int64)
     driver = build_driver(data)
 
+    share = FIXED_POINT_SHARE if fixed_point else 0.0
+
     def far_batch(ids):
-        return driver(kernel, data, permutation, col_permutation, d, dc, float(eps), far_rows_start[ids],
-                      far_rows_stop[ids], far_cols_start[ids], far_cols_stop[ids], np.ones(ids.size, dtype=np.bool_),
-                      no_offsets[ids], empty, *ACA_STEPS)
+        ranks, flags, ut, vt, far_dense = driver(
+            kernel, data, permutation, col_permutation, d, dc, float(eps), far_rows_start[ids], far_rows_stop[ids],
+            far_cols_start[ids], far_cols_stop[ids], np.ones(ids.size, dtype=np.bool_), no_offsets[ids], empty,
+            *ACA_STEPS)
+        kept = (~flags) & (ranks > 0)
+        rows = d * (far_rows_stop[ids][kept] - far_rows_start[ids][kept])
+        cols = dc * (far_cols_stop[ids][kept] - far_cols_start[ids][kept])
+        return (ranks, flags, far_dense) + split_factors(ranks[kept], rows, cols, ut, vt, float(eps), share)
 
     started = time.perf_counter()
     far_cost = (far_rows_stop - far_rows_start + far_cols_stop - far_cols_start).astype(np.float64)
     batches = _batches(far_cost, n_threads)
     u_values, v_values = _GrowingArray(factor_dtype), _GrowingArray(factor_dtype)
+    u_fixed, v_fixed = _GrowingArray(np.int16), _GrowingArray(np.int16)
+    u_scale, v_scale = _GrowingArray(), _GrowingArray()
     far_dense_values = _GrowingArray()
-    rank_parts, flag_parts = [np.zeros(0, dtype=np.int64)], [np.zeros(0, dtype=bool)]
-    for batch_ranks, batch_flags, batch_u, batch_v, batch_dense in _run_parallel(far_batch, batches, n_threads):
-        rank_parts.append(batch_ranks)
-        flag_parts.append(batch_flags)
-        u_values.append(batch_u)
-        v_values.append(batch_v)
-        far_dense_values.append(batch_dense)
-        del batch_u, batch_v, batch_dense
+    rank_parts, flag_parts, head_parts = [np.zeros(0, dtype=np.int64)], [np.zeros(0, dtype=bool)], [
+        np.zeros(0, dtype=np.int64)]
+    for ranks_b, flags_b, dense_b, head_b, u_b, v_b, u_fixed_b, v_fixed_b, u_scale_b, v_scale_b in _run_parallel(
+            far_batch, batches, n_threads):
+        rank_parts.append(ranks_b)
+        flag_parts.append(flags_b)
+        head_parts.append(head_b)
+        for store, part in ((u_values, u_b), (v_values, v_b), (u_fixed, u_fixed_b), (v_fixed, v_fixed_b),
+                            (u_scale, u_scale_b), (v_scale, v_scale_b), (far_dense_values, dense_b)):
+            store.append(part)
+        del u_b, v_b, u_fixed_b, v_fixed_b, dense_b
     u_values, v_values = u_values.finish(), v_values.finish()
+    u_fixed, v_fixed = u_fixed.finish(), v_fixed.finish()
+    u_scale, v_scale = u_scale.finish(), v_scale.finish()
+    lowrank_head = np.concatenate(head_parts)
     order = np.concatenate([np.zeros(0, dtype=np.int64)] + batches)
     ranks = np.concatenate(rank_parts)
     dense_flag = np.concatenate(flag_parts)
@@ -407,10 +467,15 @@ def assemble(generator, tree, blocks, eps, n_threads=None, factor_dtype=np.float
 
     rows_lr = far_rows_stop[lowrank] - far_rows_start[lowrank]
     cols_lr = far_cols_stop[lowrank] - far_cols_start[lowrank]
-    u_offset = np.concatenate(([0], np.cumsum(d * rows_lr * lowrank_rank))).astype(np.int64)
-    v_offset = np.concatenate(([0], np.cumsum(dc * cols_lr * lowrank_rank))).astype(np.int64)
+    tail = lowrank_rank - lowrank_head
+    u_offset = np.concatenate(([0], np.cumsum(d * rows_lr * lowrank_head))).astype(np.int64)
+    v_offset = np.concatenate(([0], np.cumsum(dc * cols_lr * lowrank_head))).astype(np.int64)
+    u_fixed_offset = np.concatenate(([0], np.cumsum(d * rows_lr * tail))).astype(np.int64)
+    v_fixed_offset = np.concatenate(([0], np.cumsum(dc * cols_lr * tail))).astype(np.int64)
     rank_offset = np.concatenate(([0], np.cumsum(lowrank_rank))).astype(np.int64)
     assert u_offset[-1] == u_values.size and v_offset[-1] == v_values.size
+    assert u_fixed_offset[-1] == u_fixed.size and v_fixed_offset[-1] == v_fixed.size
+    assert rank_offset[-1] == u_scale.size == v_scale.size
 
     leaves = tree.leaves()
     segment_start = np.concatenate((tree.start[leaves], [tree.n_elements])).astype(np.int64)
@@ -443,6 +508,13 @@ def assemble(generator, tree, blocks, eps, n_threads=None, factor_dtype=np.float
         rank_offset=rank_offset,
         u_values=u_values,
         v_values=v_values,
+        lowrank_head=lowrank_head,
+        u_fixed_offset=u_fixed_offset,
+        v_fixed_offset=v_fixed_offset,
+        u_fixed=u_fixed,
+        v_fixed=v_fixed,
+        u_scale=u_scale,
+        v_scale=v_scale,
         segment_start=segment_start,
         segment_dense_ptr=dense_ptr,
         segment_dense_ids=dense_ids,
@@ -480,13 +552,15 @@ def _segment_lists(segment_start, block_row_start, block_row_stop):
 @njit(parallel=True, cache=True, fastmath=FAST)
 def _matmat_permuted(dof, col_dof, n_rows, dense_col_start, dense_row_start, dense_col_stop, dense_offset, dense_values,
                      lowrank_row_start, lowrank_row_stop, lowrank_col_start, lowrank_col_stop, lowrank_rank,
-                     u_offset, v_offset, rank_offset, u_values, v_values, segment_start, segment_dense_ptr,
+                     u_offset, v_offset, rank_offset, u_values, v_values, lowrank_head, u_fixed_offset,
+                     v_fixed_offset, u_fixed, v_fixed, u_scale, v_scale, segment_start, segment_dense_ptr,
                      segment_dense_ids, segment_lowrank_ptr, segment_lowrank_ids, x):
     """Y = A X for X given TRANSPOSED, x of shape (nrhs, N_c*d_c), permuted ordering
     (``dof`` d_r unknowns per row element, ``col_dof`` d_c per column element,
     ``n_rows`` = N*d_r rows).
 
-    Phase 1 (parallel over low-rank blocks): t_b = V_b^T x_cols (each block owns t_b).
+    Phase 1 (parallel over low-rank blocks): t_b = V_b^T x_cols (each block owns t_b);
+    a fixed-point column is summed over its int16 codes, then scaled.
     Phase 2 (parallel over segments): y_seg = sum of dense rows and U_b rows times t_b
     over the blocks covering the segment. O(stored entries * nrhs) flops; all inner
     loops run over contiguous memory. Returns y of shape (nrhs, n_rows).
@@ -502,15 +576,23 @@ def _matmat_permuted(dof, col_dof, n_rows, dense_col_start, dense_row_start, den
         k = lowrank_rank[b]
         c0 = dc * lowrank_col_start[b]
         nc = dc * (lowrank_col_stop[b] - lowrank_col_start[b])
+        head = lowrank_head[b]
         t0 = rank_offset[b]
         for r in range(nrhs):
             x_cols = x[r, c0:c0 + nc]
-            for q in range(k):
+            for q in range(head):
                 v_column = v_values[v_offset[b] + q * nc:v_offset[b] + (q + 1) * nc]
                 total = 0.0
                 for j in range(nc):
                     total += v_column[j] * x_cols[j]
                 t[r, t0 + q] = total
+            for q in range(head, k):
+                start = v_fixed_offset[b] + (q - head) * nc
+                codes = v_fixed[start:start + nc]
+                total = 0.0
+                for j in range(nc):
+                    total += codes[j] * x_cols[j]
+                t[r, t0 + q] = total * v_scale[t0 + q]
     n_segments = segment_start.shape[0] - 1
     y = np.zeros((nrhs, n_rows))
     for s in prange(n_segments):
@@ -534,16 +616,24 @@ def _matmat_permuted(dof, col_dof, n_rows, dense_col_start, dense_row_start, den
         for e in range(segment_lowrank_ptr[s], segment_lowrank_ptr[s + 1]):
             b = segment_lowrank_ids[e]
             k = lowrank_rank[b]
+            head = lowrank_head[b]
             t0 = rank_offset[b]
             m = d * (lowrank_row_stop[b] - lowrank_row_start[b])
             shift = u_offset[b] + (r0 - d * lowrank_row_start[b])
+            fixed_shift = u_fixed_offset[b] + (r0 - d * lowrank_row_start[b])
             for r in range(nrhs):
                 y_rows = y[r, r0:r1]
-                for q in range(k):
+                for q in range(head):
                     coefficient = t[r, t0 + q]
                     u_column = u_values[shift + q * m:shift + q * m + rows]
                     for i in range(rows):
                         y_rows[i] += coefficient * u_column[i]
+                for q in range(head, k):
+                    coefficient = t[r, t0 + q] * u_scale[t0 + q]
+                    start = fixed_shift + (q - head) * m
+                    codes = u_fixed[start:start + rows]
+                    for i in range(rows):
+                        y_rows[i] += coefficient * codes[i]
     return y
 
 

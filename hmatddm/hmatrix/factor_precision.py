@@ -1,0 +1,191 @@
+"""Adaptive-precision storage of low-rank factors: leading columns in floating point,
+trailing columns as 16-bit fixed point.
+
+After recompression a far block is U V^T = sum_q sigma_q u_q v_q^T with the singular
+values folded into U (``aca.recompress_transposed``): column q of the factors carries
+a share sigma_q of the block, and the trailing columns carry little. A column stored
+with a relative rounding delta contributes an error of about sigma_q * delta, so the
+columns with small sigma_q can be stored with fewer bits for the same block accuracy
+(the adaptive-precision low-rank format of Amestoy et al. 2023, "Mixed precision
+low-rank approximations and their application to block low-rank LU factorization",
+and Kriemann 2023, "Hierarchical lowrank arithmetic with binary compression").
+
+Here a trailing column is stored as int16 with one float64 scale per column
+(``value = integer * scale``, ``scale = max|column| / 32767``): about 15 bits of the
+column's largest entry, i.e. a relative column error of ~3e-5 on smooth columns. For
+each block the longest run of trailing columns is stored so whose summed error bound
+
+    sum_q ( ||du_q|| (||v_q|| + ||dv_q||) + ||u_q|| ||dv_q|| )
+
+(the exact rounding errors du_q, dv_q, measured while rounding) stays within
+``FIXED_POINT_SHARE * eps * ||U V^T||_F``; the leading columns stay in the float store
+(float32 at eps >= 1e-5). Each block is then within (1 + FIXED_POINT_SHARE) eps of the
+kernel instead of eps. Measured on the planar crack (N = 4000, eps 1e-4): the low-rank
+factors take 0.57x their float32 memory and the smooth-field error moves from 7.4e-7 to
+7.6e-7 (``benchmarks/RESULTS.md``, "Adaptive-precision low-rank factors").
+"""
+
+import numpy as np
+from numba import njit
+
+#: Share of a block's accuracy eps spent on the fixed-point rounding of trailing columns.
+FIXED_POINT_SHARE = 0.25
+#: Largest magnitude of the int16 codes (symmetric range).
+FIXED_POINT_TOP = 32767.0
+
+
+@njit(cache=True, nogil=True)
+def _column_norm(values, start, length):
+    total = 0.0
+    for i in range(length):
+        total += values[start + i] * values[start + i]
+    return np.sqrt(total)
+
+
+@njit(cache=True, nogil=True)
+def _fixed_point_scale(values, start, length):
+    largest = 0.0
+    for i in range(length):
+        a = abs(values[start + i])
+        if a > largest:
+            largest = a
+    return largest / FIXED_POINT_TOP
+
+
+@njit(cache=True, nogil=True)
+def _rounding_error(values, start, length, scale):
+    """||column - round(column / scale) * scale|| (0 for a zero column)."""
+    if scale == 0.0:
+        return 0.0
+    total = 0.0
+    for i in range(length):
+        x = values[start + i]
+        e = x - np.rint(x / scale) * scale
+        total += e * e
+    return np.sqrt(total)
+
+
+@njit(cache=True, nogil=True)
+def fixed_point_columns(ut, vt, offset_u, offset_v, rank, m, n, eps, share):
+    """Number of leading columns of one block to keep in floating point.
+
+    ``ut[offset_u:]`` holds U^T (``rank`` rows of length ``m``), ``vt[offset_v:]`` V^T
+    (rows of length ``n``). Returns the head count h: columns h..rank-1 go to fixed
+    point, their summed rounding error bound within ``share * eps * ||U V^T||_F``
+    (Frobenius norm estimated as sqrt(sum_q ||u_q||^2 ||v_q||^2), exact for the
+    orthogonal factors of a recompression).
+    """
+    norm2 = 0.0
+    for q in range(rank):
+        a = _column_norm(ut, offset_u + q * m, m)
+        b = _column_norm(vt, offset_v + q * n, n)
+        norm2 += (a * b) ** 2
+    budget = share * eps * np.sqrt(norm2)
+    if not np.isfinite(budget):  # NaN or inf entries stay visible in the float store
+        return rank
+    used = 0.0
+    head = rank
+    while head > 0:
+        q = head - 1
+        su = _column_norm(ut, offset_u + q * m, m)
+        sv = _column_norm(vt, offset_v + q * n, n)
+        du = _rounding_error(ut, offset_u + q * m, m, _fixed_point_scale(ut, offset_u + q * m, m))
+        dv = _rounding_error(vt, offset_v + q * n, n, _fixed_point_scale(vt, offset_v + q * n, n))
+        error = du * (sv + dv) + su * dv
+        if used + error > budget:
+            break
+        used += error
+        head -= 1
+    return head
+
+
+@njit(cache=True, nogil=True)
+def split_factors(ranks, rows, cols, ut, vt, eps, share):
+    """Split the factors of a batch of low-rank blocks into float and fixed-point parts.
+
+    ``ranks[b]``, ``rows[b]`` = m, ``cols[b]`` = n of each low-rank block of the batch, in
+    the order their U^T / V^T rows follow each other in ``ut`` / ``vt``. Returns
+    (head, u_head, v_head, u_fixed, v_fixed, u_scale, v_scale): the head count of every
+    block, the leading columns (float64, cast by the store), the trailing columns as
+    int16 codes, and one scale per column of every block (0 for head columns), in the
+    same order. ``share`` 0 keeps every column in floating point.
+    """
+    count = ranks.shape[0]
+    head = np.zeros(count, dtype=np.int64)
+    u_head_size = 0
+    v_head_size = 0
+    total_rank = 0
+    offset_u = 0
+    offset_v = 0
+    for b in range(count):
+        k, m, n = ranks[b], rows[b], cols[b]
+        head[b] = fixed_point_columns(ut, vt, offset_u, offset_v, k, m, n, eps, share) if share > 0.0 else k
+        u_head_size += head[b] * m
+        v_head_size += head[b] * n
+        total_rank += k
+        offset_u += k * m
+        offset_v += k * n
+    u_head = np.empty(u_head_size)
+    v_head = np.empty(v_head_size)
+    u_fixed = np.empty(offset_u - u_head_size, dtype=np.int16)
+    v_fixed = np.empty(offset_v - v_head_size, dtype=np.int16)
+    u_scale = np.zeros(total_rank)
+    v_scale = np.zeros(total_rank)
+    offset_u = 0
+    offset_v = 0
+    uh = 0
+    vh = 0
+    uf = 0
+    vf = 0
+    column = 0
+    for b in range(count):
+        k, m, n = ranks[b], rows[b], cols[b]
+        for q in range(k):
+            if q < head[b]:
+                for i in range(m):
+                    u_head[uh + i] = ut[offset_u + q * m + i]
+                for i in range(n):
+                    v_head[vh + i] = vt[offset_v + q * n + i]
+                uh += m
+                vh += n
+            else:
+                u_scale[column + q] = _round_column(ut, offset_u + q * m, m, u_fixed, uf)
+                v_scale[column + q] = _round_column(vt, offset_v + q * n, n, v_fixed, vf)
+                uf += m
+                vf += n
+        column += k
+        offset_u += k * m
+        offset_v += k * n
+    return head, u_head, v_head, u_fixed, v_fixed, u_scale, v_scale
+
+
+@njit(cache=True, nogil=True)
+def _round_column(values, start, length, out, out_start):
+    """out[out_start:+length] = round(column / scale) as int16; returns the scale."""
+    scale = _fixed_point_scale(values, start, length)
+    if scale == 0.0:
+        for i in range(length):
+            out[out_start + i] = 0
+        return 0.0
+    for i in range(length):
+        out[out_start + i] = np.int16(np.rint(values[start + i] / scale))
+    return scale
+
+
+@njit(cache=True, nogil=True)
+def factor_columns(values, offset, fixed, fixed_offset, scale, scale_start, rank, head, length):
+    """The ``rank`` columns (length ``length``) of one stored factor as float64 rows
+    (rank x length): the first ``head`` from ``values[offset:]``, the others decoded from
+    ``fixed[fixed_offset:]`` with ``scale[scale_start + q]``."""
+    out = np.empty((rank, length))
+    for q in range(rank):
+        if q < head:
+            base = offset + q * length
+            for i in range(length):
+                out[q, i] = values[base + i]
+        else:
+            base = fixed_offset + (q - head) * length
+            s = scale[scale_start + q]
+            for i in range(length):
+                out[q, i] = fixed[base + i] * s
+    return out
