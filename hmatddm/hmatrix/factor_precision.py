@@ -112,51 +112,48 @@ def split_factors(ranks, rows, cols, ut, vt, eps, share):
     """
     count = ranks.shape[0]
     head = np.zeros(count, dtype=np.int64)
-    u_head_size = 0
-    v_head_size = 0
-    total_rank = 0
     offset_u = 0
     offset_v = 0
     for b in range(count):
         k, m, n = ranks[b], rows[b], cols[b]
         head[b] = fixed_point_columns(ut, vt, offset_u, offset_v, k, m, n, eps, share) if share > 0.0 else k
-        u_head_size += head[b] * m
-        v_head_size += head[b] * n
-        total_rank += k
         offset_u += k * m
         offset_v += k * n
-    u_head = np.empty(u_head_size)
-    v_head = np.empty(v_head_size)
-    u_fixed = np.empty(offset_u - u_head_size, dtype=np.int16)
-    v_fixed = np.empty(offset_v - v_head_size, dtype=np.int16)
-    u_scale = np.zeros(total_rank)
-    v_scale = np.zeros(total_rank)
-    offset_u = 0
-    offset_v = 0
-    uh = 0
-    vh = 0
-    uf = 0
-    vf = 0
-    column = 0
-    for b in range(count):
-        k, m, n = ranks[b], rows[b], cols[b]
-        for q in range(k):
-            if q < head[b]:
-                for i in range(m):
-                    u_head[uh + i] = ut[offset_u + q * m + i]
-                for i in range(n):
-                    v_head[vh + i] = vt[offset_v + q * n + i]
-                uh += m
-                vh += n
-            else:
-                u_scale[column + q] = _round_column(ut, offset_u + q * m, m, u_fixed, uf)
-                v_scale[column + q] = _round_column(vt, offset_v + q * n, n, v_fixed, vf)
-                uf += m
-                vf += n
-        column += k
-        offset_u += k * m
-        offset_v += k * n
+    u_head, u_fixed, u_scale = _split_factor(ut, rows, ranks, head)
+    v_head, v_fixed, v_scale = _split_factor(vt, cols, ranks, head)
     return head, u_head, v_head, u_fixed, v_fixed, u_scale, v_scale
+
+
+@njit(cache=True, nogil=True)
+def _split_factor(values, lengths, ranks, head):
+    """One factor of a batch (``ranks[b]`` columns of ``lengths[b]`` each, block after
+    block): (the first ``head[b]`` columns of every block, the others as int16 codes,
+    one scale per column with 0 for the float ones)."""
+    head_size = 0
+    total = 0
+    for b in range(ranks.shape[0]):
+        head_size += head[b] * lengths[b]
+        total += ranks[b] * lengths[b]
+    float_part = np.empty(head_size)
+    fixed_part = np.empty(total - head_size, dtype=np.int16)
+    scales = np.zeros(ranks.sum())
+    source = 0
+    used_float = 0
+    used_fixed = 0
+    column = 0
+    for b in range(ranks.shape[0]):
+        length = lengths[b]
+        for q in range(ranks[b]):
+            if q < head[b]:
+                for i in range(length):
+                    float_part[used_float + i] = values[source + i]
+                used_float += length
+            else:
+                scales[column] = _round_column(values, source, length, fixed_part, used_fixed)
+                used_fixed += length
+            source += length
+            column += 1
+    return float_part, fixed_part, scales
 
 
 @njit(cache=True, nogil=True)
