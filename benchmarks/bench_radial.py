@@ -145,7 +145,7 @@ def cpu_parts():
     wrap(schemes, "gmres", "coupled GMRES")
     wrap(hmatrix.HMatrix, "_matvec", "H matvec")
     wrap(extended.ExtendedElasticityOperator, "_matvec", "grown-mesh matvec")
-    wrap(extended.ExtendedElasticityOperator, "_block_triangular", "block-triangular preconditioner")
+    wrap(extended.ExtendedElasticityOperator, "approximate_inverse", "block-triangular preconditioner")
     wrap(schemes._CoupledLinearSystem, "compliance_preconditioner", "flow LU")
     wrap(topology, "element_edges", "topology")
     wrap(topology, "element_faces", "topology")

@@ -11,7 +11,18 @@ Matvec cost grows by ``2 N m d^2`` for ``m`` new elements, so the simulation reb
 the base operator once the border is large (see ``Simulation``). The preconditioner
 is block lower-triangular: the base near-field preconditioner for the old unknowns,
 then an exact LU of ``A_nn`` for the new ones.
+
+Growth passes share work (a pass adds a few elements to the last pass's mesh): the border
+is kept as one chunk of ``A_on`` columns and ``A_no`` rows per batch of added elements,
+so the chunks of the elements a pass shares with the previous one are reused as they are
+(no copy of the whole border per pass); the LU of ``A_nn`` grows by one level per batch
+(:class:`GrowingBlockLU`: the Schur complement of the added block, not a new
+factorisation of the whole block); and the product of the base with the old unknowns is
+kept for the last vector (a pass's first residual multiplies the previous pass's last
+iterate, whose old part it already multiplied).
 """
+from typing import NamedTuple
+
 import numpy as np
 import scipy.linalg
 from scipy.sparse.linalg import LinearOperator
@@ -27,11 +38,12 @@ class ExtendedElasticityOperator(LinearOperator):
     exact border blocks for elements ``n0..N-1``.
 
     ``previous``: the operator of an earlier growth pass over the same ``base`` (for
-    example the last one returned). The border entries of the elements it shares with
-    ``mesh`` (the longest common run of unchanged elements after the base's) are copied
-    from it; only the rows and columns of the elements added since are evaluated by the
-    kernel, so a growth pass costs O(n0 m_added) kernel pairs instead of O(n0 m). Any
-    other ``previous`` (another base, changed elements) is ignored.
+    example the last one returned). The border chunks and the ``A_nn`` factor levels of
+    the elements it shares with ``mesh`` (the longest common run of unchanged elements
+    after the base's) are taken from it (chunks as views, ``A_nn``'s entries copied); only
+    the rows and columns of the elements added since are evaluated by the kernel, so a
+    growth pass costs O(n0 m_added) kernel pairs instead of O(n0 m). Any other
+    ``previous`` (another base, changed elements) is ignored.
     """
 
     def __init__(self, base, mesh, previous=None):
@@ -52,9 +64,12 @@ class ExtendedElasticityOperator(LinearOperator):
                               n_images=base.stats.get("n_images"))  # layered: the base's images
         self._data = data
         self.n_reused = self._shared_new_elements(previous)
-        self.on, self.no, self.nn = self._border_blocks(previous, self.n_reused)
-        self._nn_lu = None
-        self.border_bytes = self.on.nbytes + self.no.nbytes + self.nn.nbytes
+        self.chunks, self.nn = self._border_blocks(previous, self.n_reused)
+        shares = isinstance(previous, ExtendedElasticityOperator) and previous.base is base
+        self._base_product = previous._base_product if shares else _LastProduct(base.matvec)
+        self._nn_levels = GrowingBlockLU(self.nn, previous._nn_levels.prefix(self.n_reused * self.dof)
+                                         if self.n_reused else None)
+        self.border_bytes = sum(c.on.nbytes + c.no.nbytes for c in self.chunks) + self.nn.nbytes
 
     def _shared_new_elements(self, previous):
         """How many of ``previous``'s border elements are elements ``n0, n0 + 1, ...`` of
@@ -78,30 +93,45 @@ class ExtendedElasticityOperator(LinearOperator):
         return max(shared - n0, 0)
 
     def _border_blocks(self, previous, reused):
-        """(A_on, A_no, A_nn): the first ``reused`` new elements' entries copied from
-        ``previous``, the rest evaluated."""
+        """(chunks, A_nn): the chunks (:class:`BorderChunk`) of the first ``reused`` new
+        elements taken from ``previous`` (views, not copies), one chunk evaluated for the
+        rest; ``A_nn`` with its shared block copied from ``previous``."""
         d, n0, n = self.dof, self.n_base, self.mesh.n_elements
         old = np.arange(n0, dtype=np.int64)
         new = np.arange(n0, n, dtype=np.int64)
         added = new[reused:]
         k = reused * d
-        on = np.empty((n0 * d, new.size * d))
-        no = np.empty((new.size * d, n0 * d))
+        chunks = []
         nn = np.empty((new.size * d, new.size * d))
         if reused:
-            on[:, :k] = previous.on[:, :k]
-            no[:k] = previous.no[:k]
+            for chunk in previous.chunks:
+                if chunk.start >= k:
+                    break
+                keep = min(chunk.stop, k) - chunk.start
+                chunks.append(chunk if keep == chunk.stop - chunk.start else
+                              BorderChunk(chunk.start, chunk.start + keep, chunk.on[:, :keep], chunk.no[:keep]))
             nn[:k, :k] = previous.nn[:k, :k]
             nn[:k, k:] = self._block(self._data, new[:reused], added)
             nn[k:, :k] = self._block(self._data, added, new[:reused])
         if added.size:
-            on[:, k:] = self._block(self._data, old, added)
-            no[k:] = self._block(self._data, added, old)
+            on, no = self._block(self._data, old, added), self._block(self._data, added, old)
+            if not (np.all(np.isfinite(on)) and np.all(np.isfinite(no))):
+                refuse_singular()
+            chunks.append(BorderChunk(k, new.size * d, on, no))
             nn[k:, k:] = self._block(self._data, added, added)
-        if not (np.all(np.isfinite(on[:, k:])) and np.all(np.isfinite(no[k:])) and np.all(np.isfinite(nn[:, k:]))
-                and np.all(np.isfinite(nn[k:]))):
+        if not (np.all(np.isfinite(nn[:, k:])) and np.all(np.isfinite(nn[k:]))):
             refuse_singular()
-        return on, no, nn
+        return chunks, nn
+
+    @property
+    def on(self):
+        """``A_on`` (old rows, new columns) as one array (assembled from the chunks)."""
+        return np.concatenate([chunk.on for chunk in self.chunks], axis=1)
+
+    @property
+    def no(self):
+        """``A_no`` (new rows, old columns) as one array (assembled from the chunks)."""
+        return np.concatenate([chunk.no for chunk in self.chunks], axis=0)
 
     def _block(self, data, rows, cols):
         out = np.empty((len(rows) * self.dof, len(cols) * self.dof))
@@ -116,12 +146,20 @@ class ExtendedElasticityOperator(LinearOperator):
         x = np.asarray(x, dtype=np.float64).ravel()
         k = self.n_base * self.dof
         x_old, x_new = x[:k], x[k:]
-        return np.concatenate([self.base.matvec(x_old) + self.on @ x_new, self.no @ x_old + self.nn @ x_new])
+        out = np.empty(self.shape[0])
+        top, bottom = out[:k], out[k:]
+        top[:] = self._base_product(x_old)
+        for chunk in self.chunks:
+            top += chunk.on @ x_new[chunk.start:chunk.stop]
+        self._border_rows(x_old, bottom)
+        bottom += self.nn @ x_new
+        return out
 
-    def _nn_factor(self):
-        if self._nn_lu is None:
-            self._nn_lu = scipy.linalg.lu_factor(self.nn, check_finite=False)
-        return self._nn_lu
+    def _border_rows(self, x_old, out):
+        """``out = A_no x_old``, chunk by chunk."""
+        for chunk in self.chunks:
+            np.dot(chunk.no, x_old, out=out[chunk.start:chunk.stop])
+        return out
 
     #: The block-triangular inverse ignores ``A_on``: never exact, a solve iterates.
     inverse_is_exact = False
@@ -129,7 +167,12 @@ class ExtendedElasticityOperator(LinearOperator):
     def approximate_inverse(self, r):
         """Block lower-triangular solve: the base's approximate inverse (LU or
         preconditioner), then LU of ``A_nn``."""
-        return self._block_triangular(r, self.base.approximate_inverse, self.no, self._nn_factor())
+        k = self.n_base * self.dof
+        r = np.asarray(r, dtype=np.float64).ravel()
+        x = np.empty(self.shape[0])
+        x[:k] = self.base.approximate_inverse(r[:k])
+        x[k:] = self._nn_levels.solve(r[k:] - self._border_rows(x[:k], np.empty(self.shape[0] - k)))
+        return x
 
     def modified_inverse(self, rows):
         """Approximate inverse (a callable) of ``S A + D`` for row operators ``rows``: the
@@ -170,3 +213,68 @@ def _flat_arrays(data):
     if isinstance(data, tuple):
         return [a for item in data for a in _flat_arrays(item)]
     return [np.asarray(data)]
+
+
+class BorderChunk(NamedTuple):
+    """The border of the new unknowns ``start:stop`` (counted from the first new one):
+    ``on`` = ``A_on[:, start:stop]``, ``no`` = ``A_no[start:stop]``."""
+
+    start: int
+    stop: int
+    on: np.ndarray
+    no: np.ndarray
+
+
+class _LastProduct:
+    """``matvec(x)``, kept for the last ``x`` (shared by the operators of one base)."""
+
+    def __init__(self, matvec):
+        self.matvec = matvec
+        self.x, self.product = None, None
+
+    def __call__(self, x):
+        if self.x is not None and self.x.shape == x.shape and np.array_equal(self.x, x):
+            return self.product
+        product = self.matvec(x)
+        self.x, self.product = x.copy(), product
+        return product
+
+
+class GrowingBlockLU:
+    """Solves with a matrix ``M`` (the ``A_nn`` of a grown mesh) factored level by level:
+    when ``M`` gains rows and columns ``s:e`` (a growth pass's elements), the factors of
+    ``M[:s, :s]`` are kept and the level adds ``R = M[s:e, :s]``, ``H = M[:s, :s]^-1
+    M[:s, s:e]`` and the LU of the Schur complement ``S = M[s:e, s:e] - R H``. A solve runs
+    the levels in order: ``y[s:e] = S^-1 (r[s:e] - R y[:s])``, ``y[:s] -= H y[s:e]`` keeps
+    ``y[:e] = M[:e, :e]^-1 r[:e]`` (block elimination; pivoting within each level, which
+    suits the diagonally dominant DDM blocks). Adding ``b`` unknowns to ``s`` costs
+    O(s^2 b) instead of the O((s + b)^3) of a new LU.
+
+    ``kept``: the levels of an earlier ``GrowingBlockLU`` whose matrix is ``M[:s, :s]``
+    (from :meth:`prefix`), or None."""
+
+    def __init__(self, matrix, kept=None):
+        self.levels = list(kept or [])
+        start = self.levels[-1][1] if self.levels else 0
+        size = matrix.shape[0]
+        if start < size:
+            coupling = matrix[:start, start:]
+            solved = self.solve(coupling) if start else None
+            rows = matrix[start:, :start] if start else None
+            schur = matrix[start:, start:] - rows @ solved if start else matrix
+            self.levels.append((start, size, rows, solved, scipy.linalg.lu_factor(schur, check_finite=False)))
+
+    def prefix(self, size):
+        """The levels that factor ``M[:size, :size]`` whole (a shared run of unknowns)."""
+        return [level for level in self.levels if level[1] <= size]
+
+    def solve(self, r):
+        """``M^-1 r`` (``r``: a vector or a matrix of columns)."""
+        y = np.array(r, dtype=np.float64)
+        for start, stop, rows, solved, lu in self.levels:
+            if start:
+                y[start:stop] -= rows @ y[:start]
+            y[start:stop] = scipy.linalg.lu_solve(lu, y[start:stop], check_finite=False)
+            if start:
+                y[:start] -= solved @ y[start:stop]
+        return y

@@ -91,3 +91,73 @@ def test_a_later_growth_pass_reuses_the_border_of_the_previous_one(grown, materi
     other_base = hd.ElasticityOperator(mesh.subset(np.arange(100)), material, backend="hmatrix", eps=1e-8,
                                        leaf_size=16)
     assert ExtendedElasticityOperator(other_base, mesh, previous=first).n_reused == 0
+
+
+def test_growing_block_lu_solves_like_a_dense_solve():
+    """Levels added one block at a time (Schur complements) solve with the whole matrix,
+    vectors and matrices of right-hand sides, as numpy's dense solve does."""
+    from hmatddm.extended_operator import GrowingBlockLU
+
+    rng = np.random.default_rng(3)
+    n = 40
+    matrix = rng.normal(size=(n, n)) + 2 * n * np.eye(n) * rng.choice([-1.0, 1.0], size=n)
+    levels = None
+    for size in (7, 8, 20, 33, 40):
+        factors = GrowingBlockLU(matrix[:size, :size], levels)
+        levels = factors.prefix(size)
+        assert len(levels) == len(factors.levels)
+        r = rng.normal(size=(size, 3))
+        np.testing.assert_allclose(factors.solve(r), np.linalg.solve(matrix[:size, :size], r), rtol=0, atol=1e-12)
+        np.testing.assert_allclose(factors.solve(r[:, 0]), np.linalg.solve(matrix[:size, :size], r[:, 0]), rtol=0,
+                                   atol=1e-12)
+    assert [(start, stop) for start, stop, *_ in factors.levels] == [(0, 7), (7, 8), (8, 20), (20, 33), (33, 40)]
+    # a shared run that ends inside a level keeps the levels before it only
+    assert [level[1] for level in factors.prefix(30)] == [7, 8, 20]
+    partly = GrowingBlockLU(matrix, factors.prefix(30))
+    assert [(start, stop) for start, stop, *_ in partly.levels] == [(0, 7), (7, 8), (8, 20), (20, 40)]
+    r = rng.normal(size=n)
+    np.testing.assert_allclose(partly.solve(r), np.linalg.solve(matrix, r), rtol=0, atol=1e-12)
+
+
+def test_growth_passes_share_border_chunks_and_the_base_product(grown, material):
+    """A chain of growth passes over one base: every pass's matvec and block-triangular
+    preconditioner equal those of a fresh operator of its mesh (the dense border and LU of
+    A_nn, written out here), the shared chunks are the previous pass's arrays (not
+    copies), and the base is multiplied once for a repeated old part."""
+    import scipy.linalg
+
+    mesh, extended, dense = grown
+    base = extended.base
+    rng = np.random.default_rng(4)
+    previous = None
+    for n in (104, 110, 111, 130, mesh.n_elements):
+        grown_op = ExtendedElasticityOperator(base, mesh.subset(np.arange(n)), previous=previous)
+        fresh = ExtendedElasticityOperator(base, mesh.subset(np.arange(n)))
+        if previous is not None:
+            assert grown_op.n_reused == previous.mesh.n_elements - 100
+            assert all(mine.on is theirs.on and mine.no is theirs.no
+                       for mine, theirs in zip(grown_op.chunks, previous.chunks))
+        x = rng.normal(size=grown_op.shape[0])
+        reference = fresh @ x
+        np.testing.assert_allclose(grown_op @ x, reference, rtol=0, atol=1e-12 * np.abs(reference).max())
+        np.testing.assert_allclose(grown_op @ x, dense.to_dense()[:x.size, :x.size] @ x, rtol=0,
+                                   atol=1e-6 * np.abs(reference).max())
+        k = 100 * base.dof
+        x_old = base.approximate_inverse(x[:k])
+        x_new = scipy.linalg.solve(fresh.nn, x[k:] - fresh.no @ x_old)
+        np.testing.assert_allclose(grown_op.approximate_inverse(x), np.concatenate([x_old, x_new]), rtol=1e-9,
+                                   atol=1e-12 * np.abs(x_new).max())
+        previous = grown_op
+
+    calls = []
+    counted = ExtendedElasticityOperator(base, mesh, previous=previous)
+    counted._base_product.matvec = lambda v: calls.append(1) or base.matvec(v)
+    counted._base_product.x = None
+    x = rng.normal(size=counted.shape[0])
+    first = counted @ x
+    x[-1] += 1.0  # the old part is the same: the base product is kept
+    second = counted @ x
+    assert len(calls) == 1 and not np.array_equal(first, second)
+    x[0] += 1.0
+    counted @ x
+    assert len(calls) == 2
