@@ -152,12 +152,15 @@ def cpu_parts():
     return parts
 
 
-def run_case(case, h, backend, t_end, scheme="krylov", front="element", scheme_options=None, parts=False):
+def run_case(case, h, backend, t_end, scheme="krylov", front="element", scheme_options=None, parts=False,
+             rebuild=None):
     """One simulation; returns a dict with the per-step history and the final errors.
     ``scheme_options``: further :class:`hmatddm.coupled.SchemeSettings` fields (e.g.
     ``{"stopping": "change", "first_linear_rtol": 1e-9}``, the plain iteration of before
     issue 17; ``{"growth_check": "converged"}``, every growth pass on a converged solve, as
-    before the third issue-17 session); ``parts``: add ``cpu_parts`` (:func:`cpu_parts`)."""
+    before the third issue-17 session); ``parts``: add ``cpu_parts`` (:func:`cpu_parts`);
+    ``rebuild``: :class:`hmatddm.simulation.settings.RebuildSettings` fields (when the
+    grown operator is rebuilt), e.g. ``{"rebuild_fraction": 0.5}``."""
     import hmatddm as hd
     from _common import peak_rss_bytes
 
@@ -176,7 +179,7 @@ def run_case(case, h, backend, t_end, scheme="krylov", front="element", scheme_o
                         [hd.Cluster((0, 0, 0), RATE, WELLBORE)], far_field_stress=np.diag([0, 0, -S_HMIN]),
                         time_step=1.0, propagation=hd.Propagation(toughness=params["toughness"], front=front),
                         initial_pressure=INITIAL_PRESSURE, initial_opening=params["initial_opening"],
-                        backend=backend, scheme=settings)
+                        backend=backend, scheme=settings, **(rebuild or {}))
     failure = None
     try:
         records = sim.run(t_end)
@@ -198,6 +201,8 @@ def run_case(case, h, backend, t_end, scheme="krylov", front="element", scheme_o
                operator_builds=int(sim.operator_builds))
     if scheme_options:
         row["scheme_options"] = dict(scheme_options)
+    if rebuild:
+        row["rebuild"] = dict(rebuild)
     if costs is not None:
         row["cpu_parts"] = dict(costs)
     if records:
@@ -608,7 +613,8 @@ def main():
             preconditioners.TWO_LEVEL_MIN_ELEMENTS = int(spec["two_level_from"])
         print(json.dumps(run_case(spec["case"], float(spec["h"]), spec["backend"], float(spec.get("t_end", 50.0)),
                                   spec.get("scheme", "krylov"), spec.get("front", "element"),
-                                  spec.get("scheme_options"), bool(spec.get("parts", False)))))
+                                  spec.get("scheme_options"), bool(spec.get("parts", False)),
+                                  spec.get("rebuild"))))
         return
     from _common import machine, markdown_table
 

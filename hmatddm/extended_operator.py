@@ -25,12 +25,19 @@ from typing import NamedTuple
 
 import numpy as np
 import scipy.linalg
+import scipy.sparse as sp
 from scipy.sparse.linalg import LinearOperator
 
 from .errors import InputError
+from .hmatrix.preconditioners import DEFAULT_ILU
 from .kernels.drivers import traction_block
 from .operator_inverse import solve_with_inverse
 from .operators import ElasticityOperator, influence_data, refuse_singular
+
+
+#: Border blocks the block-triangular preconditioner keeps (relative Frobenius norm, as the
+#: base's near-field block ILU keeps its blocks).
+NEAR_THRESHOLD = DEFAULT_ILU["threshold"]
 
 
 class ExtendedElasticityOperator(LinearOperator):
@@ -64,8 +71,9 @@ class ExtendedElasticityOperator(LinearOperator):
                               n_images=base.stats.get("n_images"))  # layered: the base's images
         self._data = data
         self.n_reused = self._shared_new_elements(previous)
-        self.chunks, self.nn = self._border_blocks(previous, self.n_reused)
         shares = isinstance(previous, ExtendedElasticityOperator) and previous.base is base
+        self._old_norms = previous._old_norms if shares else None  # ||A_jj||_F of the base's elements
+        self.chunks, self.nn = self._border_blocks(previous, self.n_reused)
         self._base_product = previous._base_product if shares else _LastProduct(base.matvec)
         self._nn_levels = GrowingBlockLU(self.nn, previous._nn_levels.prefix(self.n_reused * self.dof)
                                          if self.n_reused else None)
@@ -109,7 +117,8 @@ class ExtendedElasticityOperator(LinearOperator):
                     break
                 keep = min(chunk.stop, k) - chunk.start
                 chunks.append(chunk if keep == chunk.stop - chunk.start else
-                              BorderChunk(chunk.start, chunk.start + keep, chunk.on[:, :keep], chunk.no[:keep]))
+                              BorderChunk(chunk.start, chunk.start + keep, chunk.on[:, :keep], chunk.no[:keep],
+                                          chunk.near[:keep]))
             nn[:k, :k] = previous.nn[:k, :k]
             nn[:k, k:] = self._block(self._data, new[:reused], added)
             nn[k:, :k] = self._block(self._data, added, new[:reused])
@@ -117,8 +126,8 @@ class ExtendedElasticityOperator(LinearOperator):
             on, no = self._block(self._data, old, added), self._block(self._data, added, old)
             if not (np.all(np.isfinite(on)) and np.all(np.isfinite(no))):
                 refuse_singular()
-            chunks.append(BorderChunk(k, new.size * d, on, no))
             nn[k:, k:] = self._block(self._data, added, added)
+            chunks.append(BorderChunk(k, new.size * d, on, no, self._near_rows(no, nn[k:, k:])))
         if not (np.all(np.isfinite(nn[:, k:])) and np.all(np.isfinite(nn[k:]))):
             refuse_singular()
         return chunks, nn
@@ -132,6 +141,24 @@ class ExtendedElasticityOperator(LinearOperator):
     def no(self):
         """``A_no`` (new rows, old columns) as one array (assembled from the chunks)."""
         return np.concatenate([chunk.no for chunk in self.chunks], axis=0)
+
+    def _near_rows(self, no, nn):
+        """The near field of the border rows ``no`` (new elements x old elements; ``nn``: the
+        new elements' own block) as a sparse matrix: the element blocks that
+        :data:`hmatddm.hmatrix.preconditioners.DEFAULT_ILU`'s threshold keeps in the base's
+        block ILU, ``||A_ij||_F >= threshold sqrt(||A_ii||_F ||A_jj||_F)``."""
+        d, n0 = self.dof, self.n_base
+        m = no.shape[0] // d
+        if self._old_norms is None:
+            self._old_norms = np.linalg.norm(self.base.element_diagonal_blocks(), axis=(1, 2))
+        index = np.arange(m)
+        new_norms = np.linalg.norm(nn.reshape(m, d, m, d)[index, :, index, :], axis=(1, 2))
+        blocks = no.reshape(m, d, n0, d)
+        norms = np.sqrt(np.einsum("ipjq,ipjq->ij", blocks, blocks))
+        keep = norms >= NEAR_THRESHOLD * np.sqrt(new_norms[:, None] * self._old_norms[None, :])
+        rows, cols = np.nonzero(keep)
+        indptr = np.concatenate([[0], np.cumsum(np.count_nonzero(keep, axis=1))])
+        return sp.bsr_matrix((blocks[rows, :, cols, :], cols, indptr), shape=no.shape, blocksize=(d, d)).tocsr()
 
     def _block(self, data, rows, cols):
         out = np.empty((len(rows) * self.dof, len(cols) * self.dof))
@@ -171,7 +198,10 @@ class ExtendedElasticityOperator(LinearOperator):
         r = np.asarray(r, dtype=np.float64).ravel()
         x = np.empty(self.shape[0])
         x[:k] = self.base.approximate_inverse(r[:k])
-        x[k:] = self._nn_levels.solve(r[k:] - self._border_rows(x[:k], np.empty(self.shape[0] - k)))
+        near = np.empty(self.shape[0] - k)
+        for chunk in self.chunks:
+            near[chunk.start:chunk.stop] = chunk.near @ x[:k]
+        x[k:] = self._nn_levels.solve(r[k:] - near)
         return x
 
     def modified_inverse(self, rows):
@@ -223,6 +253,7 @@ class BorderChunk(NamedTuple):
     stop: int
     on: np.ndarray
     no: np.ndarray
+    near: object  # the near field of ``no`` (scipy CSR), which the preconditioner uses
 
 
 class _LastProduct:
