@@ -20,6 +20,7 @@ over a positive length and each element lies ahead of the other's edge. The
 overlap length and the half sizes perpendicular to the edges give the two-point
 flux of the face.
 """
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -107,19 +108,16 @@ def element_edges(mesh, height=1.0):
 
 
 def _candidate_pairs(mesh):
-    """Element pairs close enough to share an edge (i < j)."""
+    """Element pairs close enough to share an edge (i < j), by ``i`` then ``j``."""
     radii = mesh.radii
     tree = cKDTree(mesh.centers)
     reach = radii + radii.max() * (1.0 + 1e-9) + 1e-12
-    first, second = [], []
-    for i, neighbours in enumerate(tree.query_ball_point(mesh.centers, reach)):
-        neighbours = np.asarray(neighbours, dtype=np.int64)
-        neighbours = neighbours[neighbours > i]
-        first.append(np.full(len(neighbours), i, dtype=np.int64))
-        second.append(neighbours)
-    if not first:
-        return np.zeros(0, np.int64), np.zeros(0, np.int64)
-    return np.concatenate(first), np.concatenate(second)
+    neighbours = tree.query_ball_point(mesh.centers, reach, return_sorted=True)
+    counts = np.fromiter(map(len, neighbours), np.int64, len(neighbours))
+    second = np.fromiter(itertools.chain.from_iterable(neighbours), np.int64, int(counts.sum()))
+    first = np.repeat(np.arange(len(neighbours), dtype=np.int64), counts)
+    keep = second > first
+    return first[keep], second[keep]
 
 
 @njit(cache=True)
