@@ -275,10 +275,12 @@ class GrowingBlockLU:
     """Solves with a matrix ``M`` (the ``A_nn`` of a grown mesh) factored level by level:
     when ``M`` gains rows and columns ``s:e`` (a growth pass's elements), the factors of
     ``M[:s, :s]`` are kept and the level adds ``R = M[s:e, :s]``, ``H = M[:s, :s]^-1
-    M[:s, s:e]`` and the LU of the Schur complement ``S = M[s:e, s:e] - R H``. A solve runs
+    M[:s, s:e]`` and the inverse of the Schur complement ``S = M[s:e, s:e] - R H`` (a
+    growth pass's few elements: a small dense block; an explicit inverse makes a level
+    three matrix-vector products, without the per-call cost of an LU solve). A solve runs
     the levels in order: ``y[s:e] = S^-1 (r[s:e] - R y[:s])``, ``y[:s] -= H y[s:e]`` keeps
-    ``y[:e] = M[:e, :e]^-1 r[:e]`` (block elimination; pivoting within each level, which
-    suits the diagonally dominant DDM blocks). Adding ``b`` unknowns to ``s`` costs
+    ``y[:e] = M[:e, :e]^-1 r[:e]`` (block elimination without pivoting between levels,
+    which suits the diagonally dominant DDM blocks). Adding ``b`` unknowns to ``s`` costs
     O(s^2 b) instead of the O((s + b)^3) of a new LU.
 
     ``kept``: the levels of an earlier ``GrowingBlockLU`` whose matrix is ``M[:s, :s]``
@@ -293,7 +295,7 @@ class GrowingBlockLU:
             solved = self.solve(coupling) if start else None
             rows = matrix[start:, :start] if start else None
             schur = matrix[start:, start:] - rows @ solved if start else matrix
-            self.levels.append((start, size, rows, solved, scipy.linalg.lu_factor(schur, check_finite=False)))
+            self.levels.append((start, size, rows, solved, np.linalg.inv(schur)))
 
     def prefix(self, size):
         """The levels that factor ``M[:size, :size]`` whole (a shared run of unknowns)."""
@@ -302,10 +304,10 @@ class GrowingBlockLU:
     def solve(self, r):
         """``M^-1 r`` (``r``: a vector or a matrix of columns)."""
         y = np.array(r, dtype=np.float64)
-        for start, stop, rows, solved, lu in self.levels:
+        for start, stop, rows, solved, schur_inverse in self.levels:
             if start:
                 y[start:stop] -= rows @ y[:start]
-            y[start:stop] = scipy.linalg.lu_solve(lu, y[start:stop], check_finite=False)
+            y[start:stop] = schur_inverse @ y[start:stop]
             if start:
                 y[:start] -= solved @ y[start:stop]
         return y
