@@ -12,8 +12,8 @@ and Kriemann 2023, "Hierarchical lowrank arithmetic with binary compression").
 
 Here a trailing column is stored as int16 with one float64 scale per column
 (``value = integer * scale``, ``scale = max|column| / 32767``): about 15 bits of the
-column's largest entry, i.e. a relative column error of ~3e-5 on smooth columns. For
-each block the longest run of trailing columns is stored so whose summed error bound
+column's largest entry, i.e. a relative column error of ~3e-5 on smooth columns. Each
+block stores in fixed point the longest run of trailing columns whose summed error bound
 
     sum_q ( ||du_q|| (||v_q|| + ||dv_q||) + ||u_q|| ||dv_q|| )
 
@@ -22,7 +22,8 @@ each block the longest run of trailing columns is stored so whose summed error b
 (float32 at eps >= 1e-5). Each block is then within (1 + FIXED_POINT_SHARE) eps of the
 kernel instead of eps. Measured on the planar crack (N = 4000, eps 1e-4): the low-rank
 factors take 0.57x their float32 memory and the smooth-field error moves from 7.4e-7 to
-7.6e-7 (``benchmarks/RESULTS.md``, "Adaptive-precision low-rank factors").
+7.6e-7; at N = 250 000 the H-matrix takes 10.9 GB instead of 16.2 (``benchmarks/RESULTS.md``,
+"Issue 17 items 2 and 5: adaptive-precision low-rank factors").
 """
 
 import numpy as np
