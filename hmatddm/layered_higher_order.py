@@ -39,7 +39,7 @@ def _shape_values(coefficients, xi):
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")  # one njit level less above the image quadrature (issue 18)
 def image_nodes(point, receiver_layer, center, frame, a, source_layer, coefficients, n_images, gauss_points,
                 max_subdivisions, interfaces, shear_modulus, poisson_ratio, out):
     """``out[k, b, i, j]``: complementary stress at ``point`` (in ``receiver_layer``) for

@@ -56,7 +56,9 @@ H-matrix's block generator, with exactly the signature the H-matrix build calls 
 points and the singular-pair test call those two from Python (in parallel on numba's
 thread count where it pays: the compiled drivers release the GIL); the self-block maxima
 call :func:`traction_block` through a pointer from a small compiled loop (the kernel is not
-compiled again). The loops over pairs read :func:`borrowed` arrays: numba's reference
+compiled again). Inside an entry point the per-pair function is inlined into the one loop
+nest (no njit helper level between them: each such level would optimise the kernel once
+more). The loops over pairs read :func:`borrowed` arrays: numba's reference
 counts are atomic operations, and a pair's reads of the record would otherwise pay a dozen.
 The drivers are cached on disk (``cache=True``); the cache of a driver does not notice
 edits in a kind's module: delete ``hmatddm/**/__pycache__/*.nbi|*.nbc`` after changing a
@@ -236,66 +238,15 @@ def _hold(typingctx, value):
     return types.none(value), codegen
 
 
-@njit(cache=True)
-def _fill_receiver(data, i, cols, out, row, work, block):
-    """``out[row + p, d jb + q]``: the blocks of receiver ``i`` from the sources ``cols``,
-    scaled by ref. Eq. 6.11 when ``alpha > 0`` (off the diagonal); for kinds whose
-    receivers share nothing about a source (rows written contiguously)."""
-    dof = block.shape[0]
-    alpha = data.alpha
-    for jb in range(cols.shape[0]):
-        j = cols[jb]
-        _element_traction(data, i, j, 0, work, block)
-        if alpha > 0.0 and i != j:
-            scale_to_self(block, alpha * data.self_max[j])
-        for p in range(dof):
-            for q in range(dof):
-                out[row + p, dof * jb + q] = block[p, q]
-
-
-@njit(cache=True)
-def _fill_source(data, j, rows, out, column, work, block):
-    """``out[d ia + p, column + q]``: the blocks of source ``j`` at the receivers ``rows``
-    (its ``source_state`` made once), scaled as :func:`_fill_receiver`."""
-    state = _source_state(data, j, work)
-    dof = block.shape[0]
-    alpha = data.alpha
-    for ia in range(rows.shape[0]):
-        i = rows[ia]
-        _element_traction(data, i, j, state, work, block)
-        if alpha > 0.0 and i != j:
-            scale_to_self(block, alpha * data.self_max[j])
-        for p in range(dof):
-            for q in range(dof):
-                out[dof * ia + p, column + q] = block[p, q]
-
-
 def _shares_source_state(data):
     """True for kinds with a ``source_state`` (blocks are filled source by source)."""
     return kind_of(data).source_state is not no_source_state
 
 
-def _fill_block(data, rows, cols, out, work, block):
-    """``rows`` x ``cols`` into ``out``: receiver by receiver, or source by source for
-    kinds with a ``source_state`` (numba picks the loop by the record type)."""
-
-
-@overload(_fill_block)
-def _overload_fill_block(data, rows, cols, out, work, block):
-    # every array is borrowed (:func:`borrowed`): the caller, traction_block, holds them
-    if _shares_source_state(data):
-        def impl(data, rows, cols, out, work, block):
-            data_, rows_, cols_, out_, work_, block_ = borrowed((data, rows, cols, out, work, block))
-            dof = block_.shape[0]
-            for jb in range(cols_.shape[0]):
-                _fill_source(data_, cols_[jb], rows_, out_, dof * jb, work_, block_)
-    else:
-        def impl(data, rows, cols, out, work, block):
-            data_, rows_, cols_, out_, work_, block_ = borrowed((data, rows, cols, out, work, block))
-            dof = block_.shape[0]
-            for ia in range(rows_.shape[0]):
-                _fill_receiver(data_, rows_[ia], cols_, out_, dof * ia, work_, block_)
-    return impl
+@overload(_shares_source_state, inline="always")
+def _overload_shares_source_state(data):
+    shares = _shares_source_state(data)
+    return lambda data: shares
 
 
 @njit(cache=True, nogil=True)
@@ -303,10 +254,40 @@ def traction_block(data, rows, cols, out):
     """Block generator kernel (see :class:`hmatddm.hmatrix.BlockGenerator`): ``out`` of
     shape ``(d len(rows), d len(cols))`` receives ``out[d a + p, d b + q]``, the traction
     component ``p`` at the collocation point(s) of element ``rows[a]`` for a unit global
-    DD unknown ``q`` of element ``cols[b]``. Called with int64 ``rows``, ``cols`` and a
-    C-contiguous float64 ``out`` everywhere (one compiled version per record type)."""
+    DD unknown ``q`` of element ``cols[b]``, scaled by ref. Eq. 6.11 when ``alpha > 0``
+    (off the diagonal). Called with int64 ``rows``, ``cols`` and a C-contiguous float64
+    ``out`` everywhere (one compiled version per record type).
+
+    Receiver by receiver, or source by source for kinds with a ``source_state`` (made
+    once per source); the choice is a constant of the record type, so LLVM keeps one of
+    the two loop orders. One loop nest with the per-pair function inlined once: the
+    kernel is compiled (and optimised) here only, not again in helper levels."""
     dof = element_unknowns(data)
-    _fill_block(data, rows, cols, out, _workspace(data), np.empty((dof, dof)))
+    by_source = _shares_source_state(data)
+    scratch = (_workspace(data), np.empty((dof, dof)))
+    # every array borrowed (:func:`borrowed`): the caller holds the arguments, ``scratch``
+    # lives until :func:`_hold` below
+    data_, rows_, cols_, out_, work, block = borrowed((data, rows, cols, out, scratch[0], scratch[1]))
+    alpha = data_.alpha
+    n_outer = cols_.shape[0] if by_source else rows_.shape[0]
+    n_inner = rows_.shape[0] if by_source else cols_.shape[0]
+    for outer in range(n_outer):
+        if by_source:
+            state = _source_state(data_, cols_[outer], work)
+        for inner in range(n_inner):
+            ia = inner if by_source else outer
+            jb = outer if by_source else inner
+            i = rows_[ia]
+            j = cols_[jb]
+            if not by_source:
+                state = _source_state(data_, j, work)
+            _element_traction(data_, i, j, state, work, block)
+            if alpha > 0.0 and i != j:
+                scale_to_self(block, alpha * data_.self_max[j])
+            for p in range(dof):
+                for q in range(dof):
+                    out_[dof * ia + p, dof * jb + q] = block[p, q]
+    _hold(scratch)
 
 
 @njit(cache=True, nogil=True)

@@ -39,6 +39,14 @@ closed-form kernel of :mod:`hmatddm.kernels.line2d`); in any other layer, the
 transmitted and reflected pairs minus the source layer's whole-plane (Kelvin) field,
 because the callers add the closed-form kernel of the source's material at every
 receiver. So with equal layers the complementary stress is exactly zero.
+
+Compile cost (issue 18): numba links every njit function a function calls into its
+compiled library and optimises all of it again there, so each njit level above the per-pair
+stress costs one more compile of everything below it, and numba compiles one specialization
+per literal argument (``0``) where another call passes a variable. So the short functions
+above the quadrature (:func:`trace_points`, :func:`image_element_stress`) are inlined by
+numba, not compiled on their own, and calls pass run-time values (``np.int64(0)``).
+``benchmarks/bench_layered3d_compile.py --2d`` measures it.
 """
 import math
 
@@ -231,7 +239,8 @@ def _complementary_gradient(y1, y3, receiver_layer, x1, n_pairs, source_layer, t
         coef[1, 0, 0] = -k_2d
         coef[1, 1, 0] = -k_2d
         dcoef = np.zeros((2, 2, 1))
-        _pair_stress_gradient(y1 - x1, y3 - t, 1.0, coef, dcoef, 1, delta_s, g_s, _lame(g_s, nu_s), gradient, work1)
+        _pair_stress_gradient(y1 - x1, y3 - t, 1.0, coef, dcoef, np.int64(1), delta_s, g_s, _lame(g_s, nu_s), gradient,
+                              work1)
 
 
 @njit(cache=True)
@@ -250,7 +259,7 @@ def kelvin_point_stress(y1, y3, x1, x3, normal, shear_modulus, poisson_ratio, ou
     dcoef = np.zeros((2, 2, 1))
     gradient = np.zeros((2, 2, 3))
     lame = _lame(shear_modulus, poisson_ratio)
-    pair_stress_gradient(y1 - x1, y3 - x3, 1.0, coef, dcoef, 1, delta, shear_modulus, lame, gradient)
+    pair_stress_gradient(y1 - x1, y3 - x3, 1.0, coef, dcoef, np.int64(1), delta, shear_modulus, lame, gradient)
     out[:] = 0.0
     _contract(gradient, normal, shear_modulus, lame, 1.0, out)
 
@@ -284,18 +293,22 @@ def image_point_stress(y1, y3, receiver_layer, x1, x3, source_layer, normal, int
 
 
 @njit(cache=True)
-def trace_points(p0, p1, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, xi, untraced=False):
-    """The image pairs of the source points ``x(xi)`` of the element ``p0 -> p1``:
-    ``(n_pairs (G,), layer (G, P), z (G, P), eps (G, P), coef (G, P, 2, 2, O), dcoef)``.
-    ``untraced``: only allocate (fill ranges later with :func:`_trace_range`)."""
+def traced_buffer(source_layer, shear_modulus, n_images, n_points):
+    """Room for the image pairs of ``n_points`` source points, as :func:`trace_points`
+    returns them, untraced (fill ranges with :func:`_trace_range`)."""
     cap, n_orders = trace_capacity(source_layer, shear_modulus, n_images)
-    n_points = xi.shape[0]
-    traced = (np.zeros(n_points, dtype=np.int64), np.empty((n_points, cap), dtype=np.int64),
-              np.empty((n_points, cap)), np.empty((n_points, cap)), np.zeros((n_points, cap, 2, 2, n_orders)),
-              np.zeros((n_points, cap, 2, 2, n_orders)))
-    if not untraced:
-        _trace_range(p0, p1, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, xi, 0, n_points,
-                     traced)
+    return (np.zeros(n_points, dtype=np.int64), np.empty((n_points, cap), dtype=np.int64),
+            np.empty((n_points, cap)), np.empty((n_points, cap)), np.zeros((n_points, cap, 2, 2, n_orders)),
+            np.zeros((n_points, cap, 2, 2, n_orders)))
+
+
+@njit(cache=True, inline="always")
+def trace_points(p0, p1, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, xi):
+    """The image pairs of the source points ``x(xi)`` of the element ``p0 -> p1``:
+    ``(n_pairs (G,), layer (G, P), z (G, P), eps (G, P), coef (G, P, 2, 2, O), dcoef)``."""
+    traced = traced_buffer(source_layer, shear_modulus, n_images, xi.shape[0])
+    _trace_range(p0, p1, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, xi, np.int64(0),
+                 xi.shape[0], traced)
     return traced
 
 
@@ -332,7 +345,7 @@ def _integrate(y1, y3, receiver_layer, p0, p1, source_layer, shear_modulus, pois
             _contract(gradient, normal, g_s, lame_s, weights[g] * jac * shape[g, m], out[m])
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def image_element_stress(y1, y3, receiver_layer, p0, p1, source_layer, interfaces, shear_modulus, poisson_ratio,
                          n_images, xi, weights, shape, out):
     """Complementary stress integrated over the straight element ``p0 -> p1`` (normal:
@@ -345,7 +358,7 @@ def image_element_stress(y1, y3, receiver_layer, p0, p1, source_layer, interface
     traced = trace_points(p0, p1, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, xi)
     out[:] = 0.0
     _integrate(y1, y3, receiver_layer, p0, p1, source_layer, shear_modulus, poisson_ratio, xi, weights, shape, traced,
-               0, out, np.empty((2, 2, 3)), Workspace(traced[4].shape[-1]), Workspace(1))
+               np.int64(0), out, np.empty((2, 2, 3)), Workspace(traced[4].shape[-1]), Workspace(1))
 
 
 def __getattr__(name):

@@ -9,7 +9,7 @@ from numba import njit
 
 from ..kernels import line2d
 from ..kernels.drivers import KernelKind, kernel_record, register_kind
-from .images2d import Workspace, _integrate, _trace_range, image_element_stress, trace_points
+from .images2d import Workspace, _integrate, _trace_range, image_element_stress, traced_buffer
 from .segment_quadrature import composite_rule, subdivision_level, subdivisions
 
 
@@ -67,8 +67,7 @@ def source_state(data, j, work):
     p0 = data.centers[j] - data.half_length[j] * data.frames[j, 0]
     p1 = data.centers[j] + data.half_length[j] * data.frames[j, 0]
     xi, wt, start = _level_rule(data.gauss_points, _CACHED_LEVELS - 1)
-    traced = trace_points(p0, p1, ls, data.interfaces, data.shear_modulus, data.poisson_ratio, data.n_images,
-                          xi, True)
+    traced = traced_buffer(ls, data.shear_modulus, data.n_images, xi.shape[0])
     is_traced = np.zeros(_CACHED_LEVELS, dtype=np.bool_)
     return p0, p1, xi, wt, start, traced, is_traced, Workspace(traced[4].shape[-1])
 
