@@ -152,6 +152,8 @@ def test_equal_layers_give_the_homogeneous_3d_run_to_round_off():
                        rtol=1e-9, atol=0.0)
 
 
+@pytest.mark.slow  # end to end (issue 18); the default set keeps the cut (rectangles_are_cut_...) and 3D layered
+# growth (growth_up_to_a_free_surface_...)
 def test_3d_growth_across_interfaces_cuts_elements_there():
     """Stiffer bounding layers (gamma = 2) at z = +-1: the fracture grows into both, its
     new elements end on the interfaces (none straddles) and tips there use the layer ahead.
@@ -244,6 +246,8 @@ def test_sill_below_a_free_surface_reaches_toughness_first_under_the_same_pressu
 BI_MATERIAL = LayeredMedium([1.0], [2 * G, G], [NU, NU], images=1)  # one interface: cheap
 
 
+@pytest.mark.slow  # end to end (issue 18); the default set keeps kill-and-resume (test_simulation.py) and 3D
+# layered growth (growth_up_to_a_free_surface_...)
 def test_layered_3d_run_is_identical_after_kill_and_resume(tmp_path):
     """The pattern of tests/test_simulation.py: the child announces that step 1 is
     checkpointed and waits; it is killed (SIGKILL) while waiting; the resumed run, which
