@@ -72,7 +72,7 @@ class ExtendedElasticityOperator(LinearOperator):
         self._data = data
         self.n_reused = self._shared_new_elements(previous)
         shares = isinstance(previous, ExtendedElasticityOperator) and previous.base is base
-        self._old_norms = previous._old_norms if shares else None  # ||A_jj||_F of the base's elements
+        self._base_blocks = previous._base_blocks if shares else None  # the base's element self blocks
         self.chunks, self.nn = self._border_blocks(previous, self.n_reused)
         self._base_product = previous._base_product if shares else _LastProduct(base.matvec)
         self._nn_levels = GrowingBlockLU(self.nn, previous._nn_levels.prefix(self.n_reused * self.dof)
@@ -151,13 +151,12 @@ class ExtendedElasticityOperator(LinearOperator):
         block ILU, ``||A_ij||_F >= threshold sqrt(||A_ii||_F ||A_jj||_F)``."""
         d, n0 = self.dof, self.n_base
         m = no.shape[0] // d
-        if self._old_norms is None:
-            self._old_norms = np.linalg.norm(self.base.element_diagonal_blocks(), axis=(1, 2))
+        old_norms = np.linalg.norm(self._base_diagonal_blocks(), axis=(1, 2))
         index = np.arange(m)
         new_norms = np.linalg.norm(nn.reshape(m, d, m, d)[index, :, index, :], axis=(1, 2))
         blocks = no.reshape(m, d, n0, d)
         norms = np.sqrt(np.einsum("ipjq,ipjq->ij", blocks, blocks))
-        keep = norms >= NEAR_THRESHOLD * np.sqrt(new_norms[:, None] * self._old_norms[None, :])
+        keep = norms >= NEAR_THRESHOLD * np.sqrt(new_norms[:, None] * old_norms[None, :])
         rows, cols = np.nonzero(keep)
         indptr = np.concatenate([[0], np.cumsum(np.count_nonzero(keep, axis=1))])
         return sp.bsr_matrix((blocks[rows, :, cols, :], cols, indptr), shape=no.shape, blocksize=(d, d)).tocsr()
@@ -236,7 +235,14 @@ class ExtendedElasticityOperator(LinearOperator):
         d, m = self.dof, self.n_new
         index = np.arange(m)
         new = self.nn.reshape(m, d, m, d)[index, :, index, :]
-        return np.concatenate([self.base.element_diagonal_blocks(), new])
+        return np.concatenate([self._base_diagonal_blocks(), new])
+
+    def _base_diagonal_blocks(self):
+        """The base's element self blocks, computed once for the operators of one base (a
+        Python loop over the H-matrix's diagonal leaves; every growth pass asks for them)."""
+        if self._base_blocks is None:
+            self._base_blocks = self.base.element_diagonal_blocks()
+        return self._base_blocks
 
 
 def _flat_arrays(data):
