@@ -76,11 +76,13 @@ def fixed_point_columns(ut, vt, offset_u, offset_v, rank, m, n, eps, share):
     (Frobenius norm estimated as sqrt(sum_q ||u_q||^2 ||v_q||^2), exact for the
     orthogonal factors of a recompression).
     """
+    u_norms = np.empty(rank)
+    v_norms = np.empty(rank)
     norm2 = 0.0
     for q in range(rank):
-        a = _column_norm(ut, offset_u + q * m, m)
-        b = _column_norm(vt, offset_v + q * n, n)
-        norm2 += (a * b) ** 2
+        u_norms[q] = _column_norm(ut, offset_u + q * m, m)
+        v_norms[q] = _column_norm(vt, offset_v + q * n, n)
+        norm2 += (u_norms[q] * v_norms[q]) ** 2
     budget = share * eps * np.sqrt(norm2)
     if not np.isfinite(budget):  # NaN or inf entries stay visible in the float store
         return rank
@@ -88,11 +90,9 @@ def fixed_point_columns(ut, vt, offset_u, offset_v, rank, m, n, eps, share):
     head = rank
     while head > 0:
         q = head - 1
-        su = _column_norm(ut, offset_u + q * m, m)
-        sv = _column_norm(vt, offset_v + q * n, n)
         du = _rounding_error(ut, offset_u + q * m, m, _fixed_point_scale(ut, offset_u + q * m, m))
         dv = _rounding_error(vt, offset_v + q * n, n, _fixed_point_scale(vt, offset_v + q * n, n))
-        error = du * (sv + dv) + su * dv
+        error = du * (v_norms[q] + dv) + u_norms[q] * dv
         if used + error > budget:
             break
         used += error
