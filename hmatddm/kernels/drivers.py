@@ -63,6 +63,11 @@ counts are atomic operations, and a pair's reads of the record would otherwise p
 The drivers are cached on disk (``cache=True``); the cache of a driver does not notice
 edits in a kind's module: delete ``hmatddm/**/__pycache__/*.nbi|*.nbc`` after changing a
 kernel.
+
+Length (over ~400 lines): the registry of element kinds and every driver over element
+pairs (blocks, dense matrix, singular pairs, stress at points, serial and parallel) in
+one place, so that each kind writes only its per-pair functions; about 110 lines are this
+contract's documentation.
 """
 import inspect
 from concurrent.futures import ThreadPoolExecutor
