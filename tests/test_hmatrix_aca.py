@@ -216,7 +216,7 @@ def test_the_production_build_loop_gives_the_factors_of_aca_tensor():
     block must be exactly what aca_tensor + recompress give on the same elements with
     the tolerance the build uses, so the ACA tests above speak for production."""
     from hmatddm.hmatrix import HMatrix
-    from hmatddm.hmatrix.aca import ACA_TOLERANCE_FACTOR
+    from hmatddm.hmatrix.aca import RECOMPRESSED_ACA_FACTOR
     from hmatddm.hmatrix.example_kernels import tensor_generator, tensor_kernel
 
     rng = np.random.default_rng(3)
@@ -229,7 +229,7 @@ def test_the_production_build_loop_gives_the_factors_of_aca_tensor():
     for b in range(s.lowrank_rank.size):
         rows = permutation[s.lowrank_row_start[b]:s.lowrank_row_stop[b]].astype(np.int64)
         cols = permutation[s.lowrank_col_start[b]:s.lowrank_col_stop[b]].astype(np.int64)
-        u, v, _ = aca_tensor(tensor_kernel, generator.data, rows, cols, generator.dof, ACA_TOLERANCE_FACTOR * eps)
+        u, v, _ = aca_tensor(tensor_kernel, generator.data, rows, cols, generator.dof, RECOMPRESSED_ACA_FACTOR * eps)
         u, v, rank = recompress(u, v, eps)
         stored_u, stored_v = h._factors(b)
         assert rank == s.lowrank_rank[b]
@@ -287,3 +287,72 @@ def test_giving_up_leaves_ordinary_low_rank_blocks_alone():
     assert not aca_gave_up(ints)
     u, v, rank = aca_tensor(field_kernel, (data[0], sources), rows, cols, 3, 1e-6, 2)
     assert rank < 40 and relative_error(u, v, block) <= 3e-6
+
+
+def test_blocked_gram_schmidt_against_numpy_qr():
+    """The recompression's block Gram-Schmidt (panels of PANEL vectors, BLAS products
+    between panels) against numpy's Householder QR, across several panels, with
+    vectors in the span of earlier ones (they must come out as zero rows)."""
+    from hmatddm.hmatrix.aca import PANEL, _orthonormalize
+
+    rng = np.random.default_rng(11)
+    count, m = 3 * PANEL + 5, 200
+    vectors = rng.standard_normal((count, m)) * np.logspace(0, -6, count)[:, None]  # ACA-like decay
+    dependent = (PANEL + 3, 2 * PANEL + 1)
+    for k in dependent:
+        vectors[k] = 0.3 * vectors[1] - 2.0 * vectors[k - 2]
+    vectors = np.vstack((vectors, rng.standard_normal((4, m))))  # rows beyond count are ignored
+    q, r = _orthonormalize(vectors, count)
+    assert q.shape == (count, m) and r.shape == (count, count)
+    np.testing.assert_allclose(r.T @ q, vectors[:count], rtol=0, atol=1e-13 * np.abs(vectors).max())
+    assert np.allclose(np.tril(r, -1), 0.0)
+    kept = np.abs(np.diag(r)) > 0
+    assert not kept[list(dependent)].any() and kept.sum() == count - len(dependent)
+    assert np.all(q[~kept] == 0.0)
+    np.testing.assert_allclose(q[kept] @ q[kept].T, np.eye(kept.sum()), rtol=0, atol=1e-12)
+    # the same R as Householder QR up to the signs of its rows (independent vectors only)
+    independent = np.flatnonzero(kept)
+    _, reference = np.linalg.qr(vectors[independent].T)
+    _, ours = np.linalg.qr((r.T @ q)[independent].T)
+    np.testing.assert_allclose(np.abs(ours), np.abs(reference), rtol=1e-9, atol=1e-12 * np.abs(reference).max())
+
+
+def test_recompress_of_a_high_rank_factorisation_matches_the_svd():
+    """Recompression across several Gram-Schmidt panels: the kept rank and the product
+    are those of the truncated SVD of U V^T (computed apart with numpy)."""
+    from hmatddm.hmatrix.aca import PANEL
+
+    rng = np.random.default_rng(12)
+    k, m, n = 3 * PANEL + 2, 150, 170
+    u = rng.standard_normal((m, k)) * np.logspace(0, -9, k)
+    v = rng.standard_normal((n, k))
+    block = u @ v.T
+    sigma = np.linalg.svd(block, compute_uv=False)
+    for eps in (1e-2, 1e-5, 1e-8):
+        tail = np.sqrt(np.cumsum(sigma[::-1] ** 2))[::-1]  # tail[r] = ||sigma[r:]||
+        expected = int(np.argmax(tail <= eps * np.linalg.norm(sigma)))
+        u2, v2, rank = recompress(np.ascontiguousarray(u), np.ascontiguousarray(v), eps)
+        assert rank == expected
+        error = relative_error(u2, v2, block)
+        assert error <= eps
+        np.testing.assert_allclose(error, tail[rank] / np.linalg.norm(sigma), rtol=1e-6)
+
+
+@pytest.mark.parametrize("rank", [0, 1, 7, 40])
+def test_residual_updates_against_numpy(rank):
+    """The ACA's residual updates of a row element and a column element (one BLAS
+    product each) against U V^T computed with numpy."""
+    from hmatddm.hmatrix.aca import _subtract_cols, _subtract_rows
+
+    rng = np.random.default_rng(rank)
+    d, m, n = 3, 60, 75
+    ut, vt = rng.standard_normal((rank + 5, m)), rng.standard_normal((rank + 5, n))  # capacity beyond rank
+    product = ut[:rank].T @ vt[:rank]
+    rows = rng.standard_normal((d, n))
+    expected = rows - product[12:12 + d]
+    _subtract_rows(rows, ut, vt, rank, 12)
+    np.testing.assert_allclose(rows, expected, rtol=0, atol=1e-12)
+    cols = rng.standard_normal((m, d))
+    expected = cols - product[:, 30:30 + d]
+    _subtract_cols(cols, ut, vt, rank, 30)
+    np.testing.assert_allclose(cols, expected, rtol=0, atol=1e-12)
