@@ -45,7 +45,9 @@ components at points x DD components of elements, has d_r != d_c; a square opera
 d_r = d_c = d); it has m = d_r*m_e rows and n = d_c*n_e columns and is approximated by
 U V^T with U (m x k) and V (n x k). A pivot is a d_r x d_c block. The ACA and the recompression work on the transposed
 factors (``ut`` k x m, ``vt`` k x n, one vector per contiguous row) so that every
-inner loop is contiguous.
+inner loop is contiguous. The residual updates and the recompression's projections are
+BLAS products; the build runs them on one BLAS thread (storage._run_parallel), and so do
+the Python entry points here, so that the factors never depend on the BLAS thread count.
 
 Length (over ~400 lines): the one ACA loop used in production and its numba helpers
 (pivoting on tensor blocks, re-pivoting, recompression), which must compile together.
@@ -54,6 +56,7 @@ Length (over ~400 lines): the one ACA loop used in production and its numba help
 import numpy as np
 from numba import njit, types
 
+from ._threads import single_threaded_blas
 from .first_class import INDEX, compiled_for_data
 
 # Floating-point flags that let LLVM vectorise dot products (reassociation) while
@@ -617,8 +620,9 @@ def aca_tensor(kernel, data, row_elements, col_elements, dof, eps, col_dof=0):
     """
     col_dof = col_dof if col_dof > 0 else dof
     compiled = _for_data(_aca_tensor, data, 2)
-    return compiled(kernel, data, _index(row_elements), _index(col_elements), int(dof), int(col_dof), float(eps),
-                    aca_start, aca_advance)
+    with single_threaded_blas():  # as in the build (see recompress)
+        return compiled(kernel, data, _index(row_elements), _index(col_elements), int(dof), int(col_dof), float(eps),
+                        aca_start, aca_advance)
 
 
 def _aca_tensor(kernel, data, row_elements, col_elements, dof, col_dof, eps, start, advance):
@@ -684,8 +688,9 @@ def aca_compressed(kernel, data, row_elements, col_elements, row_dof, col_dof, e
     per data type (cached on disk, :func:`_for_data`).
     """
     compiled = _for_data(_aca_compressed.py_func, data, 3)
-    return compiled(kernel, data, _index(row_elements), _index(col_elements), int(row_dof), int(col_dof), float(eps),
-                    aca_start, aca_advance, recompress_state)
+    with single_threaded_blas():  # as in the build (see recompress)
+        return compiled(kernel, data, _index(row_elements), _index(col_elements), int(row_dof), int(col_dof),
+                        float(eps), aca_start, aca_advance, recompress_state)
 
 
 @njit(nogil=True)
@@ -824,9 +829,18 @@ def recompress_transposed(ut, vt, rank, eps):
     return u_out, v_out, new_rank
 
 
-@njit(cache=True, nogil=True)
 def recompress(u, v, eps):
-    """recompress_transposed for factors U (m x k), V (n x k); returns (U', V', rank')."""
+    """recompress_transposed for factors U (m x k), V (n x k); returns (U', V', rank').
+
+    On one BLAS thread, as in the build: the rounding of the BLAS products (and so the
+    factors, to round-off) would otherwise depend on the BLAS thread count."""
+    with single_threaded_blas():
+        return _recompress(u, v, eps)
+
+
+@njit(cache=True, nogil=True)
+def _recompress(u, v, eps):
+    """:func:`recompress` (compiled)."""
     ut, vt, rank = recompress_transposed(np.ascontiguousarray(u.T), np.ascontiguousarray(v.T), u.shape[1], eps)
     return np.ascontiguousarray(ut.T), np.ascontiguousarray(vt.T), rank
 
