@@ -61,7 +61,14 @@ def set_key(scene, path, value):
     return scene
 
 
-DELETE = object()
+class _Delete:
+    """The marker DELETE; its repr is the test id, the same in every pytest-xdist worker."""
+
+    def __repr__(self):
+        return "DELETE"
+
+
+DELETE = _Delete()
 
 BAD_SCENES = [
     ("material.poisson_ratio", 0.5, "material.poisson_ratio must be in [0, 0.5), got 0.5"),
