@@ -42,17 +42,53 @@ def rotation_2d(angle):
     return np.array([[c, -s], [s, c]])
 
 
+# -- parallel run (pytest-xdist: `-n 2 --dist loadgroup --no-loadscope-reorder`, pyproject.toml)
+# Most of a cold run's CPU time is numba compiling kernels on first use, on one thread,
+# and each worker process compiles for itself what the on-disk cache does not yet hold.
+# So the tests of a module run in one worker, and the modules that compile the same costly
+# kernel family form one group. The two biggest families (layered media in 3D and in 2D,
+# each also compiling the homogeneous kernels of its dimension) go out first, one to each
+# worker, so that they compile at the same time on different cores and the other modules
+# find most kernels in the cache; then the other modules, those with the most tests first.
+
+_FAMILIES = {
+    "layered-3d": ("test_layered_engine3d.py", "test_layered_halfspace3d.py",
+                   "test_layered_images3d.py", "test_layered_influence3d.py"),
+    "layered-2d": ("test_layered.py", "test_layered_engine.py", "test_layered_natural.py",
+                   "test_higher_order_elements.py", "test_kernels_drivers.py"),
+}
+_FAMILY_OF_MODULE = {module: family for family, modules in _FAMILIES.items() for module in modules}
+
+
+@pytest.hookimpl(tryfirst=True)  # before pytest-xdist reads the groups
+def pytest_collection_modifyitems(config, items):
+    for item in items:
+        module = item.path.name
+        item.add_marker(pytest.mark.xdist_group(_FAMILY_OF_MODULE.get(module, module)))
+    if hasattr(config, "workerinput"):  # a pytest-xdist worker: its order is the order sent out
+        count = {}
+        for item in items:
+            count[item.path.name] = count.get(item.path.name, 0) + 1
+        rank = {family: i for i, family in enumerate(_FAMILIES)}
+        items.sort(key=lambda item: (rank.get(_FAMILY_OF_MODULE.get(item.path.name), len(rank)),
+                                     -count[item.path.name]))
+
+
 # -- CPU time per test (load-independent, unlike --durations' wall time) -------------------
 # `python -m pytest --cpu-durations=30` lists the 30 tests that used the most CPU time
 # (this process and its threads, plus waited-for child processes), and the session's total:
-# on a shared machine this is what a test would cost on a quiet one.
+# on a shared machine this is what a test would cost on a quiet one. Under pytest-xdist each
+# worker measures its tests and sends the figure with the teardown report; the summary adds
+# the CPU time of each worker.
 
 def pytest_addoption(parser):
     parser.addoption("--cpu-durations", type=int, default=None, metavar="N",
                      help="list the N tests with the most CPU time (setup + call + teardown)")
 
 
-_CPU_SECONDS = {}
+_CPU_SECONDS = {}  # nodeid -> (CPU seconds, worker)
+_CPU_SECONDS_PER_WORKER = {}
+_CPU_START = {}
 
 
 def _cpu_now():
@@ -64,12 +100,40 @@ def _cpu_now():
 
 @pytest.hookimpl(hookwrapper=True)
 def pytest_runtest_protocol(item, nextitem):
-    if item.config.getoption("--cpu-durations") is None:
-        yield
-        return
-    start = _cpu_now()
+    if item.config.getoption("--cpu-durations") is not None:
+        _CPU_START[item.nodeid] = _cpu_now()
     yield
-    _CPU_SECONDS[item.nodeid] = _cpu_now() - start
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(item, call):
+    outcome = yield
+    if call.when == "teardown" and item.nodeid in _CPU_START:
+        outcome.get_result().user_properties.append(("cpu_seconds", _cpu_now() - _CPU_START.pop(item.nodeid)))
+
+
+def pytest_runtest_logreport(report):
+    for name, value in report.user_properties:
+        if name == "cpu_seconds":
+            worker = getattr(getattr(report, "node", None), "gateway", None)
+            worker = worker.id if worker is not None else "this process"
+            _CPU_SECONDS[report.nodeid] = value, worker
+            _CPU_SECONDS_PER_WORKER[worker] = _CPU_SECONDS_PER_WORKER.get(worker, 0.0) + value
+
+
+_CPU_SECONDS_OF_WORKER_PROCESS = {}
+
+
+def pytest_sessionfinish(session):
+    workeroutput = getattr(session.config, "workeroutput", None)
+    if workeroutput is not None and session.config.getoption("--cpu-durations") is not None:
+        workeroutput["cpu_seconds"] = _cpu_now()  # the whole worker, its collection included
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_testnodedown(node, error):
+    if "cpu_seconds" in getattr(node, "workeroutput", {}):
+        _CPU_SECONDS_OF_WORKER_PROCESS[node.gateway.id] = node.workeroutput["cpu_seconds"]
 
 
 def pytest_terminal_summary(terminalreporter, exitstatus, config):
@@ -77,9 +141,14 @@ def pytest_terminal_summary(terminalreporter, exitstatus, config):
     if count is None or not _CPU_SECONDS:
         return
     terminalreporter.section(f"most CPU time ({count} of {len(_CPU_SECONDS)} tests)")
-    for nodeid, seconds in sorted(_CPU_SECONDS.items(), key=lambda kv: -kv[1])[:count]:
-        terminalreporter.write_line(f"{seconds:8.2f}s cpu  {nodeid}")
-    terminalreporter.write_line(f"{sum(_CPU_SECONDS.values()):8.2f}s cpu  in all tests")
+    for nodeid, (seconds, worker) in sorted(_CPU_SECONDS.items(), key=lambda kv: -kv[1][0])[:count]:
+        where = f"{worker}  " if len(_CPU_SECONDS_PER_WORKER) > 1 else ""
+        terminalreporter.write_line(f"{seconds:8.2f}s cpu  {where}{nodeid}")
+    for worker, seconds in sorted(_CPU_SECONDS_PER_WORKER.items()):
+        whole = _CPU_SECONDS_OF_WORKER_PROCESS.get(worker)
+        whole = f" ({whole:.2f}s cpu in the whole worker process)" if whole is not None else ""
+        terminalreporter.write_line(f"{seconds:8.2f}s cpu  in the tests of {worker}{whole}")
+    terminalreporter.write_line(f"{sum(_CPU_SECONDS_PER_WORKER.values()):8.2f}s cpu  in all tests")
 
 
 # -- a child process killed at a point it announces (event-driven, never sleep-driven) -----
