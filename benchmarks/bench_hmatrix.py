@@ -7,6 +7,8 @@
     python benchmarks/bench_hmatrix.py --rank-study 4000   # cloud: far-block ranks by kind (same/two fractures) and level
     python benchmarks/bench_hmatrix.py --memory-study 10000,40000 --variants 1e-4:32:float64,1e-4:16:float32
                                                        # planar: where the memory goes, growth exponents
+    python benchmarks/bench_hmatrix.py --aca-study 10000 --aca-factors 0.1,0.3,0.5
+                                                       # far blocks: ACA tolerance vs cost, ranks, block error
 
 Three studies, each printed as a markdown table and saved (JSON + PNG) in benchmarks/out/:
 
@@ -250,6 +252,90 @@ def rank_study(n, eps=1e-4, leaf_size=32):
     for r in out:
         print(json.dumps(r), flush=True)
     return out
+
+
+def aca_study(n, factors, geometry="cloud", eps=1e-4, stride=9, leaf_size=32):
+    """Every ``stride``-th far block of the N-element ``geometry`` (tree as ElasticityOperator
+    builds it), compressed as the build does (whole-element ACA at ``factor * eps``, then
+    recompression at eps) for each ACA tolerance factor: process CPU time of the kernel
+    evaluations, the ACA steps and the recompression (one thread), mean ACA and stored
+    rank, and the stored block's relative Frobenius error against the exact block (worst,
+    median, count above eps). Returns a list of dicts, one per factor."""
+    import hmatddm as hd
+    from hmatddm.hmatrix import aca
+    from hmatddm.hmatrix._threads import single_threaded_blas
+    from hmatddm.hmatrix.block_tree import block_tree
+    from hmatddm.hmatrix.cluster_tree import cluster_tree
+    from hmatddm.kernels.drivers import traction_block
+    from hmatddm.operators import influence_data
+
+    mesh = (planar if geometry == "planar" else cloud)(n)
+    data = influence_data(mesh, hd.Elastic(shear_modulus=10e9, poisson_ratio=0.25))
+    tree = cluster_tree(mesh.centers, mesh.radii, leaf_size, groups=None if geometry == "planar" else mesh.fracture_id)
+    blocks = block_tree(tree, 3.0)
+    p = tree.permutation
+    sample = []
+    for b in range(0, blocks.admissible_rows.size, stride):
+        rows = p[tree.start[blocks.admissible_rows[b]]:tree.stop[blocks.admissible_rows[b]]].astype(np.int64)
+        cols = p[tree.start[blocks.admissible_cols[b]]:tree.stop[blocks.admissible_cols[b]]].astype(np.int64)
+        exact = np.empty((3 * rows.size, 3 * cols.size))
+        traction_block(data, rows, cols, exact)
+        sample.append((rows, cols, exact))
+    def compress(rows, cols, factor, cpu):
+        """(ACA rank, stored U'^T, V'^T, stored rank), or None when the ACA gave up."""
+        ut, vt, r, c, rv, cv, ints, floats, request, index = aca.aca_start(rows.size, cols.size, 3, 3, factor * eps)
+        while request != aca.REQUEST_DONE:
+            t0 = time.process_time()
+            if request == aca.REQUEST_ROW:
+                traction_block(data, rows[index:index + 1], cols, r)
+            else:
+                traction_block(data, rows, cols[index:index + 1], c)
+            t1 = time.process_time()
+            ut, vt, request, index = aca.aca_advance(ut, vt, r, c, rv, cv, ints, floats)
+            cpu["kernel"] += t1 - t0
+            cpu["aca"] += time.process_time() - t1
+        if aca.aca_gave_up(ints):
+            return None  # the build stores the block dense: exact
+        t0 = time.process_time()
+        u2, v2, k2 = aca.recompress_state(ut, vt, ints, eps)
+        cpu["recompression"] += time.process_time() - t0
+        return int(ints[1]), u2, v2, k2
+
+    out = []
+    with single_threaded_blas():
+        compress(sample[0][0], sample[0][1], factors[0], dict(kernel=0.0, aca=0.0, recompression=0.0))  # compile
+        for factor in factors:
+            cpu = dict(kernel=0.0, aca=0.0, recompression=0.0)
+            aca_rank, ranks, errors, gave_up = [], [], [], 0
+            for rows, cols, exact in sample:
+                result = compress(rows, cols, factor, cpu)
+                if result is None:
+                    gave_up += 1
+                    continue
+                aca_rank.append(result[0])
+                ranks.append(result[3])
+                errors.append(np.linalg.norm(result[1].T @ result[2] - exact) / np.linalg.norm(exact) / eps)
+            errors = np.array(errors)
+            out.append(dict(geometry=geometry, n=mesh.n_elements, eps=eps, factor=factor, blocks=len(sample),
+                            gave_up=gave_up, **{k + "_cpu_s": v for k, v in cpu.items()},
+                            total_cpu_s=sum(cpu.values()), aca_rank=float(np.mean(aca_rank)),
+                            stored_rank=float(np.mean(ranks)), worst_error_over_eps=float(errors.max()),
+                            median_error_over_eps=float(np.median(errors)), above_eps=int((errors > 1.0).sum())))
+    for r in out:
+        print(json.dumps(r), flush=True)
+    return out
+
+
+def print_aca_table(rows):
+    from _common import markdown_table
+
+    header = ["geometry", "N", "eps", "ACA at", "blocks", "CPU kernel / ACA / recompression (s)", "total CPU (s)",
+              "ACA rank", "stored rank", "block error / eps, worst / median", "blocks above eps", "gave up (dense)"]
+    print(markdown_table(header, [[r["geometry"], r["n"], f"{r['eps']:.0e}", f"{r['factor']:g} eps", r["blocks"],
+                                   f"{r['kernel_cpu_s']:.2f} / {r['aca_cpu_s']:.2f} / {r['recompression_cpu_s']:.2f}",
+                                   f"{r['total_cpu_s']:.2f}", f"{r['aca_rank']:.1f}", f"{r['stored_rank']:.1f}",
+                                   f"{r['worst_error_over_eps']:.2f} / {r['median_error_over_eps']:.2f}",
+                                   r["above_eps"], r["gave_up"]] for r in rows]))
 
 
 def sampled_smooth_error(mesh, data, y, n_rows=300, chunk=10):
@@ -519,6 +605,10 @@ def main():
                              "cluster boxes; factors default, adaptive, float32 or float64)")
     parser.add_argument("--rank-study", type=int, default=None, metavar="N",
                         help="cloud of N elements: rank and memory of far blocks by kind and level, then exit")
+    parser.add_argument("--aca-study", type=int, default=None, metavar="N",
+                        help="every 9th far block of N-element cloud and planar meshes: ACA tolerance factor against "
+                             "CPU split, ranks and stored block error (one thread), then exit")
+    parser.add_argument("--aca-factors", default="0.1,0.3", help="ACA tolerance factors (times eps) for --aca-study")
     parser.add_argument("--memory-case", default=None, help=argparse.SUPPRESS)
     args = parser.parse_args()
     sys.path.insert(0, HERE)
@@ -547,6 +637,15 @@ def main():
         return
     if args.tree_study:
         tree_study(args.tree_study)
+        return
+    if args.aca_study:
+        from _common import machine
+
+        print(f"Machine: {machine()}")
+        factors = [float(f) for f in args.aca_factors.split(",")]
+        rows = [r for g in args.geometries.split(",") for r in aca_study(args.aca_study, factors, geometry=g,
+                                                                         eps=args.eps)]
+        print_aca_table(rows)
         return
     if args.rank_study:
         rank_study(args.rank_study)
