@@ -34,10 +34,15 @@ ACA only ends normally through a passed stopping test and convergence check (or 
 zero block); an end without them after every row or every column element was a pivot
 makes it GIVE UP by design: it stops and flags the block (:func:`aca_gave_up`), and the
 callers store and apply the block exactly (dense); the kernel fill costs no more
-entries than the ACA already spent. Full rank min(m, n) is exact in exact arithmetic
-and goes through the check like convergence. (Giving up also on rank min(m, n), or
-on a converged block with no unvisited element left to check, was tried: those
-blocks were within eps after recompression, and storing them dense cost memory.)
+entries than the ACA already spent. It also gives up on reaching rank min(m, n): exact
+in exact arithmetic, but not in floating point (on an AMD EPYC the 28 x 32-element field
+block above reached rank 64 of 64 with "converged" factors 17x eps off at eps 1e-6, a
+different rounding of the same pivots), while the check can only probe unvisited
+elements; and min(m, n) (m + n) > m n, so dense storage is smaller too. (An earlier
+version checked full rank like convergence: those blocks were within eps after
+recompression on an Intel Xeon, where some recompressed below the dense break-even.)
+(Giving up on a converged block with no unvisited element left to check was tried and
+not kept: those blocks were within eps after recompression, and storing them dense cost memory.)
 
 Conventions: a block is given by its row elements (m_e of them, d_r unknowns each)
 and column elements (n_e, d_c unknowns each: a rectangular matrix, e.g. stress
@@ -383,6 +388,7 @@ def _next_check(row_visited, col_visited, ints):
 
 # Why the ACA gave up (ints[_GAVE_UP]; 0: it did not).
 GAVE_UP_NO_PIVOT = 1  # ended unconverged after every row or column element was a pivot
+GAVE_UP_FULL_RANK = 2  # the rank reached min(m, n)
 
 
 @njit(cache=True, nogil=True)
@@ -476,7 +482,7 @@ def aca_advance(ut, vt, rows, cols, row_visited, col_visited, ints, floats):
     When the ACA ends without a passed stopping test and check after every row or
     every column element was a pivot (the pivots ran out, or only zero residuals were
     left where pivots were), it gives up (REQUEST_DONE with :func:`aca_gave_up` true;
-    module docstring). Full rank is checked like convergence.
+    module docstring). It also gives up on reaching rank min(m, n).
     Returns (ut, vt, request, index); ut, vt may have been reallocated to grow.
     """
     d = rows.shape[0]  # unknowns per row element
@@ -570,8 +576,13 @@ def aca_advance(ut, vt, rows, cols, row_visited, col_visited, ints, floats):
     ints[_RANK] = rank
     floats[_NORM2] = max(floats[_NORM2] + update_norm2 + cross, 0.0)
     ints[_FAILURES] = 0
-    if rank >= max_rank or update_norm2 <= floats[_EPS] ** 2 * floats[_NORM2]:
-        # converged, or full rank (exact in exact arithmetic: the check measures it)
+    if rank >= max_rank:
+        # Full rank: exact in exact arithmetic, but not always in floating point (the
+        # weak directions of rectangular pivots), and the check can only probe unvisited
+        # elements: the exact block is both safe and no larger (min(m, n) (m + n) > m n).
+        request, index = _give_up(ints, GAVE_UP_FULL_RANK)
+        return ut, vt, request, index
+    if update_norm2 <= floats[_EPS] ** 2 * floats[_NORM2]:
         request, index = _next_check(row_visited, col_visited, ints)
         return ut, vt, request, index
     row = _next_pivot_row(cols, row_visited, d, True, NEGLIGIBLE * floats[_SCALE])
