@@ -281,6 +281,8 @@ def aca_study(n, factors, geometry="cloud", eps=1e-4, stride=9, leaf_size=32):
         exact = np.empty((3 * rows.size, 3 * cols.size))
         traction_block(data, rows, cols, exact)
         sample.append((rows, cols, exact))
+    aca.aca_steps()  # the steps compiled for the drivers' signatures before the direct calls below
+
     def compress(rows, cols, factor, cpu):
         """(ACA rank, stored U'^T, V'^T, stored rank), or None when the ACA gave up."""
         ut, vt, r, c, rv, cv, ints, floats, request, index = aca.aca_start(rows.size, cols.size, 3, 3, factor * eps)

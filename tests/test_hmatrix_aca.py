@@ -276,14 +276,14 @@ def test_a_block_the_aca_cannot_compress_is_exact_not_approximate(seed, eps):
 def test_giving_up_leaves_ordinary_low_rank_blocks_alone():
     """The same kernel on a well separated block (4x farther): an ordinary low-rank ACA,
     not given up, within eps, rank far below min(m, n)."""
-    from hmatddm.hmatrix.aca import _aca_loop, aca_advance, aca_gave_up, aca_start
+    from hmatddm.hmatrix.aca import _aca_loop, aca_gave_up, aca_steps
     from hmatddm.hmatrix.example_kernels import field_kernel
 
     data, rows, cols, _ = near_full_rank_field_block(0)
     sources = data[1] + np.array([8.0, 0.0, 0.0])
     block = np.empty((84, 64))
     field_kernel((data[0], sources), rows, cols, block)
-    _, _, ints = _aca_loop(field_kernel, (data[0], sources), rows, cols, 3, 2, 1e-6, aca_start, aca_advance)
+    _, _, ints = _aca_loop(field_kernel, (data[0], sources), rows, cols, 3, 2, 1e-6, *aca_steps()[:2])
     assert not aca_gave_up(ints)
     u, v, rank = aca_tensor(field_kernel, (data[0], sources), rows, cols, 3, 1e-6, 2)
     assert rank < 40 and relative_error(u, v, block) <= 3e-6

@@ -17,6 +17,18 @@ def test_importing_the_package_loads_no_engine_and_no_renderer():
     assert loaded == []
 
 
+def test_importing_the_aca_module_compiles_nothing_until_the_steps_are_asked_for():
+    """Issue 18 item 7: the ACA steps are compiled on first use (``aca_steps()``), with
+    their declared signatures, not when ``hmatddm.hmatrix.aca`` is imported."""
+    out = _fresh("from hmatddm.hmatrix import aca\n"
+                 "print(*[len(step.overloads) for step in aca.ACA_STEPS])\n"
+                 "steps = aca.aca_steps()\n"
+                 "print(*[len(step.overloads) for step in steps])\n"
+                 "print(*[step.get_compile_result(kind.signature).signature == kind.signature\n"
+                 "        for step, kind in zip(steps, aca.ACA_STEP_TYPES)])")
+    assert out == ["0", "0", "0", "1", "1", "1", "True", "True", "True"]
+
+
 def test_a_name_is_imported_on_first_access_and_then_bound():
     out = _fresh("import sys, hmatddm as hd\n"
                  "print('hmatddm.material' in sys.modules)\n"

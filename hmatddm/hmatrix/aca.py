@@ -426,10 +426,12 @@ def aca_gave_up(ints):
     return ints[_GAVE_UP] != 0
 
 
-# Explicit signatures of the state-machine steps: with them the kernel-specific build
-# and product drivers take these compiled functions as first-class function arguments
+# Signatures of the state-machine steps: compiled for these (:func:`aca_steps`), the
+# kernel-specific build and product drivers take them as first-class function arguments
 # and call them through pointers instead of linking (and re-optimising) their code,
-# which cuts the cold compile per kernel data type from ~10 s to ~3 s of CPU.
+# which cuts the cold compile per kernel data type from ~10 s to ~3 s of CPU. They are
+# compiled on first use, not at import: ~28 s of CPU with a cold cache (AMD EPYC),
+# which each test process and every dense-only run used to pay on importing this module.
 _MATRIX = types.float64[:, ::1]
 _FLAGS = types.boolean[::1]
 _INTS = types.int64[::1]
@@ -443,7 +445,7 @@ ACA_ADVANCE_SIGNATURE = types.Tuple((_MATRIX, _MATRIX, types.int64, types.int64)
 RECOMPRESS_STATE_SIGNATURE = types.Tuple((_MATRIX, _MATRIX, types.int64))(_MATRIX, _MATRIX, _INTS, types.float64)
 
 
-@njit(ACA_START_SIGNATURE, cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def aca_start(n_row_elements, n_col_elements, row_dof, col_dof, eps):
     """Allocate the ACA state of an (m_e x n_e)-element block with ``row_dof`` unknowns
     per row element and ``col_dof`` per column element; first request: row element 0.
@@ -467,7 +469,7 @@ def aca_start(n_row_elements, n_col_elements, row_dof, col_dof, eps):
             np.zeros(n_col_elements, dtype=np.bool_), ints, floats, REQUEST_ROW, 0)
 
 
-@njit(ACA_ADVANCE_SIGNATURE, cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def aca_advance(ut, vt, rows, cols, row_visited, col_visited, ints, floats):
     """One step of the whole-element ACA after the requested entries were evaluated.
 
@@ -634,7 +636,7 @@ def aca_tensor(kernel, data, row_elements, col_elements, dof, eps, col_dof=0):
     compiled = _for_data(_aca_tensor, data, 2)
     with single_threaded_blas():  # as in the build (see recompress)
         return compiled(kernel, data, _index(row_elements), _index(col_elements), int(dof), int(col_dof), float(eps),
-                        aca_start, aca_advance)
+                        *aca_steps()[:2])
 
 
 def _aca_tensor(kernel, data, row_elements, col_elements, dof, col_dof, eps, start, advance):
@@ -702,7 +704,7 @@ def aca_compressed(kernel, data, row_elements, col_elements, row_dof, col_dof, e
     compiled = _for_data(_aca_compressed.py_func, data, 3)
     with single_threaded_blas():  # as in the build (see recompress)
         return compiled(kernel, data, _index(row_elements), _index(col_elements), int(row_dof), int(col_dof),
-                        float(eps), aca_start, aca_advance, recompress_state)
+                        float(eps), *aca_steps())
 
 
 @njit(nogil=True)
@@ -857,7 +859,7 @@ def _recompress(u, v, eps):
     return np.ascontiguousarray(ut.T), np.ascontiguousarray(vt.T), rank
 
 
-@njit(RECOMPRESS_STATE_SIGNATURE, cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def recompress_state(ut, vt, ints, eps):
     """recompress_transposed of a finished ACA state: (U'^T, V'^T, rank')."""
     return recompress_transposed(ut, vt, ints[_RANK], eps)
@@ -869,6 +871,16 @@ def recompress_state(ut, vt, ints, eps):
 ACA_STEPS = (aca_start, aca_advance, recompress_state)
 ACA_STEP_TYPES = (types.FunctionType(ACA_START_SIGNATURE), types.FunctionType(ACA_ADVANCE_SIGNATURE),
                   types.FunctionType(RECOMPRESS_STATE_SIGNATURE))
+
+
+def aca_steps():
+    """:data:`ACA_STEPS`, each compiled for its signature (:data:`ACA_STEP_TYPES`) on the
+    first call (from the on-disk cache when it holds them): pass these, not the bare
+    dispatchers, to the compiled drivers, and call this before calling a step from
+    Python, so that the one compiled version has the declared signature."""
+    for step, kind in zip(ACA_STEPS, ACA_STEP_TYPES):
+        step.get_compile_result(kind.signature)  # a dictionary look-up once compiled
+    return ACA_STEPS
 
 
 def _index(elements):

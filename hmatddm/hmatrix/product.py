@@ -14,7 +14,7 @@ import numpy as np
 from numba import types
 
 from ..errors import InputError
-from .aca import _RANK, ACA_STEP_TYPES, ACA_STEPS, _aca_loop, aca_gave_up
+from .aca import _RANK, ACA_STEP_TYPES, _aca_loop, aca_gave_up, aca_steps
 from .block_tree import block_tree
 from .cluster_tree import cluster_tree
 from .generator import BlockGenerator
@@ -140,7 +140,7 @@ def build_free_product(generator, x, eps, eta=3.0, leaf_size=64, col_leaf_size=N
 
     def run(ids):
         return driver(kernel, data, tree.permutation, col_tree.permutation, d, dc, float(eps), row_start[ids],
-                      row_stop[ids], col_start[ids], col_stop[ids], admissible[ids], x, n_rows, *ACA_STEPS[:2])
+                      row_stop[ids], col_start[ids], col_stop[ids], admissible[ids], x, n_rows, *aca_steps()[:2])
 
     y = np.zeros(n_rows)
     try:

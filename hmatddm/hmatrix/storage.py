@@ -31,7 +31,7 @@ import numba
 import numpy as np
 from numba import njit, prange, types
 
-from .aca import ACA_STEP_TYPES, ACA_STEPS, FAST, _aca_compressed
+from .aca import ACA_STEP_TYPES, FAST, _aca_compressed, aca_steps
 from .factor_precision import FIXED_POINT_SHARE, factor_columns, split_factors
 from .first_class import INDEX, compiled_for_data
 
@@ -379,7 +379,7 @@ def assemble(generator, tree, blocks, eps, n_threads=None, factor_dtype=np.float
         ranks, flags, ut, vt, far_dense = driver(
             kernel, data, permutation, col_permutation, d, dc, float(eps), far_rows_start[ids], far_rows_stop[ids],
             far_cols_start[ids], far_cols_stop[ids], np.ones(ids.size, dtype=np.bool_), no_offsets[ids], empty,
-            *ACA_STEPS)
+            *aca_steps())
         kept = (~flags) & (ranks > 0)
         rows = d * (far_rows_stop[ids][kept] - far_rows_start[ids][kept])
         cols = dc * (far_cols_stop[ids][kept] - far_cols_start[ids][kept])
@@ -450,12 +450,12 @@ def assemble(generator, tree, blocks, eps, n_threads=None, factor_dtype=np.float
         if dense_values.dtype == np.float64:
             return driver(kernel, data, permutation, col_permutation, d, dc, float(eps), near_rows_start[ids],
                           near_rows_stop[ids], near_cols_start[ids], near_cols_stop[ids],
-                          np.zeros(ids.size, dtype=np.bool_), near_offset[ids], dense_values, *ACA_STEPS)
+                          np.zeros(ids.size, dtype=np.bool_), near_offset[ids], dense_values, *aca_steps())
         local = np.concatenate(([0], np.cumsum(near_size[ids]))).astype(np.int64)
         buffer = np.empty(local[-1])  # the kernel fills float64; the store holds the rounded values
         driver(kernel, data, permutation, col_permutation, d, dc, float(eps), near_rows_start[ids],
                near_rows_stop[ids], near_cols_start[ids], near_cols_stop[ids], np.zeros(ids.size, dtype=np.bool_),
-               local[:-1], buffer, *ACA_STEPS)
+               local[:-1], buffer, *aca_steps())
         _round_into(buffer, local, dense_values, near_offset[ids])
         return None
 
