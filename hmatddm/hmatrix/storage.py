@@ -234,11 +234,11 @@ def build_driver(data):
     The kernel argument is typed as a first-class function (:mod:`.first_class`) rather
     than as its dispatcher, so numba caches the compiled driver: its compile is paid once
     per data type, not once per process. The ACA steps and the recompression are
-    first-class function arguments too (:data:`ACA_STEPS`; see aca._aca_loop): called
+    first-class function arguments too (:func:`aca.aca_steps`; see aca._aca_loop): called
     through pointers, their code is compiled once for all types instead of being linked
     into (and re-optimised with) every driver, which cuts the per-type compile from ~10 s
     to ~3 s of CPU. Call it with the kernel dispatcher as first argument and
-    ``*ACA_STEPS`` last; numba compiles the kernel for its signature.
+    ``*aca_steps()`` last; numba compiles the kernel for its signature.
     """
     index = INDEX
     outputs = types.Tuple((index, types.boolean[::1], types.float64[::1], types.float64[::1], types.float64[::1]))
