@@ -34,15 +34,13 @@ ACA only ends normally through a passed stopping test and convergence check (or 
 zero block); an end without them after every row or every column element was a pivot
 makes it GIVE UP by design: it stops and flags the block (:func:`aca_gave_up`), and the
 callers store and apply the block exactly (dense); the kernel fill costs no more
-entries than the ACA already spent. It also gives up on reaching rank min(m, n): exact
-in exact arithmetic, but not in floating point (on an AMD EPYC the 28 x 32-element field
-block above reached rank 64 of 64 with "converged" factors 17x eps off at eps 1e-6, a
-different rounding of the same pivots), while the check can only probe unvisited
-elements; and min(m, n) (m + n) > m n, so dense storage is smaller too. (An earlier
-version checked full rank like convergence: those blocks were within eps after
-recompression on an Intel Xeon, where some recompressed below the dense break-even.)
-(Giving up on a converged block with no unvisited element left to check was tried and
-not kept: those blocks were within eps after recompression, and storing them dense cost memory.)
+entries than the ACA already spent. It also gives up on reaching rank min(m, n), which
+is exact in exact arithmetic but not in floating point, where the check can only probe
+unvisited elements (on an AMD EPYC the 28 x 32-element block above reached rank 64 of 64
+with "converged" factors 17x eps off at eps 1e-6); stored dense, such a block is smaller
+too, as min(m, n) (m + n) > m n. (Giving up on a converged block with no unvisited
+element left to check was tried and not kept: those blocks were within eps after
+recompression, and storing them dense cost memory.)
 
 Conventions: a block is given by its row elements (m_e of them, d_r unknowns each)
 and column elements (n_e, d_c unknowns each: a rectangular matrix, e.g. stress
