@@ -122,6 +122,7 @@ def cpu_parts():
     import hmatddm.coupled.schemes as schemes
     import hmatddm.extended_operator as extended
     import hmatddm.hmatrix.hmatrix as hmatrix
+    import hmatddm.hmatrix.solvers as solvers
     import hmatddm.simulation.growing_operator as growing
     import hmatddm.topology as topology
 
@@ -142,7 +143,9 @@ def cpu_parts():
 
     wrap(growing.GrowingOperator, "build", "H builds")
     wrap(extended.ExtendedElasticityOperator, "_border_blocks", "border blocks")
-    wrap(schemes, "gmres", "coupled GMRES")
+    # every GMRES solve (the coupled ones only, in these runs), paused or not
+    wrap(solvers.PausableGmres, "pause", "coupled GMRES")
+    wrap(solvers.PausableGmres, "finish", "coupled GMRES")
     wrap(hmatrix.HMatrix, "_matvec", "H matvec")
     wrap(extended.ExtendedElasticityOperator, "_matvec", "grown-mesh matvec")
     wrap(extended.ExtendedElasticityOperator, "approximate_inverse", "block-triangular preconditioner")

@@ -237,6 +237,10 @@ SCHEME = {  # -> hmatddm.coupled.schemes.SchemeSettings (ref. Sec. 4.5)
     "first_linear_rtol": Setting("number", SCHEME_DEFAULTS["first_linear_rtol"], **_UNIT_INTERVAL,
                                  doc="GMRES relative residual of the first nonlinear iteration of a solve "
                                      "(coupled schemes; at least linear_rtol)"),
+    "provisional_linear_rtol": Setting("number", SCHEME_DEFAULTS["provisional_linear_rtol"], **_UNIT_INTERVAL,
+                                       doc="relative residual at which the first GMRES solve of a growth-deciding "
+                                           "solve pauses first (then tenfold smaller, down to first_linear_rtol): "
+                                           "a pass decides there when no tip is near its threshold"),
     "growth_check": Setting("choice", SCHEME_DEFAULTS["growth_check"], choices=GROWTH_CHECKS,
                             doc="element front: first: decide a growth pass on a solve's first (loose) iterate "
                                 "and converge only the mesh the step keeps; converged: on the converged solve"),

@@ -170,8 +170,10 @@ def test_a_provisional_solve_finishes_with_the_iterates_of_a_plain_one(backend):
     # solve_step(provisional=True) stops after the loose first iterate; finish() continues
     # the same iteration: the converged result is bit for bit the plain solve's, and the
     # two infos add up to its counts. The hmatrix backend is checked against the dense one.
+    # (provisional_linear_rtol = first_linear_rtol: the provisional iterate is the plain
+    # solve's first one; a looser one is tested below.)
     mesh = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 8.0, 8.0, 8, 8)
-    settings = SchemeSettings(scheme="krylov")
+    settings = SchemeSettings(scheme="krylov", provisional_linear_rtol=1e-6)
     problem, dd0, p0 = _problem(mesh, backend=backend, rate=1e-2, viscosity=1e-5)
     dd_plain, p_plain, info_plain = solve_step(problem, settings, dd0, p0, 1.0)
     assert info_plain["pending"] is None
@@ -185,6 +187,55 @@ def test_a_provisional_solve_finishes_with_the_iterates_of_a_plain_one(backend):
     np.testing.assert_array_equal(p, p_plain)
     for key in ("nonlinear_iterations", "linear_iterations", "restarts"):
         assert info_first[key] + info[key] == info_plain[key]
+    if backend == "hmatrix":
+        problem, dd0, p0 = _problem(mesh, backend="dense", rate=1e-2, viscosity=1e-5)
+        dd_dense, p_dense, _ = solve_step(problem, settings, dd0, p0, 1.0)
+        np.testing.assert_allclose(p, p_dense, atol=1e-5 * np.abs(p_dense).max())
+        np.testing.assert_allclose(dd, dd_dense, atol=1e-5 * np.abs(dd_dense).max())
+
+
+@pytest.mark.parametrize("backend", ["dense", "hmatrix"])
+def test_a_paused_provisional_iterate_finishes_with_the_iterates_of_a_plain_one(backend):
+    # provisional_linear_rtol > first_linear_rtol (the default): the provisional iterate is
+    # the first GMRES solve paused at provisional_linear_rtol (fewer GMRES iterations);
+    # refine() continues that solve to the plain first iterate, finish() to the converged
+    # one: bit for bit the plain solve's, with its counts (also when refine() is skipped).
+    mesh = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 8.0, 8.0, 8, 8)
+    settings = SchemeSettings(scheme="krylov", provisional_linear_rtol=1e-3)
+    assert SchemeSettings().provisional_linear_rtol > SchemeSettings().first_linear_rtol
+    problem, dd0, p0 = _problem(mesh, backend=backend, rate=1e-2, viscosity=1e-5)
+    dd_plain, p_plain, info_plain = solve_step(problem, settings, dd0, p0, 1.0)
+    problem, dd0, p0 = _problem(mesh, backend=backend, rate=1e-2, viscosity=1e-5)
+    tight = SchemeSettings(scheme="krylov", provisional_linear_rtol=1e-6)
+    dd_tight, p_tight, info_tight = solve_step(problem, tight, dd0, p0, 1.0, provisional=True)
+    for refine in (False, True):
+        problem, dd0, p0 = _problem(mesh, backend=backend, rate=1e-2, viscosity=1e-5)
+        dd_first, p_first, info_first = solve_step(problem, settings, dd0, p0, 1.0, provisional=True)
+        pending = info_first["pending"]
+        assert pending.refinable and info_first["nonlinear_iterations"] == 1
+        assert info_first["linear_iterations"] < info_tight["linear_iterations"]
+        # the paused iterate is the tight first one to within the looser tolerance
+        np.testing.assert_allclose(p_first, p_tight, rtol=0, atol=1e-2 * np.abs(p_tight).max())
+        levels = [pending.paused_level]  # a GMRES iteration may pass more than one level
+        infos = [info_first]
+        if refine:  # pauses at 1e-3, 1e-4, 1e-5, then the plain first iterate (1e-6)
+            while pending.refinable:
+                dd_refined, p_refined, info_refined = pending.refine()
+                assert info_refined["pending"] is pending and info_refined["nonlinear_iterations"] == 0
+                levels.append(pending.paused_level)
+                infos.append(info_refined)
+            assert levels[-1] is None and set(levels[:-1]) <= {1e-3, 1e-4, 1e-5} and len(levels) >= 3
+            assert levels[:-1] == sorted(levels[:-1], reverse=True)
+            assert sum(i["linear_iterations"] for i in infos) == info_tight["linear_iterations"]
+            np.testing.assert_array_equal(dd_refined, dd_tight)
+            np.testing.assert_array_equal(p_refined, p_tight)
+        dd, p, info = pending.finish()
+        assert info["pending"] is None
+        infos.append(info)
+        np.testing.assert_array_equal(dd, dd_plain)
+        np.testing.assert_array_equal(p, p_plain)
+        for key in ("nonlinear_iterations", "linear_iterations", "restarts"):
+            assert sum(i[key] for i in infos) == info_plain[key]
     if backend == "hmatrix":
         problem, dd0, p0 = _problem(mesh, backend="dense", rate=1e-2, viscosity=1e-5)
         dd_dense, p_dense, _ = solve_step(problem, settings, dd0, p0, 1.0)

@@ -261,3 +261,29 @@ def test_default_preconditioner_does_not_depend_on_the_element_frames():
     exact = np.linalg.solve(dense, b)
     assert np.linalg.norm(x - exact) < 1e-8 * np.linalg.norm(exact)
     assert np.linalg.norm(x_rotated - Q @ exact) < 1e-8 * np.linalg.norm(exact)
+
+
+def test_a_paused_gmres_finishes_bit_for_bit_as_an_unpaused_one(spd_problem):
+    # PausableGmres: pause() stops at pause_rtol (preconditioned estimate) with an iterate of
+    # about that residual, finish() continues the same Krylov cycle: the result and the
+    # iteration count of gmres without a pause, bit for bit.
+    from hmatddm.hmatrix.solvers import PausableGmres
+
+    h, dense, b = spd_problem
+    precond = default_preconditioner(h)
+    x_ref, info_ref = gmres(h, b, M=precond, rtol=1e-10, restart=50, maxiter=10, x0=0.1 * b)
+    solver = PausableGmres(h, b, M=precond, rtol=1e-10, restart=50, maxiter=10, x0=0.1 * b, pause_rtol=1e-4)
+    x_pause, iterations = solver.pause()
+    assert solver.result is None and 0 < iterations < info_ref["iterations"]
+    assert np.linalg.norm(b - dense @ x_pause) < 1e-2 * np.linalg.norm(b)
+    assert np.linalg.norm(b - dense @ x_pause) > 1e-10 * np.linalg.norm(b)
+    x, info = solver.finish()
+    np.testing.assert_array_equal(x, x_ref)
+    assert info == info_ref
+    assert solver.finish()[0] is x
+    # no pause, or a solve that ends before it: pause() returns the result
+    solver = PausableGmres(h, b, M=precond, rtol=1e-10, restart=50, maxiter=10)
+    x, iterations = solver.pause()
+    assert solver.result is not None and iterations == solver.result[1]["iterations"]
+    with pytest.raises(InputError, match="pause_rtol"):
+        PausableGmres(h, b, rtol=1e-6, pause_rtol=1e-8).pause()

@@ -42,9 +42,14 @@ iteration, and a step converges only when the active set no longer changes.
 Elements with a ``fixed_pressure`` (natural elements that failed remotely and are not
 connected to an injection point) keep that pressure: their flow row is ``p_i = p_fixed``.
 
-Length (over ~400 lines): the four schemes share one iteration loop, its stopping and
+A provisional solve's first GMRES solve may pause at coarser residuals
+(``provisional_linear_rtol``) and be continued in the same Krylov space
+(:mod:`hmatddm.coupled.paused`): a growth pass decides on the cheapest iterate that can
+decide it, and the iterates after it are a plain solve's, bit for bit.
+
+Length (over ~500 lines): the four schemes share one iteration loop, its stopping and
 divergence rules, the relaxation restarts and the provisional (pending) solve; a split
-would pass that state between modules. About 90 lines are this docstring and the
+would pass that state between modules. About 100 lines are this docstring and the
 settings' parameter documentation.
 """
 import math
@@ -57,7 +62,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..errors import ConvergenceError
-from ..hmatrix import gmres
+from ..hmatrix.solvers import PausableGmres
+from .paused import PausedIterate, pause_levels
 
 from ..options import SCHEME_DEFAULTS, SCHEMES  # noqa: E402,F401
 from ..settings import SCHEME  # noqa: E402  (ranges and units of the fields)
@@ -81,6 +87,12 @@ class SchemeSettings:
     stopping : ``"contraction"`` or ``"change"`` (module docstring)
     first_linear_rtol : relative residual of the first GMRES solve of each attempt (coupled
         schemes; at least ``linear_rtol``)
+    provisional_linear_rtol : relative residual at which the first GMRES solve of a
+        provisional solve (``solve_step(provisional=True)``) first pauses (then at tenfold
+        smaller ones above ``first_linear_rtol``, :mod:`hmatddm.coupled.paused`): a growth pass
+        decides on such a cheaper iterate when no tip is near its threshold;
+        ``PendingSolve.refine`` and ``finish`` continue the same GMRES solve, so the
+        iterates that follow are a plain solve's, bit for bit.
     growth_check : ``"first"`` or ``"converged"``: on which iterate a simulation with the
         element front (and no natural fractures) decides a growth pass. ``"first"``: on the
         first (loose) iterate of a coupled solve, converging it only when no element grows
@@ -110,6 +122,7 @@ class SchemeSettings:
     stopping: str = SCHEME_DEFAULTS["stopping"]
     first_linear_rtol: float = SCHEME_DEFAULTS["first_linear_rtol"]
     growth_check: str = SCHEME_DEFAULTS["growth_check"]
+    provisional_linear_rtol: float = SCHEME_DEFAULTS["provisional_linear_rtol"]
 
     def __post_init__(self):
         object.__setattr__(self, "scheme", SCHEME["scheme"].value("scheme", self.scheme))
@@ -117,7 +130,7 @@ class SchemeSettings:
             object.__setattr__(self, "relaxation_growth", 2.0 if self.scheme in COUPLED_SCHEMES else 1.0)
         for name in ("relaxation_growth", "omega", "relaxation", "min_relaxation", "tolerance_pressure",
                      "tolerance_opening", "linear_rtol", "max_iterations", "linear_restart", "linear_maxiter",
-                     "stopping", "first_linear_rtol", "growth_check"):
+                     "stopping", "first_linear_rtol", "growth_check", "provisional_linear_rtol"):
             object.__setattr__(self, name, SCHEME[name].value(name, getattr(self, name)))
 
 
@@ -244,7 +257,6 @@ class _CoupledLinearSystem:
     def __init__(self, problem, matrix, dd, p):
         self.problem = problem
         self.flow_matrix = matrix.tocsr()
-        n, d = problem.n, problem.d
         # powers of two: the scaled guess scales back to exactly the DD and pressure of the
         # last iterate (StepProblem.elastic_matvec finds its product)
         self.s_u = _power_of_two(max(float(np.max(np.abs(dd))), 1e-12))
@@ -253,8 +265,14 @@ class _CoupledLinearSystem:
         self.blocks = blocks = problem.elastic.diagonal_blocks(self.rows)
         self.block_inverse = np.linalg.inv(blocks)  # (N, d, d), M_u^-1 without s_u
         self.flow_diagonal = self.flow_matrix.diagonal()
-        size = n * d + n
-        self.operator = spla.LinearOperator((size, size), matvec=self._matvec, dtype=np.float64)
+
+    @property
+    def operator(self):
+        """The scaled matrix as a LinearOperator (made on demand, not kept: a kept one would
+        tie the system into a reference cycle, which a paused GMRES solve keeps out of the
+        reach of reference counting, with the problem's operator and border blocks)."""
+        size = self.problem.n * self.problem.d + self.problem.n
+        return spla.LinearOperator((size, size), matvec=self._matvec, dtype=np.float64)
 
     def left_scale(self, residual_u, residual_p):
         n, d = self.problem.n, self.problem.d
@@ -299,7 +317,13 @@ class _CoupledLinearSystem:
         return spla.LinearOperator((nd + problem.n,) * 2, matvec=apply, dtype=np.float64)
 
 
-def _coupled_iteration(problem, settings, dd, p, alpha, counters, first=False):
+def _coupled_iteration(problem, settings, dd, p, alpha, counters, first=False, pause=None):
+    """One coupled iterate from ``(dd, p)`` (the widths lagged there); ``first``: its GMRES at
+    ``first_linear_rtol``. ``pause`` (a list, with ``first``): the GMRES solve pauses at
+    :func:`~hmatddm.coupled.paused.pause_levels` (:class:`hmatddm.hmatrix.solvers.PausableGmres`),
+    the iterate returned is the first paused one, and a
+    :class:`~hmatddm.coupled.paused.PausedIterate` appended to ``pause``
+    continues the same solve (nothing appended when it ended before a pause)."""
     matrix, flow_rhs = problem.flow_matrices(dd)
     if not (np.all(np.isfinite(matrix.data)) and np.all(np.isfinite(flow_rhs))):
         raise _Diverged("non-finite flow matrix")
@@ -311,16 +335,25 @@ def _coupled_iteration(problem, settings, dd, p, alpha, counters, first=False):
     except (RuntimeError, np.linalg.LinAlgError) as error:  # singular flow or diagonal blocks
         raise _Diverged(f"singular coupled system: {error}") from None
     guess = np.concatenate([dd / system.s_u, p / system.s_p])
+    rtol = max(settings.linear_rtol, settings.first_linear_rtol) if first else settings.linear_rtol
+    levels = pause_levels(settings) if pause is not None else None
+    solver = PausableGmres(system.operator, system.rhs(flow_rhs), M=preconditioner, rtol=rtol,
+                           restart=settings.linear_restart, maxiter=settings.linear_maxiter, x0=guess,
+                           pause_rtol=levels or None)
+    paused = PausedIterate(solver, system.split, dd, p, alpha, counters)
+    iterate = _continued(paused.advance)
+    if pause is not None and not paused.done:
+        pause.append(paused)
+    return iterate
+
+
+def _continued(call):
+    """``call()`` (a :class:`~hmatddm.coupled.paused.PausedIterate` step), its GMRES failure
+    a divergence of the attempt."""
     try:
-        rtol = max(settings.linear_rtol, settings.first_linear_rtol) if first else settings.linear_rtol
-        y, info = gmres(system.operator, system.rhs(flow_rhs), M=preconditioner, rtol=rtol,
-                        restart=settings.linear_restart, maxiter=settings.linear_maxiter, x0=guess)
+        return call()
     except ConvergenceError as error:
-        counters["linear"] += error.iterations or 0
         raise _Diverged(str(error)) from None
-    counters["linear"] += info["iterations"]
-    dd_new, p_new = system.split(y)
-    return alpha * dd_new + (1.0 - alpha) * dd, alpha * p_new + (1.0 - alpha) * p
 
 
 # "contraction" stopping: the extrapolated next change times this must be below the
@@ -388,15 +421,58 @@ class PendingSolve:
 
     def _start_attempt(self):
         self.dd, self.p = self.dd_guess.copy(), self.p_guess.copy()
+        self._paused = None    # the attempt's first iterate, paused (a PausedIterate)
+        self._continue = None  # "advance" or "finish": the next first iteration continues it
         if self.problem.contact is not None:
             self.problem.contact.reset()
         self.history = []
         self.iteration = 0
         self.last_change = math.nan
 
+    @property
+    def looser_provisional(self):
+        """Whether a provisional first iterate comes from a GMRES solve paused above
+        ``first_linear_rtol`` (``provisional_linear_rtol`` larger)."""
+        settings = self.settings
+        return self.loose_first and settings.provisional_linear_rtol > max(settings.first_linear_rtol,
+                                                                           settings.linear_rtol)
+
+    @property
+    def refinable(self):
+        """Whether the provisional iterate is a paused one that :meth:`refine` continues."""
+        return self._paused is not None
+
+    @property
+    def paused_level(self):
+        """The relative residual of the paused GMRES solve of the provisional iterate (one of
+        :func:`~hmatddm.coupled.paused.pause_levels`), None when it is not paused."""
+        return None if self._paused is None else self._paused.level
+
+    def _rewind(self, mode):
+        """Back to the attempt's start, its first iteration to be the paused GMRES solve
+        continued (``mode``: to its next pause or to its end; the same linear system,
+        nothing else is recomputed)."""
+        paused = self._paused
+        self._start_attempt()
+        self._paused, self._continue = paused, mode
+
+    def refine(self):
+        """``(dd, p, info)``, still pending: the first iterate with its GMRES solve continued
+        to the next of :func:`~hmatddm.coupled.paused.pause_levels` or, after the last, to ``first_linear_rtol``
+        (the same Krylov space: then bit for bit the first iterate of a plain solve, for
+        the GMRES iterations a plain solve makes beyond the pauses). A growth pass that
+        cannot decide on a paused iterate decides on the refined one."""
+        if not self.refinable:
+            raise RuntimeError("refine() needs a paused provisional iterate (refinable)")
+        self._rewind("advance")
+        return self._run(True)
+
     def finish(self):
         """``(dd, p, info)`` of the converged solve (``info`` counts the work since the
-        provisional return only, so that the two infos add up to the whole solve)."""
+        provisional return only, so that the two infos add up to the whole solve): the
+        iterates of a plain solve, bit for bit (a paused first GMRES solve is continued)."""
+        if self.refinable:
+            self._rewind("finish")
         return self.run(False)
 
     def run(self, provisional=False):
@@ -411,9 +487,9 @@ class PendingSolve:
                 while self.iteration < settings.max_iterations:
                     iteration = self.iteration
                     self.iteration += 1
-                    self.counters["nonlinear"] += 1
-                    dd_new, p_new = self.iterate(problem, settings, self.dd, self.p, self.alpha, self.counters,
-                                                 first=iteration == 0)
+                    if not (iteration == 0 and self._continue):  # a paused one is counted already
+                        self.counters["nonlinear"] += 1
+                    dd_new, p_new = self._iterate(iteration, provisional)
                     if not (np.all(np.isfinite(dd_new)) and np.all(np.isfinite(p_new))):
                         raise _Diverged("non-finite iterate")
                     change_p = _relative_change(p_new, self.p)
@@ -451,6 +527,25 @@ class PendingSolve:
                 self.alpha /= 2.0
                 self.restarts += 1
                 self._start_attempt()
+
+    def _iterate(self, iteration, provisional):
+        """The next iterate from ``(self.dd, self.p)``: the paused first GMRES solve
+        continued, or ``self.iterate``, its first GMRES solve paused at
+        ``provisional_linear_rtol`` for a provisional return."""
+        first = iteration == 0
+        if first and self._continue:
+            paused, mode, self._continue = self._paused, self._continue, None
+            out = _continued(paused.advance if mode == "advance" else paused.finish)
+            if paused.done:
+                self._paused = None
+            return out
+        if not self.coupled:
+            return self.iterate(self.problem, self.settings, self.dd, self.p, self.alpha, self.counters, first=first)
+        pause = [] if first and provisional and self.looser_provisional else None
+        out = self.iterate(self.problem, self.settings, self.dd, self.p, self.alpha, self.counters, first=first,
+                           pause=pause)
+        self._paused = pause[0] if pause else None
+        return out
 
     def _finished(self, pending):
         counts = dict(nonlinear_iterations=self.counters["nonlinear"], linear_iterations=self.counters["linear"],

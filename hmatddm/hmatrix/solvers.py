@@ -144,6 +144,12 @@ class _Arnoldi:
 
 
 def gmres(A, b, M=None, rtol=1e-8, restart=50, maxiter=20, x0=None, max_restart=None):
+    """Solve ``A x = b`` (:class:`PausableGmres` without a pause: see its parameters)."""
+    return PausableGmres(A, b, M=M, rtol=rtol, restart=restart, maxiter=maxiter, x0=x0,
+                         max_restart=max_restart).finish()
+
+
+class PausableGmres:
     """Solve ``A x = b`` with restarted, (left-)preconditioned GMRES.
 
     Parameters
@@ -168,9 +174,17 @@ def gmres(A, b, M=None, rtol=1e-8, restart=50, maxiter=20, x0=None, max_restart=
         restarted. Default: the smaller of 8 * restart and the length whose Krylov
         basis takes 1 GiB (at least ``restart``); ``max_restart=restart`` gives plain
         GMRES(restart).
+    pause_rtol : float >= rtol, or a decreasing sequence of them, optional
+        :meth:`pause` stops the iteration as soon as the preconditioned residual
+        estimate falls below the next ``pause_rtol`` times that of ``b`` (the inner test,
+        as ``rtol`` does, without the true residual's product) and returns that iterate
+        (``level``: the smallest pause it passed); the next :meth:`pause` or
+        :meth:`finish` continues the same Krylov cycle: the result is bit for bit the one
+        without pauses (loose iterates to decide on, the accurate one for the cost of
+        solving for it alone).
 
-    Returns
-    -------
+    :meth:`finish` returns ``(x, info)`` (``gmres(...)`` is ``PausableGmres(...).finish()``):
+
     x : (n,) array
     info : dict
         ``iterations`` (inner iterations = matvecs with A, not counting residual
@@ -182,6 +196,48 @@ def gmres(A, b, M=None, rtol=1e-8, restart=50, maxiter=20, x0=None, max_restart=
     returns zeros at once. Cost per iteration: one product with A, one with M and
     O(n * current restart); memory O(n * current restart).
     """
+    def __init__(self, A, b, M=None, rtol=1e-8, restart=50, maxiter=20, x0=None, max_restart=None, pause_rtol=None):
+        pauses = [] if pause_rtol is None else list(np.atleast_1d(np.asarray(pause_rtol, dtype=np.float64)))
+        if any(not (rtol <= level < 1.0) for level in pauses) or any(np.diff(pauses) >= 0.0):
+            raise InputError(f"pause_rtol must be decreasing values in [rtol, 1), got {pause_rtol!r}")
+        self._steps = _gmres_steps(A, b, M, rtol, restart, maxiter, x0, max_restart, pauses)
+        self.result = None
+        self.level = None  # the smallest pause_rtol the last pause passed (rtol once finished)
+        self._rtol = rtol
+
+    def pause(self):
+        """``(x, iterations)``: the iterate at the next pause and the inner iterations so
+        far; the converged ``x`` if the solve ended first (a guess already good enough, or
+        no pause left), ``result`` then set. Raises ConvergenceError as :func:`gmres`."""
+        if self.result is None:
+            with single_threaded_blas():
+                try:
+                    x, iterations, self.level = next(self._steps)
+                    return x, iterations
+                except StopIteration as stop:
+                    self.result = stop.value
+        self.level = self._rtol
+        return self.result[0], self.result[1]["iterations"]
+
+    def finish(self):
+        """``(x, info)`` of the whole solve (see the class docstring)."""
+        if self.result is None:
+            with single_threaded_blas():
+                try:
+                    while True:
+                        next(self._steps)
+                except StopIteration as stop:
+                    self.result = stop.value
+        self.level = self._rtol
+        return self.result
+
+
+def _gmres_steps(A, b, M, rtol, restart, maxiter, x0, max_restart, pauses):
+    """The iteration of :class:`PausableGmres` as a generator: yields ``(x, iterations,
+    level)`` at the pauses (``pauses``: decreasing relative residuals), returns ``(x, info)``. The caller limits BLAS to one thread
+    around each step (the Krylov vector operations are memory-bound, and idle spinning
+    BLAS threads would steal the cores from the parallel H-matrix matvec: measured,
+    matvec twice slower inside GMRES otherwise); not while paused."""
     if isinstance(rtol, bool) or not isinstance(rtol, (int, float, np.floating)) or not (0.0 < rtol < 1.0):
         raise InputError(f"rtol must be in (0, 1), got {rtol!r}")
     restart = _positive_integer("restart", restart)
@@ -226,59 +282,61 @@ def gmres(A, b, M=None, rtol=1e-8, restart=50, maxiter=20, x0=None, max_restart=
     iterations = cycles = 0
     length = min(restart, n)
     history = [length]
-    # One BLAS thread: the Krylov vector operations are memory-bound, and idle
-    # spinning BLAS threads would steal the cores from the parallel H-matrix matvec
-    # (measured: matvec twice slower inside GMRES otherwise).
-    with single_threaded_blas():
-        lartg = get_lapack_funcs("lartg", dtype=np.float64)
-        x = np.zeros(n) if x0 is None else x0.copy()
-        r = b - matvec(x) if x.any() else b.copy()
-        residual_norm = float(np.linalg.norm(r))
-        # inner tolerance on the preconditioned residual, adapted between cycles as in scipy
-        ptol_factor = 1.0
-        ptol = float(np.linalg.norm(psolve(b))) * min(1.0, float(rtol))
-        krylov = _Arnoldi(n, length)
-        while residual_norm > atol and iterations < budget:
-            cycles += 1
-            start_norm = residual_norm
-            presid = krylov.start(psolve(r))
-            if not math.isfinite(presid):
-                raise ConvergenceError(f"GMRES: the preconditioner returned non-finite values after {iterations} "
-                                       "iterations", residual=residual_norm / b_norm, iterations=iterations)
-            if presid == 0.0:
-                break  # M r = 0 with r != 0: M is singular, nothing to iterate on
-            while True:
-                while krylov.size < length and iterations < budget:
-                    presid = krylov.step(matvec, psolve, lartg)
-                    iterations += 1
-                    if presid <= ptol or krylov.breakdown or not math.isfinite(presid):
-                        break
-                candidate = x + krylov.correction()
-                if not np.all(np.isfinite(candidate)):
-                    raise ConvergenceError(f"GMRES produced a non-finite iterate after {iterations} iterations",
-                                           residual=math.nan, iterations=iterations)
-                r = b - matvec(candidate)
-                residual_norm = float(np.linalg.norm(r))
-                full = krylov.size == length and presid > ptol and not krylov.breakdown
-                remaining = budget - iterations
-                if residual_norm <= atol or not full or remaining == 0 or length >= min(max_restart, n):
+    lartg = get_lapack_funcs("lartg", dtype=np.float64)
+    x = np.zeros(n) if x0 is None else x0.copy()
+    r = b - matvec(x) if x.any() else b.copy()
+    residual_norm = float(np.linalg.norm(r))
+    # inner tolerance on the preconditioned residual, adapted between cycles as in scipy
+    ptol_factor = 1.0
+    b_precond = float(np.linalg.norm(psolve(b)))
+    ptol = b_precond * min(1.0, float(rtol))
+    pauses = [(b_precond * level, level) for level in pauses]
+    krylov = _Arnoldi(n, length)
+    while residual_norm > atol and iterations < budget:
+        cycles += 1
+        start_norm = residual_norm
+        presid = krylov.start(psolve(r))
+        if not math.isfinite(presid):
+            raise ConvergenceError(f"GMRES: the preconditioner returned non-finite values after {iterations} "
+                                   "iterations", residual=residual_norm / b_norm, iterations=iterations)
+        if presid == 0.0:
+            break  # M r = 0 with r != 0: M is singular, nothing to iterate on
+        while True:
+            while krylov.size < length and iterations < budget:
+                presid = krylov.step(matvec, psolve, lartg)
+                iterations += 1
+                if pauses and presid <= pauses[0][0] and math.isfinite(presid):
+                    while pauses and presid <= pauses[0][0]:
+                        level = pauses.pop(0)[1]
+                    yield x + krylov.correction(), iterations, level
+                if presid <= ptol or krylov.breakdown or not math.isfinite(presid):
                     break
-                # Stagnation: continue this cycle in a larger space instead of restarting.
-                ratio = residual_norm / start_norm
-                rate = min(1.0, ratio) ** (1.0 / krylov.size)
-                if ratio <= STAGNATION_RATIO and residual_norm * rate**remaining <= atol:
-                    break
-                length = min(max_restart, RESTART_GROWTH * length, n)
-                history.append(length)
-                krylov.grow(length)
-            x = candidate
-            if residual_norm <= atol or krylov.breakdown or not math.isfinite(presid):
+            candidate = x + krylov.correction()
+            if not np.all(np.isfinite(candidate)):
+                raise ConvergenceError(f"GMRES produced a non-finite iterate after {iterations} iterations",
+                                       residual=math.nan, iterations=iterations)
+            r = b - matvec(candidate)
+            residual_norm = float(np.linalg.norm(r))
+            full = krylov.size == length and presid > ptol and not krylov.breakdown
+            remaining = budget - iterations
+            if residual_norm <= atol or not full or remaining == 0 or length >= min(max_restart, n):
                 break
-            if presid <= ptol:  # inner test passed, outer did not: tighten the inner one
-                ptol_factor = max(np.finfo(np.float64).eps, 0.25 * ptol_factor)
-            else:
-                ptol_factor = min(1.0, 1.5 * ptol_factor)
-            ptol = presid * min(ptol_factor, atol / residual_norm)
+            # Stagnation: continue this cycle in a larger space instead of restarting.
+            ratio = residual_norm / start_norm
+            rate = min(1.0, ratio) ** (1.0 / krylov.size)
+            if ratio <= STAGNATION_RATIO and residual_norm * rate**remaining <= atol:
+                break
+            length = min(max_restart, RESTART_GROWTH * length, n)
+            history.append(length)
+            krylov.grow(length)
+        x = candidate
+        if residual_norm <= atol or krylov.breakdown or not math.isfinite(presid):
+            break
+        if presid <= ptol:  # inner test passed, outer did not: tighten the inner one
+            ptol_factor = max(np.finfo(np.float64).eps, 0.25 * ptol_factor)
+        else:
+            ptol_factor = min(1.0, 1.5 * ptol_factor)
+        ptol = presid * min(ptol_factor, atol / residual_norm)
     residual = residual_norm / b_norm
     if not residual <= rtol:
         grown = "" if len(history) == 1 else f", grown on stagnation to {'->'.join(map(str, history[1:]))}"

@@ -100,6 +100,7 @@ The format, annotated (``=`` values are the defaults unless marked REQUIRED)::
     stopping = "contraction"       # "contraction" (also stop on the extrapolated next change) or "change"
     first_linear_rtol = 1e-6       # GMRES relative residual of a solve's first iteration, (0, 1)
     growth_check = "first"         # growth pass decided on a solve's first iterate, or "converged"
+    provisional_linear_rtol = 1e-4  # that first GMRES solve pauses there first to decide, (0, 1)
     initial_pressure = 10e6        # Pa, fluid pressure at t = 0 (default 0)
     initial_opening = 1e-5         # m, >= 0, opening of the initial elements
     # minimum_width = 1e-5         # m, > 0, width floor of the flow (default initial_opening)

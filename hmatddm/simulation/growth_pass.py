@@ -16,11 +16,29 @@ from .encounters import meet_natural_fractures
 from .junctions import stop_at_other_fractures
 from .state import Growth, NewElements, Origin
 
+#: What :func:`grow` returns with a ``margin`` when a tip's criterion is that close to its
+#: threshold: the iterate is not accurate enough to decide.
+UNCERTAIN = "uncertain"
 
-def grow(simulation, state, edges, faces, drained, events):
+#: A growth pass decided on a paused iterate (GMRES at relative residual ``level``,
+#: :func:`hmatddm.coupled.schemes.pause_levels`) refuses to decide when a tip is within
+#: ``PAUSED_MARGIN_PER_RTOL * level`` of its threshold: over the h = 0.5 m radial K-vertex
+#: run the tips' ``K / K_Ic`` of such iterates differed from the plain first iterate's by
+#: at most 2.6e-2 at level 1e-4 and 1.5e-3 at 1e-5 (RESULTS.md, issue 17, fifth pass).
+PAUSED_MARGIN_PER_RTOL = 500.0
+
+
+def paused_margin(level):
+    """The margin of :func:`grow` for an iterate paused at relative residual ``level``."""
+    return PAUSED_MARGIN_PER_RTOL * level
+
+
+def grow(simulation, state, edges, faces, drained, events, margin=None):
     """The :class:`~hmatddm.simulation.state.Growth` of the tips of ``state`` (``edges``,
     ``faces``: its mesh's, as solved) or None. Tips of ``drained`` elements (remotely
-    failed, not reached by the fluid) do not grow; ``events`` counts what happened."""
+    failed, not reached by the fluid) do not grow; ``events`` counts what happened.
+    ``margin``: :data:`UNCERTAIN` when a tip's criterion (``K / K_Ic`` or ``G / G_c``,
+    ref. Eqs 4.18-4.19) is within ``margin`` of 1 (in a layered medium: always)."""
     sim, mesh = simulation, state.mesh
     element, edge = topology.tip_edges(mesh, faces, edges)
     if sim.growing_fractures is not None:
@@ -32,6 +50,9 @@ def grow(simulation, state, edges, faces, drained, events):
     if element.size == 0:
         return None
     tips = evaluate_tips(mesh, edges, element, edge, state.dd, sim.elastic_constants(mesh, element), sim.propagation)
+    if margin is not None and (sim.medium is not None or _closest_call(tips, sim.propagation, sim.elastic_constants(
+            mesh, element)) < margin):
+        return UNCERTAIN
     if sim.medium is not None:  # per-layer toughness; new elements end on interfaces
         from ..layered import engine as layered_engine
 
@@ -58,6 +79,18 @@ def grow(simulation, state, edges, faces, drained, events):
     if elements is None and not connections:
         return None
     return Growth(elements, connections)
+
+
+def _closest_call(tips, propagation, material):
+    """The smallest ``|criterion / threshold - 1|`` over ``tips`` (ref. Eqs 4.18-4.19)."""
+    if propagation.criterion == "mcs":
+        ratio = tips.k_bar / propagation.toughness
+    else:
+        g_c = propagation.critical_energy_release_rate
+        if g_c is None:
+            g_c = propagation.toughness**2 / material.plane_strain_modulus
+        ratio = tips.energy_release_rate / g_c
+    return float(np.min(np.abs(ratio - 1.0)))
 
 
 def remote_failures(simulation, state, events):

@@ -299,7 +299,15 @@ class Simulation:
                        and self.settings.growth_check == "first")
         while True:
             trial, info, solved = step_solve.solve(self, trial, start, t_old, t_new, relaxation, provisional)
-            growth = None if tally.growth_passes >= max_passes else self._growth(trial, solved, info, tally)
+            growth = None if tally.growth_passes >= max_passes else self._growth(
+                trial, solved, info, tally, margin=_paused_margin(info))
+            while ((growth is None or growth is growth_pass.UNCERTAIN) and _paused_margin(info) is not None
+                   and tally.growth_passes < max_passes):
+                # no growth, or a tip too close to its threshold, on a paused iterate: continue
+                # its GMRES solve (to the next pause, at last to the plain first iterate)
+                tally.add_solve(info)
+                trial, info = step_solve.refine(trial, info)
+                growth = self._growth(trial, solved, info, tally, margin=_paused_margin(info))
             if growth is None and info.get("pending") is not None:  # converge, then check again
                 tally.add_solve(info)
                 trial, info = step_solve.finish(trial, info)
@@ -326,12 +334,15 @@ class Simulation:
             t_new = float(end_time)
         return t_old, t_new
 
-    def _growth(self, trial, solved, info, tally):
+    def _growth(self, trial, solved, info, tally, margin=None):
         """What the growth pass after a solve adds: the tips' growth (ref. Sec. 4.2.2), else
-        the remote failures of intact natural elements (ref. Sec. 5.3), else None."""
+        the remote failures of intact natural elements (ref. Sec. 5.3), else None;
+        ``growth_pass.UNCERTAIN`` when a tip is within ``margin`` of its threshold."""
         growth = None
         if self.propagation is not None:
-            growth = growth_pass.grow(self, trial, solved.edges, solved.faces, info["drained"], tally.events)
+            growth = growth_pass.grow(self, trial, solved.edges, solved.faces, info["drained"], tally.events, margin)
+            if growth is growth_pass.UNCERTAIN:
+                return growth
         if growth is None:
             growth = growth_pass.remote_failures(self, trial, tally.events)
         return growth
@@ -441,3 +452,12 @@ class Simulation:
         # resumed run applies the same operator (bit for bit)
         self.operators.restore(self.state.mesh, int(metadata.get("compressed_elements", 0)))
         return self.state
+
+
+def _paused_margin(info):
+    """The growth-pass margin of a solve whose provisional iterate is paused
+    (:func:`hmatddm.simulation.growth_pass.paused_margin`), None otherwise."""
+    pending = info.get("pending")
+    if pending is None or not pending.refinable:
+        return None
+    return growth_pass.paused_margin(pending.paused_level)

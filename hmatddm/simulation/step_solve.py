@@ -112,6 +112,16 @@ def solve(simulation, trial, start, t_old, t_new, relaxation, provisional=False)
     return _with_solution(trial, problem, dd, p, info), info, SolvedMesh(edges, faces, flow)
 
 
+def refine(trial, info):
+    """``(trial, info)`` with the provisional solve's first iterate redone at
+    ``first_linear_rtol`` (:meth:`hmatddm.coupled.schemes.PendingSolve.refine`: the growth
+    pass decided on a looser one), still pending."""
+    pending = info["pending"]
+    dd, p, more = pending.refine()
+    more["drained"] = info["drained"]
+    return _with_solution(trial, pending.problem, dd, p, more), more
+
+
 def finish(trial, info):
     """``(trial, info)`` of the converged solve whose provisional result is ``trial`` and
     ``info`` (from :func:`solve` with ``info["pending"]``); the new ``info`` counts the
