@@ -1,35 +1,48 @@
 """Layered rock in the coupled flow/propagation engine (ref. Ch. 3 + Ch. 4): a vertical
 cross-section of a fracture growing in height, and the [[layer]] scene tables."""
+import dataclasses
+
 import numpy as np
 import pytest
 
 import hmatddm as hd
 import hmatddm.scene as hs
 from hmatddm.errors import InputError
+from hmatddm.coupled import SchemeSettings
 from hmatddm.layered import LayeredMedium
 
 G, NU = 10e9, 0.25
 
 
-def _height_run(material, end_time=8.0, toughness=5e6):
+def _height_run(material, end_time=8.0, toughness=5e6, scheme="krylov"):
     """KGD-like vertical fracture (x horizontal, y up) under 0.5 MPa horizontal stress."""
     mesh = hd.mesh.line([0.0, -0.375], [0.0, 0.375], 3)
     sim = hd.Simulation(mesh, material, hd.Fluid(1e-4, 4.5e-10), [hd.Cluster((0.0, 0.0), 5e-4, 0.01)],
                         far_field_stress=np.diag([-0.5e6, 0.0]), time_step=1.0,
                         propagation=hd.Propagation(toughness=toughness), initial_pressure=0.6e6,
-                        initial_opening=1e-5, backend="dense")
+                        initial_opening=1e-5, backend="dense", scheme=scheme)
     records = sim.run(end_time=end_time)
     return sim, records
 
 
-def test_equal_layers_give_the_homogeneous_run_to_round_off():
-    homogeneous, records_h = _height_run(hd.Elastic(G, NU))
-    layered, records_l = _height_run(LayeredMedium([1.0, -1.0], [G, G, G], [NU, NU, NU]))
+@pytest.mark.parametrize("paused", [False, True])
+def test_equal_layers_give_the_homogeneous_run_to_round_off(paused):
+    """Without paused growth decisions the two runs take the same solver path: equal to
+    round-off. With them (the default), whether a pass decides on a paused GMRES iterate
+    depends on how near a tip is to its threshold, and a round-off difference in K there
+    can change which iterate the next pass starts from: equal to the GMRES tolerance
+    (linear_rtol 1e-9; measured 2.3e-11 in the pressures)."""
+    settings = SchemeSettings(scheme="krylov")
+    if not paused:
+        settings = dataclasses.replace(settings, provisional_linear_rtol=settings.first_linear_rtol)
+    homogeneous, records_h = _height_run(hd.Elastic(G, NU), scheme=settings)
+    layered, records_l = _height_run(LayeredMedium([1.0, -1.0], [G, G, G], [NU, NU, NU]), scheme=settings)
     assert layered.state.mesh.n_elements == homogeneous.state.mesh.n_elements > 3  # it grew, past y = +-1
+    tolerance = settings.linear_rtol if paused else 1e-12
     scale = np.abs(homogeneous.state.dd).max()
-    assert np.max(np.abs(layered.state.dd - homogeneous.state.dd)) <= 1e-12 * scale
+    assert np.max(np.abs(layered.state.dd - homogeneous.state.dd)) <= tolerance * scale
     assert np.allclose([r["wellbore_pressure"] for r in records_l], [r["wellbore_pressure"] for r in records_h],
-                       rtol=1e-12, atol=0.0)
+                       rtol=tolerance, atol=0.0)
 
 
 def test_growth_across_interfaces_cuts_elements_there():
