@@ -38,7 +38,8 @@ def grow(simulation, state, edges, faces, drained, events, margin=None):
     ``faces``: its mesh's, as solved) or None. Tips of ``drained`` elements (remotely
     failed, not reached by the fluid) do not grow; ``events`` counts what happened.
     ``margin``: :data:`UNCERTAIN` when a tip's criterion (``K / K_Ic`` or ``G / G_c``,
-    ref. Eqs 4.18-4.19) is within ``margin`` of 1 (in a layered medium: always)."""
+    ref. Eqs 4.18-4.19; in a layered medium against the layer ahead's toughness) is within
+    ``margin`` of 1."""
     sim, mesh = simulation, state.mesh
     element, edge = topology.tip_edges(mesh, faces, edges)
     if sim.growing_fractures is not None:
@@ -49,16 +50,18 @@ def grow(simulation, state, edges, faces, drained, events, margin=None):
         element, edge = element[keep], edge[keep]
     if element.size == 0:
         return None
-    tips = evaluate_tips(mesh, edges, element, edge, state.dd, sim.elastic_constants(mesh, element), sim.propagation)
-    if margin is not None and (sim.medium is not None or _closest_call(tips, sim.propagation, sim.elastic_constants(
-            mesh, element)) < margin):
-        return UNCERTAIN
+    materials = sim.elastic_constants(mesh, element)
+    tips = evaluate_tips(mesh, edges, element, edge, state.dd, materials, sim.propagation)
+    toughness = None  # the propagation's
     if sim.medium is not None:  # per-layer toughness; new elements end on interfaces
         from ..layered import engine as layered_engine
 
-        tips = layered_engine.tip_criterion(tips, sim.elastic_constants(mesh, element),
-                                            layered_engine.layers_ahead(edges, element, edge, sim.medium),
-                                            sim.medium, sim.propagation)
+        layers = layered_engine.layers_ahead(edges, element, edge, sim.medium)
+        tips = layered_engine.tip_criterion(tips, materials, layers, sim.medium, sim.propagation)
+        if sim.medium.toughness is not None:
+            toughness = np.asarray(sim.medium.toughness)[layers]
+    if margin is not None and _closest_call(tips, sim.propagation, materials, toughness) < margin:
+        return UNCERTAIN
     candidates = new_elements(mesh, edges, tips, sim.propagation, return_tips=True)
     if candidates is None:
         return None
@@ -81,14 +84,16 @@ def grow(simulation, state, edges, faces, drained, events, margin=None):
     return Growth(elements, connections)
 
 
-def _closest_call(tips, propagation, material):
-    """The smallest ``|criterion / threshold - 1|`` over ``tips`` (ref. Eqs 4.18-4.19)."""
+def _closest_call(tips, propagation, material, toughness=None):
+    """The smallest ``|criterion / threshold - 1|`` over ``tips`` (ref. Eqs 4.18-4.19), the
+    thresholds those the tips were judged by: ``toughness`` per tip (the layer ahead's,
+    :func:`hmatddm.layered.engine.tip_criterion`) or, when None, the propagation's."""
     if propagation.criterion == "mcs":
-        ratio = tips.k_bar / propagation.toughness
+        ratio = tips.k_bar / (propagation.toughness if toughness is None else toughness)
     else:
-        g_c = propagation.critical_energy_release_rate
+        g_c = propagation.critical_energy_release_rate if toughness is None else None
         if g_c is None:
-            g_c = propagation.toughness**2 / material.plane_strain_modulus
+            g_c = (propagation.toughness if toughness is None else toughness)**2 / material.plane_strain_modulus
         ratio = tips.energy_release_rate / g_c
     return float(np.min(np.abs(ratio - 1.0)))
 
