@@ -151,6 +151,23 @@ def pytest_terminal_summary(terminalreporter, exitstatus, config):
     terminalreporter.write_line(f"{sum(_CPU_SECONDS_PER_WORKER.values()):8.2f}s cpu  in all tests")
 
 
+# -- child processes import the hmatddm under test ------------------------------------------
+
+def child_environment(**overrides):
+    """``os.environ`` for a child ``python`` with the directory holding the ``hmatddm`` this
+    process imported put first on ``PYTHONPATH`` (plus ``overrides``), so that the child
+    runs the same copy and shares its numba cache. Without it a child started outside the
+    repository (``.ci/run``: ``pip install .`` then pytest from the clone) imports the
+    installed copy in ``site-packages``, tests that copy instead, and compiles its every
+    kernel again into a second, empty cache (the 3D layered kill-and-resume child alone:
+    ~100 s of CPU)."""
+    package_parent = os.path.dirname(os.path.dirname(os.path.abspath(hd.__file__)))
+    path = os.environ.get("PYTHONPATH")
+    env = dict(os.environ, PYTHONPATH=package_parent + (os.pathsep + path if path else ""))
+    env.update(overrides)
+    return env
+
+
 # -- a child process killed at a point it announces (event-driven, never sleep-driven) -----
 
 def kill_when_announced(script):
@@ -161,7 +178,8 @@ def kill_when_announced(script):
     import signal
     import subprocess
 
-    process = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
+    process = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True,
+                               env=child_environment())
     try:
         return process.stdout.readline()
     finally:

@@ -12,6 +12,7 @@ from pathlib import Path
 import pytest
 
 from hmatddm import bench_cli, cli, runner
+from conftest import child_environment
 from scene_texts import KGD_2D_HEAD
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -160,7 +161,7 @@ def test_validate_keeps_its_exit_codes(capsys, monkeypatch):
 
 def test_console_script_and_examples_compile():
     result = subprocess.run([sys.executable, "-m", "hmatddm.cli", "scenes"], capture_output=True, text=True,
-                            cwd=ROOT, timeout=1800)  # a hang guard only: a loaded CI took > 120 s
+                            cwd=ROOT, env=child_environment(), timeout=1800)  # a hang guard only: a loaded CI took > 120 s
     assert result.returncode == 0 and "radial-k" in result.stdout
     examples = sorted((ROOT / "examples").glob("*.py"))
     assert len(examples) >= 3
@@ -234,7 +235,7 @@ assert len(err.getvalue().strip().splitlines()) == 1
 assert not loaded(), loaded()
 print("ok")
 """
-    env = {k: v for k, v in os.environ.items() if k != "OMP_WAIT_POLICY"}
+    env = {k: v for k, v in child_environment().items() if k != "OMP_WAIT_POLICY"}
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, env=env)
     assert result.returncode == 0 and result.stdout.strip() == "ok", result.stderr
     assert not (tmp_path / "out").exists()  # refused before anything was written

@@ -33,11 +33,12 @@ on purpose, so that the new tolerance is measured and written down rather than f
 by a user comparing two machines.
 """
 import json
-import os
 import subprocess
 import sys
 
 import pytest
+
+from conftest import child_environment
 
 #: Two fresh processes that compile and run a growing H-matrix simulation (~20 s warm,
 #: minutes on a cold numba cache): the slow set, run by .ci/run after the default set.
@@ -75,7 +76,7 @@ print(json.dumps(result))
 
 
 def _probe(threads):
-    env = dict(os.environ, NUMBA_NUM_THREADS=str(threads))
+    env = child_environment(NUMBA_NUM_THREADS=str(threads))
     completed = subprocess.run([sys.executable, "-c", PROBE], env=env, capture_output=True, text=True,
                                timeout=3600)  # a hang guard only, never a speed limit
     assert completed.returncode == 0, completed.stderr[-3000:]

@@ -4,9 +4,12 @@ limit is set (a busy machine only makes it slower)."""
 import subprocess
 import sys
 
+from conftest import child_environment
+
 
 def _fresh(code):
-    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                            env=child_environment())
     assert result.returncode == 0, result.stderr
     return result.stdout.split()
 
