@@ -285,7 +285,7 @@ def aca_study(n, factors, geometry="cloud", eps=1e-4, stride=9, leaf_size=32):
 
     def compress(rows, cols, factor, cpu):
         """(ACA rank, stored U'^T, V'^T, stored rank), or None when the ACA gave up."""
-        ut, vt, r, c, rv, cv, ints, floats, request, index = aca.aca_start(rows.size, cols.size, 3, 3, factor * eps)
+        ut, vt, gram, r, c, rv, cv, ints, floats, request, index = aca.aca_start(rows.size, cols.size, 3, 3, factor * eps)
         while request != aca.REQUEST_DONE:
             t0 = time.process_time()
             if request == aca.REQUEST_ROW:
@@ -293,13 +293,13 @@ def aca_study(n, factors, geometry="cloud", eps=1e-4, stride=9, leaf_size=32):
             else:
                 traction_block(data, rows, cols[index:index + 1], c)
             t1 = time.process_time()
-            ut, vt, request, index = aca.aca_advance(ut, vt, r, c, rv, cv, ints, floats)
+            ut, vt, gram, request, index = aca.aca_advance(ut, vt, gram, r, c, rv, cv, ints, floats)
             cpu["kernel"] += t1 - t0
             cpu["aca"] += time.process_time() - t1
         if aca.aca_gave_up(ints):
             return None  # the build stores the block dense: exact
         t0 = time.process_time()
-        u2, v2, k2 = aca.recompress_state(ut, vt, ints, eps)
+        u2, v2, k2 = aca.recompress_state(ut, vt, gram, ints, eps)
         cpu["recompression"] += time.process_time() - t0
         return int(ints[1]), u2, v2, k2
 

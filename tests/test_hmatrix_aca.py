@@ -356,3 +356,92 @@ def test_residual_updates_against_numpy(rank):
     expected = cols - product[:, 30:30 + d]
     _subtract_cols(cols, ut, vt, rank, 30)
     np.testing.assert_allclose(cols, expected, rtol=0, atol=1e-12)
+
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_eigen_recompression_against_numpy_svd(seed):
+    """The build's recompression at eps >= EIGEN_MIN_EPS (QR of V, the Gram matrix of U,
+    a symmetric eigenproblem) against numpy's truncated SVD of U V^T: the same rank, the
+    same error, V' orthonormal, singular values folded into U' in decreasing order; and
+    against the SVD path (used below EIGEN_MIN_EPS) to round-off. U is ill-conditioned
+    on purpose (it is never inverted)."""
+    from hmatddm.hmatrix.aca import EIGEN_MIN_EPS, recompress_gram, recompress_transposed
+
+    rng = np.random.default_rng(seed)
+    k, m, n = 40 + 5 * seed, 150, 120
+    # ACA-like factors: U columns of unit size, V columns decaying, both mixed
+    u = rng.standard_normal((m, k)) @ (np.eye(k) + 0.3 * rng.standard_normal((k, k)))
+    u[:, 5] = u[:, 2] + 1e-9 * u[:, 7]  # nearly dependent columns of U
+    v = rng.standard_normal((n, k)) * np.logspace(0, -10, k)
+    block = u @ v.T
+    sigma = np.linalg.svd(block, compute_uv=False)
+    ut, vt = np.ascontiguousarray(u.T), np.ascontiguousarray(v.T)
+    gram = np.zeros((k + 3, k + 3))  # capacity beyond the rank, as in the ACA state
+    gram[:k, :k] = ut @ ut.T
+    for eps in (1e-2, 1e-3, 1e-4, EIGEN_MIN_EPS):
+        tail = np.sqrt(np.cumsum(sigma[::-1] ** 2))[::-1]  # tail[r] = ||sigma[r:]||
+        expected = int(np.argmax(tail <= eps * np.linalg.norm(sigma)))
+        u2, v2, rank = recompress_gram(ut, vt, gram, k, eps)
+        assert rank == expected
+        error = relative_error(u2.T, v2.T, block)
+        np.testing.assert_allclose(error, tail[rank] / np.linalg.norm(sigma), rtol=1e-6)
+        np.testing.assert_allclose(v2 @ v2.T, np.eye(rank), rtol=0, atol=1e-12)
+        np.testing.assert_allclose(np.linalg.norm(u2, axis=1), sigma[:rank], rtol=1e-9)
+        u3, v3, rank3 = recompress_transposed(ut, vt, k, eps)
+        assert rank3 == rank
+        assert np.linalg.norm(u2.T @ v2 - u3.T @ v3) <= 1e-10 * np.linalg.norm(block)
+        u4, v4, rank4 = recompress(u, v, eps)  # the Python entry point takes the same path
+        assert rank4 == rank
+        assert np.linalg.norm(u4 @ v4.T - u2.T @ v2) <= 1e-12 * np.linalg.norm(block)
+    for eps in (0.5 * EIGEN_MIN_EPS, 1e-9):  # the SVD path, exactly
+        u2, v2, rank = recompress_gram(ut, vt, gram, k, eps)
+        u3, v3, rank3 = recompress_transposed(ut, vt, k, eps)
+        assert rank == rank3
+        np.testing.assert_array_equal(u2, u3)
+        np.testing.assert_array_equal(v2, v3)
+
+
+def test_eigen_recompression_with_dependent_columns_of_v():
+    """Dependent columns of V (zero rows of its block Gram-Schmidt) and of U: the exact
+    rank of the product, within eps."""
+    from hmatddm.hmatrix.aca import recompress_gram
+
+    rng = np.random.default_rng(22)
+    k, m, n = 12, 60, 50
+    u, v = rng.standard_normal((m, k)), rng.standard_normal((n, k)) * np.logspace(0, -3, k)
+    v[:, 4] = v[:, 1] - 0.5 * v[:, 2]
+    u[:, 9] = u[:, 3]
+    block = u @ v.T
+    ut, vt = np.ascontiguousarray(u.T), np.ascontiguousarray(v.T)
+    sigma = np.linalg.svd(block, compute_uv=False)
+    assert sigma[9] > 1e-5 * sigma[0] and sigma[10] < 1e-14 * sigma[0]  # rank 10 of 12
+    for eps in (1e-3, 1e-5):
+        tail = np.sqrt(np.cumsum(sigma[::-1] ** 2))[::-1]
+        u2, v2, rank = recompress_gram(ut, vt, ut @ ut.T, k, eps)
+        assert rank == int(np.argmax(tail <= eps * np.linalg.norm(sigma))) <= 10
+        assert relative_error(u2.T, v2.T, block) <= eps
+    zero = recompress_gram(ut, np.zeros_like(vt), ut @ ut.T, k, 1e-4)
+    assert zero[2] == 0 and zero[0].shape == (0, m) and zero[1].shape == (0, n)
+
+
+@pytest.mark.parametrize("eps", [1e-4, 1e-8])
+def test_the_aca_keeps_the_gram_matrix_of_u(eps):
+    """The Gram matrix U^T U that the ACA keeps for the recompression (from the products
+    its norm update takes) against numpy's, on a smooth tensor block."""
+    from hmatddm.hmatrix.aca import _RANK, _aca_run, aca_steps
+
+    rng = np.random.default_rng(7)
+    scalar, x, y = smooth_block(40, 36, rng, power=1.0)
+    d = x - y.mean(axis=0)
+    block = np.kron(scalar, np.eye(3) + np.outer(d[0], d[0]) / (d[0] @ d[0]))
+    me, ne = 40, 36
+    full = np.zeros(((me + ne) * 3, (me + ne) * 3))
+    full[:120, 120:] = block
+    data = (full, np.array([3], dtype=np.int64))
+    ut, vt, gram, ints = _aca_run(matrix_kernel, data, np.arange(me, dtype=np.int64),
+                                  np.arange(me, me + ne, dtype=np.int64), 3, 3, eps, *aca_steps()[:2])
+    k = ints[_RANK]
+    assert 10 < k < 100 and gram.shape[0] >= k
+    reference = ut[:k] @ ut[:k].T
+    np.testing.assert_allclose(gram[:k, :k], reference, rtol=0, atol=1e-13 * np.abs(reference).max())
