@@ -93,7 +93,7 @@ def test_float32_near_field_solves_within_tolerance_of_dense():
         errors[near_dtype] = (np.linalg.norm(h @ x - dense @ x) / np.linalg.norm(dense @ x),
                               np.linalg.norm(solution - reference) / np.linalg.norm(reference),
                               h.storage.dense_values.nbytes)
-    (matvec64, solution64, bytes64), (matvec32, solution32, bytes32) = errors[np.float64], errors[np.float32]
+    (_, solution64, bytes64), (matvec32, solution32, bytes32) = errors[np.float64], errors[np.float32]
     assert bytes32 * 2 == bytes64
     assert matvec32 <= 1e-6 and solution32 <= 2e-6  # float32 rounding amplified by the near-field cancellation
     assert solution64 <= 1e-6
