@@ -127,23 +127,29 @@ class ElasticityOperator(LinearOperator):
                                build_seconds=build, n_admissible=0, n_dense_blocks=1, max_rank=0,
                                eps=0.0, eta=eta, leaf_size=leaf_size, n_elements=mesh.n_elements, dof=self.dof)
         else:
-            from .hmatrix import BlockGenerator, HMatrix
-
             self._matrix = None
-            generator = BlockGenerator(kernel=drivers.traction_block, data=self.data,
-                                       points=mesh.centers, radii=mesh.radii, dof=self.dof)
-            # 3D: clusters split between whole fractures first (clouds of tall fractures:
-            # -24% build CPU, -12% memory at 40k, benchmarks/RESULTS.md "Solver at scale")
-            groups = mesh.fracture_id if mesh.dim == 3 else None
-            self._hmatrix = HMatrix.build(generator, eps=eps, eta=eta, leaf_size=leaf_size, groups=groups)
-            if not self._hmatrix.is_finite():
-                self._refuse_singular()
-            self._stats = dict(self._hmatrix.stats)
-            self._stats["backend"] = "hmatrix"
+            self._build_compressed(eps, eta, leaf_size)
         if isinstance(material, LayeredMedium):
             self._stats["n_images"] = int(self.data.n_images)
         self._lu = None
         self._preconditioner = None
+
+    def _build_compressed(self, eps, eta, leaf_size):
+        """The ``hmatrix`` backend's build (:class:`hmatddm.planar_operator.PlanarElasticityOperator`
+        builds two)."""
+        from .hmatrix import BlockGenerator, HMatrix
+
+        mesh = self.mesh
+        generator = BlockGenerator(kernel=drivers.traction_block, data=self.data,
+                                   points=mesh.centers, radii=mesh.radii, dof=self.dof)
+        # 3D: clusters split between whole fractures first (clouds of tall fractures:
+        # -24% build CPU, -12% memory at 40k, benchmarks/RESULTS.md "Solver at scale")
+        groups = mesh.fracture_id if mesh.dim == 3 else None
+        self._hmatrix = HMatrix.build(generator, eps=eps, eta=eta, leaf_size=leaf_size, groups=groups)
+        if not self._hmatrix.is_finite():
+            self._refuse_singular()
+        self._stats = dict(self._hmatrix.stats)
+        self._stats["backend"] = "hmatrix"
 
     # -- LinearOperator interface -------------------------------------------------
     def _matvec(self, x):

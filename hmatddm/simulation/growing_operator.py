@@ -2,7 +2,10 @@
 blocks while the mesh grows a little, rebuilt when it grew too much.
 
 The operator is rebuilt only when the mesh has grown, never inside the nonlinear
-iterations of a step.
+iterations of a step. A planar 3D mesh in a homogeneous medium gets the ``hmatrix``
+backend's opening and shear operators apart (:mod:`hmatddm.planar_operator`; the same
+matrix, ~7x faster products for a crack loaded in opening) unless
+:data:`SPLIT_PLANAR_MODES` is False.
 """
 import warnings
 from dataclasses import asdict
@@ -11,7 +14,12 @@ import numpy as np
 
 from ..errors import MeshQualityWarning
 from ..extended_operator import ExtendedElasticityOperator
+from ..material import Elastic
 from ..operators import ElasticityOperator
+from ..planar_operator import PlanarElasticityOperator, is_planar
+
+#: Build a planar mesh's operator as its opening and shear parts (see the module docstring).
+SPLIT_PLANAR_MODES = True
 
 
 class GrowingOperator:
@@ -53,7 +61,10 @@ class GrowingOperator:
         # the mesh-quality check runs at every build of a growing mesh: warn once per run
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", MeshQualityWarning)
-            self.base = ElasticityOperator(mesh, self.material, **asdict(self.operator_settings))
+            settings = asdict(self.operator_settings)
+            split = (SPLIT_PLANAR_MODES and settings["backend"] == "hmatrix" and isinstance(self.material, Elastic)
+                     and is_planar(mesh))
+            self.base = (PlanarElasticityOperator if split else ElasticityOperator)(mesh, self.material, **settings)
         for warning in caught:
             if issubclass(warning.category, MeshQualityWarning):
                 if not self._mesh_quality_warned:
