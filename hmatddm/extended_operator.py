@@ -44,6 +44,10 @@ class ExtendedElasticityOperator(LinearOperator):
     """``base`` (an ElasticityOperator of the first ``n0`` elements of ``mesh``) plus
     exact border blocks for elements ``n0..N-1``.
 
+    ``base`` may also be one part of a planar crack's operator
+    (:meth:`hmatddm.planar_operator.PlanarElasticityOperator.part`): its ``dof`` unknowns
+    per element and its ``block_kernel`` then give the border blocks.
+
     ``previous``: the operator of an earlier growth pass over the same ``base`` (for
     example the last one returned). The border chunks and the ``A_nn`` factor levels of
     the elements it shares with ``mesh`` (the longest common run of unchanged elements
@@ -54,8 +58,9 @@ class ExtendedElasticityOperator(LinearOperator):
     """
 
     def __init__(self, base, mesh, previous=None):
-        if not isinstance(base, ElasticityOperator):
+        if not (isinstance(base, ElasticityOperator) or hasattr(base, "block_kernel")):
             raise InputError(f"base must be an ElasticityOperator, got {type(base).__name__}")
+        self._kernel = getattr(base, "block_kernel", traction_block)
         n0, n = base.mesh.n_elements, mesh.n_elements
         if n <= n0 or not np.array_equal(mesh.centers[:n0], base.mesh.centers):
             raise InputError(f"mesh must extend the base operator's mesh ({n0} elements) by appending elements, "
@@ -163,7 +168,7 @@ class ExtendedElasticityOperator(LinearOperator):
 
     def _block(self, data, rows, cols):
         out = np.empty((len(rows) * self.dof, len(cols) * self.dof))
-        traction_block(data, rows, cols, out)
+        self._kernel(data, rows, cols, out)
         return out
 
     @property

@@ -27,11 +27,13 @@ builds the 3 x 3 operator for it on first use.
 """
 import numpy as np
 from numba import njit
+from scipy.sparse.linalg import LinearOperator
 
 from .errors import InputError
 from .kernels.drivers import traction_block
 from .material import Elastic
 from .mesh import Mesh3D
+from .operator_inverse import solve_with_inverse
 from .operators import ElasticityOperator
 
 #: Relative flatness asked of a planar mesh: every centre within this fraction of the
@@ -91,6 +93,39 @@ def shear_traction_block(data, rows, cols, out):
                     out[2 * a + k, 2 * b + m] = total
 
 
+def split_modes(x, normals, axes):
+    """(opening part (N,), shear part (2N,) or None when it is round-off) of the flat,
+    global DDs (or tractions) ``x``, in the elements' frames (``normals`` (N, 3), ``axes``
+    (N, 2, 3))."""
+    vectors = np.asarray(x, dtype=np.float64).reshape(-1, 3)
+    opening = np.einsum("ek,ek->e", vectors, normals)
+    shear = np.einsum("eak,ek->ea", axes, vectors).ravel()
+    if not np.any(np.abs(shear) > SHEAR_ROUND_OFF * np.abs(vectors).max(initial=0.0)):
+        shear = None
+    return opening, shear
+
+
+def join_modes(opening, shear, normals, axes):
+    """The flat global vector of an opening part and a shear part (None: zero)."""
+    vectors = opening[:, None] * normals
+    if shear is not None:
+        vectors += np.einsum("ea,eak->ek", shear.reshape(-1, 2), axes)
+    return vectors.ravel()
+
+
+def exact_diagonal_blocks(data, start, stop):
+    """(stop - start, 3, 3): the self blocks of elements ``start..stop-1`` from the kernel,
+    32 elements per call."""
+    blocks = np.empty((stop - start, 3, 3))
+    for first in range(start, stop, 32):
+        chunk = np.arange(first, min(first + 32, stop), dtype=np.int64)
+        full = np.empty((3 * chunk.size, 3 * chunk.size))
+        traction_block(data, chunk, chunk, full)
+        index = np.arange(chunk.size)
+        blocks[first - start:first - start + chunk.size] = full.reshape(chunk.size, 3, chunk.size, 3)[index, :, index, :]
+    return blocks
+
+
 class PlanarElasticityOperator(ElasticityOperator):
     """:class:`~hmatddm.ElasticityOperator` (``hmatrix`` backend) of a planar 3D mesh in a
     homogeneous medium, compressed as an opening operator and a shear operator (the
@@ -111,6 +146,8 @@ class PlanarElasticityOperator(ElasticityOperator):
         self._shear = None
         self._shear_preconditioner = None
         self._full = None
+        self._diagonal_blocks = None
+        self._parts = {}
         super().__init__(mesh, material, backend="hmatrix", singular_correction=singular_correction, alpha=alpha,
                          **options)
 
@@ -156,22 +193,32 @@ class PlanarElasticityOperator(ElasticityOperator):
                      n_elements=self.mesh.n_elements, parts="normal" if self._shear is None else "normal+shear")
         return stats
 
+    def part(self, name):
+        """The ``"normal"`` or ``"shear"`` part as an operator of its own (:class:`OperatorPart`),
+        the base of a grown mesh's part (:class:`PlanarExtendedOperator`)."""
+        if name not in ("normal", "shear"):
+            raise InputError(f"part must be 'normal' or 'shear', got {name!r}")
+        if name not in self._parts:  # one object per part: grown operators share by identity
+            self._parts[name] = OperatorPart(self, name)
+        return self._parts[name]
+
+    def _part_preconditioner(self, name):
+        from .hmatrix import default_preconditioner
+
+        if name == "normal":
+            if self._preconditioner is None:
+                self._preconditioner = default_preconditioner(self._hmatrix)
+            return self._preconditioner
+        if self._shear_preconditioner is None:
+            self._shear_preconditioner = default_preconditioner(self._shear_operator())
+        return self._shear_preconditioner
+
     # -- the two parts of a vector ----------------------------------------------------
     def _split(self, x):
-        """(opening part (N,), shear part (2N,) or None when it is round-off)."""
-        vectors = np.asarray(x, dtype=np.float64).reshape(-1, 3)
-        opening = np.einsum("ek,ek->e", vectors, self._normals)
-        shear = np.einsum("eak,ek->ea", self._axes, vectors).ravel()
-        scale = np.abs(vectors).max(initial=0.0)
-        if not np.any(np.abs(shear) > SHEAR_ROUND_OFF * scale):
-            shear = None
-        return opening, shear
+        return split_modes(x, self._normals, self._axes)
 
     def _join(self, opening, shear):
-        vectors = opening[:, None] * self._normals
-        if shear is not None:
-            vectors += np.einsum("ea,eak->ek", shear.reshape(-1, 2), self._axes)
-        return vectors.ravel()
+        return join_modes(opening, shear, self._normals, self._axes)
 
     # -- LinearOperator interface -------------------------------------------------
     def _matvec(self, x):
@@ -206,29 +253,18 @@ class PlanarElasticityOperator(ElasticityOperator):
         return LinearOperator(self.shape, matvec=self.approximate_inverse, dtype=np.float64)
 
     def element_diagonal_blocks(self):
-        """(N, 3, 3): the exact self-influence block of each element (from the kernel, a
-        few dozen elements per call)."""
-        n = self.mesh.n_elements
-        blocks = np.empty((n, 3, 3))
-        for start in range(0, n, 32):
-            chunk = np.arange(start, min(start + 32, n), dtype=np.int64)
-            index = np.arange(chunk.size)
-            blocks[chunk] = self.exact_block(chunk, chunk).reshape(chunk.size, 3, chunk.size, 3)[index, :, index, :]
-        return blocks
+        """(N, 3, 3): the exact self-influence block of each element (computed once)."""
+        if self._diagonal_blocks is None:
+            self._diagonal_blocks = exact_diagonal_blocks(self.data, 0, self.mesh.n_elements)
+        return self._diagonal_blocks.copy()
 
     def approximate_inverse(self, r):
         """One application of each part's near-field preconditioner (the shear part's
         only when ``r`` has one)."""
-        from .hmatrix import default_preconditioner
-
-        if self._preconditioner is None:
-            self._preconditioner = default_preconditioner(self._hmatrix)
         opening, shear = self._split(r)
         if shear is not None:
-            if self._shear_preconditioner is None:
-                self._shear_preconditioner = default_preconditioner(self._shear_operator())
-            shear = self._shear_preconditioner @ shear
-        return self._join(self._preconditioner @ opening, shear)
+            shear = self._part_preconditioner("shear") @ shear
+        return self._join(self._part_preconditioner("normal") @ opening, shear)
 
     def modified_inverse(self, rows):
         """The approximate inverse of ``S A + D`` (contact rows) of the 3 x 3 operator of
@@ -237,4 +273,114 @@ class PlanarElasticityOperator(ElasticityOperator):
             self._full = ElasticityOperator(self.mesh, self.material, backend="hmatrix",
                                             singular_correction=self.singular_correction, alpha=self.alpha,
                                             **self._compression)
+        return self._full.modified_inverse(rows)
+
+
+class OperatorPart:
+    """The opening (``"normal"``: 1 unknown per element) or shear (``"shear"``: 2) part of
+    a :class:`PlanarElasticityOperator`, with what :class:`~hmatddm.extended_operator.
+    ExtendedElasticityOperator` asks of a base: ``block_kernel`` for the border blocks,
+    products, the part's near-field preconditioner and self blocks."""
+
+    def __init__(self, planar, name):
+        self.planar, self.name = planar, name
+        self.mesh, self.material, self.backend = planar.mesh, planar.material, "hmatrix"
+        self.singular_correction, self.alpha = planar.singular_correction, planar.alpha
+        self.dof = 1 if name == "normal" else 2
+        self.block_kernel = normal_traction_block if name == "normal" else shear_traction_block
+        self.stats = {}
+
+    @property
+    def hmatrix(self):
+        return self.planar.hmatrix if self.name == "normal" else self.planar._shear_operator()
+
+    def matvec(self, x):
+        return self.hmatrix.matvec(np.asarray(x, dtype=np.float64).ravel())
+
+    def approximate_inverse(self, r):
+        return self.planar._part_preconditioner(self.name) @ np.asarray(r, dtype=np.float64).ravel()
+
+    def element_diagonal_blocks(self):
+        return self.hmatrix.element_diagonal_blocks()
+
+    def modified_inverse(self, rows):
+        raise InputError("contact rows act on whole elements: use the PlanarExtendedOperator's modified_inverse")
+
+
+class PlanarExtendedOperator(LinearOperator):
+    """A planar crack's operator (``base``, a :class:`PlanarElasticityOperator`) grown by
+    elements in its plane: each part extended by its own exact border blocks
+    (:class:`~hmatddm.extended_operator.ExtendedElasticityOperator` over
+    :meth:`PlanarElasticityOperator.part`), the shear part on first use. 1/9 (opening) of
+    the border entries, products and border preconditioner of the 3 x 3 border. Contact
+    rows (:meth:`modified_inverse`) get the whole-tensor extension on first use."""
+
+    inverse_is_exact = False
+
+    def __init__(self, base, mesh, previous=None):
+        if not isinstance(base, PlanarElasticityOperator):
+            raise InputError(f"base must be a PlanarElasticityOperator, got {type(base).__name__}")
+        if not is_planar(mesh):
+            raise InputError("mesh must lie in the base operator's plane (is_planar)")
+        from .extended_operator import ExtendedElasticityOperator
+
+        self.base, self.mesh, self.material, self.backend, self.dof = base, mesh, base.material, "hmatrix", 3
+        self.n_base = base.mesh.n_elements
+        super().__init__(dtype=np.float64, shape=(3 * mesh.n_elements, 3 * mesh.n_elements))
+        shares = isinstance(previous, PlanarExtendedOperator) and previous.base is base
+        self._normal = ExtendedElasticityOperator(base.part("normal"), mesh, previous._normal if shares else None)
+        self._shear_previous = previous._shear if shares else None
+        self._shear = None
+        self._full = None
+        frames = self._normal._data.frames
+        self._normals, self._axes = np.ascontiguousarray(frames[:, 2]), np.ascontiguousarray(frames[:, :2])
+
+    @property
+    def n_new(self):
+        return self.mesh.n_elements - self.n_base
+
+    @property
+    def border_bytes(self):
+        return self._normal.border_bytes + (0 if self._shear is None else self._shear.border_bytes)
+
+    def _shear_operator(self):
+        if self._shear is None:
+            from .extended_operator import ExtendedElasticityOperator
+
+            self._shear = ExtendedElasticityOperator(self.base.part("shear"), self.mesh, self._shear_previous)
+            self._shear_previous = None
+        return self._shear
+
+    def _matvec(self, x):
+        opening, shear = split_modes(x, self._normals, self._axes)
+        return join_modes(self._normal.matvec(opening), None if shear is None else self._shear_operator().matvec(shear),
+                          self._normals, self._axes)
+
+    def approximate_inverse(self, r):
+        """Each part's block-triangular solve (the shear part's only when ``r`` has one)."""
+        opening, shear = split_modes(r, self._normals, self._axes)
+        if shear is not None:
+            shear = self._shear_operator().approximate_inverse(shear)
+        return join_modes(self._normal.approximate_inverse(opening), shear, self._normals, self._axes)
+
+    def preconditioner(self):
+        return LinearOperator(self.shape, matvec=self.approximate_inverse, dtype=np.float64)
+
+    def solve(self, rhs, x0=None, rtol=1e-9, restart=100, maxiter=20):
+        """``(x, info)``: GMRES preconditioned by :meth:`approximate_inverse`."""
+        return solve_with_inverse(self, rhs, self.approximate_inverse, False, x0=x0, rtol=rtol, restart=restart,
+                                  maxiter=maxiter)
+
+    def element_diagonal_blocks(self):
+        """(N, 3, 3): the base's exact self blocks, then the new elements' (kernel)."""
+        return np.concatenate([self.base.element_diagonal_blocks(),
+                               exact_diagonal_blocks(self._normal._data, self.n_base, self.mesh.n_elements)])
+
+    def modified_inverse(self, rows):
+        """The whole-tensor extension's (built on first use): contact rows mix an
+        element's components."""
+        if self._full is None:
+            from .extended_operator import ExtendedElasticityOperator
+
+            self._full = ExtendedElasticityOperator(self.base, self.mesh)
         return self._full.modified_inverse(rows)

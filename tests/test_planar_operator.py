@@ -6,7 +6,8 @@ import pytest
 import hmatddm as hd
 from hmatddm.coupled.contact import ContactRows
 from hmatddm.errors import InputError
-from hmatddm.planar_operator import PlanarElasticityOperator, is_planar
+from hmatddm.extended_operator import ExtendedElasticityOperator
+from hmatddm.planar_operator import PlanarElasticityOperator, PlanarExtendedOperator, is_planar
 from hmatddm.simulation import growing_operator
 
 MATERIAL = hd.Elastic(10e9, 0.25)
@@ -90,6 +91,37 @@ def test_contact_rows_use_the_whole_tensor_operator():
     np.testing.assert_array_equal(op.modified_inverse(rows)(r), full.modified_inverse(rows)(r))
 
 
+def test_a_grown_planar_operator_matches_the_dense_one_and_reuses_the_last_border(pair):
+    mesh, dense = pair
+    n = mesh.n_elements
+    sizes = (n - 30, n - 12, n)  # the base, a first growth pass, a second
+    base = PlanarElasticityOperator(mesh.subset(np.arange(sizes[0])), MATERIAL, eps=1e-6)
+    first = PlanarExtendedOperator(base, mesh.subset(np.arange(sizes[1])))
+    grown = PlanarExtendedOperator(base, mesh, previous=first)
+    fresh = PlanarExtendedOperator(base, mesh)
+    assert grown._normal.n_reused == sizes[1] - sizes[0]
+    opening = (np.cos(mesh.centers[:, 0])[:, None] * mesh.normals).ravel()
+    x = np.random.default_rng(2).normal(size=3 * n)
+    for vector, parts in ((opening, None), (x, "shear")):
+        exact = dense @ vector
+        product = grown @ vector
+        assert np.linalg.norm(product - exact) <= 1e-5 * np.linalg.norm(exact)
+        np.testing.assert_allclose(product, fresh @ vector, rtol=0, atol=1e-12 * np.abs(exact).max())
+        assert (grown._shear is None) == (parts is None)
+    index = np.arange(n)
+    np.testing.assert_array_equal(grown.element_diagonal_blocks(), dense.reshape(n, 3, n, 3)[index, :, index, :])
+    rhs = dense @ x
+    solution, info = grown.solve(rhs, rtol=1e-10)
+    assert info["converged"] and np.linalg.norm(solution - x) <= 1e-5 * np.linalg.norm(x)
+    # contact rows: the whole-tensor extension of the same base
+    select = np.tile(np.eye(3), (n, 1, 1))
+    select[::4] = np.diag([1.0, 1.0, 0.0])
+    direct = np.zeros((n, 3, 3))
+    direct[::4, 2, 2] = 1e12
+    rows = ContactRows(select, direct, np.zeros((n, 3)), "closed")
+    np.testing.assert_array_equal(grown.modified_inverse(rows)(x), ExtendedElasticityOperator(base, mesh).modified_inverse(rows)(x))
+
+
 def test_refuses_what_does_not_split():
     with pytest.raises(InputError, match="one plane"):
         PlanarElasticityOperator(hd.mesh.concatenate([_mesh("horizontal"), _mesh("tilted")]), MATERIAL)
@@ -103,7 +135,15 @@ def test_refuses_what_does_not_split():
 def test_a_growing_planar_run_is_the_same_with_the_parts_apart_or_together(monkeypatch):
     """The simulation builds the split operator for a planar mesh; the run matches the one
     with the 3 x 3 operator to the GMRES tolerance (the H-matrices differ within eps)."""
-    runs = {}
+    runs = {"grown": []}
+    grow = growing_operator.GrowingOperator.__call__
+
+    def recorded(self, mesh):
+        operator = grow(self, mesh)
+        runs["grown"].append(operator)
+        return operator
+
+    monkeypatch.setattr(growing_operator.GrowingOperator, "__call__", recorded)
     for split in (True, False):
         monkeypatch.setattr(growing_operator, "SPLIT_PLANAR_MODES", split)
         start = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 6.0, 6.0, 3, 3)
@@ -115,6 +155,7 @@ def test_a_growing_planar_run_is_the_same_with_the_parts_apart_or_together(monke
         runs[split] = records, simulation.operators.base
     (split_records, split_base), (whole_records, whole_base) = runs[True], runs[False]
     assert isinstance(split_base, PlanarElasticityOperator) and split_base.shear_hmatrix is None
+    assert any(isinstance(o, PlanarExtendedOperator) for o in runs["grown"])
     assert not isinstance(whole_base, PlanarElasticityOperator)
     assert split_records[-1]["n_elements"] > 9  # it grew
     assert [r["n_elements"] for r in split_records] == [r["n_elements"] for r in whole_records]

@@ -3,9 +3,9 @@ blocks while the mesh grows a little, rebuilt when it grew too much.
 
 The operator is rebuilt only when the mesh has grown, never inside the nonlinear
 iterations of a step. A planar 3D mesh in a homogeneous medium gets the ``hmatrix``
-backend's opening and shear operators apart (:mod:`hmatddm.planar_operator`; the same
-matrix, ~7x faster products for a crack loaded in opening) unless
-:data:`SPLIT_PLANAR_MODES` is False.
+backend's opening and shear operators apart, and their border blocks apart while it grows
+in its plane (:mod:`hmatddm.planar_operator`; the same matrix, ~7x faster products for a
+crack loaded in opening) unless :data:`SPLIT_PLANAR_MODES` is False.
 """
 import warnings
 from dataclasses import asdict
@@ -16,7 +16,7 @@ from ..errors import MeshQualityWarning
 from ..extended_operator import ExtendedElasticityOperator
 from ..material import Elastic
 from ..operators import ElasticityOperator
-from ..planar_operator import PlanarElasticityOperator, is_planar
+from ..planar_operator import PlanarElasticityOperator, PlanarExtendedOperator, is_planar
 
 #: Build a planar mesh's operator as its opening and shear parts (see the module docstring).
 SPLIT_PLANAR_MODES = True
@@ -50,7 +50,9 @@ class GrowingOperator:
         elif (extends and self.operator_settings.backend == "hmatrix"
               and self.rebuild_settings.border_fits(base.mesh.n_elements, n - base.mesh.n_elements, base.dof)):
             # the border blocks of the elements the last operator had are copied, not re-evaluated
-            operator = ExtendedElasticityOperator(base, mesh, previous=self._operator)
+            grown = (PlanarExtendedOperator if isinstance(base, PlanarElasticityOperator) and is_planar(mesh)
+                     else ExtendedElasticityOperator)
+            operator = grown(base, mesh, previous=self._operator)
         else:
             operator = self.build(mesh)
         self._operator, self._mesh = operator, mesh
