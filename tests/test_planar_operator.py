@@ -162,3 +162,24 @@ def test_a_growing_planar_run_is_the_same_with_the_parts_apart_or_together(monke
     for a, b in zip(split_records, whole_records):
         np.testing.assert_allclose(a["wellbore_pressure"], b["wellbore_pressure"], rtol=1e-6)
         np.testing.assert_allclose(a["max_opening"], b["max_opening"], rtol=1e-5)
+
+
+def _planar_run(**kwargs):
+    start = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 6.0, 6.0, 3, 3)
+    return hd.Simulation(start, hd.Elastic(24e9, 0.25), hd.Fluid(1e-3, 4.4e-10), [hd.Cluster((0, 0, 0), 0.01, 0.005)],
+                         far_field_stress=np.diag([0, 0, -8e6]), time_step=1.0,
+                         propagation=hd.Propagation(toughness=5e6), initial_pressure=10e6, initial_opening=1e-5,
+                         backend="hmatrix", eps=1e-6, **kwargs)
+
+
+@pytest.mark.parametrize("split", [True, False])
+def test_a_resumed_planar_run_repeats_the_uninterrupted_one(tmp_path, monkeypatch, split):
+    """The resumed run rebuilds the interrupted run's split base (GrowingOperator.restore)."""
+    monkeypatch.setattr(growing_operator, "SPLIT_PLANAR_MODES", split)
+    whole = _planar_run().run(6.0)
+    _planar_run(checkpoint_dir=tmp_path).run(3.0)
+    resumed = _planar_run(checkpoint_dir=tmp_path).run(6.0, resume=True)
+    assert [r["step"] for r in resumed] == [r["step"] for r in whole]
+    assert resumed[-1]["n_elements"] == whole[-1]["n_elements"] > 9
+    for a, b in zip(whole, resumed):
+        assert a["wellbore_pressure"] == b["wellbore_pressure"] and a["max_opening"] == b["max_opening"]

@@ -826,6 +826,21 @@ def _orthonormalize(vectors, count):
 
 
 @njit(cache=True, nogil=True, fastmath=FAST)
+def _kept_rank(tail_squares, total, eps):
+    """The truncation rule of both recompressions: the smallest rank whose discarded
+    squared singular values, ``tail_squares`` (all of them, the smallest first), sum to
+    at most ``eps^2 * total``."""
+    tail = 0.0
+    kept = tail_squares.shape[0]
+    for square in tail_squares:
+        if tail + square > eps * eps * total:
+            break
+        tail += square
+        kept -= 1
+    return kept
+
+
+@njit(cache=True, nogil=True, fastmath=FAST)
 def recompress_transposed(ut, vt, rank, eps):
     """Truncate U V^T (given as the first ``rank`` rows of U^T and V^T) to the smallest
     rank with relative Frobenius error <= eps.
@@ -848,15 +863,7 @@ def recompress_transposed(ut, vt, rank, eps):
         total += x * x
     if total == 0.0 or not np.isfinite(total):
         return np.zeros((0, m)), np.zeros((0, n)), 0
-    # smallest rank whose discarded tail satisfies tail^2 <= eps^2 * total
-    tail = 0.0
-    new_rank = s.shape[0]
-    while new_rank > 0:
-        candidate = tail + s[new_rank - 1] ** 2
-        if candidate > eps * eps * total:
-            break
-        tail = candidate
-        new_rank -= 1
+    new_rank = _kept_rank(s[::-1] ** 2, total, eps)
     if new_rank == 0:
         return np.zeros((0, m)), np.zeros((0, n)), 0
     # U'^T = (W S)^T qu and V'^T = Z^T qv over the kept columns: two BLAS products
@@ -922,15 +929,7 @@ def recompress_gram(ut, vt, gram_u, rank, eps):
             total += x
     if total == 0.0 or not np.isfinite(total):
         return np.zeros((0, m)), np.zeros((0, n)), 0
-    # smallest rank whose discarded eigenvalues (squared singular values) sum to <= eps^2 * total
-    tail = 0.0
-    new_rank = rank
-    while new_rank > 0:
-        candidate = tail + max(values[rank - new_rank], 0.0)
-        if candidate > eps * eps * total:
-            break
-        tail = candidate
-        new_rank -= 1
+    new_rank = _kept_rank(np.maximum(values, 0.0), total, eps)  # eigenvalues: squared singular values
     if new_rank == 0:
         return np.zeros((0, m)), np.zeros((0, n)), 0
     # kept eigenvectors, largest first: Z_k^T (k' x k)
