@@ -17,7 +17,10 @@ plane, the radial and planar benchmarks) never needs ``A_ss``: it is built on th
 product whose shear part is not zero. Products, the near-field preconditioner and the
 build then cost what a scalar kernel costs (N = 3969, eps 1e-4, one thread, against the
 3 x 3 operator: 8.9x less memory, 6.9x faster products, 9.8x faster ILU solves, 2.9x
-faster build; benchmarks/RESULTS.md, issue 17).
+faster build). A growing planar crack extends each part by its own border blocks
+(:class:`PlanarExtendedOperator`): the h = 0.5 m radial K-vertex run of issue 17 takes 44.7 s
+of CPU instead of 106.6 s, with the same errors (AMD EPYC, 1-thread dgemm 30-34 GFLOP/s;
+benchmarks/RESULTS.md, session of 2026-12-02, sixth).
 
 A shear part counts as zero when it is below :data:`SHEAR_ROUND_OFF` of the largest
 component: projecting an opening ``w n`` stored in global components on the in-plane
