@@ -33,7 +33,7 @@ from numba import njit
 from scipy.sparse.linalg import LinearOperator
 
 from .errors import InputError
-from .kernels.drivers import traction_block
+from .kernels.drivers import self_blocks, traction_block
 from .material import Elastic
 from .mesh import Mesh3D
 from .operator_inverse import solve_with_inverse
@@ -114,19 +114,6 @@ def join_modes(opening, shear, normals, axes):
     if shear is not None:
         vectors += np.einsum("ea,eak->ek", shear.reshape(-1, 2), axes)
     return vectors.ravel()
-
-
-def exact_diagonal_blocks(data, start, stop):
-    """(stop - start, 3, 3): the self blocks of elements ``start..stop-1`` from the kernel,
-    32 elements per call."""
-    blocks = np.empty((stop - start, 3, 3))
-    for first in range(start, stop, 32):
-        chunk = np.arange(first, min(first + 32, stop), dtype=np.int64)
-        full = np.empty((3 * chunk.size, 3 * chunk.size))
-        traction_block(data, chunk, chunk, full)
-        index = np.arange(chunk.size)
-        blocks[first - start:first - start + chunk.size] = full.reshape(chunk.size, 3, chunk.size, 3)[index, :, index, :]
-    return blocks
 
 
 class PlanarElasticityOperator(ElasticityOperator):
@@ -258,7 +245,7 @@ class PlanarElasticityOperator(ElasticityOperator):
     def element_diagonal_blocks(self):
         """(N, 3, 3): the exact self-influence block of each element (computed once)."""
         if self._diagonal_blocks is None:
-            self._diagonal_blocks = exact_diagonal_blocks(self.data, 0, self.mesh.n_elements)
+            self._diagonal_blocks = self_blocks(self.data)
         return self._diagonal_blocks.copy()
 
     def approximate_inverse(self, r):
@@ -377,7 +364,7 @@ class PlanarExtendedOperator(LinearOperator):
     def element_diagonal_blocks(self):
         """(N, 3, 3): the base's exact self blocks, then the new elements' (kernel)."""
         return np.concatenate([self.base.element_diagonal_blocks(),
-                               exact_diagonal_blocks(self._normal._data, self.n_base, self.mesh.n_elements)])
+                               self_blocks(self._normal._data, self.n_base, self.mesh.n_elements)])
 
     def modified_inverse(self, rows):
         """The whole-tensor extension's (built on first use): contact rows mix an

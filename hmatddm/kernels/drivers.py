@@ -384,37 +384,36 @@ def singular_pairs(data, rows, cols, out):
         out[pairs] = ~np.all(np.isfinite(block.reshape(len(pairs), -1)), axis=1)
 
 
-def _self_block_max(kernel, data, out):
-    """:func:`self_block_max` with the block generator ``kernel`` (:func:`traction_block`)."""
+def _self_blocks(kernel, data, first, out):
+    """:func:`self_blocks` with the block generator ``kernel`` (:func:`traction_block`)."""
     element = np.empty(1, dtype=np.int64)
-    dof = element_unknowns(data)
-    block = np.empty((dof, dof))
-    for i in range(out.shape[0]):
-        element[0] = i
-        kernel(data, element, element, block)
-        largest = 0.0  # np.max(np.abs(block)), NaN included, without compiling numpy's reductions
-        for p in range(dof):
-            for q in range(dof):
-                value = abs(block[p, q])
-                if value > largest or value != value:
-                    largest = value
-                    if value != value:
-                        break
-            if largest != largest:
-                break
-        out[i] = largest
+    for k in range(out.shape[0]):
+        element[0] = first + k
+        kernel(data, element, element, out[k])
 
 
-def self_block_max(data, out):
-    """``out[i]`` (``out`` (N,) float64): the largest |entry| of element ``i``'s self block
-    (the ``self_max`` of ref. Eq. 6.11; the Eq. 6.11 scaling never applies to a self block).
+def self_blocks(data, start=0, stop=None):
+    """(stop - start, d, d): the exact self block of elements ``start..stop-1`` (all by
+    default), one kernel call per element.
 
     One compiled loop per record type that calls :func:`traction_block` as a first-class
     function (:mod:`hmatddm.hmatrix.first_class`, as the H-matrix build does): the kernel is
     not compiled again, and the loop is small and cached on disk."""
     from ..hmatrix.first_class import compiled_for_data
 
-    compiled_for_data(_self_block_max, data, (types.float64[::1],), types.none)(traction_block, data, out)
+    stop = data.centers.shape[0] if stop is None else stop
+    dof = element_unknowns(data)
+    out = np.empty((stop - start, dof, dof))
+    compiled_for_data(_self_blocks, data, (types.int64, types.float64[:, :, ::1]), types.none)(
+        traction_block, data, start, out)
+    return out
+
+
+def self_block_max(data, out):
+    """``out[i]`` (``out`` (N,) float64): the largest |entry| of element ``i``'s self block,
+    NaN if it has one (the ``self_max`` of ref. Eq. 6.11; the Eq. 6.11 scaling never applies
+    to a self block)."""
+    out[:] = np.abs(self_blocks(data)).max(axis=(1, 2))
 
 
 def with_self_max(data):
@@ -468,5 +467,5 @@ def finite_stress_sum(data, points, dd, point_layer, edge="element edge"):
 
 __all__ = ["COMMON_FIELDS", "HOMOGENEOUS_FIELDS", "kernel_record", "KernelKind", "register_kind", "no_source_state",
            "kind_of", "element_unknowns", "borrowed", "traction_block", "stress_block", "edge_distance",
-           "traction_matrix", "influence_matrix", "singular_pairs", "self_block_max", "with_self_max",
+           "traction_matrix", "influence_matrix", "singular_pairs", "self_blocks", "self_block_max", "with_self_max",
            "self_block_maxima", "stress_at_points", "stress_sum", "finite_stress_sum"]
