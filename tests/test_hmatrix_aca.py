@@ -276,14 +276,16 @@ def test_a_block_the_aca_cannot_compress_is_exact_not_approximate(seed, eps):
 def test_giving_up_leaves_ordinary_low_rank_blocks_alone():
     """The same kernel on a well separated block (4x farther): an ordinary low-rank ACA,
     not given up, within eps, rank far below min(m, n)."""
-    from hmatddm.hmatrix.aca import _aca_loop, aca_gave_up, aca_steps
+    from hmatddm.hmatrix.aca import _aca_loop, _for_data, aca_gave_up, aca_steps
     from hmatddm.hmatrix.example_kernels import field_kernel
 
     data, rows, cols, _ = near_full_rank_field_block(0)
     sources = data[1] + np.array([8.0, 0.0, 0.0])
     block = np.empty((84, 64))
     field_kernel((data[0], sources), rows, cols, block)
-    _, _, ints = _aca_loop(field_kernel, (data[0], sources), rows, cols, 3, 2, 1e-6, *aca_steps()[:2])
+    # the loop as the build runs it: kernel and steps as first-class functions (cached)
+    loop = _for_data(_aca_loop.py_func, (data[0], sources), 2)
+    _, _, ints = loop(field_kernel, (data[0], sources), rows, cols, 3, 2, 1e-6, *aca_steps()[:2])
     assert not aca_gave_up(ints)
     u, v, rank = aca_tensor(field_kernel, (data[0], sources), rows, cols, 3, 1e-6, 2)
     assert rank < 40 and relative_error(u, v, block) <= 3e-6
@@ -429,7 +431,7 @@ def test_eigen_recompression_with_dependent_columns_of_v():
 def test_the_aca_keeps_the_gram_matrix_of_u(eps):
     """The Gram matrix U^T U that the ACA keeps for the recompression (from the products
     its norm update takes) against numpy's, on a smooth tensor block."""
-    from hmatddm.hmatrix.aca import _RANK, _aca_run, aca_steps
+    from hmatddm.hmatrix.aca import _RANK, _aca_run, _for_data, aca_steps
 
     rng = np.random.default_rng(7)
     scalar, x, y = smooth_block(40, 36, rng, power=1.0)
@@ -439,8 +441,9 @@ def test_the_aca_keeps_the_gram_matrix_of_u(eps):
     full = np.zeros(((me + ne) * 3, (me + ne) * 3))
     full[:120, 120:] = block
     data = (full, np.array([3], dtype=np.int64))
-    ut, vt, gram, ints = _aca_run(matrix_kernel, data, np.arange(me, dtype=np.int64),
-                                  np.arange(me, me + ne, dtype=np.int64), 3, 3, eps, *aca_steps()[:2])
+    run = _for_data(_aca_run.py_func, data, 2)  # as the build runs it (first-class functions, cached)
+    ut, vt, gram, ints = run(matrix_kernel, data, np.arange(me, dtype=np.int64),
+                             np.arange(me, me + ne, dtype=np.int64), 3, 3, eps, *aca_steps()[:2])
     k = ints[_RANK]
     assert 10 < k < 100 and gram.shape[0] >= k
     reference = ut[:k] @ ut[:k].T
