@@ -19,43 +19,17 @@ import time
 
 try:
     from _common import machine, markdown_table
+    from compile_profile import CompileRecorder
 except ImportError:  # run from the repository root
     from benchmarks._common import machine, markdown_table
+    from benchmarks.compile_profile import CompileRecorder
 
 
 def _child(two_d):
     """In the measured process: the compile events and each entry point's first call."""
     from collections import defaultdict
 
-    from numba.core import event
-
-    exclusive = defaultdict(lambda: [0.0, 0.0, 0])  # name -> [CPU s, LLVM CPU s, signatures]
-    stack = []  # [name, start CPU, child CPU, llvm CPU, llvm start]
-
-    class Compiles(event.Listener):
-        def on_start(self, ev):
-            dispatcher = ev.data["dispatcher"]
-            name = f"{dispatcher.py_func.__module__.split('.')[-1]}.{dispatcher.py_func.__name__}"
-            stack.append([name, time.process_time(), 0.0, 0.0])
-
-        def on_end(self, ev):
-            name, start, children, llvm = stack.pop()
-            spent = time.process_time() - start
-            entry = exclusive[name]
-            entry[0] += spent - children
-            entry[1] += llvm
-            entry[2] += 1
-            if stack:
-                stack[-1][2] += spent
-
-    class Llvm(event.Listener):
-        def on_start(self, ev):
-            if stack:
-                stack[-1].append(time.process_time())
-
-        def on_end(self, ev):
-            if stack and len(stack[-1]) > 4:
-                stack[-1][3] += time.process_time() - stack[-1].pop()
+    recorder = CompileRecorder()
 
     import numpy as np
 
@@ -66,7 +40,7 @@ def _child(two_d):
         function()
         timings.append((label, time.process_time() - c0, time.perf_counter() - t0))
 
-    with event.install_listener("numba:compile", Compiles()), event.install_listener("numba:llvm_lock", Llvm()):
+    with recorder.listening():
         modules = {}
         timed("import hmatddm", lambda: modules.update(hd=__import__("hmatddm")))
         from hmatddm import operators
@@ -92,6 +66,12 @@ def _child(two_d):
         timed("stress_block", lambda: drivers.stress_sum(data, points, np.ones((n, dim)),
                                                           medium.layer_of(points[:, -1]).astype(np.int64)))
         timed("edge_distance", lambda: drivers.edge_distance(data, 0, 1))
+    exclusive = defaultdict(lambda: [0.0, 0.0, 0])  # name -> [CPU s, LLVM CPU s, signatures]
+    for record in recorder.records:
+        entry = exclusive[f"{record['module'].split('.')[-1]}.{record['name'].split('.')[-1]}"]
+        entry[0] += record["exclusive"]
+        entry[1] += record["llvm"]
+        entry[2] += 1
     print("RESULT " + json.dumps({"timings": timings, "functions": dict(exclusive),
                                   "checksum": float(np.abs(out).sum())}))
 
