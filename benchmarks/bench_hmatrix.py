@@ -358,12 +358,14 @@ def sampled_smooth_error(mesh, data, y, n_rows=300, chunk=10):
     return float(np.linalg.norm(y[index] - exact) / np.linalg.norm(exact))
 
 
-def memory_case(n, eps=1e-4, leaf_size=32, near_dtype="float64", geometry="planar", boxes="axis", factor="default"):
+def memory_case(n, eps=1e-4, leaf_size=32, near_dtype="float64", geometry="planar", boxes="axis", factor="default",
+                eta=3.0):
     """Planar crack (or cloud, fractures-first tree as ElasticityOperator builds it) of N elements: where the H-matrix memory goes (near-field dense
     blocks, far blocks stored dense, low-rank factors, index), build wall and CPU time,
     peak RSS and the sampled smooth-field error, with the near field stored as
     ``near_dtype``, admissibility on ``boxes`` ("axis" or "oriented"), low-rank factors stored as ``factor``
-    ("default": HMatrix.build's choice, "adaptive", "float32" or "float64"). Returns a dict (run in a fresh
+    ("default": HMatrix.build's choice, "adaptive", "float32" or "float64"), admissibility
+    parameter ``eta``. Returns a dict (run in a fresh
     process by --memory-study)."""
     import hmatddm as hd
     from _common import peak_rss_bytes
@@ -379,13 +381,13 @@ def memory_case(n, eps=1e-4, leaf_size=32, near_dtype="float64", geometry="plana
         load = float(f.read().split()[0])
     t0, c0 = time.perf_counter(), time.process_time()
     factor_dtype = None if factor == "default" else factor if factor == "adaptive" else np.dtype(factor)
-    h = HMatrix.build(generator, eps=eps, eta=3.0, leaf_size=leaf_size, near_dtype=np.dtype(near_dtype),
+    h = HMatrix.build(generator, eps=eps, eta=eta, leaf_size=leaf_size, near_dtype=np.dtype(near_dtype),
                       groups=groups, boxes=boxes, factor_dtype=factor_dtype)
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     s = h.storage
     near = int(sum(s.dense_offset[b + 1] - s.dense_offset[b] for b in np.flatnonzero(s.dense_is_near)))
     item = s.dense_values.itemsize
-    row = dict(geometry=geometry, boxes=boxes, n=mesh.n_elements, eps=eps, leaf_size=leaf_size,
+    row = dict(geometry=geometry, boxes=boxes, n=mesh.n_elements, eps=eps, eta=eta, leaf_size=leaf_size,
                near_dtype=str(np.dtype(near_dtype)), n_admissible=int(s.admissible_kind.size),
                build_s=wall, build_cpu_s=cpu, load_before=load, memory_mb=s.memory_bytes / 2**20,
                near_mb=near * item / 2**20, far_dense_mb=(s.dense_values.size - near) * item / 2**20,
@@ -411,10 +413,10 @@ def memory_case(n, eps=1e-4, leaf_size=32, near_dtype="float64", geometry="plana
 def memory_table(rows):
     from _common import markdown_table
 
-    header = ["geometry", "boxes", "N", "eps", "leaf", "near field", "factors", "build wall / CPU (s)", "load", "H memory (MB)", "near field (MB)",
+    header = ["geometry", "boxes", "N", "eps", "eta", "leaf", "near field", "factors", "build wall / CPU (s)", "load", "H memory (MB)", "near field (MB)",
               "far dense (MB)", "low-rank (MB)", "KB / element", "mean / max rank", "peak RSS (MB)",
               "matvec first / median of 3 (s)", "smooth-field error (sampled)"]
-    body = [[r.get("geometry", "planar"), r.get("boxes", "axis"), r["n"], f"{r['eps']:.0e}", r["leaf_size"], r["near_dtype"], r.get("factor_dtype", "float32"), f"{r['build_s']:.1f} / {r['build_cpu_s']:.1f}",
+    body = [[r.get("geometry", "planar"), r.get("boxes", "axis"), r["n"], f"{r['eps']:.0e}", f"{r.get('eta', 3.0):g}", r["leaf_size"], r["near_dtype"], r.get("factor_dtype", "float32"), f"{r['build_s']:.1f} / {r['build_cpu_s']:.1f}",
              f"{r['load_before']:.1f}", f"{r['memory_mb']:.0f}", f"{r['near_mb']:.0f}", f"{r['far_dense_mb']:.0f}",
              f"{r['lowrank_mb']:.0f}", f"{r['kb_per_element']:.1f}", f"{r['mean_rank']:.1f} / {r['max_rank']}",
              f"{r['peak_rss_mb']:.0f}", _matvec_cell(r), f"{r['smooth_error']:.1e}"] for r in rows if "failed" not in r]
@@ -430,9 +432,11 @@ def _matvec_cell(row):
 
 
 def memory_slopes(rows):
-    """Log-log slopes of build CPU time and memory against N per (geometry, eps, leaf, near dtype)."""
+    """Log-log slopes of build CPU time and memory against N per (geometry, eps, leaf, near dtype);
+    eta other than 3 is named with the geometry."""
     out = {}
-    variant = lambda r: (r.get("geometry", "planar") + ("" if r.get("boxes", "axis") == "axis" else " oriented"),  # noqa: E731
+    variant = lambda r: (r.get("geometry", "planar") + ("" if r.get("boxes", "axis") == "axis" else " oriented")  # noqa: E731
+                         + ("" if r.get("eta", 3.0) == 3.0 else f" eta {r['eta']:g}"),
                          r["eps"], r["leaf_size"], r["near_dtype"] + "/" + r.get("factor_dtype", "float32"))
     for key in sorted({variant(r) for r in rows if "failed" not in r}):
         sel = sorted((r for r in rows if "failed" not in r and variant(r) == key), key=lambda r: r["n"])
@@ -444,10 +448,10 @@ def memory_slopes(rows):
     return out
 
 
-def spawn_memory(n, eps, leaf_size, near_dtype, geometry="planar", boxes="axis", factor="default"):
+def spawn_memory(n, eps, leaf_size, near_dtype, geometry="planar", boxes="axis", factor="default", eta=3.0):
     cmd = [sys.executable, os.path.abspath(__file__), "--memory-case", json.dumps(
         dict(n=n, eps=eps, leaf_size=leaf_size, near_dtype=near_dtype, geometry=geometry, boxes=boxes,
-             factor=factor))]
+             factor=factor, eta=eta))]
     print("  running", cmd[-1], flush=True)
     result = subprocess.run(cmd, capture_output=True, text=True, cwd=HERE)
     if result.returncode != 0:
@@ -616,9 +620,10 @@ def main():
     parser.add_argument("--memory-study", default=None, metavar="N,N,...",
                         help="memory per element by kind (near field, low rank) and its growth, then exit")
     parser.add_argument("--variants", default="1e-4:32:float64,1e-4:32:float32",
-                        help="memory study: comma-separated eps:leaf:near_dtype[:geometry[:boxes[:factors]]] (geometry "
-                             "planar or cloud; boxes axis or oriented: admissibility on axis-aligned or oriented "
-                             "cluster boxes; factors default, adaptive, float32 or float64)")
+                        help="memory study: comma-separated eps:leaf:near_dtype[:geometry[:boxes[:factors[:eta]]]] "
+                             "(geometry planar or cloud; boxes axis or oriented: admissibility on axis-aligned or "
+                             "oriented cluster boxes; factors default, adaptive, float32 or float64; eta the "
+                             "admissibility parameter, default 3)")
     parser.add_argument("--rank-study", type=int, default=None, metavar="N",
                         help="cloud of N elements: rank and memory of far blocks by kind and level, then exit")
     parser.add_argument("--aca-study", type=int, default=None, metavar="N",
@@ -639,8 +644,8 @@ def main():
         for n in (int(v) for v in args.memory_study.split(",")):
             for variant in args.variants.split(","):
                 parts = variant.split(":")
-                eps, leaf, near_dtype, geometry, boxes, factor = parts + ["planar", "axis", "default"][len(parts) - 3:]
-                rows.append(spawn_memory(n, float(eps), int(leaf), near_dtype, geometry, boxes, factor))
+                eps, leaf, near_dtype, geometry, boxes, factor, eta = parts + ["planar", "axis", "default", "3"][len(parts) - 3:]
+                rows.append(spawn_memory(n, float(eps), int(leaf), near_dtype, geometry, boxes, factor, float(eta)))
                 print(json.dumps(rows[-1]), flush=True)
         os.makedirs(OUT, exist_ok=True)
         with open(os.path.join(OUT, "hmatrix_memory.json"), "w") as f:
