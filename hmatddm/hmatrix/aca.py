@@ -820,7 +820,10 @@ def _orthonormalize(vectors, count):
             for _ in range(2):
                 coefficients = np.dot(previous, panel.T)  # first x (last - first)
                 panel -= np.dot(coefficients.T, previous)
-                r[:first, first:last] += coefficients
+                # element by element, not by slice assignment (docs/conventions.md, §5)
+                for a in range(first):
+                    for b in range(first, last):
+                        r[a, b] += coefficients[a, b - first]
         _orthonormalize_panel(q, r, first, last, original)
     return q, r
 

@@ -550,6 +550,9 @@ def _sort_block_rows(indptr, indices, data):
         order = np.argsort(indices[start:stop])
         sorted_indices = indices[start:stop][order]
         sorted_data = data[start:stop][order]
+        # element by element, not by slice assignment (docs/conventions.md, §5)
         for k in range(stop - start):
             indices[start + k] = sorted_indices[k]
-            data[start + k] = sorted_data[k]
+            for p in range(data.shape[1]):
+                for q in range(data.shape[2]):
+                    data[start + k, p, q] = sorted_data[k, p, q]

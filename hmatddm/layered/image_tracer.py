@@ -121,7 +121,10 @@ def trace_potentials(t, source_layer, interfaces, shear_modulus, poisson_ratio, 
         q_ref[e] = 0
         q_z[e] = t
         q_eps[e] = 1.0
-        q_coef[e, :, :, 0] = original[e]
+        # element by element, not by slice assignment (docs/conventions.md, §5)
+        for f in range(n_f):
+            for j in range(n_j):
+                q_coef[e, f, j, 0] = original[e, f, j]
     n_queue = 2
     mirrored = np.empty((n_f, n_j, n_orders))
     dmirrored = np.empty((n_f, n_j, n_orders))
@@ -203,7 +206,10 @@ def trace_potentials(t, source_layer, interfaces, shear_modulus, poisson_ratio, 
         pair_z[n_out] = q_z[k]
         pair_eps[n_out] = q_eps[k]
         pair_sigma[n_out] = float(q_dir[k])
-        pair_coef[n_out] = q_coef[k]
-        pair_dcoef[n_out] = q_dcoef[k]
+        for f in range(n_f):
+            for j in range(n_j):
+                for n in range(n_orders):
+                    pair_coef[n_out, f, j, n] = q_coef[k, f, j, n]
+                    pair_dcoef[n_out, f, j, n] = q_dcoef[k, f, j, n]
         n_out += 1
     return n_out

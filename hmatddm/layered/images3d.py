@@ -510,7 +510,10 @@ def _contract_vector(gradient, normal, shear_modulus, lame, out):
     """``out[b, i] =`` the moment contraction (see :func:`_contract`) of ``gradient[p, q, i]``."""
     contracted = np.zeros((3, 3, 1))
     _contract(gradient.reshape((3, 3, 3, 1)), normal, shear_modulus, lame, 1.0, contracted)
-    out[:] = contracted[:, :, 0]
+    # element by element, not by slice assignment (docs/conventions.md, §5)
+    for b in range(3):
+        for i in range(3):
+            out[b, i] = contracted[b, i, 0]
 
 
 @njit(cache=True)
@@ -688,12 +691,17 @@ def _trace_range(center, frame, a, b, source_layer, interfaces, shear_modulus, p
         else:
             n = n_pairs[same]
             n_pairs[g] = n
-            layer[g, :n] = layer[same, :n]
-            z[g, :n] = z[same, :n]
-            eps[g, :n] = eps[same, :n]
-            sigma[g, :n] = sigma[same, :n]
-            coef[g, :n] = coef[same, :n]
-            dcoef[g, :n] = dcoef[same, :n]
+            # element by element, not by slice assignment (docs/conventions.md, §5)
+            for k in range(n):
+                layer[g, k] = layer[same, k]
+                z[g, k] = z[same, k]
+                eps[g, k] = eps[same, k]
+                sigma[g, k] = sigma[same, k]
+                for f in range(coef.shape[2]):
+                    for j in range(coef.shape[3]):
+                        for o in range(coef.shape[4]):
+                            coef[g, k, f, j, o] = coef[same, k, f, j, o]
+                            dcoef[g, k, f, j, o] = dcoef[same, k, f, j, o]
 
 
 @njit(cache=True)
@@ -772,9 +780,11 @@ def _cached_rules(n_gauss):
     wt = np.empty(start[-1])
     for s in range(n_gauss + 1):
         x, e, w = square_rule(s + 1 if s < n_gauss else n_gauss, 1 if s < n_gauss else 2)  # one specialization
-        xi[start[s]:start[s + 1]] = x
-        eta[start[s]:start[s + 1]] = e
-        wt[start[s]:start[s + 1]] = w
+        # element by element, not by slice assignment (docs/conventions.md, §5)
+        for q in range(x.shape[0]):
+            xi[start[s] + q] = x[q]
+            eta[start[s] + q] = e[q]
+            wt[start[s] + q] = w[q]
     return xi, eta, wt, start
 
 

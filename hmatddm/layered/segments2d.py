@@ -28,8 +28,10 @@ def _level_rule(n_gauss, max_level):
     w = np.empty(start[-1])
     for level in range(max_level + 1):
         x, wt = composite_rule(n_gauss, 2 ** level)
-        xi[start[level]:start[level + 1]] = x
-        w[start[level]:start[level + 1]] = wt
+        # element by element, not by slice assignment (docs/conventions.md, §5)
+        for q in range(x.shape[0]):
+            xi[start[level] + q] = x[q]
+            w[start[level] + q] = wt[q]
     return xi, w, start
 
 
