@@ -26,7 +26,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import hmatddm as hd  # noqa: E402
 from _common import machine, markdown_table  # noqa: E402
-from hmatddm import topology  # noqa: E402
+from hmatddm.mesh import topology  # noqa: E402
 from hmatddm.coupled import ElasticSolver, SchemeSettings, StepProblem, solve_step  # noqa: E402
 from hmatddm.coupled.contact import SLIP, ContactLaw, ContactModel  # noqa: E402
 from hmatddm.flow import LeakOff, LubricationModel, fracture_compliance  # noqa: E402

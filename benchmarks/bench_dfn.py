@@ -26,7 +26,7 @@ wall time of the step and its parts (coupled solve incl. operator builds, operat
 builds alone, growth/encounter logic, the whole remote-failure check, checkpoint), CPU
 time (``time.process_time``, all threads) of the step and of the remote-failure check,
 the remote-failure checks and the targets whose stress they evaluated (the others are
-cleared by the stress bound of :mod:`hmatddm.field_bound`),
+cleared by the stress bound of :mod:`hmatddm.elasticity.field_bound`),
 peak RSS (``resource.getrusage(...).ru_maxrss``), active elements (total, natural
 activated), natural elements failed by remote failure, nonlinear and GMRES iterations,
 and the memory a dense run would need: ``N_active^2 * 9 * 8`` bytes for the DDM matrix
@@ -79,7 +79,7 @@ from _common import machine  # noqa: E402
 
 import hmatddm as hd  # noqa: E402
 from hmatddm.network import NetworkSpec, generate_network  # noqa: E402
-from hmatddm.operators import NEAR_SINGULAR_FRACTION  # noqa: E402
+from hmatddm.elasticity.operator import NEAR_SINGULAR_FRACTION  # noqa: E402
 from hmatddm.simulation import checkpoint as checkpoint_module  # noqa: E402
 from hmatddm.simulation import natural as natural_module  # noqa: E402
 from hmatddm.simulation import growing_operator as growing_operator_module  # noqa: E402
@@ -409,7 +409,7 @@ def remote_check(sim, original_kernel=True):
 
     from hmatddm.kernels import element_data, rectangle3d
 
-    fields_module = importlib.import_module("hmatddm.fields")
+    fields_module = importlib.import_module("hmatddm.elasticity.fields")
     s = sim.state
     points = np.ascontiguousarray(sim.network.mesh.centers[s.intact])
     mesh, dd, mat = s.mesh, np.ascontiguousarray(s.dd), sim.material

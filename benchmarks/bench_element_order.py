@@ -24,7 +24,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from _common import machine, markdown_table  # noqa: E402
 
 import hmatddm as hd  # noqa: E402
-from hmatddm import shape_functions  # noqa: E402
+from hmatddm.mesh import shape_functions  # noqa: E402
 from hmatddm.analytical import griffith_opening  # noqa: E402
 
 MATERIAL = hd.Elastic(shear_modulus=1.0, poisson_ratio=0.25)

@@ -2,7 +2,7 @@
 
 10 seeded realizations for each of a = 2, 3 and rho_NF = 0.05, 0.1 m^-2 on a 100 m x
 100 m domain (mu = 45 deg, kappa = 5, l in [1, 30] m, ref. Table 6.1), run with
-``hmatddm.ensemble.sweep`` on a local Dask cluster (or ``--scheduler ADDRESS``).
+``hmatddm.app.ensemble.sweep`` on a local Dask cluster (or ``--scheduler ADDRESS``).
 Prints a markdown table and saves ``benchmarks/ensemble_intersections.png``.
 """
 import argparse
@@ -14,7 +14,7 @@ sys.path.insert(0, os.path.dirname(__file__))
 
 from _common import machine  # noqa: E402
 
-from hmatddm import ensemble  # noqa: E402
+from hmatddm.app import ensemble  # noqa: E402
 
 
 def main():

@@ -1,4 +1,4 @@
-"""Stress at many points from many elements (hmatddm.fields behind hd.stress_at): time and
+"""Stress at many points from many elements (hmatddm.elasticity.fields behind hd.stress_at): time and
 error of the exact sum and of the points x elements H-matrix, before and after field
 evaluation moved onto the generic H-matrix engine.
 
@@ -32,7 +32,7 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 
-NEAR_FRACTION = 0.5  # hmatddm.operators.NEAR_SINGULAR_FRACTION, what remote failure uses
+NEAR_FRACTION = 0.5  # hmatddm.elasticity.operator.NEAR_SINGULAR_FRACTION, what remote failure uses
 
 
 def scenes(quick=False):

@@ -28,7 +28,7 @@ from _common import machine, markdown_table  # noqa: E402
 import hmatddm as hd  # noqa: E402
 from hmatddm import analytical as an  # noqa: E402
 from hmatddm import network as nw  # noqa: E402
-from hmatddm.cases import graded_line, mixed_scales  # noqa: E402
+from hmatddm.mesh.hard_cases import graded_line, mixed_scales  # noqa: E402
 from hmatddm.errors import ConvergenceError  # noqa: E402
 from hmatddm.hmatrix import gmres  # noqa: E402
 
@@ -370,9 +370,9 @@ def case_tilted_curved():
 # ------------------------------------------------------------- 7. coupled scaling
 def case_coupled():
     print("7. coupled system scaling", flush=True)
-    from hmatddm import topology
+    from hmatddm.mesh import topology
     from hmatddm.coupled import ElasticSolver, StepProblem
-    from hmatddm.coupled.schemes import _CoupledLinearSystem
+    from hmatddm.coupled.scaled_system import _CoupledLinearSystem
     from hmatddm.flow import LeakOff, LubricationModel, fracture_compliance
 
     rows = []

@@ -186,7 +186,7 @@ def tree_study(n, leaf_size=32):
     import hmatddm as hd
     from hmatddm.hmatrix import BlockGenerator, HMatrix
     from hmatddm.kernels.drivers import traction_block
-    from hmatddm.operators import influence_data
+    from hmatddm.elasticity.operator import influence_data
 
     mesh = cloud(n)
     data = influence_data(mesh, hd.Elastic(shear_modulus=10e9, poisson_ratio=0.25))
@@ -220,7 +220,7 @@ def rank_study(n, eps=1e-4, leaf_size=32):
     from hmatddm.hmatrix import BlockGenerator, HMatrix
     from hmatddm.hmatrix.storage import KIND_DENSE, KIND_LOWRANK
     from hmatddm.kernels.drivers import traction_block
-    from hmatddm.operators import influence_data
+    from hmatddm.elasticity.operator import influence_data
 
     mesh = cloud(n)
     data = influence_data(mesh, hd.Elastic(shear_modulus=10e9, poisson_ratio=0.25))
@@ -262,12 +262,12 @@ def aca_study(n, factors, geometry="cloud", eps=1e-4, stride=9, leaf_size=32):
     rank, and the stored block's relative Frobenius error against the exact block (worst,
     median, count above eps). Returns a list of dicts, one per factor."""
     import hmatddm as hd
-    from hmatddm.hmatrix import aca
+    from hmatddm.hmatrix import aca, aca_loop
     from hmatddm.hmatrix._threads import single_threaded_blas
     from hmatddm.hmatrix.block_tree import block_tree
     from hmatddm.hmatrix.cluster_tree import cluster_tree
     from hmatddm.kernels.drivers import traction_block
-    from hmatddm.operators import influence_data
+    from hmatddm.elasticity.operator import influence_data
 
     mesh = (planar if geometry == "planar" else cloud)(n)
     data = influence_data(mesh, hd.Elastic(shear_modulus=10e9, poisson_ratio=0.25))
@@ -285,18 +285,19 @@ def aca_study(n, factors, geometry="cloud", eps=1e-4, stride=9, leaf_size=32):
 
     def compress(rows, cols, factor, cpu):
         """(ACA rank, stored U'^T, V'^T, stored rank), or None when the ACA gave up."""
-        ut, vt, gram, r, c, rv, cv, ints, floats, request, index = aca.aca_start(rows.size, cols.size, 3, 3, factor * eps)
-        while request != aca.REQUEST_DONE:
+        ut, vt, gram, r, c, rv, cv, ints, floats, request, index = aca_loop.aca_start(rows.size, cols.size, 3, 3,
+                                                                                      factor * eps)
+        while request != aca_loop.REQUEST_DONE:
             t0 = time.process_time()
-            if request == aca.REQUEST_ROW:
+            if request == aca_loop.REQUEST_ROW:
                 traction_block(data, rows[index:index + 1], cols, r)
             else:
                 traction_block(data, rows, cols[index:index + 1], c)
             t1 = time.process_time()
-            ut, vt, gram, request, index = aca.aca_advance(ut, vt, gram, r, c, rv, cv, ints, floats)
+            ut, vt, gram, request, index = aca_loop.aca_advance(ut, vt, gram, r, c, rv, cv, ints, floats)
             cpu["kernel"] += t1 - t0
             cpu["aca"] += time.process_time() - t1
-        if aca.aca_gave_up(ints):
+        if aca_loop.aca_gave_up(ints):
             return None  # the build stores the block dense: exact
         t0 = time.process_time()
         u2, v2, k2 = aca.recompress_state(ut, vt, gram, ints, eps)
@@ -371,7 +372,7 @@ def memory_case(n, eps=1e-4, leaf_size=32, near_dtype="float64", geometry="plana
     from _common import peak_rss_bytes
     from hmatddm.hmatrix import BlockGenerator, HMatrix
     from hmatddm.kernels.drivers import traction_block
-    from hmatddm.operators import influence_data
+    from hmatddm.elasticity.operator import influence_data
 
     mesh = (planar if geometry == "planar" else cloud)(n)
     data = influence_data(mesh, hd.Elastic(shear_modulus=10e9, poisson_ratio=0.25))

@@ -159,7 +159,7 @@ def neighbour_ratio(mesh, width, k):
 def coupling_ratio(mesh, material, alpha, i, j):
     """max |A_ij| / max |A_jj| (receiver i, source j) of the operator the run used."""
     from hmatddm.kernels.drivers import traction_block
-    from hmatddm.operators import influence_data
+    from hmatddm.elasticity.operator import influence_data
 
     data = influence_data(mesh, material, "average", alpha)
     d = mesh.dim

@@ -43,7 +43,7 @@ def _child(two_d):
     with recorder.listening():
         modules = {}
         timed("import hmatddm", lambda: modules.update(hd=__import__("hmatddm")))
-        from hmatddm import operators
+        from hmatddm.elasticity import operator as operators
         from hmatddm.kernels import drivers
         from hmatddm.layered import LayeredMedium
         from hmatddm.mesh import concatenate, line, rectangle

@@ -12,7 +12,7 @@ import time
 import numpy as np
 
 import hmatddm as hd
-from hmatddm import operators
+from hmatddm.elasticity import operator as operators
 from hmatddm.kernels import drivers
 from hmatddm.layered import LayeredMedium
 from hmatddm.mesh import concatenate, rectangle

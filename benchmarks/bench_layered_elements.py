@@ -30,8 +30,8 @@ from _common import machine, markdown_table  # noqa: E402
 import hmatddm as hd  # noqa: E402
 from hmatddm.analytical import griffith_opening  # noqa: E402
 from hmatddm.layered import LayeredMedium  # noqa: E402
-from hmatddm.layered_higher_order import dense_matrix  # noqa: E402
-from hmatddm.nodal import opening_at  # noqa: E402
+from hmatddm.layered.higher_order2d import dense_matrix  # noqa: E402
+from hmatddm.elasticity.nodal import opening_at  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 HEIGHT = 1.0

@@ -4,10 +4,10 @@ stress contrast.
 
 Scenes (2D, dense operator):
 
-* ``crossing``: the crossing scene of tests/test_crossing.py (a fracture along x meets a
+* ``crossing``: the crossing scene of tests/fracture/test_crossing.py (a fracture along x meets a
   natural fracture across its path), 20 s;
 * ``network``: a 40-element fracture along x injected for 4 s next to 300 random natural
-  segments (the remote-failure scene of tests/test_simulation_natural.py), so that the
+  segments (the remote-failure scene of tests/simulation/test_simulation_natural.py), so that the
   remote-failure checks dominate: in uniform rock and equal layers they are screened by the
   stress bound; with images every intact element is evaluated by the layered direct sum.
 

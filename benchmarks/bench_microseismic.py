@@ -46,6 +46,7 @@ sys.path.insert(0, HERE)
 from _common import machine, markdown_table  # noqa: E402
 
 from hmatddm import microseismic as ms  # noqa: E402
+from hmatddm.app import catalogue  # noqa: E402
 from hmatddm.microseismic.inversion import invert_source_draws  # noqa: E402
 
 MEDIUM = ms.Medium(4000.0, 2350.0, 3000.0)  # ref. Table 7.1
@@ -111,7 +112,7 @@ def forward_speed(count, stations=100, seed=0):
 def run_2d(out, quick=False, reuse=False):
     """The dfn-3cluster run in ``out`` (``reuse``: a finished run there is read, not redone;
     its wall time is the one its summary.json recorded, its CPU time unknown: nan)."""
-    from hmatddm.runner import SceneRun, read_summary
+    from hmatddm.app.runner import SceneRun, read_summary
     from hmatddm.scene import load_scene
 
     overrides = ["output.every=1", "output.snapshots=false"] + (["numerics.end_time=30"] if quick else [])
@@ -121,10 +122,10 @@ def run_2d(out, quick=False, reuse=False):
     if summary and summary.get("steps") and summary["steps"][-1]["time"] >= end - 1e-9:
         clock = Clock()
         clock.wall, clock.cpu = float(summary["wall_seconds"]), float("nan")
-        return ms.read_run(out), clock
+        return catalogue.read_run(out), clock
     with Clock() as clock:
         SceneRun(scene, out, overwrite=True, quiet=True).execute()
-    return ms.read_run(out), clock
+    return catalogue.read_run(out), clock
 
 
 def run_3d(quick=False, cache=None, reuse=False):
@@ -141,14 +142,14 @@ def run_3d(quick=False, cache=None, reuse=False):
         onset.centers, onset.time, onset.step = data["onset_centers"], data["onset_time"], data["onset_step"]
         clock = Clock()
         clock.wall, clock.cpu = float(data["wall"]), float(data["cpu"])
-        return ms.catalogue.RunState(mesh=mesh, dd=data["dd"], state=data["state"], time=float(data["time"]),
+        return catalogue.RunState(mesh=mesh, dd=data["dd"], state=data["state"], time=float(data["time"]),
                                      step=int(data["step"]), onset=onset, height=1.0), clock
     scene = bench_dfn.FULL if not quick else bench_dfn.REDUCED
     simulation = bench_dfn.build_simulation(scene, "hmatrix")
     onset = ms.SlipOnset()
     with Clock() as clock:
-        simulation.run(scene.end_time, callback=ms.onset_recorder(onset))
-    run = ms.run_state_from_simulation(simulation, onset)
+        simulation.run(scene.end_time, callback=catalogue.onset_recorder(onset))
+    run = catalogue.run_state_from_simulation(simulation, onset)
     if cache is not None:
         mesh = run.mesh
         np.savez(cache, centers=mesh.centers, frames=mesh.frames, half_a=mesh.half_a, half_b=mesh.half_b,
@@ -201,7 +202,7 @@ def plot_maps(run, events, path, title, seed=1):
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    from hmatddm.microseismic.maps import draw_map
+    from hmatddm.render.microseismic_maps import draw_map
 
     figure = Figure(figsize=(13.0, 10.5), dpi=100, layout="constrained")
     FigureCanvasAgg(figure)
@@ -373,7 +374,7 @@ def main(argv=None):
     for label, (run, clock) in runs.items():
         tag = "2d" if label.startswith("2D") else "3d"
         with Clock() as events_clock:
-            events = ms.events_from_run(run, MEDIUM)
+            events = catalogue.events_from_run(run, MEDIUM)
         failed = int(np.count_nonzero(run.state == 2))
         print(f"# {label}: run {clock.wall:.0f} s wall ({clock.cpu:.0f} s CPU); {failed} failed/activated natural "
               f"elements, {len(events)} shear events (Eq. 7.29) in {events_clock.wall:.2f} s", flush=True)

@@ -119,12 +119,12 @@ def cpu_parts():
     GMRES" includes the matvecs and the preconditioner, "grown-mesh matvec" the H matvec."""
     import functools
 
-    import hmatddm.coupled.schemes as schemes
-    import hmatddm.extended_operator as extended
+    import hmatddm.coupled.scaled_system as scaled_system
+    import hmatddm.elasticity.extended as extended
     import hmatddm.hmatrix.hmatrix as hmatrix
     import hmatddm.hmatrix.solvers as solvers
     import hmatddm.simulation.growing_operator as growing
-    import hmatddm.topology as topology
+    import hmatddm.mesh.topology as topology
 
     parts = {}
 
@@ -149,7 +149,7 @@ def cpu_parts():
     wrap(hmatrix.HMatrix, "_matvec", "H matvec")
     wrap(extended.ExtendedElasticityOperator, "_matvec", "grown-mesh matvec")
     wrap(extended.ExtendedElasticityOperator, "approximate_inverse", "block-triangular preconditioner")
-    wrap(schemes._CoupledLinearSystem, "compliance_preconditioner", "flow LU")
+    wrap(scaled_system._CoupledLinearSystem, "compliance_preconditioner", "flow LU")
     wrap(topology, "element_edges", "topology")
     wrap(topology, "element_faces", "topology")
     return parts

@@ -95,7 +95,7 @@ def run_2d(scheme, omega, backend, t_end, early_abort=True):
 def _step_problem(sim):
     """The StepProblem and flow matrix the next step's first iteration sees (dense A)."""
     import hmatddm as hd
-    from hmatddm import topology
+    from hmatddm.mesh import topology
     from hmatddm.coupled import ElasticSolver, StepProblem
     from hmatddm.flow import fracture_compliance
 
@@ -115,7 +115,7 @@ def _step_problem(sim):
 
 def condition_numbers(sim, label):
     """cond of A, A M_2, M_1^-1 A M_2 and P^-1 M_1^-1 A M_2 (P: the krylov compliance split)."""
-    from hmatddm.coupled.schemes import _CoupledLinearSystem
+    from hmatddm.coupled.scaled_system import _CoupledLinearSystem
 
     problem, dd, p = _step_problem(sim)
     matrix, _ = problem.flow_matrices(dd)

@@ -1,6 +1,6 @@
 """How fast the command answers: `hmatddm --help`, `hmatddm scenes` and refused scenes.
 
-Each case runs ``python -m hmatddm.cli ...`` in a fresh process ``--repeats`` times and
+Each case runs ``python -m hmatddm.app.cli ...`` in a fresh process ``--repeats`` times and
 reports the median wall time and the median CPU time of the child (user + system), with
 the exit code and the first line of the answer: the check that the answer is the right
 one. ``--source DIR`` runs the package found in DIR instead of this checkout, e.g. an
@@ -100,7 +100,7 @@ def run_case(argv, source, repeats, timeout):
         before = resource.getrusage(resource.RUSAGE_CHILDREN)
         start = time.perf_counter()
         with tempfile.TemporaryDirectory() as out:
-            command = [sys.executable, "-m", "hmatddm.cli", *(a.replace("{out}", out + "/run") for a in argv)]
+            command = [sys.executable, "-m", "hmatddm.app.cli", *(a.replace("{out}", out + "/run") for a in argv)]
             try:
                 result = subprocess.run(command, capture_output=True, text=True, env=env, cwd=tempfile.gettempdir(),
                                         timeout=timeout)

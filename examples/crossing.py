@@ -11,7 +11,7 @@ Run: ``python examples/crossing.py`` (a few seconds).
 from pathlib import Path
 
 import hmatddm.scene as hs
-from hmatddm.runner import SceneRun
+from hmatddm.app.runner import SceneRun
 
 
 def main():

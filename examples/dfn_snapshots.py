@@ -12,7 +12,7 @@ Run: ``python examples/dfn_snapshots.py`` (about 1-3 minutes on 2 cores).
 from pathlib import Path
 
 import hmatddm.scene as hs
-from hmatddm.runner import SceneRun
+from hmatddm.app.runner import SceneRun
 
 OUT = Path("examples_out/dfn_3cluster")
 

@@ -17,7 +17,7 @@ Run: ``python examples/radial_fracture.py`` (30-60 s on 2 cores).
 from pathlib import Path
 
 import hmatddm.scene as hs
-from hmatddm.runner import SceneRun
+from hmatddm.app.runner import SceneRun
 
 OUT = Path("examples_out/radial_fracture")
 

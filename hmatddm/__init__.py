@@ -23,8 +23,7 @@ A growing radial fracture (ref. Ch. 4)::
     records = sim.run(end_time=50.0)
 """
 from ._lazy import attach
-
-__version__ = "0.1.0"
+from ._version import __version__
 
 # Everything below is imported on first use (PEP 562), so that ``import hmatddm`` is
 # quick and loads neither numba, the H-matrix engine, scipy.special, pyvista nor
@@ -35,13 +34,20 @@ _EXPORTS = {
     "SchemeSettings": ".coupled", "ConvergenceError": ".errors", "HmatddmError": ".errors",
     "InputError": ".errors", "OutputError": ".errors", "Cluster": ".flow", "Fluid": ".flow", "LeakOff": ".flow",
     "NaturalFractureProperties": ".fracture", "Propagation": ".fracture", "Elastic": ".material",
-    "Mesh2D": ".mesh", "Mesh3D": ".mesh", "ElasticityOperator": ".operators", "CheckpointError": ".simulation",
-    "Simulation": ".simulation", "mean_stress_at": ".solve", "opening": ".solve", "slip": ".solve",
-    "solve": ".solve", "stress_at": ".solve", "opening_at": ".nodal", "LayeredMedium": ".layered",
+    "Mesh2D": ".mesh", "Mesh3D": ".mesh", "ElasticityOperator": ".elasticity", "CheckpointError": ".simulation",
+    "Simulation": ".simulation", "mean_stress_at": ".elasticity", "opening": ".elasticity", "slip": ".elasticity",
+    "solve": ".elasticity", "stress_at": ".elasticity", "opening_at": ".elasticity", "LayeredMedium": ".layered",
 }
-_SUBMODULES = ("analytical", "kernels", "mesh", "network", "topology", "simulation", "scene", "render", "io",
-               "hmatrix", "coupled", "flow", "fracture", "operators", "runner", "errors", "material",
-               "ensemble", "validate", "extended_operator", "cli", "bench_cli", "nodal", "shape_functions", "layered")
+# the rooms (docs/architecture.md), and the short names that modules now in a room had
+# at the package root, kept so that ``hd.topology``, ``hd.operators``, ... still work
+_SUBMODULES = {name: "." + name for name in (
+    "analytical", "kernels", "mesh", "network", "simulation", "scene", "render", "io", "hmatrix", "coupled", "flow",
+    "fracture", "errors", "material", "layered", "elasticity", "app", "microseismic", "settings", "options")}
+_SUBMODULES.update({
+    "topology": ".mesh.topology", "shape_functions": ".mesh.shape_functions", "operators": ".elasticity.operator",
+    "extended_operator": ".elasticity.extended", "nodal": ".elasticity.nodal", "runner": ".app.runner",
+    "ensemble": ".app.ensemble", "validate": ".app.validate", "cli": ".app.cli", "bench_cli": ".app.bench",
+})
 __getattr__, __dir__ = attach(__name__, _EXPORTS, _SUBMODULES)
 
 __all__ = [

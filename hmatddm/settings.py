@@ -217,7 +217,7 @@ PROPAGATION = {  # -> hmatddm.fracture.growth.Propagation (ref. Sec. 4.2.2)
     "front_tolerance": Setting("number", 1e-3, **_UNIT_INTERVAL),
 }
 
-SCHEME = {  # -> hmatddm.coupled.schemes.SchemeSettings (ref. Sec. 4.5)
+SCHEME = {  # -> hmatddm.coupled.step_problem.SchemeSettings (ref. Sec. 4.5)
     "scheme": Setting("choice", SCHEME_DEFAULTS["scheme"], choices=SCHEMES),
     "tolerance_pressure": Setting("number", SCHEME_DEFAULTS["tolerance_pressure"], **_UNIT_INTERVAL),
     "tolerance_opening": Setting("number", SCHEME_DEFAULTS["tolerance_opening"], **_UNIT_INTERVAL),
@@ -283,7 +283,7 @@ NATURAL_FRACTURE = {
 
 _POSITIVE_LENGTH = dict(low=0.0, low_open=True, unit="m")
 
-OPERATOR = {  # -> hmatddm.operators.ElasticityOperator (the H-matrix options, ref. Ch. 5)
+OPERATOR = {  # -> hmatddm.elasticity.operator.ElasticityOperator (the H-matrix options, ref. Ch. 5)
     "backend": Setting("choice", "dense", choices=BACKENDS),
     "eps": Setting("number", DEFAULT_EPS, **_UNIT_INTERVAL, doc="ACA tolerance of the admissible blocks"),
     "eta": Setting("number", DEFAULT_ETA, low=0.0, low_open=True, doc="admissibility, min(diam) <= eta * dist"),

@@ -194,7 +194,7 @@ def kill_when_announced(script):
     """Run ``python -c script``; wait for its first stdout line (the child prints it when
     it has reached the point to kill at, then waits), SIGKILL it and return that line
     ('' when the child died before announcing). No wall-clock limit: a busy machine only
-    makes it slower (tests/test_simulation.py, tests/test_layered_engine3d.py)."""
+    makes it slower (tests/simulation/test_simulation.py, tests/layered/test_layered_engine3d.py)."""
     import signal
     import subprocess
 

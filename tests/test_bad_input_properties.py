@@ -154,7 +154,7 @@ def test_zero_injection_warns():
 def test_sweep_refuses_bad_values_before_starting_dask(capsys, monkeypatch):
     import dask.distributed
 
-    from hmatddm import cli
+    from hmatddm.app import cli
 
     def no_cluster(*args, **kwargs):
         raise AssertionError("a Dask cluster was started for a refused grid")
@@ -208,11 +208,11 @@ def _run_mutated(scene, path, value):
     import tempfile
     from unittest import mock
 
-    from hmatddm import cli, runner
+    from hmatddm.app import cli, runner
 
     with tempfile.TemporaryDirectory() as folder, contextlib.ExitStack() as stack:
         stack.enter_context(mock.patch.object(runner.SceneRun, "execute", side_effect=_WouldRun))
-        stack.enter_context(mock.patch("hmatddm.operators.ElasticityOperator.__init__",
+        stack.enter_context(mock.patch("hmatddm.elasticity.operator.ElasticityOperator.__init__",
                                        side_effect=AssertionError("an operator was built")))
         err = stack.enter_context(contextlib.redirect_stderr(io.StringIO()))
         stack.enter_context(contextlib.redirect_stdout(io.StringIO()))

@@ -24,7 +24,8 @@ import numpy as np
 import pytest
 
 import hmatddm as hd
-from hmatddm import cli, io as hio
+from hmatddm.app import cli
+from hmatddm import io as hio
 from hmatddm.errors import OutputError
 from hmatddm.simulation import checkpoint as checkpoints
 from hmatddm.simulation.checkpoint import CheckpointWriteError
@@ -94,8 +95,8 @@ def disk(monkeypatch):
                 raise _disk_full(temporary)
 
     monkeypatch.setattr(checkpoints, "_atomic_write", atomic_write)
-    for name in ("hmatddm.runner", "hmatddm.run_folder", "hmatddm.io.vtk", "hmatddm.render.offscreen",
-                 "hmatddm.render.plots", "hmatddm.microseismic.catalogue", "hmatddm.microseismic.maps"):
+    for name in ("hmatddm.app.runner", "hmatddm.app.run_folder", "hmatddm.io.vtk", "hmatddm.render.offscreen",
+                 "hmatddm.render.plots", "hmatddm.app.catalogue", "hmatddm.render.microseismic_maps"):
         module = importlib.import_module(name)
         monkeypatch.setattr(module, "atomic_output", atomic_output)
     return state

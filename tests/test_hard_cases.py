@@ -32,7 +32,7 @@ import scipy.sparse.linalg as spla
 import hmatddm as hd
 from hmatddm import analytical as an
 from hmatddm import network as nw
-from hmatddm.cases import graded_line, mixed_scales
+from hmatddm.mesh.hard_cases import graded_line, mixed_scales
 from hmatddm.kernels import rectangle3d
 
 P = 1e6          # net pressure, Pa
@@ -489,7 +489,7 @@ def test_mixed_scales_block_error_at_default_eps(material):
     2.8e-2 error: its pivots all fell in the large fracture, whose rows and columns do
     not see the small fractures' interaction, and the stop test (last cross only)
     passed. The ACA now checks the residual of unvisited rows and columns before
-    stopping (ACA+-like, hmatddm/hmatrix/aca.py)."""
+    stopping (ACA+-like, hmatddm/hmatrix/aca_loop.py)."""
     mesh = mixed_scales(2, seed=2)
     op = hd.ElasticityOperator(mesh, material, backend="hmatrix", eps=1e-4, leaf_size=32)
     assert op.check_against_dense(n_samples=64) < 10 * 1e-4  # was 4.3e-2; measured 3.7e-4
@@ -573,9 +573,9 @@ def test_arc_crack_converges_under_refinement(material, half_angle_deg):
 
 # ------------------------------------------------------- 7. coupled system scaling
 def coupled_system(length, n):
-    from hmatddm import topology
+    from hmatddm.mesh import topology
     from hmatddm.coupled import ElasticSolver, StepProblem
-    from hmatddm.coupled.schemes import _CoupledLinearSystem
+    from hmatddm.coupled.scaled_system import _CoupledLinearSystem
     from hmatddm.flow import LeakOff, LubricationModel, fracture_compliance
 
     mesh = hd.mesh.line([-length / 2, 0], [length / 2, 0], n)

@@ -2,8 +2,8 @@
 from .._lazy import attach
 
 _EXPORTS = {
-    "ElasticSolver": ".elastic", "SCHEMES": ".schemes", "SchemeSettings": ".schemes", "StepProblem": ".schemes",
-    "solve_step": ".schemes",
+    "ElasticSolver": ".elastic", "SCHEMES": ".step_problem", "SchemeSettings": ".step_problem",
+    "StepProblem": ".step_problem", "solve_step": ".schemes",
 }
 __getattr__, __dir__ = attach(__name__, _EXPORTS)
 

@@ -1,7 +1,7 @@
 """Solves with the elasticity block ``A`` of the coupled system, for any operator.
 
-The operator (:class:`~hmatddm.operators.ElasticityOperator` of either backend, or an
-:class:`~hmatddm.extended_operator.ExtendedElasticityOperator` of a grown mesh) does the
+The operator (:class:`~hmatddm.elasticity.operator.ElasticityOperator` of either backend, or an
+:class:`~hmatddm.elasticity.extended.ExtendedElasticityOperator` of a grown mesh) does the
 solving: ``solve`` (dense: cached LU; otherwise GMRES preconditioned by its approximate
 inverse, warm-started), ``approximate_inverse`` (what the Krylov-accelerated coupled
 scheme uses inside its preconditioner: the exact LU solve for ``dense``, one
@@ -18,7 +18,7 @@ of ``S A_near + D``: the two-level correction is not built for modified rows.
 import numpy as np
 import scipy.sparse.linalg as spla
 
-from ..operator_inverse import solve_with_inverse
+from ..elasticity.inverse import solve_with_inverse
 
 
 class ElasticSolver:

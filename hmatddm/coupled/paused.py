@@ -1,7 +1,7 @@
 """A provisional iterate whose GMRES solve is paused (issue 17).
 
 A growing simulation decides each growth pass on the first iterate of a coupled solve
-(:class:`hmatddm.coupled.schemes.SchemeSettings` ``growth_check = "first"``), which GMRES
+(:class:`hmatddm.coupled.step_problem.SchemeSettings` ``growth_check = "first"``), which GMRES
 solves to ``first_linear_rtol`` (ref. Eq. 4.41 with the widths lagged). Most passes grow,
 and their iterate is then only the next pass's guess. Here that GMRES solve pauses at
 coarser relative residuals first (:func:`pause_levels`,

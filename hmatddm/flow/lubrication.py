@@ -52,7 +52,7 @@ class LubricationModel:
     ----------
     areas : (N,) element areas S_i, m^2
     normals : (N, d) unit normals
-    faces : hmatddm.topology.Faces
+    faces : hmatddm.mesh.topology.Faces
     fluid : Fluid
     leak_off : LeakOff
     injection_elements : (C,) element of each cluster

@@ -255,7 +255,7 @@ def fill(cells, field, asymptote, n_sub=8, length=np.inf):
     """Filled fraction, mean opening and "fully inside" of cells (M, k) of the grid.
 
     The mean opening is the asymptote ``w(-phi, V)`` (with the finite-fracture factor of
-    ``length``, :func:`~hmatddm.fracture.tip_asymptote.finite_fracture_factor`) averaged over
+    ``length``, :func:`~hmatddm.analytical.tip_asymptote.finite_fracture_factor`) averaged over
     the cell's sample points, zero outside the front.
     """
     cells = np.asarray(cells, np.int64).reshape(-1, field.k)

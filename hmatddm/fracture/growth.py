@@ -5,7 +5,7 @@ maximum circumferential stress).
 A new element hinges on its parent's tip edge: the parent frame is rotated by
 ``theta_0`` about the edge axis (from ``ahead`` towards the normal), so the new
 element shares the tip edge exactly and the flow faces and tip edges of
-:mod:`hmatddm.topology` find it. In 3D, ``turning="plan"`` lets only edges parallel
+:mod:`hmatddm.mesh.topology` find it. In 3D, ``turning="plan"`` lets only edges parallel
 to the vertical axis turn (fractures turn in plan view and stay vertical); the
 others grow straight.
 """
@@ -54,7 +54,7 @@ class Propagation:
         ``"element"``: the reference's switch, whole elements added where the criterion
         holds (ref. Sec. 4.2.2, growth direction from ref. Eqs 4.10-4.11, so fractures
         may turn). ``"asymptotic"``: the front is located inside the tip elements by
-        inverting the universal tip asymptote (:mod:`hmatddm.fracture.tip_asymptote`,
+        inverting the universal tip asymptote (:mod:`hmatddm.analytical.tip_asymptote`,
         :mod:`hmatddm.fracture.front`); partially filled tip elements carry the
         asymptote's opening. Planar fractures only (one fracture, square elements on one
         grid in 3D, equal segments on a line in 2D), without leak-off, natural

@@ -111,6 +111,19 @@ def block_ilu0(indptr, indices, data):
     return values, inverse_diagonal, diagonal_position, -1
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _subtract_blocks(values, indices, first, stop, x, i, d):
+    """``x_i -= sum_p values[p] x_{indices[p]}`` over the stored blocks ``first <= p < stop``
+    of block row ``i`` (one sweep of a block triangular solve)."""
+    for p in range(first, stop):
+        j = indices[p]
+        for r in range(d):
+            total = 0.0
+            for c in range(d):
+                total += values[p, r, c] * x[d * j + c]
+            x[d * i + r] -= total
+
+
 @njit(cache=True, nogil=True)
 def block_ilu_solve(indptr, indices, values, inverse_diagonal, diagonal_position, rhs):
     """x = U^-1 L^-1 rhs for the factors of :func:`block_ilu0`; rhs (n_blocks * d,)."""
@@ -118,22 +131,10 @@ def block_ilu_solve(indptr, indices, values, inverse_diagonal, diagonal_position
     d = values.shape[1]
     x = rhs.copy()
     for i in range(n_blocks):  # forward: unit block lower triangle
-        for p in range(indptr[i], diagonal_position[i]):
-            j = indices[p]
-            for r in range(d):
-                total = 0.0
-                for c in range(d):
-                    total += values[p, r, c] * x[d * j + c]
-                x[d * i + r] -= total
+        _subtract_blocks(values, indices, indptr[i], diagonal_position[i], x, i, d)
     work = np.empty(d)
     for i in range(n_blocks - 1, -1, -1):  # backward
-        for p in range(diagonal_position[i] + 1, indptr[i + 1]):
-            j = indices[p]
-            for r in range(d):
-                total = 0.0
-                for c in range(d):
-                    total += values[p, r, c] * x[d * j + c]
-                x[d * i + r] -= total
+        _subtract_blocks(values, indices, diagonal_position[i] + 1, indptr[i + 1], x, i, d)
         for r in range(d):
             total = 0.0
             for c in range(d):

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hmatddm.errors import InputError
+from ..errors import InputError
 
 
 @dataclass(frozen=True)

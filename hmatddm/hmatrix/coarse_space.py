@@ -33,7 +33,7 @@ import scipy.linalg
 import scipy.sparse.linalg as spla
 from numba import njit
 
-from hmatddm.errors import InputError
+from ..errors import InputError
 
 from ._threads import single_threaded_blas
 from .factor_precision import factor_columns

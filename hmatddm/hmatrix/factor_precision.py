@@ -2,7 +2,7 @@
 trailing columns as 16-bit fixed point.
 
 After recompression a far block is U V^T = sum_q sigma_q u_q v_q^T with the singular
-values folded into U (``aca.recompress_transposed``): column q of the factors carries
+values folded into U (``recompression.recompress_transposed``): column q of the factors carries
 a share sigma_q of the block, and the trailing columns carry little. A column stored
 with a relative rounding delta contributes an error of about sigma_q * delta, so the
 columns with small sigma_q can be stored with fewer bits for the same block accuracy

@@ -9,7 +9,7 @@ import logging
 import numpy as np
 import scipy.sparse.linalg as spla
 
-from hmatddm.errors import InputError
+from ..errors import InputError
 
 from .block_ilu import block_ilu0, block_ilu_solve
 

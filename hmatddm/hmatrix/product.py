@@ -1,10 +1,10 @@
 """One-shot H-matrix product without storage ("build-free apply"): ``y = A x`` for a
 matrix given by its :class:`~hmatddm.hmatrix.BlockGenerator`, when the matrix is applied
-once (a stress field from given DDs, :mod:`hmatddm.fields`).
+once (a stress field from given DDs, :mod:`hmatddm.elasticity.fields`).
 
 The same cluster trees and block tree as :meth:`HMatrix.build <hmatddm.hmatrix.HMatrix.build>`;
 each near block is filled by the kernel and multiplied at once; each admissible block
-runs the production whole-element ACA (:func:`hmatddm.hmatrix.aca._aca_loop`, the loop the
+runs the production whole-element ACA (:func:`hmatddm.hmatrix.aca_loop._aca_loop`, the loop the
 build calls) to ``eps`` and adds ``U (V^T x)`` to the result. No recompression (it would
 only shrink factors that are used once) and nothing is stored, so the cost is the ACA's
 kernel entries plus O((m + n) k) flops per far block.
@@ -14,12 +14,13 @@ import numpy as np
 from numba import types
 
 from ..errors import InputError
-from .aca import _RANK, ACA_STEP_TYPES, _aca_loop, aca_gave_up, aca_steps
+from .aca import ACA_STEP_TYPES, aca_steps
+from .aca_loop import _RANK, _aca_loop, aca_gave_up
 from .block_tree import block_tree
 from .cluster_tree import cluster_tree
 from .generator import BlockGenerator
-from .first_class import INDEX, compiled_for_data
-from .storage import _batches, _run_parallel
+from ..compiled import INDEX, compiled_for_data
+from .assembly import _batches, _run_parallel
 
 
 def _apply_blocks(kernel, data, row_permutation, col_permutation, row_dof, col_dof, eps, row_start, row_stop,
@@ -28,9 +29,10 @@ def _apply_blocks(kernel, data, row_permutation, col_permutation, row_dof, col_d
     order); returns the batch's part of ``A x`` (``n_rows`` values, original row order).
 
     Compiled per kernel data type by :func:`product_driver` (the kernel arrives as a
-    first-class function, as in the build driver of hmatrix/storage.py, so the compiled
-    driver is cached on disk; the ACA steps ``start``, ``advance`` = aca.aca_start,
-    aca.aca_advance arrive as first-class functions too, see storage.build_driver). Admissible blocks: ``_aca_loop`` at ``eps``, then
+    first-class function, as in the build driver of hmatrix/assembly.py, so the compiled
+    driver is cached on disk; the ACA steps ``start``, ``advance`` = aca_loop.aca_start,
+    aca_loop.aca_advance arrive as first-class functions too, see assembly.build_driver).
+    Admissible blocks: ``_aca_loop`` at ``eps``, then
     ``y += U (V^T x)``; the others, those the ACA gave up on, and those whose ACA rank does not pay
     (``rank (m + n) >= m n``, which the build stores dense too): kernel fill of the
     block, then ``y += B x``.

@@ -24,8 +24,7 @@ import numpy as np
 import scipy.sparse.linalg as spla
 from scipy.linalg import get_lapack_funcs
 
-from hmatddm.errors import ConvergenceError, InputError
-from hmatddm.settings import integer
+from ..errors import ConvergenceError, InputError
 
 from ._threads import single_threaded_blas
 
@@ -40,7 +39,14 @@ MAX_BASIS_BYTES = 1 << 30
 
 
 def _positive_integer(name, value):
-    return integer(name, value, 1)
+    """``value`` as an int >= 1 (Python or numpy integer; bools refused), with the message
+    of the package's settings (the compressor imports no settings, docs/architecture.md)."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        shown = "true" if value is True else "false" if value is False else repr(value)
+        raise InputError(f"{name} must be an integer (>= 1), got {shown}")
+    if value < 1:
+        raise InputError(f"{name} must be an integer >= 1, got {value}")
+    return int(value)
 
 
 def _default_max_restart(restart, n):

@@ -27,7 +27,7 @@ import numpy as np
 from .._validation import finite_scalar
 from ..errors import InputError
 from ..mesh import Mesh2D, Mesh3D
-from . import atomic_output
+from .atomic import atomic_output
 
 VTK_LINE = 3
 VTK_QUAD = 9

@@ -29,14 +29,14 @@ def element_data(mesh, material, singular_shift=0.0, alpha=0.0, self_max=None, n
     (``element_order`` 1 or 2) or :class:`.rectangle3d.Rectangles`, with
     the fields ``singular_shift``, ``near_fraction`` and ``alpha`` of :mod:`.drivers`.
     ``near_fraction`` (0 = exact hits only) widens the singular set to near-miss
-    junctions (see :data:`hmatddm.operators.NEAR_SINGULAR_FRACTION`); ``self_max`` (N,)
+    junctions (see :data:`hmatddm.elasticity.operator.NEAR_SINGULAR_FRACTION`); ``self_max`` (N,)
     is needed for ``alpha > 0`` (ref. Eq. 6.11; zeros when None).
     """
     options = dict(singular_shift=float(singular_shift), near_fraction=float(near_fraction), alpha=float(alpha))
     self_max = np.zeros(mesh.n_elements) if self_max is None else np.asarray(self_max, dtype=np.float64)
     g, nu = float(material.shear_modulus), float(material.poisson_ratio)
     if mesh.dim == 2 and mesh.element_order > 0:  # + shape functions (line2d_higher_order)
-        from ..shape_functions import coefficients, nodes
+        from ..mesh.shape_functions import coefficients, nodes
         from .line2d_higher_order import NodalSegments
 
         return NodalSegments(mesh.centers, mesh.frames, mesh.half_length, g, nu, **options, self_max=self_max,

@@ -4,7 +4,7 @@ singular-pair test and the stress at points (ref. Eqs 2.47, 2.57-2.59).
 What differs between 2D and 3D, constant and higher-order elements, a homogeneous and a
 layered medium is the influence of ONE source element at ONE receiver; that lives with
 each kind of element (:mod:`.line2d`, :mod:`.rectangle3d`, :mod:`.line2d_higher_order`,
-:mod:`hmatddm.layered.images2d`, :mod:`hmatddm.layered_higher_order`). The loops over
+:mod:`hmatddm.layered.images2d`, :mod:`hmatddm.layered.higher_order2d`). The loops over
 element pairs, the reference's scaling of blocks larger than the self-influence
 (ref. Eq. 6.11) and the parallel assembly live here, once.
 
@@ -19,7 +19,7 @@ record has the fields
   across it (ref. Sec. 6.2.3);
 * ``near_fraction`` (float): a point closer than this fraction of the smaller half size
   to an edge of another element counts as on it (a near-miss junction;
-  :data:`hmatddm.operators.NEAR_SINGULAR_FRACTION`);
+  :data:`hmatddm.elasticity.operator.NEAR_SINGULAR_FRACTION`);
 * ``alpha`` (float): > 0 -- blocks whose largest entry exceeds ``alpha`` times the
   largest entry of the source's self block are scaled down to it (ref. Eq. 6.11);
   0 -- no scaling;
@@ -397,9 +397,9 @@ def self_blocks(data, start=0, stop=None):
     default), one kernel call per element.
 
     One compiled loop per record type that calls :func:`traction_block` as a first-class
-    function (:mod:`hmatddm.hmatrix.first_class`, as the H-matrix build does): the kernel is
+    function (:mod:`hmatddm.compiled`, as the H-matrix build does): the kernel is
     not compiled again, and the loop is small and cached on disk."""
-    from ..hmatrix.first_class import compiled_for_data
+    from ..compiled import compiled_for_data
 
     stop = data.centers.shape[0] if stop is None else stop
     dof = element_unknowns(data)

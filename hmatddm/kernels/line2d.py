@@ -75,6 +75,26 @@ def tip_distance(x, y, a):
     return math.sqrt(d * d + y * y)
 
 
+#: Cases of :func:`tip_averaging`.
+REGULAR, UNDEFINED, AVERAGED = 0, 1, 2
+
+
+@njit(cache=True, inline="always")
+def tip_averaging(x, y, a, singular_shift, near):
+    """How the stress at local ``(x, y)`` of a segment of half length ``a`` is evaluated
+    (ref. Sec. 6.2.3): ``(REGULAR, x, x)`` away from the end points; ``(UNDEFINED, ...)``
+    on an end point (or within ``near > 0`` of one) when ``singular_shift <= 0``; else
+    ``(AVERAGED, x_plus, x_minus)``, the two points ``tip +- singular_shift * a`` on the
+    segment's line whose mean value replaces the singular one."""
+    if not (on_tip(x, y, a) or (near > 0.0 and tip_distance(x, y, a) <= near)):
+        return REGULAR, x, x
+    if singular_shift <= 0.0:
+        return UNDEFINED, x, x
+    tip = a if x >= 0.0 else -a
+    delta = singular_shift * a
+    return AVERAGED, tip + delta, tip - delta
+
+
 @njit(cache=True)
 def local_stress_corrected(x, y, a, shear_modulus, poisson_ratio, singular_shift, out, near=0.0):
     """:func:`local_stress`, with singular points handled by the reference's averaging
@@ -86,17 +106,16 @@ def local_stress_corrected(x, y, a, shear_modulus, poisson_ratio, singular_shift
     caller reports them); otherwise the point is moved onto the end point and the
     stress is the mean of the values ``+-singular_shift * a`` along the segment from it.
     """
-    if not (on_tip(x, y, a) or (near > 0.0 and tip_distance(x, y, a) <= near)):
+    case, x_plus, x_minus = tip_averaging(x, y, a, singular_shift, near)
+    if case == REGULAR:
         local_stress(x, y, a, shear_modulus, poisson_ratio, out)
         return
-    if singular_shift <= 0.0:
+    if case == UNDEFINED:
         out[:] = np.nan
         return
-    tip = a if x >= 0.0 else -a
-    delta = singular_shift * a
     tmp = np.empty((2, 2, 2))
-    local_stress(tip + delta, 0.0, a, shear_modulus, poisson_ratio, out)
-    local_stress(tip - delta, 0.0, a, shear_modulus, poisson_ratio, tmp)
+    local_stress(x_plus, 0.0, a, shear_modulus, poisson_ratio, out)
+    local_stress(x_minus, 0.0, a, shear_modulus, poisson_ratio, tmp)
     for k in range(2):
         for i in range(2):
             for j in range(2):

@@ -3,7 +3,7 @@ plane strain), in closed form (ref. Sec. 3.5; Crawford & Curran 1982).
 
 The element lies on its local axis ``y = 0`` from ``x = -a`` to ``x = a``; its DD varies
 as ``D(s) = sum_k N_k(s/a) D_k`` with the shape functions of ref. App. B
-(:mod:`hmatddm.shape_functions`), nodes inside the element where it is collocated. The
+(:mod:`hmatddm.mesh.shape_functions`), nodes inside the element where it is collocated. The
 stress formulas of the constant element (:mod:`.line2d`, ref. App. A eqs 10-19) hold for
 any DD density along ``y = 0`` once ``g`` is the potential of that density:
 
@@ -39,7 +39,7 @@ import numpy as np
 from numba import njit
 
 from .drivers import HOMOGENEOUS_FIELDS, KernelKind, kernel_record, no_source_state, register_kind
-from .line2d import SEGMENT_FIELDS, on_tip, rotate_to_global, tip_distance
+from .line2d import REGULAR, SEGMENT_FIELDS, UNDEFINED, rotate_to_global, tip_averaging, tip_distance
 
 _INV_4PI = 1.0 / (4.0 * math.pi)
 
@@ -175,17 +175,16 @@ def local_stress_nodes_corrected(x, y, a, coefficients, shear_modulus, poisson_r
     within ``near`` of one) handled as :func:`hmatddm.kernels.line2d.local_stress_corrected`:
     NaN when ``singular_shift <= 0``, else the mean of the values ``+-singular_shift * a``
     along the segment from the end point (ref. Sec. 6.2.3)."""
-    if not (on_tip(x, y, a) or (near > 0.0 and tip_distance(x, y, a) <= near)):
+    case, x_plus, x_minus = tip_averaging(x, y, a, singular_shift, near)
+    if case == REGULAR:
         local_stress_nodes(x, y, a, coefficients, shear_modulus, poisson_ratio, out)
         return
-    if singular_shift <= 0.0:
+    if case == UNDEFINED:
         out[:] = np.nan
         return
-    tip = a if x >= 0.0 else -a
-    delta = singular_shift * a
     tmp = np.empty_like(out)
-    local_stress_nodes(tip + delta, 0.0, a, coefficients, shear_modulus, poisson_ratio, out)
-    local_stress_nodes(tip - delta, 0.0, a, coefficients, shear_modulus, poisson_ratio, tmp)
+    local_stress_nodes(x_plus, 0.0, a, coefficients, shear_modulus, poisson_ratio, out)
+    local_stress_nodes(x_minus, 0.0, a, coefficients, shear_modulus, poisson_ratio, tmp)
     for n in range(out.shape[0]):
         for k in range(2):
             for i in range(2):
@@ -309,7 +308,7 @@ def set_node_rows(block, pair, r):
 def edge_distance(data, i, j):
     """Distance from the collocation nodes of element ``i`` to the nearer end of element
     ``j`` (any record with ``centers``, ``frames``, ``half_length`` and ``nodes``, as the
-    layered one of :mod:`hmatddm.layered_higher_order`)."""
+    layered one of :mod:`hmatddm.layered.higher_order2d`)."""
     centers, frames, half_length, nodes = data.centers, data.frames, data.half_length, data.nodes
     point = np.empty(2)
     best = np.inf

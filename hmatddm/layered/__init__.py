@@ -7,7 +7,10 @@
   (images through the interfaces, shared with 3D), :mod:`.segment_quadrature` (the image
   quadrature along a segment), :mod:`.segments2d` (kernel data of constant 2D elements).
 * :mod:`.images3d`: the same for constant rectangles in 3D (any orientation), with the
-  3D Hansen potentials (ref. Eq. 3.24); :mod:`.influence3d` builds their kernel data.
+  3D Hansen potentials (ref. Eq. 3.24); :mod:`.influence3d` builds their kernel data. Its
+  parts: :mod:`.potentials3d` (the potentials and the field of one image triple),
+  :mod:`.image_tracer3d` (the triples through the interfaces), :mod:`.image_points3d` (the
+  field of a point source), :mod:`.rectangle_quadrature` (the quadrature over a rectangle).
 * :func:`split_at_interfaces`: cut a mesh's elements where they cross interfaces (2D
   segments; 3D rectangles with a horizontal edge).
 """
@@ -18,7 +21,7 @@ from .medium import LayeredMedium
 
 def __getattr__(name):
     if name in ("images2d", "influence2d", "images3d", "influence3d", "image_tracer", "segment_quadrature",
-                "segments2d"):
+                "segments2d", "potentials3d", "image_tracer3d", "image_points3d", "rectangle_quadrature"):
         return importlib.import_module(f"{__name__}.{name}")
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 

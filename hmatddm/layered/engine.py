@@ -13,7 +13,7 @@ Natural fractures (ref. Ch. 5) run as in uniform rock, with the layers:
   the image terms (the layered :func:`hmatddm.stress_at`, direct sum, with the number of
   images of the run's operator), adds the in-situ stress of each element's layer and
   takes Poisson's ratio of its layer for the undrained pore-pressure change (2D); the
-  rigorous screen of :mod:`hmatddm.field_bound` holds for a homogeneous kernel only, so
+  rigorous screen of :mod:`hmatddm.elasticity.field_bound` holds for a homogeneous kernel only, so
   it is used where all layers have the same moduli (the images vanish: the medium's
   stress is the homogeneous one) and every target is evaluated otherwise
   (:func:`remote_failure_setting`);

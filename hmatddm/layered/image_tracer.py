@@ -1,6 +1,6 @@
 """The image method's tracer (ref. Sec. 3.2, Fig. 3.4): the Hansen potentials of a point
 force reflected and transmitted through the interfaces of a plane-layered medium, for the 2D
-pairs of :mod:`hmatddm.layered.images2d` and the 3D triples of :mod:`hmatddm.layered.images3d`.
+pairs of :mod:`hmatddm.layered.images2d` and the 3D triples of :mod:`hmatddm.layered.image_tracer3d`.
 
 Reflection and transmission at an interface ``y3 = d`` of a pair emanating from ``z``
 (ref. Eqs 3.25-3.28, with ``h = z - d`` signed, ``D = d/dy3``, ``gamma = G_far/G_near``,

@@ -188,6 +188,25 @@ def _lame(shear_modulus, poisson_ratio):
     return 2.0 * shear_modulus * poisson_ratio / (1.0 - 2.0 * poisson_ratio)
 
 
+@njit(cache=True, inline="always")
+def zero_in_void(shear_modulus, layer, out):
+    """True, with ``out`` set to zero, when ``layer`` is a void (zero shear modulus: a
+    free surface's outside), where an element induces no stress."""
+    if shear_modulus[layer] <= 0.0:
+        out[:] = 0.0
+        return True
+    return False
+
+
+@njit(cache=True, inline="always")
+def receiver_constants(shear_modulus, poisson_ratio, layer):
+    """``(G, delta = 1/(3 - 4 nu), lambda)`` of ``layer``: the material constants the image
+    fields take at a receiver in that layer (ref. Eq. 3.14), in 2D and 3D alike."""
+    g = shear_modulus[layer]
+    nu = poisson_ratio[layer]
+    return g, 1.0 / (3.0 - 4.0 * nu), _lame(g, nu)
+
+
 @njit(cache=True)
 def _contract(gradient, normal, shear_modulus, lame, weight, out):
     """``out[b, i, j] += weight *`` stress of a unit DD density along global ``b`` on a
@@ -219,10 +238,7 @@ def _complementary_gradient(y1, y3, receiver_layer, x1, n_pairs, source_layer, t
     :func:`Workspace` of the pairs' order, ``work1`` one of order 1."""
     gradient[:] = 0.0
     n_orders = pair_coef.shape[-1]
-    g_r = shear_modulus[receiver_layer]
-    nu_r = poisson_ratio[receiver_layer]
-    delta_r = 1.0 / (3.0 - 4.0 * nu_r)
-    lame_r = _lame(g_r, nu_r)
+    g_r, delta_r, lame_r = receiver_constants(shear_modulus, poisson_ratio, receiver_layer)
     for k in range(n_pairs):
         if pair_layer[k] == receiver_layer:
             _pair_stress_gradient(y1 - x1, y3 - pair_z[k], pair_eps[k], pair_coef[k], pair_dcoef[k], n_orders,
@@ -360,12 +376,3 @@ def image_element_stress(y1, y3, receiver_layer, p0, p1, source_layer, interface
     _integrate(y1, y3, receiver_layer, p0, p1, source_layer, shear_modulus, poisson_ratio, xi, weights, shape, traced,
                np.int64(0), out, np.empty((2, 2, 3)), Workspace(traced[4].shape[-1]), Workspace(1))
 
-
-def __getattr__(name):
-    """``LayeredSegments`` lives in :mod:`.segments2d`; numba's on-disk cache indexes written
-    before it moved there unpickle it from here (without this they raise, not recompile)."""
-    if name == "LayeredSegments":
-        from .segments2d import LayeredSegments
-
-        return LayeredSegments
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -52,11 +52,11 @@ def choose_images(mesh, medium, data, max_samples=12, max_sources=120):
 
 
 def _prepared(mesh, medium, dd, points, singular_correction, near_fraction, n_images):
-    from ..operators import _AVERAGE_SHIFT
+    from ..options import AVERAGE_SHIFT
 
     points = finite_array("points", points, (None, 3))
     dd = finite_array("dd", dd).reshape(mesh.n_elements, 3)
-    shift = _AVERAGE_SHIFT if singular_correction == "average" else 0.0
+    shift = AVERAGE_SHIFT if singular_correction == "average" else 0.0
     data = influence_data(mesh, medium, shift, 0.0, near_fraction, 0)
     if n_images is None:
         n_images = choose_images(mesh, medium, data)

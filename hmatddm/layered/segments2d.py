@@ -9,7 +9,7 @@ from numba import njit
 
 from ..kernels import line2d
 from ..kernels.drivers import KernelKind, kernel_record, register_kind
-from .images2d import Workspace, _integrate, _trace_range, image_element_stress, traced_buffer
+from .images2d import Workspace, _integrate, _trace_range, image_element_stress, traced_buffer, zero_in_void
 from .segment_quadrature import composite_rule, subdivision_level, subdivisions
 
 
@@ -121,11 +121,10 @@ def element_stress(data, point, point_layer, j, work, out):
     quadrature of :func:`element_traction`). A point within ``near_fraction`` half
     lengths of an end counts as on it."""
     local, image, gradient, ws1 = work
+    if zero_in_void(data.shear_modulus, point_layer, out):
+        return
     g = data.shear_modulus
     nu = data.poisson_ratio
-    if g[point_layer] <= 0.0:
-        out[:] = 0.0
-        return
     ls = data.layer[j]
     a = data.half_length[j]
     line2d.stress_pair(point, data.centers[j], data.frames[j], a, g[ls], nu[ls], data.singular_shift, out,

@@ -7,7 +7,7 @@
     hs.reference_values(scene.data, records)     # closed-form values at each step
 
 ``hmatddm run SCENE --out DIR`` does the same and writes the outputs (see
-:mod:`hmatddm.runner`). ``hmatddm scenes`` lists the embedded scenes and
+:mod:`hmatddm.app.runner`). ``hmatddm scenes`` lists the embedded scenes and
 ``hmatddm scenes NAME`` prints one, a good start for a scene of your own.
 
 Conventions

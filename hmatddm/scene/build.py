@@ -6,12 +6,12 @@ import math
 
 import numpy as np
 
-from .. import mesh as meshes
-from ..errors import InputError
 from ..flow import Cluster, Fluid, LeakOff
 from ..material import Elastic
 from ..settings import NATURAL_FRACTURE
-from .schema import SCHEME_KEYS, far_field_stress, has_natural_fractures, show
+from .meshes import check_clusters, fracture_mesh, initial_mesh, natural_mesh
+from .preflight import estimate, refuse_too_many_elements
+from .schema import SCHEME_KEYS, far_field_stress, has_natural_fractures
 
 _CROSSING_NAMES = {"mohr-coulomb": "mohr-coulomb", "energy-release-rate": "energy", "stress-intensity": "sif"}
 
@@ -52,62 +52,6 @@ def clusters(scene):
             for c in scene["cluster"]]
 
 
-def _fracture_mesh(fracture, fracture_id):
-    shape, size = fracture["shape"], fracture["element_size"]
-    if shape == "rectangle":
-        nx = int(round(fracture["length"] / size))
-        ny = int(round(fracture["height"] / size))
-        return meshes.rectangle(fracture["center"], fracture["e1"], fracture["e2"], fracture["length"],
-                                fracture["height"], nx, ny, fracture_id=fracture_id)
-    if shape == "penny":
-        return meshes.penny(fracture["center"], fracture["normal"], fracture["radius"], size,
-                            fracture_id=fracture_id)
-    p0, p1 = np.array(fracture["p0"]), np.array(fracture["p1"])
-    n = int(round(np.linalg.norm(p1 - p0) / size))
-    return meshes.line(p0, p1, n, fracture_id=fracture_id)
-
-
-def initial_mesh(scene):
-    """The initial fractures as one mesh; fracture ``i`` of the scene has fracture id ``i``."""
-    parts = []
-    for index, fracture in enumerate(scene["initial_fracture"]):
-        try:
-            parts.append(_fracture_mesh(fracture, index))
-        except InputError as error:
-            raise InputError(f"initial_fracture[{index}]: {error}") from None
-    mesh = meshes.concatenate(parts)
-    _check_overlaps(scene, mesh)
-    return mesh
-
-
-def _check_overlaps(scene, mesh):
-    """Two initial fractures must not put collocation points on top of each other."""
-    if len(scene["initial_fracture"]) < 2:
-        return
-    from ..neighbours import pairs_within  # numpy only: refusing a scene does not wait for scipy.spatial
-
-    sources, receivers = pairs_within(mesh.centers, 1e-6 * float(np.max(mesh.radii)))
-    if len(sources):
-        first, second = int(sources[0]), int(receivers[0])
-        a, b = int(mesh.fracture_id[first]), int(mesh.fracture_id[second])
-        raise InputError(f"initial_fracture[{a}] and initial_fracture[{b}] overlap: elements {first} and {second} "
-                         f"share the centre {show(mesh.centers[first].tolist())}")
-
-
-def _check_clusters(scene, mesh):
-    """Every cluster must lie on an initial fracture (it feeds the nearest element)."""
-    for index, cluster in enumerate(scene["cluster"]):
-        position = np.asarray(cluster["position"])
-        distance = np.linalg.norm(mesh.centers - position, axis=1)
-        nearest = int(np.argmin(distance))
-        reach = 1.0001 * float(mesh.radii[nearest])
-        if distance[nearest] > reach:
-            raise InputError(f"cluster[{index}].position = {show(cluster['position'])} m is "
-                             f"{distance[nearest]:.6g} m from the nearest initial-fracture element "
-                             f"(centre {show(mesh.centers[nearest].tolist())}); a cluster must lie on an "
-                             f"initial fracture (within {reach:.6g} m of an element centre)")
-
-
 def propagation(scene):
     settings = scene.get("propagation")
     if settings is None:
@@ -144,11 +88,10 @@ def build_simulation(scene, checkpoint_dir=None):
     fractures.
     """
     from ..simulation import Simulation  # the engine loads here, not when a scene is validated
-    from .preflight import estimate, refuse_too_many_elements
 
     refuse_too_many_elements(scene, estimate(scene))
     mesh = initial_mesh(scene)
-    _check_clusters(scene, mesh)
+    check_clusters(scene, mesh)
     rock = material(scene)
     if "layer" in scene:  # initial elements end on the interfaces
         from ..layered import split_at_interfaces
@@ -167,40 +110,6 @@ def build_simulation(scene, checkpoint_dir=None):
         natural_fractures=natural_mesh(scene), natural=natural_properties(scene),
         remote_failure=scene.get("network", {}).get("remote_failure", True), contact=numerics["contact"],
         max_elements=numerics.get("max_elements"))
-
-
-def natural_network(scene):
-    """The scene's natural fractures as an :class:`hmatddm.network.Network` (generated
-    when ``network.density`` is given, plus the explicit ``[[natural_fracture]]``), or None."""
-    from ..network import Network, NetworkSpec, generate_network
-
-    if not has_natural_fractures(scene):
-        return None
-    settings = scene.get("network", {})
-    height, z_center = settings.get("height", 1.0), settings.get("z_center", 0.0)
-    p0 = [np.asarray(f["p0"], float) for f in scene.get("natural_fracture", [])]
-    p1 = [np.asarray(f["p1"], float) for f in scene.get("natural_fracture", [])]
-    if "density" in settings:
-        keys = ("region", "density", "length_exponent", "l_min", "l_max", "mean_azimuths_deg", "kappas",
-                "weights", "seed", "boundary")
-        spec = NetworkSpec(height=height, z_center=z_center,
-                           **{k: (tuple(settings[k]) if isinstance(settings[k], list) else settings[k])
-                              for k in keys if k in settings and settings[k] is not None})
-        generated = generate_network(spec)
-        p0.extend(generated.p0)
-        p1.extend(generated.p1)
-    return Network.from_segments(np.array(p0), np.array(p1), height=height, z_center=z_center)
-
-
-def natural_mesh(scene):
-    """Elements of the natural fractures (2D segments or 3D vertical rectangles), or None."""
-    network = natural_network(scene)
-    if network is None:
-        return None
-    size = scene.get("network", {}).get("element_size", 1.0)
-    if scene["dimension"] == 2:
-        return network.to_mesh2d(size)
-    return network.to_mesh3d(size, max(1, int(round(network.height / size))))
 
 
 def natural_properties(scene):
@@ -223,7 +132,7 @@ def confining_stress(scene, normal=None):
     """Compressive normal stress on the first initial fracture (Pa, positive), the
     ``S_hmin`` that the net pressure of the closed forms is measured from."""
     if normal is None:
-        mesh = _fracture_mesh(scene["initial_fracture"][0], 0)
+        mesh = fracture_mesh(scene["initial_fracture"][0], 0)
         normal = mesh.normals[0]
     normal = np.asarray(normal, dtype=float)
     return float(-normal @ far_field_stress(scene) @ normal)

@@ -14,7 +14,7 @@ scene and starting the engine, so that every refusal comes within a second:
    element's edge when ``numerics.singular_correction = "none"`` -- the check the
    elasticity operator would otherwise make only once it is built (minutes later).
 
-Only numpy is used here (neighbours by :func:`hmatddm.neighbours.pairs_within`); scipy,
+Only numpy is used here (neighbours by :func:`hmatddm.mesh.neighbours.pairs_within`); scipy,
 numba, the H-matrix engine, pyvista and matplotlib are not imported.
 """
 import math
@@ -24,12 +24,9 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from ..errors import InputError
+from ..options import NEAR_SINGULAR_FRACTION
 from .schema import has_natural_fractures, show
 
-#: Fraction of the smaller half size within which a collocation point counts as on an
-#: element edge: the operator's value (:data:`hmatddm.operators.NEAR_SINGULAR_FRACTION`,
-#: restated here so that this check does not import the operator; a test keeps them equal).
-NEAR_SINGULAR_FRACTION = 0.5
 
 # Rough cost model, fitted to benchmarks/RESULTS.md ("H-matrix vs dense": planar and cloud
 # geometries, N = 1k-100k, eps 1e-4, 2 cores): H-matrix bytes ~ 80 * 8 d^2 N log2 N (an
@@ -258,7 +255,7 @@ def near_edge_pairs(mesh, near_fraction=NEAR_SINGULAR_FRACTION):
     return NaN there), computed geometrically: the point in the source's frame, then its
     distance to the nearest point of the source's boundary.
     """
-    from ..neighbours import pairs_within
+    from ..mesh.neighbours import pairs_within
 
     sizes = _half_sizes(mesh)
     reach = mesh.radii * (1.0 + 1e-9) + near_fraction * sizes
@@ -318,10 +315,10 @@ def check_scene(scene):
     :class:`Estimate`. Raises InputError (one line, naming the key) on the first problem."""
     size = estimate(scene)
     refuse_too_large(scene, size)
-    from .build import _check_clusters, initial_mesh, natural_mesh  # meshes: numpy and scipy.spatial
+    from .meshes import check_clusters, initial_mesh, natural_mesh  # meshes: numpy and scipy.spatial
 
     mesh = initial_mesh(scene)       # each fracture meshable, no two sharing a collocation point
-    _check_clusters(scene, mesh)     # every cluster on an initial fracture
+    check_clusters(scene, mesh)     # every cluster on an initial fracture
     natural = natural_mesh(scene)    # the network generates and meshes
     _check_collocation(scene, mesh, natural)
     return size

@@ -24,8 +24,8 @@ import numpy as np
 from ..errors import InputError
 from ..settings import ABSENT, REQUIRED, show  # noqa: F401  (show: re-exported for scene.build and preflight)
 from .echo import far_field_stress, has_natural_fractures, to_toml  # noqa: F401  (the scene's public names)
-from .sections import (FILLED_WHEN_ABSENT, INITIAL_FRACTURE, NETWORK_GENERATOR, SCHEME_KEYS,  # noqa: F401
-                       SECTIONS, SHAPE_KEYS, SHAPES, TOP)
+from .sections import (FILLED_WHEN_ABSENT, INITIAL_FRACTURE, NETWORK_GENERATOR, SCHEME_KEYS, SECTIONS,
+                       SHAPE_KEYS, SHAPES, TOP)
 
 
 # ---------------------------------------------------------------------------------
@@ -272,7 +272,7 @@ def validate(raw, name=None):
         elif section == "network":
             echo = _check_network(echo, set(value))
         elif section == "microseismic":
-            from ..microseismic.catalogue import check_section
+            from ..microseismic.monitoring import check_section
 
             echo = check_section(echo)
         scene[section] = echo

@@ -16,12 +16,12 @@ time step, with the ribbon elements (channel elements next to the front) fixed:
 2. the coupled step (:func:`hmatddm.coupled.solve_step`, any scheme) with the tip rows
    ``DD_i = w_i n_i``;
 3. the ribbon openings give new ``s_r`` by inverting the asymptote with ``V = (s_r -
-   s_r^n) / dt`` (:meth:`~hmatddm.fracture.tip_asymptote.TipAsymptote.front_distance`);
+   s_r^n) / dt`` (:meth:`~hmatddm.analytical.tip_asymptote.TipAsymptote.front_distance`);
 
 until no ``s_r`` changes by more than ``front_tolerance`` element sizes.
 
 Both the inversion (3) and the tip openings (1) use the asymptote of a fracture of finite size
-``L`` (:func:`~hmatddm.fracture.tip_asymptote.finite_fracture_factor`), with ``L`` the radius
+``L`` (:func:`~hmatddm.analytical.tip_asymptote.finite_fracture_factor`), with ``L`` the radius
 ``sqrt(A/pi)`` (3D) or the half-length (2D) at the start of the step plus the trial front's
 mean advance (``AsymptoticFront.finite_fracture = False``: the bare semi-infinite asymptote).
 """
@@ -36,7 +36,7 @@ from ..coupled.contact import ContactRows
 from ..errors import ConvergenceError, InputError
 from ..flow import fracture_compliance
 from ..fracture.front import CHANNEL, EMPTY, FILLED, TIP, FrontField, PlanarGrid, fill, front_radii, level_set
-from ..fracture.tip_asymptote import TipAsymptote
+from ..analytical.tip_asymptote import TipAsymptote
 from .records import StepTally, step_record
 from .step_solve import mesh_topology
 from .state import NewElements, StepStart

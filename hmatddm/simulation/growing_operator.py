@@ -4,7 +4,7 @@ blocks while the mesh grows a little, rebuilt when it grew too much.
 The operator is rebuilt only when the mesh has grown, never inside the nonlinear
 iterations of a step. A planar 3D mesh in a homogeneous medium gets the ``hmatrix``
 backend's opening and shear operators apart, and their border blocks apart while it grows
-in its plane (:mod:`hmatddm.planar_operator`; the same matrix, ~7x faster products for a
+in its plane (:mod:`hmatddm.elasticity.planar`; the same matrix, ~7x faster products for a
 crack loaded in opening) unless :data:`SPLIT_PLANAR_MODES` is False.
 """
 import warnings
@@ -13,10 +13,10 @@ from dataclasses import asdict
 import numpy as np
 
 from ..errors import MeshQualityWarning
-from ..extended_operator import ExtendedElasticityOperator
+from ..elasticity.extended import ExtendedElasticityOperator
 from ..material import Elastic
-from ..operators import ElasticityOperator
-from ..planar_operator import PlanarElasticityOperator, PlanarExtendedOperator, is_planar
+from ..elasticity.operator import ElasticityOperator
+from ..elasticity.planar import PlanarElasticityOperator, PlanarExtendedOperator, is_planar
 
 #: Build a planar mesh's operator as its opening and shear parts (see the module docstring).
 SPLIT_PLANAR_MODES = True

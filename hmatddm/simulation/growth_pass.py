@@ -10,7 +10,7 @@ elements that fail remotely (ref. Sec. 5.3) join instead.
 """
 import numpy as np
 
-from .. import topology
+from ..mesh import topology
 from ..fracture import evaluate_tips, new_elements
 from .encounters import meet_natural_fractures
 from .junctions import stop_at_other_fractures

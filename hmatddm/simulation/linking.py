@@ -8,7 +8,7 @@ from .state import Connection
 
 def link(edges, tip, edge, network, reached, point, size, target, target_is_new=False):
     """The :class:`Connection` of tip ``tip`` (its edge ``edge``; ``edges``:
-    :func:`hmatddm.topology.element_edges`) to element ``reached`` of ``network`` (a
+    :func:`hmatddm.mesh.topology.element_edges`) to element ``reached`` of ``network`` (a
     :class:`~hmatddm.simulation.natural.NaturalNetwork`), which it meets at ``point``.
     ``target`` numbers that element in the system (see :class:`Connection`).
 

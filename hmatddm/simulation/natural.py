@@ -29,13 +29,13 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..errors import InputError
-from ..field_bound import stress_bound
+from ..elasticity.field_bound import stress_bound
 from ..fracture.crossing import NaturalFractureProperties, crosses
 from ..layered.medium import LayeredMedium
 from ..material import Elastic
 from ..mesh import Mesh2D, Mesh3D, check_mesh
-from ..operators import NEAR_SINGULAR_FRACTION
-from ..solve import stress_at
+from ..elasticity.operator import NEAR_SINGULAR_FRACTION
+from ..elasticity.solve import stress_at
 
 
 #: Natural element centres per leaf of :meth:`NaturalNetwork.target_tree`.
@@ -224,7 +224,7 @@ class ScreenMemory:
     induced-stress change (Frobenius norm) it can take from that state without failing.
 
     A check with DDs ``dd`` bounds, at each target, the change of the induced stress
-    since the last check (:func:`hmatddm.field_bound.stress_bound` of the DD changes,
+    since the last check (:func:`hmatddm.elasticity.field_bound.stress_bound` of the DD changes,
     the new elements' DDs whole) and evaluates the stress only where the bound reaches
     the margin. The margins then become: the evaluated targets' own
     (:func:`failure_margin` at their exact stress), the others' less the bound. A first
@@ -293,7 +293,7 @@ def _sizes(mesh):
 
 
 def _screenable(mesh, material):
-    """Whether :func:`hmatddm.field_bound.stress_bound` applies: constant elements in a
+    """Whether :func:`hmatddm.elasticity.field_bound.stress_bound` applies: constant elements in a
     homogeneous medium."""
     return isinstance(material, Elastic) and isinstance(mesh, (Mesh2D, Mesh3D)) and getattr(mesh, "n_nodes", 1) == 1
 

@@ -34,7 +34,7 @@ class OperatorSettings:
 @dataclass(frozen=True)
 class RebuildSettings:
     """``hmatrix`` backend: elements added by growth join the operator as exact border
-    blocks (:class:`~hmatddm.extended_operator.ExtendedElasticityOperator`) until they
+    blocks (:class:`~hmatddm.elasticity.extended.ExtendedElasticityOperator`) until they
     exceed ``rebuild_fraction`` of the compressed elements or the border exceeds
     ``max_border_bytes``; then the H-matrix is rebuilt."""
 

@@ -412,7 +412,7 @@ class Simulation:
             self.load_checkpoint()
         shown = None
         if progress:
-            from ..progress import Progress
+            from .progress import Progress
 
             shown = Progress(end_time, self.time_step, stream=None if progress is True else progress,
                              start_time=self.state.time)

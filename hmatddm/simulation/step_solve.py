@@ -7,7 +7,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .. import topology
+from ..mesh import topology
 from ..coupled import ElasticSolver, StepProblem, solve_step
 from ..coupled.contact import ContactLaw, ContactModel
 from ..flow import fracture_compliance
@@ -18,7 +18,7 @@ from .state import Origin
 class SolvedMesh(NamedTuple):
     """What a solve built of its mesh, which the growth pass and the record reuse."""
 
-    edges: object  # hmatddm.topology.Edges
+    edges: object  # hmatddm.mesh.topology.Edges
     faces: object  # flow faces, intersection links included
     flow: object   # the LubricationModel
 
@@ -56,7 +56,7 @@ class _MeshTopology:
 
 mesh_topology = _MeshTopology()
 """``mesh_topology(mesh, height)``: ``(edges, faces)`` of ``mesh``
-(:func:`hmatddm.topology.element_edges`, :func:`~hmatddm.topology.element_faces`), kept for
+(:func:`hmatddm.mesh.topology.element_edges`, :func:`~hmatddm.mesh.topology.element_faces`), kept for
 the last mesh."""
 
 

@@ -1,0 +1,23 @@
+"""Closed-form solutions (the bottom of the house, docs/architecture.md): what the tests,
+the validation table and the scenes' ``[reference]`` blocks compare with.
+
+* :mod:`.solutions`: Griffith and Sneddon cracks, the radial and KGD vertex solutions
+  (K and M), their regime numbers and the radial K-M transition (Dontsov 2016).
+* :mod:`.tip_asymptote`: the universal tip asymptote (Dontsov and Peirce 2015), inverted
+  by the asymptotic front.
+
+Names of :mod:`.solutions` are exported here (``hd.analytical.radial_k_vertex``), loaded
+on first use (scipy.special is not imported with the package).
+"""
+from .._lazy import attach
+
+_SOLUTIONS = (
+    "griffith_opening", "sneddon_opening", "sneddon_volume", "sneddon_axis_stress", "toughness_scale",
+    "radial_k_vertex", "radial_m_vertex", "kgd_k_vertex", "radial_m_vertex_profile", "well_element_radius",
+    "radial_m_vertex_pressure", "kgd_m_vertex_profile", "kgd_m_vertex", "radial_regime", "kgd_regime",
+    "radial_transition_profile", "radial_transition",
+)
+_EXPORTS = {name: ".solutions" for name in _SOLUTIONS}
+__getattr__, __dir__ = attach(__name__, _EXPORTS)
+
+__all__ = list(_SOLUTIONS)

@@ -1,0 +1,257 @@
+"""The output folder of a run (see :mod:`hmatddm.app.runner` for its layout): file names,
+summary.json, the per-element fields of the .vtu files, the pictures of a state, and
+reading a finished or partial run back (``hmatddm render``).
+"""
+import json
+import math
+import platform
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError
+from ..io import atomic_output, read_vtu
+from ..mesh import Mesh2D, Mesh3D
+from ..simulation import checkpoint as checkpoints
+
+
+SUMMARY = "summary.json"
+SCENE_FILE = "scene.toml"
+PVD = "fractures.pvd"
+VTU_DIR = "vtu"
+CHECKPOINT_DIR = "checkpoints"
+SNAPSHOT_DIR = "snapshots"
+HISTORY = "history.png"
+SUMMARY_KEYS = ("scene", "versions", "steps", "reference", "wall_seconds")
+HYDRAULIC = 0
+
+
+# ---------------------------------------------------------------------------------
+# Small helpers
+# ---------------------------------------------------------------------------------
+
+def versions():
+    """Versions of hmatddm, numpy, scipy, numba and python."""
+    import numba
+    import scipy
+
+    from .._version import __version__
+
+    return {"hmatddm": __version__, "numpy": np.__version__, "scipy": scipy.__version__,
+            "numba": numba.__version__, "python": platform.python_version()}
+
+
+def _json_safe(value):
+    """Plain JSON: numpy scalars and arrays converted, NaN and inf written as null."""
+    if isinstance(value, dict):
+        return {str(k): _json_safe(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_json_safe(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return _json_safe(value.tolist())
+    if isinstance(value, (np.integer,)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        value = float(value)
+        return value if math.isfinite(value) else None
+    return value
+
+
+def write_json(path, document):
+    text = json.dumps(_json_safe(document), indent=1, allow_nan=False)
+    with atomic_output(path) as temporary:
+        temporary.write_text(text + "\n", encoding="utf-8")
+
+
+def read_summary(out):
+    """The summary.json of an output folder, or None when there is none."""
+    path = Path(out) / SUMMARY
+    if not path.is_file():
+        return None
+    try:
+        return json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError) as error:
+        raise InputError(f"{path} is not a readable summary.json: {error}") from None
+
+
+def vtu_name(step):
+    return f"{VTU_DIR}/step-{step:06d}.vtu"
+
+
+def vtu_steps(out):
+    folder = Path(out) / VTU_DIR
+    if not folder.is_dir():
+        return []
+    steps = []
+    for path in folder.glob("step-*.vtu"):
+        try:
+            steps.append(int(path.stem.split("-", 1)[1]))
+        except ValueError:
+            continue
+    return sorted(steps)
+
+
+# ---------------------------------------------------------------------------------
+# Fields, VTU and pictures
+# ---------------------------------------------------------------------------------
+
+def cell_fields(mesh, dd, pressure, stress, state=None):
+    """Per-element fields written to the .vtu files (see the docstring of :mod:`hmatddm.app.runner`)."""
+    from ..elasticity.solve import opening, slip  # numba: loaded when a run writes, not when it is checked
+
+    dd = np.asarray(dd, dtype=float).reshape(mesh.n_elements, mesh.dim)
+    normal_stress = np.einsum("ei,ij,ej->e", mesh.normals, stress, mesh.normals)
+    return {"opening": opening(mesh, dd), "slip": slip(mesh, dd), "pressure": np.asarray(pressure, dtype=float),
+            "net_pressure": np.asarray(pressure, dtype=float) + normal_stress,
+            "fracture_id": mesh.fracture_id,
+            "state": np.full(mesh.n_elements, HYDRAULIC, dtype=np.int64) if state is None else state,
+            "dd": dd}
+
+
+def _visible_slip(mesh, slip_vectors, opening_values):
+    """Slip worth drawing as arrows: None when it is round-off next to the opening."""
+    largest = float(np.max(np.linalg.norm(slip_vectors, axis=1))) if len(slip_vectors) else 0.0
+    scale = float(np.max(np.abs(opening_values))) if len(opening_values) else 0.0
+    return slip_vectors if largest > 1e-3 * scale and largest > 0.0 else None
+
+
+def snapshot_views(mesh):
+    """The views worth drawing: the plan view only in 2D, plan and oblique in 3D. A
+    plan view of (mostly) vertical 3D fractures, which looking down z would see edge
+    on, draws their horizontal traces coloured by the largest opening over the height
+    (:func:`hmatddm.render.layout.plan_traces`)."""
+    if mesh.dim == 2:
+        return ("plan",)
+    return ("plan", "oblique")
+
+
+def snapshot_title(name, time_value, mesh, state=None):
+    """The title of a snapshot: the run's element count (``n_elements`` of its record:
+    hydraulic and activated or failed natural elements, the unknowns), and apart from it
+    the intact natural elements drawn as stress targets."""
+    intact = 0 if state is None else int(np.count_nonzero(np.asarray(state) == 1))
+    text = f"{name}: t = {time_value:g} s, {mesh.n_elements - intact} elements"
+    return text + (f" (+ {intact} intact natural)" if intact else "")
+
+
+def layer_interfaces(scene):
+    """Interface heights (m) of a scene's ``[[layer]]`` tables (validated data); () without layers."""
+    layers = (scene or {}).get("layer") or []
+    return tuple(float(layer["bottom"]) for layer in layers[:-1])
+
+
+def write_snapshots(out, mesh, fields, step, time_value, title_prefix, interfaces=()):
+    """``snapshots/step-NNNNNN_{plan,oblique}.png`` of one state; returns the paths.
+    ``interfaces``: layer interface heights, drawn across a 2D section."""
+    from ..render import snapshot
+
+    title = snapshot_title(title_prefix, time_value, mesh, fields.get("state"))
+    slip_vectors = _visible_slip(mesh, fields["slip"], fields["opening"])
+    return [snapshot(mesh, Path(out) / SNAPSHOT_DIR / f"step-{step:06d}_{view}.png", opening=fields["opening"],
+                     state=fields.get("state"), slip=slip_vectors, view=view, title=title, interfaces=interfaces)
+            for view in snapshot_views(mesh)]
+
+
+def write_history(out, records, scene):
+    """``history.png`` with the closed form overlaid; None when there is nothing to plot."""
+    from ..render import plot_history
+    from ..scene import confining_stress, reference_curves
+
+    if not records:
+        return None
+    reference = reference_curves(scene, end_time=max(r["time"] for r in records)) if scene is not None else None
+    confining = confining_stress(scene) if scene is not None and reference is not None else 0.0
+    if reference is not None and "net_pressure" not in reference:
+        confining = 0.0
+    return plot_history(records, Path(out) / HISTORY, reference=reference, confining_stress=confining)
+
+
+# ---------------------------------------------------------------------------------
+# Render a finished or partial run
+# ---------------------------------------------------------------------------------
+
+def _mesh_from_checkpoint(arrays):
+    if "half_a" in arrays:
+        return Mesh3D(arrays["centers"], arrays["frames"], arrays["half_a"], arrays["half_b"],
+                      arrays["fracture_id"].astype(np.int64))
+    return Mesh2D(arrays["centers"], arrays["frames"], arrays["half_length"], arrays["fracture_id"].astype(np.int64))
+
+
+def mesh_from_vtu(points, cells, cell_data):
+    """Rebuild a mesh from the cells that :func:`hmatddm.io.write_vtu` writes (quads in
+    3D with corners counter-clockwise about the normal, lines at z = 0 in 2D)."""
+    fracture_id = np.asarray(cell_data.get("fracture_id", np.zeros(len(cells))), dtype=np.int64)
+    if cells.shape[1] == 4:
+        corners = points[cells]                       # (N, 4, 3)
+        side_a = corners[:, 1] - corners[:, 0]
+        side_b = corners[:, 3] - corners[:, 0]
+        length_a = np.linalg.norm(side_a, axis=1)
+        length_b = np.linalg.norm(side_b, axis=1)
+        return Mesh3D.from_rectangles(corners.mean(axis=1), side_a / length_a[:, None], side_b / length_b[:, None],
+                                      0.5 * length_a, 0.5 * length_b, fracture_id=fracture_id)
+    if cells.shape[1] == 2:
+        return Mesh2D.from_segments(points[cells[:, 0], :2], points[cells[:, 1], :2], fracture_id=fracture_id)
+    raise InputError(f"cannot rebuild a mesh from cells with {cells.shape[1]} points")
+
+
+def latest_state(out):
+    """``(mesh, fields, step, time)`` of the newest state in an output folder: the newest
+    good checkpoint, else the newest .vtu file."""
+    out = Path(out)
+    stress = None
+    summary = read_summary(out)
+    if summary is not None and "scene" in summary:
+        from ..scene import far_field_stress, scene_from_dict
+
+        stress = far_field_stress(scene_from_dict(summary["scene"]).data)
+    if checkpoints.list_checkpoints(out / CHECKPOINT_DIR):
+        arrays, metadata = checkpoints.load_latest(out / CHECKPOINT_DIR)
+        mesh = _mesh_from_checkpoint(arrays)
+        if stress is None:
+            stress = np.zeros((mesh.dim, mesh.dim))
+        state = np.where(arrays["origin"] >= 1, 2, 0).astype(np.int64) if "origin" in arrays else None
+        fields = cell_fields(mesh, arrays["dd"], arrays["pressure"], stress, state)
+        return mesh, fields, int(metadata["step"]), float(metadata["time"])
+    steps = vtu_steps(out)
+    if not steps:
+        raise InputError(f"{str(out)!r} holds no checkpoint and no .vtu file; give the --out folder of an "
+                         "`hmatddm run`")
+    step = steps[-1]
+    points, cells, data = read_vtu(out / vtu_name(step))
+    mesh = mesh_from_vtu(points, cells, data)
+    fields = {"opening": np.asarray(data["opening"], dtype=float),
+              "slip": np.asarray(data["slip"], dtype=float)[:, :mesh.dim],
+              "state": np.asarray(data.get("state", np.zeros(mesh.n_elements)), dtype=np.int64)}
+    times = dict(read_pvd_entries(out))
+    return mesh, fields, step, float(times.get(vtu_name(step), float("nan")))
+
+
+def read_pvd_entries(out):
+    from ..io import read_pvd
+
+    path = Path(out) / PVD
+    return [(name, time_value) for time_value, name in read_pvd(path)] if path.is_file() else []
+
+
+def render_folder(out):
+    """Snapshots of the newest state and the history plot of an output folder (a
+    finished or partial run); returns the written paths."""
+    from ..scene import scene_from_dict
+
+    out = Path(out)
+    if not out.is_dir():
+        raise InputError(f"{str(out)!r} is not a folder; give the --out folder of an `hmatddm run`")
+    mesh, fields, step, time_value = latest_state(out)
+    summary = read_summary(out)
+    scene = scene_from_dict(summary["scene"]).data if summary is not None and "scene" in summary else None
+    name = scene["name"] if scene is not None else out.name
+    written = list(write_snapshots(out, mesh, fields, step, time_value, name, layer_interfaces(scene)))
+    if summary is not None and summary.get("steps"):
+        written.append(write_history(out, summary["steps"], scene))
+    return written
+
+
+__all__ = ["SUMMARY", "SCENE_FILE", "PVD", "VTU_DIR", "CHECKPOINT_DIR", "SNAPSHOT_DIR", "HISTORY", "SUMMARY_KEYS",
+           "versions", "write_json", "read_summary", "vtu_name", "vtu_steps", "cell_fields", "snapshot_views",
+           "snapshot_title", "layer_interfaces", "write_snapshots", "write_history", "mesh_from_vtu", "latest_state",
+           "read_pvd_entries", "render_folder"]

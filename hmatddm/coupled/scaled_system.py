@@ -1,0 +1,83 @@
+"""The scaled linear system of one iterate of the coupled schemes (``"fully-coupled"``,
+``"krylov"``; ref. Eqs 4.52-4.61): ``M_1^-1 A M_2`` for the flow matrix ``D`` of the
+lagged widths, with ``M_1`` the element diagonal blocks of ``A`` and the diagonal of ``D``
+times the scales ``s_u``, ``s_p`` (powers of two), and the fracture-compliance split
+preconditioner of the ``"krylov"`` scheme. The iteration that solves it is
+:mod:`hmatddm.coupled.schemes`.
+"""
+import math
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+
+def _power_of_two(x):
+    """The power of two nearest ``x`` > 0 (within a factor sqrt(2))."""
+    return 2.0 ** round(math.log2(x))
+
+
+class _CoupledLinearSystem:
+    """The scaled coupled matrix ``M_1^-1 A M_2`` of ref. Eqs 4.53-4.61 for fixed D."""
+
+    def __init__(self, problem, matrix, dd, p):
+        self.problem = problem
+        self.flow_matrix = matrix.tocsr()
+        # powers of two: the scaled guess scales back to exactly the DD and pressure of the
+        # last iterate (StepProblem.elastic_matvec finds its product)
+        self.s_u = _power_of_two(max(float(np.max(np.abs(dd))), 1e-12))
+        self.s_p = _power_of_two(max(float(np.max(np.abs(p))), 1.0))
+        self.rows = problem.rows()
+        self.blocks = blocks = problem.elastic.diagonal_blocks(self.rows)
+        self.block_inverse = np.linalg.inv(blocks)  # (N, d, d), M_u^-1 without s_u
+        self.flow_diagonal = self.flow_matrix.diagonal()
+
+    @property
+    def operator(self):
+        """The scaled matrix as a LinearOperator (made on demand, not kept: a kept one would
+        tie the system into a reference cycle, which a paused GMRES solve keeps out of the
+        reach of reference counting, with the problem's operator and border blocks)."""
+        size = self.problem.n * self.problem.d + self.problem.n
+        return spla.LinearOperator((size, size), matvec=self._matvec, dtype=np.float64)
+
+    def left_scale(self, residual_u, residual_p):
+        n, d = self.problem.n, self.problem.d
+        u = np.einsum("eij,ej->ei", self.block_inverse, residual_u.reshape(n, d)).ravel() / self.s_u
+        return np.concatenate([u, residual_p / (self.s_p * self.flow_diagonal)])
+
+    def unscale_left(self, z):
+        """Inverse of :meth:`left_scale`."""
+        n, d = self.problem.n, self.problem.d
+        u = np.einsum("eij,ej->ei", self.blocks, z[:n * d].reshape(n, d)).ravel() * self.s_u
+        return u, z[n * d:] * self.s_p * self.flow_diagonal
+
+    def split(self, y):
+        nd = self.problem.n * self.problem.d
+        return y[:nd] * self.s_u, y[nd:] * self.s_p
+
+    def _matvec(self, y):
+        dd, p = self.split(np.asarray(y).ravel())
+        problem = self.problem
+        u = problem.elastic_apply(dd, p, self.rows)
+        q = problem.coupling @ dd + self.flow_matrix @ p
+        return self.left_scale(u, q)
+
+    def rhs(self, flow_rhs):
+        return self.left_scale(self.problem.elastic_rhs(self.rows), flow_rhs)
+
+    def compliance_preconditioner(self, omega):
+        """Inverse of the scaled fracture-compliance split, as a LinearOperator."""
+        problem = self.problem
+        schur = (self.flow_matrix + sp.diags(omega * problem.compliance_term)).tocsc()
+        flow_lu = spla.splu(schur)
+        nd = problem.n * problem.d
+
+        def apply(z):
+            r_u, r_p = self.unscale_left(np.asarray(z).ravel())
+            p = flow_lu.solve(r_p)
+            b_p = problem.b_times(p)
+            dd = problem.elastic.approximate_inverse(r_u - (b_p if self.rows is None else self.rows.select_rows(b_p)),
+                                                     self.rows)
+            return np.concatenate([dd / self.s_u, p / self.s_p])
+
+        return spla.LinearOperator((nd + problem.n,) * 2, matvec=apply, dtype=np.float64)

@@ -1,0 +1,326 @@
+"""An elasticity operator grown by a few elements without recompressing it.
+
+When a fracture grows, the mesh gains a ring of elements at its front. Rebuilding the
+H-matrix for every growth pass would dominate the run time, so the new elements are
+added as exact border blocks around the existing operator::
+
+    A = [ A_oo   A_on ]    A_oo: the H-matrix (or dense matrix) already built
+        [ A_no   A_nn ]    A_on, A_no, A_nn: exact kernel blocks (dense)
+
+Matvec cost grows by ``2 N m d^2`` for ``m`` new elements, so the simulation rebuilds
+the base operator once the border is large (see ``Simulation``). The preconditioner
+is block lower-triangular: the base near-field preconditioner for the old unknowns,
+then an exact LU of ``A_nn`` for the new ones.
+
+Growth passes share work (a pass adds a few elements to the last pass's mesh): the border
+is kept as one chunk of ``A_on`` columns and ``A_no`` rows per batch of added elements,
+so the chunks of the elements a pass shares with the previous one are reused as they are
+(no copy of the whole border per pass); the LU of ``A_nn`` grows by one level per batch
+(:class:`GrowingBlockLU`: the Schur complement of the added block, not a new
+factorisation of the whole block); and the product of the base with the old unknowns is
+kept for the last vector (a pass's first residual multiplies the previous pass's last
+iterate, whose old part it already multiplied).
+"""
+from typing import NamedTuple
+
+import numpy as np
+import scipy.linalg
+import scipy.sparse as sp
+from scipy.sparse.linalg import LinearOperator
+
+from ..errors import InputError
+from ..hmatrix.preconditioners import DEFAULT_ILU
+from ..kernels.drivers import traction_block
+from .inverse import solve_with_inverse
+from .operator import ElasticityOperator, influence_data, refuse_singular
+
+
+#: Border blocks the block-triangular preconditioner keeps (relative Frobenius norm, as the
+#: base's near-field block ILU keeps its blocks).
+NEAR_THRESHOLD = DEFAULT_ILU["threshold"]
+
+
+class ExtendedElasticityOperator(LinearOperator):
+    """``base`` (an ElasticityOperator of the first ``n0`` elements of ``mesh``) plus
+    exact border blocks for elements ``n0..N-1``.
+
+    ``base`` may also be one part of a planar crack's operator
+    (:meth:`hmatddm.elasticity.planar.PlanarElasticityOperator.part`): its ``dof`` unknowns
+    per element and its ``block_kernel`` then give the border blocks.
+
+    ``previous``: the operator of an earlier growth pass over the same ``base`` (for
+    example the last one returned). The border chunks and the ``A_nn`` factor levels of
+    the elements it shares with ``mesh`` (the longest common run of unchanged elements
+    after the base's) are taken from it (chunks as views, ``A_nn``'s entries copied); only
+    the rows and columns of the elements added since are evaluated by the kernel, so a
+    growth pass costs O(n0 m_added) kernel pairs instead of O(n0 m). Any other
+    ``previous`` (another base, changed elements) is ignored.
+    """
+
+    def __init__(self, base, mesh, previous=None):
+        if not (isinstance(base, ElasticityOperator) or hasattr(base, "block_kernel")):
+            raise InputError(f"base must be an ElasticityOperator, got {type(base).__name__}")
+        self._kernel = getattr(base, "block_kernel", traction_block)
+        n0, n = base.mesh.n_elements, mesh.n_elements
+        if n <= n0 or not np.array_equal(mesh.centers[:n0], base.mesh.centers):
+            raise InputError(f"mesh must extend the base operator's mesh ({n0} elements) by appending elements, "
+                             f"got {n} elements")
+        self.base = base
+        self.mesh = mesh
+        self.material = base.material
+        self.backend = base.backend
+        self.dof = d = base.dof
+        self.n_base = n0
+        super().__init__(dtype=np.float64, shape=(n * d, n * d))
+        data = influence_data(mesh, base.material, base.singular_correction, base.alpha,
+                              n_images=base.stats.get("n_images"))  # layered: the base's images
+        self._data = data
+        self.n_reused = self._shared_new_elements(previous)
+        shares = isinstance(previous, ExtendedElasticityOperator) and previous.base is base
+        self._base_blocks = previous._base_blocks if shares else None  # the base's element self blocks
+        self.chunks, self.nn = self._border_blocks(previous, self.n_reused)
+        self._base_product = previous._base_product if shares else _LastProduct(base.matvec)
+        self._nn_levels = GrowingBlockLU(self.nn, previous._nn_levels.prefix(self.n_reused * self.dof)
+                                         if self.n_reused else None)
+        self.border_bytes = sum(c.on_t.nbytes + c.no.nbytes for c in self.chunks) + self.nn.nbytes
+
+    def _shared_new_elements(self, previous):
+        """How many of ``previous``'s border elements are elements ``n0, n0 + 1, ...`` of
+        this mesh unchanged (same kernel data), 0 if ``previous`` cannot be reused."""
+        if not isinstance(previous, ExtendedElasticityOperator) or previous.base is not self.base:
+            return 0
+        n0, n_previous = self.n_base, previous.mesh.n_elements
+        mine, theirs = _flat_arrays(self._data), _flat_arrays(previous._data)
+        if len(mine) != len(theirs):
+            return 0
+        shared = min(n_previous, self.mesh.n_elements)
+        for a, b in zip(mine, theirs):
+            if a.ndim >= 1 and b.ndim >= 1 and a.shape[0] == self.mesh.n_elements and b.shape[0] == n_previous:
+                if a.shape[1:] != b.shape[1:] or a.dtype != b.dtype:
+                    return 0
+                differ = np.flatnonzero(np.any((a[:shared] != b[:shared]).reshape(shared, -1), axis=1))
+                if differ.size:
+                    shared = int(differ[0])
+            elif not (a.shape == b.shape and np.array_equal(a, b)):
+                return 0  # a per-mesh setting (material, options) changed
+        return max(shared - n0, 0)
+
+    def _border_blocks(self, previous, reused):
+        """(chunks, A_nn): the chunks (:class:`BorderChunk`) of the first ``reused`` new
+        elements taken from ``previous`` (views, not copies), one chunk evaluated for the
+        rest; ``A_nn`` with its shared block copied from ``previous``."""
+        d, n0, n = self.dof, self.n_base, self.mesh.n_elements
+        old = np.arange(n0, dtype=np.int64)
+        new = np.arange(n0, n, dtype=np.int64)
+        added = new[reused:]
+        k = reused * d
+        chunks = []
+        nn = np.empty((new.size * d, new.size * d))
+        if reused:
+            for chunk in previous.chunks:
+                if chunk.start >= k:
+                    break
+                keep = min(chunk.stop, k) - chunk.start
+                chunks.append(chunk if keep == chunk.stop - chunk.start else
+                              BorderChunk(chunk.start, chunk.start + keep, chunk.on_t[:keep], chunk.no[:keep],
+                                          chunk.near[:keep]))
+            nn[:k, :k] = previous.nn[:k, :k]
+            nn[:k, k:] = self._block(self._data, new[:reused], added)
+            nn[k:, :k] = self._block(self._data, added, new[:reused])
+        if added.size:
+            on, no = self._block(self._data, old, added), self._block(self._data, added, old)
+            if not (np.all(np.isfinite(on)) and np.all(np.isfinite(no))):
+                refuse_singular()
+            nn[k:, k:] = self._block(self._data, added, added)
+            # A_on stored transposed: a product with a few columns of a C-ordered A_on runs
+            # ~1.4x slower (short BLAS rows) than with the rows of its transpose
+            chunks.append(BorderChunk(k, new.size * d, np.ascontiguousarray(on.T), no, self._near_rows(no, nn[k:, k:])))
+        if not (np.all(np.isfinite(nn[:, k:])) and np.all(np.isfinite(nn[k:]))):
+            refuse_singular()
+        return chunks, nn
+
+    @property
+    def on(self):
+        """``A_on`` (old rows, new columns) as one array (assembled from the chunks)."""
+        return np.concatenate([chunk.on_t.T for chunk in self.chunks], axis=1)
+
+    @property
+    def no(self):
+        """``A_no`` (new rows, old columns) as one array (assembled from the chunks)."""
+        return np.concatenate([chunk.no for chunk in self.chunks], axis=0)
+
+    def _near_rows(self, no, nn):
+        """The near field of the border rows ``no`` (new elements x old elements; ``nn``: the
+        new elements' own block) as a sparse matrix: the element blocks that
+        :data:`hmatddm.hmatrix.preconditioners.DEFAULT_ILU`'s threshold keeps in the base's
+        block ILU, ``||A_ij||_F >= threshold sqrt(||A_ii||_F ||A_jj||_F)``."""
+        d, n0 = self.dof, self.n_base
+        m = no.shape[0] // d
+        old_norms = np.linalg.norm(self._base_diagonal_blocks(), axis=(1, 2))
+        index = np.arange(m)
+        new_norms = np.linalg.norm(nn.reshape(m, d, m, d)[index, :, index, :], axis=(1, 2))
+        blocks = no.reshape(m, d, n0, d)
+        norms = np.sqrt(np.einsum("ipjq,ipjq->ij", blocks, blocks))
+        keep = norms >= NEAR_THRESHOLD * np.sqrt(new_norms[:, None] * old_norms[None, :])
+        rows, cols = np.nonzero(keep)
+        indptr = np.concatenate([[0], np.cumsum(np.count_nonzero(keep, axis=1))])
+        return sp.bsr_matrix((blocks[rows, :, cols, :], cols, indptr), shape=no.shape, blocksize=(d, d)).tocsr()
+
+    def _block(self, data, rows, cols):
+        out = np.empty((len(rows) * self.dof, len(cols) * self.dof))
+        self._kernel(data, rows, cols, out)
+        return out
+
+    @property
+    def n_new(self):
+        return self.mesh.n_elements - self.n_base
+
+    def _matvec(self, x):
+        x = np.asarray(x, dtype=np.float64).ravel()
+        k = self.n_base * self.dof
+        x_old, x_new = x[:k], x[k:]
+        out = np.empty(self.shape[0])
+        top, bottom = out[:k], out[k:]
+        top[:] = self._base_product(x_old)
+        for chunk in self.chunks:
+            top += x_new[chunk.start:chunk.stop] @ chunk.on_t
+        self._border_rows(x_old, bottom)
+        bottom += self.nn @ x_new
+        return out
+
+    def _border_rows(self, x_old, out):
+        """``out = A_no x_old``, chunk by chunk."""
+        for chunk in self.chunks:
+            np.dot(chunk.no, x_old, out=out[chunk.start:chunk.stop])
+        return out
+
+    #: The block-triangular inverse ignores ``A_on``: never exact, a solve iterates.
+    inverse_is_exact = False
+
+    def approximate_inverse(self, r):
+        """Block lower-triangular solve: the base's approximate inverse (LU or
+        preconditioner), then LU of ``A_nn``."""
+        k = self.n_base * self.dof
+        r = np.asarray(r, dtype=np.float64).ravel()
+        x = np.empty(self.shape[0])
+        x[:k] = self.base.approximate_inverse(r[:k])
+        near = np.empty(self.shape[0] - k)
+        for chunk in self.chunks:
+            near[chunk.start:chunk.stop] = chunk.near @ x[:k]
+        x[k:] = self._nn_levels.solve(r[k:] - near)
+        return x
+
+    def modified_inverse(self, rows):
+        """Approximate inverse (a callable) of ``S A + D`` for row operators ``rows``: the
+        block-triangular solve with the base's modified inverse and modified blocks."""
+        n0 = self.n_base
+        base_inverse = self.base.modified_inverse(rows.subset(0, n0))
+        no_rows = rows.modify_rows(self.no, n0)
+        nn_lu = scipy.linalg.lu_factor(rows.subset(n0, rows.n).modify_dense(self.nn), check_finite=False)
+        return lambda r: self._block_triangular(r, base_inverse, no_rows, nn_lu)
+
+    def _block_triangular(self, r, base_inverse, no, nn_lu):
+        k = self.n_base * self.dof
+        r = np.asarray(r, dtype=np.float64).ravel()
+        x_old = base_inverse(r[:k])
+        x_new = scipy.linalg.lu_solve(nn_lu, r[k:] - no @ x_old, check_finite=False)
+        return np.concatenate([x_old, x_new])
+
+    def preconditioner(self):
+        return LinearOperator(self.shape, matvec=self.approximate_inverse, dtype=np.float64)
+
+    def solve(self, rhs, x0=None, rtol=1e-9, restart=100, maxiter=20):
+        """``(x, info)``: GMRES preconditioned by :meth:`approximate_inverse`
+        (:func:`hmatddm.elasticity.inverse.solve_with_inverse`)."""
+        return solve_with_inverse(self, rhs, self.approximate_inverse, False, x0=x0, rtol=rtol, restart=restart,
+                                  maxiter=maxiter)
+
+    def element_diagonal_blocks(self):
+        """(N, d, d): the base operator's self blocks, then those of ``A_nn``."""
+        d, m = self.dof, self.n_new
+        index = np.arange(m)
+        new = self.nn.reshape(m, d, m, d)[index, :, index, :]
+        return np.concatenate([self._base_diagonal_blocks(), new])
+
+    def _base_diagonal_blocks(self):
+        """The base's element self blocks, computed once for the operators of one base (a
+        Python loop over the H-matrix's diagonal leaves; every growth pass asks for them)."""
+        if self._base_blocks is None:
+            self._base_blocks = self.base.element_diagonal_blocks()
+        return self._base_blocks
+
+
+def _flat_arrays(data):
+    """The arrays of kernel data (a tuple or named tuple, possibly nested; scalars as
+    0-d arrays), in order."""
+    if isinstance(data, tuple):
+        return [a for item in data for a in _flat_arrays(item)]
+    return [np.asarray(data)]
+
+
+class BorderChunk(NamedTuple):
+    """The border of the new unknowns ``start:stop`` (counted from the first new one):
+    ``on_t`` = ``A_on[:, start:stop]`` transposed (C order), ``no`` = ``A_no[start:stop]``."""
+
+    start: int
+    stop: int
+    on_t: np.ndarray
+    no: np.ndarray
+    near: object  # the near field of ``no`` (scipy CSR), which the preconditioner uses
+
+
+class _LastProduct:
+    """``matvec(x)``, kept for the last ``x`` (shared by the operators of one base)."""
+
+    def __init__(self, matvec):
+        self.matvec = matvec
+        self.x, self.product = None, None
+
+    def __call__(self, x):
+        if self.x is not None and self.x.shape == x.shape and np.array_equal(self.x, x):
+            return self.product
+        product = self.matvec(x)
+        self.x, self.product = x.copy(), product
+        return product
+
+
+class GrowingBlockLU:
+    """Solves with a matrix ``M`` (the ``A_nn`` of a grown mesh) factored level by level:
+    when ``M`` gains rows and columns ``s:e`` (a growth pass's elements), the factors of
+    ``M[:s, :s]`` are kept and the level adds ``R = M[s:e, :s]``, ``H = M[:s, :s]^-1
+    M[:s, s:e]`` and the inverse of the Schur complement ``S = M[s:e, s:e] - R H`` (a
+    growth pass's few elements: a small dense block; an explicit inverse makes a level
+    three matrix-vector products, without the per-call cost of an LU solve). A solve runs
+    the levels in order: ``y[s:e] = S^-1 (r[s:e] - R y[:s])``, ``y[:s] -= H y[s:e]`` keeps
+    ``y[:e] = M[:e, :e]^-1 r[:e]`` (block elimination without pivoting between levels,
+    which suits the diagonally dominant DDM blocks). Adding ``b`` unknowns to ``s`` costs
+    O(s^2 b) instead of the O((s + b)^3) of a new LU.
+
+    ``kept``: the levels of an earlier ``GrowingBlockLU`` whose matrix is ``M[:s, :s]``
+    (from :meth:`prefix`), or None."""
+
+    def __init__(self, matrix, kept=None):
+        self.levels = list(kept or [])
+        start = self.levels[-1][1] if self.levels else 0
+        size = matrix.shape[0]
+        if start < size:
+            coupling = matrix[:start, start:]
+            solved = self.solve(coupling) if start else None
+            rows = matrix[start:, :start] if start else None
+            schur = matrix[start:, start:] - rows @ solved if start else matrix
+            self.levels.append((start, size, rows, solved, np.linalg.inv(schur)))
+
+    def prefix(self, size):
+        """The levels that factor ``M[:size, :size]`` whole (a shared run of unknowns)."""
+        return [level for level in self.levels if level[1] <= size]
+
+    def solve(self, r):
+        """``M^-1 r`` (``r``: a vector or a matrix of columns)."""
+        y = np.array(r, dtype=np.float64)
+        for start, stop, rows, solved, schur_inverse in self.levels:
+            if start:
+                y[start:stop] -= rows @ y[:start]
+            y[start:stop] = schur_inverse @ y[start:stop]
+            if start:
+                y[:start] -= solved @ y[start:stop]
+        return y

@@ -1,0 +1,61 @@
+"""Solving with any elasticity operator through its approximate inverse.
+
+Every operator (:class:`~hmatddm.elasticity.operator.ElasticityOperator` of either backend,
+:class:`~hmatddm.elasticity.extended.ExtendedElasticityOperator`) offers ``solve``,
+``approximate_inverse``, ``modified_inverse(rows)`` and ``inverse_is_exact``; this module
+holds what they share: the direct-or-GMRES solve given an approximate inverse, and the
+ILU of a contact-modified near field (``S A_near + D``, see :mod:`hmatddm.coupled.contact`).
+"""
+import numpy as np
+import scipy.sparse.linalg as spla
+from scipy.sparse.linalg import LinearOperator
+
+from ..errors import ConvergenceError
+
+
+def solve_with_inverse(operator, rhs, inverse, exact, x0=None, rtol=1e-9, restart=100, maxiter=20):
+    """``(x, info)`` solving ``operator x = rhs`` given an approximate inverse (a callable).
+
+    ``exact``: the inverse is exact (a direct factorisation): ``x = inverse(rhs)``, ``info``
+    ``{"iterations": 0}`` (no residual: it would cost a product). Otherwise GMRES
+    (:func:`hmatddm.hmatrix.gmres`, from ``x0``) preconditioned by ``inverse``; ``info`` is
+    its dict (``iterations``, ``residual``, ...). Raises ConvergenceError when GMRES stops
+    above ``rtol`` or ``x`` is not finite.
+    """
+    rhs = np.asarray(rhs, dtype=np.float64).ravel()
+    if exact:
+        x, info = inverse(rhs), {"iterations": 0}
+    else:
+        from ..hmatrix import gmres
+
+        preconditioner = LinearOperator(operator.shape, matvec=inverse, dtype=np.float64)
+        x, info = gmres(operator, rhs, M=preconditioner, rtol=rtol, restart=restart, maxiter=maxiter, x0=x0)
+    if not np.all(np.isfinite(x)):
+        raise ConvergenceError("the solution contains NaN or inf", residual=float("nan"))
+    return x, info
+
+
+# scalar ILU of the contact-modified near field (its rows mix element frames, so the
+# block ILU of the default preconditioner does not apply); the entries kept are those of
+# the default preconditioner's block threshold
+_CONTACT_ILU = {"drop_tol": 1e-3, "fill_factor": 5.0}
+
+
+def modified_near_field_inverse(operator, rows):
+    """ILU of ``S A_near + D`` (the default preconditioner's near field with contact rows),
+    falling back to block Jacobi of the modified diagonal blocks."""
+    from ..hmatrix.preconditioners import DEFAULT_ILU
+
+    hmatrix = operator.hmatrix
+    matrix = rows.modify_sparse(hmatrix.near_field_csr(part="near", threshold=DEFAULT_ILU["threshold"]))
+    try:
+        factor = spla.spilu(matrix, drop_tol=_CONTACT_ILU["drop_tol"], fill_factor=_CONTACT_ILU["fill_factor"])
+        inverse = LinearOperator(operator.shape, matvec=factor.solve, dtype=np.float64)
+        if np.all(np.isfinite(inverse @ np.ones(operator.shape[0]))):
+            return inverse
+    except RuntimeError:
+        pass
+    blocks = np.linalg.pinv(rows.modify_blocks(operator.element_diagonal_blocks()))
+    n, d = blocks.shape[0], blocks.shape[1]
+    return LinearOperator(operator.shape, dtype=np.float64,
+                          matvec=lambda x: np.einsum("eij,ej->ei", blocks, np.reshape(x, (n, d))).ravel())

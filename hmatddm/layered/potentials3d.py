@@ -1,0 +1,398 @@
+"""The Hansen potentials of a point force in 3D and the field of one image triple (ref.
+Secs 3.2-3.3, Eqs 3.14-3.17, 3.22, 3.24): the point-force potentials in a gauge, the
+derivatives of their base functions, the stress and displacement gradients of one traced
+triple at a receiver, and the moment-tensor contraction that makes them the field of a DD
+density. The tracer of the triples is :mod:`.image_tracer3d`, their sum at a receiver
+:mod:`.image_points3d`, the entry of the 3D image method :mod:`.images3d`.
+
+Coordinates: ``(x, y, z)`` with ``z`` vertical (the reference's ``x3``); interfaces are
+the planes ``z = d_k`` (see :class:`LayeredMedium`, docs/conventions.md §3).
+
+Hansen potentials (ref. Eqs 3.14-3.17, 3.22). A potential triple ``(phi1, phi2, phi3)``
+in a layer of ``delta = 1/(3 - 4 nu)`` gives the displacement
+
+    u_i = phi1,i - phi2,i - 2 delta s phi2,i3 + 2 delta_i3 phi2,3 + eps_ij3 phi3,j
+
+with ``s = y3 - z`` the height above the point ``z`` the triple emanates from. (Ref. Eq.
+3.22 prints ``+Phi_i3,1`` in ``U_i2``; Eq. 3.17 gives ``-phi3,1``, which is what
+reproduces Kelvin's solution.) The point-force kernel of ref. Eq. 3.24 is written with two
+harmonic base functions in a *gauge* ``sigma = +-1`` (``u = r + sigma r3``):
+
+    F = r - sigma r3 log u,   L = log u          (singular on the half-line sigma r3 < 0)
+
+    force x: phi = K (d1 F, -d1 F,  2 (1 + delta) d2 F)
+    force y: phi = K (d2 F, -d2 F, -2 (1 + delta) d1 F)
+    force z: phi = K sigma (L, L, 0),            K = 1/(8 pi G (1 + delta))
+
+Eq. 3.24's ``r1 r / rh^2`` equals ``d1 F`` plus ``d1 (sigma r3 log rh)``, a term singular on
+the whole vertical that produces no displacement; the gauge moves the singular line to
+the half-line pointing away from the receivers, so every image is regular where it is
+evaluated (``_derive_images3d.py`` checks these coefficients against Kelvin's solution).
+
+Derivatives. ``D F = -sigma L``, ``D L = sigma / r``, so every derivative with a vertical
+part is a derivative of ``1/r``, whose Taylor coefficients follow a three-term recurrence
+(any order). Horizontal derivatives (up to order 5) of ``F`` and ``L`` come from
+one-variable Taylor series along x of the closed forms of ``d1 F``, ``d2 F``, ``d1 L``,
+``d2 L`` and from Laplace's equation (both are harmonic) for the higher ``d2`` powers.
+"""
+import math
+
+import numpy as np
+from numba import njit
+
+_INV_8PI = 1.0 / (8.0 * math.pi)
+
+
+@njit(cache=True)
+def _original(coef, delta, shear_modulus, sigma, scale):
+    """``coef[f, j, 0] += scale *`` the point-force potentials of gauge ``sigma`` (ref. Eq. 3.24)."""
+    k = _INV_8PI / (shear_modulus * (1.0 + delta))
+    coef[0, 0, 0] += scale * k
+    coef[0, 1, 0] -= scale * k
+    coef[0, 2, 0] += scale * 2.0 * (1.0 + delta) * k
+    coef[1, 0, 0] += scale * k
+    coef[1, 1, 0] -= scale * k
+    coef[1, 2, 0] -= scale * 2.0 * (1.0 + delta) * k
+    coef[2, 0, 0] += scale * sigma * k
+    coef[2, 1, 0] += scale * sigma * k
+
+
+@njit(cache=True)
+def _axis_series(r1, r3, r, m, ser):
+    """Taylor coefficients (``k < m``) in ``t`` at ``(r1 + t, r2, r3)``, gauge +1, ``U = R + r3``:
+    ``ser[0] = R``, ``ser[1] = 1/R``, ``ser[2] = V = 1/U``, ``ser[3] = W = V/R``."""
+    rs, ir, v, w = ser[0], ser[1], ser[2], ser[3]
+    u0 = r + r3
+    rs[0] = r
+    ir[0] = 1.0 / r
+    v[0] = 1.0 / u0
+    for k in range(1, m):
+        s = 2.0 * r1 if k == 1 else (1.0 if k == 2 else 0.0)  # R^2 = r^2 + 2 r1 t + t^2
+        for i in range(1, k):
+            s -= rs[i] * rs[k - i]
+        rs[k] = s / (2.0 * r)
+        s_ir = 0.0
+        s_v = 0.0
+        for i in range(1, k + 1):
+            s_ir += rs[i] * ir[k - i]
+            s_v += rs[i] * v[k - i]  # U_i = R_i for i >= 1
+        ir[k] = -s_ir / r
+        v[k] = -s_v / u0
+    for k in range(m):
+        s = 0.0
+        for i in range(k + 1):
+            s += v[i] * ir[k - i]
+        w[k] = s
+
+
+@njit(cache=True)
+def base_derivatives(r1, r2, r3, sf, sl, q, ser):
+    """Derivatives of the gauge +1 base functions at ``(r1, r2, r3)``, ``r3 >= 0`` (away
+    from the singular half-line): ``q[a, b, c] = d1^a d2^b d3^c (1/r)`` (all of ``q``'s
+    shape, :func:`inverse_distance_derivatives`), ``sf[a, b] = d1^a d2^b F`` and
+    ``sl[a, b] = d1^a d2^b L`` for ``a + b <= 5``. Along x from one-variable Taylor series
+    of the closed forms ``d1 F = r1 / U``, ``d1 L = r1 / (R U)``, ``d2 F = r2 / U``,
+    ``d2 L = r2 / (R U)`` (``U = r + r3``, no cancelling terms); the other horizontal
+    derivatives from Laplace's equation, ``d2^2 F = -d1^2 F + 1/r``,
+    ``d2^2 L = -d1^2 L - d3 (1/r)`` (``F`` and ``L`` are harmonic; ``ser``: (4, 6) scratch)."""
+    inverse_distance_derivatives(r1, r2, r3, q)
+    r = math.sqrt(r1 * r1 + r2 * r2 + r3 * r3)
+    _axis_series(r1, r3, r, 5, ser)
+    v = ser[2]
+    w = ser[3]
+    sf[0, 0] = r - r3 * math.log(r + r3)
+    sl[0, 0] = math.log(r + r3)
+    fact = 1.0  # (a - 1)!
+    for a in range(1, 6):
+        if a > 1:
+            fact *= a - 1
+        sf[a, 0] = fact * (r1 * v[a - 1] + (v[a - 2] if a >= 2 else 0.0))
+        sl[a, 0] = fact * (r1 * w[a - 1] + (w[a - 2] if a >= 2 else 0.0))
+    fact = 1.0  # a!
+    for a in range(5):
+        if a > 0:
+            fact *= a
+        sf[a, 1] = fact * r2 * v[a]
+        sl[a, 1] = fact * r2 * w[a]
+    for b in range(2, 6):
+        for a in range(6 - b):
+            sf[a, b] = -sf[a + 2, b - 2] + q[a, b - 2, 0]
+            sl[a, b] = -sl[a + 2, b - 2] - q[a, b - 2, 1]
+
+
+@njit(cache=True)
+def inverse_distance_derivatives(r1, r2, r3, q):
+    """``q[a, b, c] = d1^a d2^b d3^c (1/r)`` for ``a + b < q.shape[0]``, ``c < q.shape[2]``
+    by the recurrence of the Taylor coefficients ``t_k = d^k (1/r) / k!``:
+    ``n r^2 t_k + (2n - 1) sum_i r_i t_(k - e_i) + (n - 1) sum_i t_(k - 2 e_i) = 0``
+    (here on the unit vector, then scaled)."""
+    r = math.sqrt(r1 * r1 + r2 * r2 + r3 * r3)
+    inv = 1.0 / r
+    x0 = r1 * inv
+    x1 = r2 * inv
+    x2 = r3 * inv
+    ha = q.shape[0]
+    nc = q.shape[2]
+    for c in range(nc):
+        for a in range(ha):
+            for b in range(ha - a):
+                n = a + b + c
+                if n == 0:
+                    q[0, 0, 0] = 1.0
+                    continue
+                s = 0.0
+                if a >= 1:
+                    s += x0 * q[a - 1, b, c]
+                if b >= 1:
+                    s += x1 * q[a, b - 1, c]
+                if c >= 1:
+                    s += x2 * q[a, b, c - 1]
+                s *= 2 * n - 1
+                t = 0.0
+                if a >= 2:
+                    t += q[a - 2, b, c]
+                if b >= 2:
+                    t += q[a, b - 2, c]
+                if c >= 2:
+                    t += q[a, b, c - 2]
+                q[a, b, c] = -(s + (n - 1) * t) / n
+    # t_k / r^(n+1) * a! b! c!
+    fc = inv
+    for c in range(nc):
+        if c > 0:
+            fc *= c * inv
+        fa = fc
+        for a in range(ha):
+            if a > 0:
+                fa *= a * inv
+            fb = fa
+            for b in range(ha - a):
+                if b > 0:
+                    fb *= b * inv
+                q[a, b, c] *= fb
+
+
+@njit(cache=True)
+def _base_table(sigma, n_c, sf, sl, q, base):
+    """``base[kind, a, b, c] = d1^a d2^b d3^c`` of ``F`` (kind 0) or ``L`` (kind 1) of
+    gauge ``sigma`` (``a + b <= 5``, ``c < n_c``), from the gauge +1 derivatives at the
+    flipped point: ``sigma^c`` times ``sf``/``sl``/``q`` (``d3 F = -L``, ``d3 L = 1/r``).
+    The bound is the array's size, not the constant 6: LLVM unrolls constant loops of this
+    copy into ~17k instructions, a third of the compile time of every caller."""
+    top = sf.shape[0]
+    flip = -1.0 if sigma < 0.0 else 1.0
+    for a in range(top):
+        for b in range(top - a):
+            base[0, a, b, 0] = sf[a, b]
+            base[1, a, b, 0] = sl[a, b]
+            sign = flip
+            if n_c > 1:
+                base[0, a, b, 1] = -sign * sl[a, b]
+                base[1, a, b, 1] = sign * q[a, b, 0]
+            for c in range(2, n_c):
+                sign *= flip
+                base[0, a, b, c] = -sign * q[a, b, c - 2]
+                base[1, a, b, c] = sign * q[a, b, c - 1]
+
+
+@njit(cache=True)
+def _potential_table(coef, base, order, table):
+    """``table[f, j, a, b, c] = d1^a d2^b d3^c phi_j`` of force ``f`` for the triple
+    ``coef`` (``phi_j = sum_n coef[f, j, n] D^n`` of its base function ``d1 F``, ``d2 F``
+    or ``L``): the orders the stress needs, ``a + b + c = order`` (and ``order + 1`` for
+    ``phi_2``, the only one with the ``s`` term of ref. Eq. 3.22)."""
+    n_orders = coef.shape[2]
+    for f in range(3):
+        for j in range(3):
+            if f == 2 and j == 2:
+                continue
+            if f == 2:
+                kind, ia, ib = 1, 0, 0
+            elif (f == 0) == (j < 2):
+                kind, ia, ib = 0, 1, 0
+            else:
+                kind, ia, ib = 0, 0, 1
+            n0 = 0
+            while n0 < n_orders and coef[f, j, n0] == 0.0:
+                n0 += 1
+            n1 = n_orders
+            while n1 > n0 and coef[f, j, n1 - 1] == 0.0:
+                n1 -= 1
+            top = order + 1 if j == 1 else order
+            for o in range(order, top + 1):
+                for a in range(o + 1):
+                    for b in range(o + 1 - a):
+                        c = o - a - b
+                        s = 0.0
+                        for n in range(n0, n1):
+                            s += coef[f, j, n] * base[kind, a + ia, b + ib, c + n]
+                        table[f, j, a, b, c] = s
+
+
+@njit(cache=True, inline="always")
+def Workspace(n_orders):
+    """Scratch arrays of :func:`_pair_stress_gradient` for triples of up to ``n_orders``:
+    ``sf, sl`` (6, 6), the series (4, 6), ``q`` (6, 6, n_orders + 4), the base table
+    (2, 6, 6, n_orders + 5) and the potential tables (3, 3, 6, 6, 6)."""
+    return (np.empty((6, 6)), np.empty((6, 6)), np.empty((4, 6)), np.empty((6, 6, n_orders + 4)),
+            np.empty((2, 6, 6, n_orders + 5)), np.zeros((3, 3, 6, 6, 6)), np.zeros((3, 3, 6, 6, 6)))
+
+
+@njit(cache=True)
+def _pair_tables(r1, r2, r3, sigma, coef, dcoef, order, work):
+    """Fill ``work``'s potential tables of the triple at the receiver ``r`` (relative to
+    the triple's point): ``coef`` at ``order`` (3 for the stress, 2 for the displacement),
+    ``dcoef`` one lower."""
+    sf, sl, ser, q, base, table, dtable = work
+    n_orders = coef.shape[2]
+    used = 1
+    for f in range(3):
+        for j in range(3):
+            for n in range(n_orders - 1, used - 1, -1):
+                if coef[f, j, n] != 0.0 or dcoef[f, j, n] != 0.0:
+                    used = n + 1
+                    break
+    n_c = order + used + 1
+    base_derivatives(r1, r2, sigma * r3, sf, sl, q[:, :, :n_c - 1], ser)
+    _base_table(sigma, n_c, sf, sl, q, base)
+    lower = order - 1  # a run-time int: one compiled _potential_table for both orders
+    _potential_table(coef, base, lower + 1, table)
+    _potential_table(dcoef, base, lower, dtable)
+
+
+@njit(cache=True)
+def _stress(table, f, da, db, dc, scale, s, delta, shear_modulus, lame, out):
+    """``out[i, k] += scale *`` the stress of force ``f`` from the potential derivatives
+    ``table`` shifted by ``(da, db, dc)``: ref. Eq. 3.22's displacement, with harmonic
+    potentials (so ``div u = 2 (1 - delta) phi2,33``),
+    ``sigma_ik = G (2 phi1,ik - 2 phi2,ik - 4 delta s phi2,ik3 + 2 (1 - delta)
+    (delta_k3 phi2,i3 + delta_i3 phi2,k3) + eps_ij3 phi3,jk + eps_kj3 phi3,ji)
+    + 2 lambda (1 - delta) delta_ik phi2,33`` (``s`` the height above the triple's point)."""
+    t0 = table[f, 0]
+    t1 = table[f, 1]
+    t2 = table[f, 2]
+    g = shear_modulus
+    w = 2.0 * (1.0 - delta)
+    d33 = w * t1[da, db, dc + 2]
+    for i in range(3):
+        for k in range(i, 3):
+            a = da + (1 if i == 0 else 0) + (1 if k == 0 else 0)
+            b = db + (1 if i == 1 else 0) + (1 if k == 1 else 0)
+            c = dc + (1 if i == 2 else 0) + (1 if k == 2 else 0)
+            v = 2.0 * (t0[a, b, c] - t1[a, b, c]) - 4.0 * delta * s * t1[a, b, c + 1]
+            if k == 2:
+                v += w * t1[da + (1 if i == 0 else 0), db + (1 if i == 1 else 0), dc + (1 if i == 2 else 0) + 1]
+                if i == 2:
+                    v += w * t1[da, db, dc + 2]
+            if i == 0 and k == 0:
+                v += 2.0 * t2[da + 1, db + 1, dc]
+            elif i == 1 and k == 1:
+                v -= 2.0 * t2[da + 1, db + 1, dc]
+            elif i == 0 and k == 1:
+                v += t2[da, db + 2, dc] - t2[da + 2, db, dc]
+            elif i == 0 and k == 2:
+                v += t2[da, db + 1, dc + 1]
+            elif i == 1 and k == 2:
+                v -= t2[da + 1, db, dc + 1]
+            v *= g
+            if i == k:
+                v += lame * d33
+            out[i, k] += scale * v
+            if i != k:
+                out[k, i] += scale * v
+
+
+@njit(cache=True)
+def _pair_stress_gradient(r1, r2, r3, eps, sigma, coef, dcoef, delta, shear_modulus, lame, out, work):
+    """``out[f, q, i, k] +=`` derivative along the source coordinate ``q`` of the stress
+    ``(i, k)`` at the receiver ``r`` (relative to the triple's point) of a unit force
+    along ``f``; ``delta``, moduli: the receiver layer's; ``eps = dz/dt``. Horizontal
+    source derivatives are minus receiver derivatives; the vertical one differentiates
+    the coefficients (``dcoef``), the triple's height ``z`` and ``s = y3 - z``."""
+    _pair_tables(r1, r2, r3, sigma, coef, dcoef, 3, work)
+    table = work[5]
+    dtable = work[6]
+    for f in range(3):
+        # literal shifts: numba compiles four _stress (LLVM inlines them with the shifts folded);
+        # one compiled _stress with run-time shifts measured ~30% more CPU per pair
+        _stress(table, f, 1, 0, 0, -1.0, r3, delta, shear_modulus, lame, out[f, 0])
+        _stress(table, f, 0, 1, 0, -1.0, r3, delta, shear_modulus, lame, out[f, 1])
+        _stress(dtable, f, 0, 0, 0, 1.0, r3, delta, shear_modulus, lame, out[f, 2])
+        _stress(table, f, 0, 0, 1, -eps, r3, delta, shear_modulus, lame, out[f, 2])
+        t1 = table[f, 1]
+        for i in range(3):
+            for k in range(3):
+                a = (1 if i == 0 else 0) + (1 if k == 0 else 0)
+                b = (1 if i == 1 else 0) + (1 if k == 1 else 0)
+                c = (1 if i == 2 else 0) + (1 if k == 2 else 0)
+                out[f, 2, i, k] += 4.0 * shear_modulus * delta * eps * t1[a, b, c + 1]
+
+
+@njit(cache=True)
+def _displacement(table, f, da, db, dc, scale, s, delta, out):
+    """``out[i] += scale * u_i`` of force ``f`` (ref. Eq. 3.22) from ``table`` shifted by
+    ``(da, db, dc)``."""
+    for i in range(3):
+        a = da + (1 if i == 0 else 0)
+        b = db + (1 if i == 1 else 0)
+        c = dc + (1 if i == 2 else 0)
+        v = table[f, 0, a, b, c] - table[f, 1, a, b, c] - 2.0 * delta * s * table[f, 1, a, b, c + 1]
+        if i == 2:
+            v += 2.0 * table[f, 1, a, b, c]
+        if i == 0:  # M_1 = phi3,2
+            v += table[f, 2, da, db + 1, dc]
+        elif i == 1:  # M_2 = -phi3,1
+            v -= table[f, 2, da + 1, db, dc]
+        out[i] += scale * v
+
+
+@njit(cache=True)
+def _pair_displacement_gradient(r1, r2, r3, eps, sigma, coef, dcoef, delta, out, work):
+    """``out[f, q, i] +=`` derivative along the source coordinate ``q`` of the
+    displacement ``u_i`` at the receiver ``r`` of a unit force along ``f``."""
+    _pair_tables(r1, r2, r3, sigma, coef, dcoef, 2, work)
+    table = work[5]
+    dtable = work[6]
+    for f in range(3):
+        for v in range(4):  # as in _pair_stress_gradient
+            _displacement(dtable if v == 2 else table, f, 1 if v == 0 else 0, 1 if v == 1 else 0, 1 if v == 3 else 0,
+                          -eps if v == 3 else (1.0 if v == 2 else -1.0), r3, delta, out[f, min(v, 2)])
+        for i in range(3):
+            a = 1 if i == 0 else 0
+            b = 1 if i == 1 else 0
+            c = 1 if i == 2 else 0
+            out[f, 2, i] += 2.0 * delta * eps * table[f, 1, a, b, c + 1]
+
+
+@njit(cache=True)
+def _contract(gradient, normal, shear_modulus, lame, weight, out):
+    """``out[b, i, k] += weight *`` stress of a unit DD density along global ``b`` on a
+    plane of ``normal``: ``M_pq = lame (b.n) delta_pq + G (b_p n_q + b_q n_p)`` applied
+    to ``gradient[p, q, i, k]`` (any number of ``k``)."""
+    for b in range(3):
+        for i in range(3):
+            for k in range(gradient.shape[3]):
+                acc = 0.0
+                for p in range(3):
+                    for q in range(3):
+                        m = 0.0
+                        if p == b:
+                            m += shear_modulus * normal[q]
+                        if q == b:
+                            m += shear_modulus * normal[p]
+                        if p == q:
+                            m += lame * normal[b]
+                        if m != 0.0:
+                            acc += m * gradient[p, q, i, k]
+                out[b, i, k] += weight * acc
+
+
+@njit(cache=True)
+def _contract_vector(gradient, normal, shear_modulus, lame, out):
+    """``out[b, i] =`` the moment contraction (see :func:`_contract`) of ``gradient[p, q, i]``."""
+    contracted = np.zeros((3, 3, 1))
+    _contract(gradient.reshape((3, 3, 3, 1)), normal, shear_modulus, lame, 1.0, contracted)
+    # element by element, not by slice assignment (docs/conventions.md, §5)
+    for b in range(3):
+        for i in range(3):
+            out[b, i] = contracted[b, i, 0]

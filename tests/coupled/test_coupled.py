@@ -1,0 +1,258 @@
+"""The four coupling schemes on one time step (ref. Sec. 4.4): same answer, dense twin,
+scaling of ref. Eqs 4.53-4.61 (Fig. 4.13)."""
+import numpy as np
+import pytest
+
+import hmatddm as hd
+from hmatddm.mesh import topology
+from hmatddm.coupled import ElasticSolver, SchemeSettings, StepProblem, solve_step
+from hmatddm.coupled.scaled_system import _CoupledLinearSystem
+from hmatddm.flow import LeakOff, LubricationModel, fracture_compliance
+
+
+def _problem(mesh, backend="dense", dt=1.0, height=1.0, rate=5e-4, leak=0.0, viscosity=1e-3):
+    mat = hd.Elastic(10e9, 0.25)
+    fluid = hd.Fluid(viscosity=viscosity, compressibility=4.5e-10)
+    faces = topology.element_faces(mesh, height=height)
+    areas = mesh.areas * (height if mesh.dim == 2 else 1.0)
+    flow = LubricationModel(areas=areas, normals=mesh.normals, faces=faces, fluid=fluid,
+                            leak_off=LeakOff(coefficient=leak, pore_pressure=0.5e6),
+                            injection_elements=np.array([mesh.n_elements // 2]), injection_rates=np.array([rate]),
+                            wellbore_volumes=np.array([0.5]), minimum_width=1e-5)
+    op = hd.ElasticityOperator(mesh, mat, backend=backend, eps=1e-8, leaf_size=8)
+    stress = np.zeros((mesh.dim, mesh.dim))
+    stress[-1, -1] = -0.5e6
+    n = mesh.n_elements
+    width_old = 1e-4 * (1 - (mesh.centers[:, 0] / (1.05 * np.abs(mesh.centers[:, 0]).max())) ** 2)
+    problem = StepProblem(elastic=ElasticSolver(op, rtol=1e-11), normals=mesh.normals,
+                          far_field=-(mesh.normals @ stress.T).ravel(), flow=flow,
+                          compliance=fracture_compliance(mesh, mat), dt=dt, width_old=width_old,
+                          pressure_old=np.full(n, 1e6), leak_off_rate=flow.leak_off_rate(np.zeros(n), 0.0, dt))
+    guess = (width_old[:, None] * mesh.normals).ravel()
+    return problem, guess, np.full(n, 1e6)
+
+
+@pytest.fixture(scope="module")
+def reference_step():
+    mesh = hd.mesh.line([-5, 0], [5, 0], 20)
+    problem, dd0, p0 = _problem(mesh, leak=1e-12)
+    settings = SchemeSettings(scheme="krylov", tolerance_pressure=1e-9, tolerance_opening=1e-9, linear_rtol=1e-12)
+    dd, p, info = solve_step(problem, settings, dd0, p0, 1.0)
+    return mesh, dd, p, info
+
+
+@pytest.mark.parametrize("scheme", ["fixed-width", "fracture-compliance", "fully-coupled"])
+def test_schemes_reach_the_same_step_solution(reference_step, scheme):
+    mesh, dd_ref, p_ref, _ = reference_step
+    problem, dd0, p0 = _problem(mesh, leak=1e-12)
+    settings = SchemeSettings(scheme=scheme, tolerance_pressure=1e-9, tolerance_opening=1e-9,
+                              linear_rtol=1e-12, max_iterations=3000)
+    dd, p, info = solve_step(problem, settings, dd0, p0, 1.0)
+    # a converged relaxed iteration stops within about tol/alpha of the fixed point
+    tolerance = 1e-9 / info["relaxation"] * 20
+    np.testing.assert_allclose(p, p_ref, rtol=tolerance)
+    np.testing.assert_allclose(dd, dd_ref, atol=tolerance * np.abs(dd_ref).max())
+
+
+def test_step_conserves_mass(reference_step):
+    mesh, dd, p, _ = reference_step
+    problem, _, _ = _problem(mesh, leak=1e-12)
+    width = problem.width(dd)
+    flow = problem.flow
+    stored = np.sum(flow.areas * (width - problem.width_old))
+    compressed = np.sum(4.5e-10 * (flow.areas * np.maximum(width, 1e-5) + flow.wellbore_storage()) * (p - 1e6))
+    leaked = np.sum(flow.areas * problem.leak_off_rate * (p - 0.5e6)) * problem.dt
+    np.testing.assert_allclose(stored + compressed + leaked, 5e-4 * problem.dt, rtol=1e-6)
+
+
+def test_relaxation_ordering_of_the_segregated_schemes():
+    # ref. Figs 4.11-4.15: the fixed-width split needs more relaxation than the
+    # fracture-compliance split, and the coupled schemes none
+    mesh = hd.mesh.line([-5, 0], [5, 0], 20)
+    alphas = {}
+    for scheme in ("fixed-width", "fracture-compliance", "krylov"):
+        problem, dd0, p0 = _problem(mesh)
+        _, _, info = solve_step(problem, SchemeSettings(scheme=scheme, max_iterations=3000), dd0, p0, 1.0)
+        alphas[scheme] = info["relaxation"]
+    assert alphas["fixed-width"] < alphas["fracture-compliance"] <= alphas["krylov"] == 1.0
+
+
+def test_hmatrix_step_matches_dense():
+    mesh = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 8.0, 8.0, 8, 8)
+    results = {}
+    for backend in ("dense", "hmatrix"):
+        problem, dd0, p0 = _problem(mesh, backend=backend, rate=1e-2)
+        settings = SchemeSettings(scheme="krylov", tolerance_pressure=1e-9, tolerance_opening=1e-9, linear_rtol=1e-11)
+        results[backend] = solve_step(problem, settings, dd0, p0, 1.0)
+    np.testing.assert_allclose(results["hmatrix"][1], results["dense"][1], rtol=1e-6)
+    np.testing.assert_allclose(results["hmatrix"][0], results["dense"][0], atol=1e-6 * np.abs(results["dense"][0]).max())
+
+
+def test_scaling_makes_the_coupled_matrix_well_conditioned():
+    # ref. Fig. 4.13: cond(A) ~ 1e19 falls to O(100) after M_1^-1 A M_2
+    mesh = hd.mesh.line([-1.5, 0], [1.5, 0], 3)
+    problem, dd0, p0 = _problem(mesh)
+    matrix, _ = problem.flow_matrices(dd0)
+    system = _CoupledLinearSystem(problem, matrix, dd0, p0)
+    a = problem.elastic.operator.to_dense()
+    b = np.zeros((a.shape[0], mesh.n_elements))
+    for i in range(mesh.n_elements):
+        b[2 * i:2 * i + 2, i] = mesh.normals[i]
+    full = np.block([[a, b], [problem.coupling.toarray(), matrix.toarray()]])
+    scaled = np.column_stack([system.operator @ e for e in np.eye(full.shape[0])])
+    assert np.linalg.cond(full) > 1e12
+    assert np.linalg.cond(scaled) < 1e3
+
+
+
+@pytest.mark.parametrize("scheme", ["krylov", "fully-coupled"])
+def test_contraction_stopping_matches_the_change_rule_within_the_tolerance(scheme):
+    # the default rule (stop on the extrapolated next change, first GMRES solve at
+    # first_linear_rtol) against the plain one (change between iterates, every GMRES solve
+    # at linear_rtol), both at the default tolerance 1e-6, and against a tight solve. A thin
+    # fluid (K-vertex-like) contracts fast: the contraction rule saves an iteration there.
+    mesh = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 8.0, 8.0, 8, 8)
+    tight = SchemeSettings(scheme="krylov", tolerance_pressure=1e-10, tolerance_opening=1e-10, linear_rtol=1e-12,
+                           stopping="change")
+    problem, dd0, p0 = _problem(mesh, rate=1e-2, viscosity=1e-5)
+    dd_ref, p_ref, _ = solve_step(problem, tight, dd0, p0, 1.0)
+    results = {}
+    for stopping, first in (("change", 1e-12), ("contraction", 1e-6)):
+        problem, dd0, p0 = _problem(mesh, rate=1e-2, viscosity=1e-5)
+        settings = SchemeSettings(scheme=scheme, linear_rtol=1e-12, stopping=stopping, first_linear_rtol=first,
+                                  max_iterations=3000)
+        results[stopping] = solve_step(problem, settings, dd0, p0, 1.0)
+    (dd_c, p_c, info_c), (dd_s, p_s, info_s) = results["contraction"], results["change"]
+    tolerance = 1e-6 / info_s["relaxation"]  # a relaxed iteration stops within about tol/alpha
+    for dd, p in ((dd_c, p_c), (dd_s, p_s)):
+        np.testing.assert_allclose(p, p_ref, atol=tolerance * np.abs(p_ref).max())
+        np.testing.assert_allclose(dd, dd_ref, atol=tolerance * np.abs(dd_ref).max())
+    np.testing.assert_allclose(p_c, p_s, atol=tolerance * np.abs(p_ref).max())
+    assert info_c["nonlinear_iterations"] <= info_s["nonlinear_iterations"]
+    if scheme == "krylov":
+        assert info_c["nonlinear_iterations"] == info_s["nonlinear_iterations"] - 1
+        assert info_c["linear_iterations"] < info_s["linear_iterations"]
+
+
+def test_contraction_rule_needs_a_fast_contraction():
+    from hmatddm.coupled.schemes import _converged
+
+    assert _converged("change", 0.9, []) and _converged("contraction", 0.9, [])
+    assert not _converged("contraction", 100.0, [])           # no rate yet
+    assert _converged("contraction", 100.0, [1e6])            # rate 1e-4: next change 0.01 tolerance
+    assert _converged("contraction", 100.0, [1e5])            # rate 1e-3: 0.1 tolerance, x3 safety
+    assert not _converged("contraction", 100.0, [2e4])        # rate 5e-3: 0.5 tolerance, x3 safety: no
+    assert not _converged("contraction", 100.0, [2e6, 1e6])   # the rate before was 0.5: slow
+    assert not _converged("contraction", 1.5, [2.0])          # rate 0.75 > 1/2: too slow to extrapolate
+    assert not _converged("change", 100.0, [1e6])
+    with pytest.raises(hd.errors.InputError, match="stopping"):
+        SchemeSettings(stopping="guess")
+
+
+def test_a_loose_first_solve_is_never_accepted():
+    # a guess whose residual is already below first_linear_rtol comes back unchanged from
+    # the first GMRES solve (change 0): it must still be checked at linear_rtol
+    mesh = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 8.0, 8.0, 8, 8)
+    problem, dd0, p0 = _problem(mesh, rate=1e-2, viscosity=1e-5)
+    tight = SchemeSettings(scheme="krylov", tolerance_pressure=1e-10, tolerance_opening=1e-10, linear_rtol=1e-12,
+                           stopping="change")
+    dd_ref, p_ref, _ = solve_step(problem, tight, dd0, p0, 1.0)
+    problem, _, _ = _problem(mesh, rate=1e-2, viscosity=1e-5)
+    loose = SchemeSettings(scheme="krylov", linear_rtol=1e-12, first_linear_rtol=0.5)
+    dd, p, info = solve_step(problem, loose, 1.01 * dd_ref, 1.001 * p_ref, 1.0)
+    assert info["nonlinear_iterations"] >= 2
+    np.testing.assert_allclose(p, p_ref, atol=1e-6 * np.abs(p_ref).max())
+    np.testing.assert_allclose(dd, dd_ref, atol=1e-6 * np.abs(dd_ref).max())
+
+
+@pytest.mark.parametrize("backend", ["dense", "hmatrix"])
+def test_a_provisional_solve_finishes_with_the_iterates_of_a_plain_one(backend):
+    # solve_step(provisional=True) stops after the loose first iterate; finish() continues
+    # the same iteration: the converged result is bit for bit the plain solve's, and the
+    # two infos add up to its counts. The hmatrix backend is checked against the dense one.
+    # (provisional_linear_rtol = first_linear_rtol: the provisional iterate is the plain
+    # solve's first one; a looser one is tested below.)
+    mesh = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 8.0, 8.0, 8, 8)
+    settings = SchemeSettings(scheme="krylov", provisional_linear_rtol=1e-6)
+    problem, dd0, p0 = _problem(mesh, backend=backend, rate=1e-2, viscosity=1e-5)
+    dd_plain, p_plain, info_plain = solve_step(problem, settings, dd0, p0, 1.0)
+    assert info_plain["pending"] is None
+    problem, dd0, p0 = _problem(mesh, backend=backend, rate=1e-2, viscosity=1e-5)
+    dd_first, p_first, info_first = solve_step(problem, settings, dd0, p0, 1.0, provisional=True)
+    assert info_first["pending"] is not None and info_first["nonlinear_iterations"] == 1
+    assert np.all(np.isfinite(p_first)) and not np.array_equal(p_first, p_plain)  # an iterate, not the answer
+    dd, p, info = info_first["pending"].finish()
+    assert info["pending"] is None
+    np.testing.assert_array_equal(dd, dd_plain)
+    np.testing.assert_array_equal(p, p_plain)
+    for key in ("nonlinear_iterations", "linear_iterations", "restarts"):
+        assert info_first[key] + info[key] == info_plain[key]
+    if backend == "hmatrix":
+        problem, dd0, p0 = _problem(mesh, backend="dense", rate=1e-2, viscosity=1e-5)
+        dd_dense, p_dense, _ = solve_step(problem, settings, dd0, p0, 1.0)
+        np.testing.assert_allclose(p, p_dense, atol=1e-5 * np.abs(p_dense).max())
+        np.testing.assert_allclose(dd, dd_dense, atol=1e-5 * np.abs(dd_dense).max())
+
+
+@pytest.mark.parametrize("backend", ["dense", "hmatrix"])
+def test_a_paused_provisional_iterate_finishes_with_the_iterates_of_a_plain_one(backend):
+    # provisional_linear_rtol > first_linear_rtol (the default): the provisional iterate is
+    # the first GMRES solve paused at provisional_linear_rtol (fewer GMRES iterations);
+    # refine() continues that solve to the plain first iterate, finish() to the converged
+    # one: bit for bit the plain solve's, with its counts (also when refine() is skipped).
+    mesh = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 8.0, 8.0, 8, 8)
+    settings = SchemeSettings(scheme="krylov", provisional_linear_rtol=1e-3)
+    assert SchemeSettings().provisional_linear_rtol > SchemeSettings().first_linear_rtol
+    problem, dd0, p0 = _problem(mesh, backend=backend, rate=1e-2, viscosity=1e-5)
+    dd_plain, p_plain, info_plain = solve_step(problem, settings, dd0, p0, 1.0)
+    problem, dd0, p0 = _problem(mesh, backend=backend, rate=1e-2, viscosity=1e-5)
+    tight = SchemeSettings(scheme="krylov", provisional_linear_rtol=1e-6)
+    dd_tight, p_tight, info_tight = solve_step(problem, tight, dd0, p0, 1.0, provisional=True)
+    for refine in (False, True):
+        problem, dd0, p0 = _problem(mesh, backend=backend, rate=1e-2, viscosity=1e-5)
+        dd_first, p_first, info_first = solve_step(problem, settings, dd0, p0, 1.0, provisional=True)
+        pending = info_first["pending"]
+        assert pending.refinable and info_first["nonlinear_iterations"] == 1
+        assert info_first["linear_iterations"] < info_tight["linear_iterations"]
+        # the paused iterate is the tight first one to within the looser tolerance
+        np.testing.assert_allclose(p_first, p_tight, rtol=0, atol=1e-2 * np.abs(p_tight).max())
+        levels = [pending.paused_level]  # a GMRES iteration may pass more than one level
+        infos = [info_first]
+        if refine:  # pauses at 1e-3, 1e-4, 1e-5, then the plain first iterate (1e-6)
+            while pending.refinable:
+                dd_refined, p_refined, info_refined = pending.refine()
+                assert info_refined["pending"] is pending and info_refined["nonlinear_iterations"] == 0
+                levels.append(pending.paused_level)
+                infos.append(info_refined)
+            assert levels[-1] is None and set(levels[:-1]) <= {1e-3, 1e-4, 1e-5} and len(levels) >= 3
+            assert levels[:-1] == sorted(levels[:-1], reverse=True)
+            assert sum(i["linear_iterations"] for i in infos) == info_tight["linear_iterations"]
+            np.testing.assert_array_equal(dd_refined, dd_tight)
+            np.testing.assert_array_equal(p_refined, p_tight)
+        dd, p, info = pending.finish()
+        assert info["pending"] is None
+        infos.append(info)
+        np.testing.assert_array_equal(dd, dd_plain)
+        np.testing.assert_array_equal(p, p_plain)
+        for key in ("nonlinear_iterations", "linear_iterations", "restarts"):
+            assert sum(i[key] for i in infos) == info_plain[key]
+    if backend == "hmatrix":
+        problem, dd0, p0 = _problem(mesh, backend="dense", rate=1e-2, viscosity=1e-5)
+        dd_dense, p_dense, _ = solve_step(problem, settings, dd0, p0, 1.0)
+        np.testing.assert_allclose(p, p_dense, atol=1e-5 * np.abs(p_dense).max())
+        np.testing.assert_allclose(dd, dd_dense, atol=1e-5 * np.abs(dd_dense).max())
+
+
+def test_a_provisional_solve_converges_at_once_without_a_loose_first_iteration():
+    # segregated schemes, or first_linear_rtol == linear_rtol: nothing to stop early
+    from hmatddm.coupled.schemes import PendingSolve
+
+    mesh = hd.mesh.line([-5, 0], [5, 0], 20)
+    problem, dd0, p0 = _problem(mesh, leak=1e-12)
+    _, _, info = solve_step(problem, SchemeSettings(scheme="krylov", first_linear_rtol=1e-9), dd0, p0, 1.0,
+                            provisional=True)
+    assert info["pending"] is None and info["nonlinear_iterations"] >= 2
+    for scheme in ("fixed-width", "fracture-compliance"):
+        assert not PendingSolve(problem, SchemeSettings(scheme=scheme), dd0, p0, 1.0).loose_first
+    with pytest.raises(hd.errors.InputError, match="growth_check"):
+        SchemeSettings(growth_check="never")

@@ -1,0 +1,185 @@
+"""hmatddm.elasticity.planar: a planar crack's operator compressed as its opening and shear
+parts, against the dense 3 x 3 operator of the same mesh."""
+import numpy as np
+import pytest
+
+import hmatddm as hd
+from hmatddm.coupled.contact import ContactRows
+from hmatddm.errors import InputError
+from hmatddm.elasticity.extended import ExtendedElasticityOperator
+from hmatddm.elasticity.planar import PlanarElasticityOperator, PlanarExtendedOperator, is_planar
+from hmatddm.simulation import growing_operator
+
+MATERIAL = hd.Elastic(10e9, 0.25)
+# a horizontal plane, and one tilted about every axis (its frames in global components are
+# not exact, so projections leave round-off)
+_TILTED_U = np.array([1.0, 1.0, 0.3]) / np.linalg.norm([1.0, 1.0, 0.3])
+_TILTED_V = np.cross(_TILTED_U, [0.2, -0.4, 1.0])
+_TILTED_V /= np.linalg.norm(_TILTED_V)
+PLANES = {"horizontal": ([1.0, 0, 0], [0, 1.0, 0]), "tilted": (_TILTED_U, _TILTED_V)}
+
+
+def _mesh(plane, n=12):
+    u, v = PLANES[plane]
+    return hd.mesh.rectangle([1.0, 2.0, 3.0], u, v, 6.0, 4.0, n, n - 4)
+
+
+@pytest.fixture(scope="module", params=sorted(PLANES))
+def pair(request):
+    mesh = _mesh(request.param)
+    return mesh, hd.ElasticityOperator(mesh, MATERIAL).to_dense()
+
+
+def test_planar_meshes_are_recognised():
+    assert is_planar(_mesh("horizontal")) and is_planar(_mesh("tilted"))
+    bent = _mesh("tilted")
+    bent.centers[5] += 1e-6 * bent.normals[5]
+    assert not is_planar(bent)
+    two_planes = hd.mesh.concatenate([_mesh("horizontal"), hd.mesh.rectangle([0, 0, 1.0], [1.0, 0, 0], [0, 1.0, 0],
+                                                                       2.0, 2.0, 2, 2)])
+    assert not is_planar(two_planes)
+    assert not is_planar(hd.mesh.line([0, 0], [1, 0], 4))
+
+
+def test_an_opening_product_needs_no_shear_operator_and_matches_dense(pair):
+    mesh, dense = pair
+    op = PlanarElasticityOperator(mesh, MATERIAL, eps=1e-6)
+    opening = (np.cos(mesh.centers[:, 0])[:, None] * mesh.normals).ravel()
+    exact = dense @ opening
+    assert np.linalg.norm(op @ opening - exact) <= 1e-5 * np.linalg.norm(exact)
+    preconditioned = op.approximate_inverse(exact)
+    assert op.shear_hmatrix is None and op.stats["parts"] == "normal"
+    # the preconditioned opening load stays an opening: no shear part
+    shear = np.einsum("eak,ek->ea", mesh.frames[:, :2], preconditioned.reshape(-1, 3))
+    assert np.abs(shear).max() <= 1e-12 * np.abs(preconditioned).max()
+
+
+def test_every_product_and_solve_matches_the_dense_operator(pair):
+    mesh, dense = pair
+    op = PlanarElasticityOperator(mesh, MATERIAL, eps=1e-6)
+    x = np.random.default_rng(0).normal(size=dense.shape[0])
+    assert np.linalg.norm(op @ x - dense @ x) <= 1e-5 * np.linalg.norm(dense @ x)
+    assert op.shear_hmatrix is not None and op.stats["parts"] == "normal+shear"
+    stats = op.stats
+    assert stats["memory_bytes"] == op.hmatrix.stats["memory_bytes"] + op.shear_hmatrix.stats["memory_bytes"]
+    assert stats["dense_bytes"] == 8 * dense.size and stats["compression"] == 8 * dense.size / stats["memory_bytes"]
+    assert np.abs(op.to_dense() - dense).max() <= 1e-5 * np.abs(dense).max()
+    assert op.check_against_dense() <= 1e-5
+    n = mesh.n_elements
+    index = np.arange(n)
+    np.testing.assert_array_equal(op.element_diagonal_blocks(), dense.reshape(n, 3, n, 3)[index, :, index, :])
+    product = op @ x
+    np.testing.assert_allclose(op.matmat(np.column_stack([x, 2 * x])), np.column_stack([product, 2 * product]),
+                               rtol=0, atol=1e-13 * np.abs(product).max())
+    rhs = dense @ x
+    solution, info = op.solve(rhs, rtol=1e-10)
+    assert info["converged"]
+    assert np.linalg.norm(solution - x) <= 1e-5 * np.linalg.norm(x)
+
+
+def test_contact_rows_use_the_whole_tensor_operator():
+    mesh = _mesh("horizontal", n=8)
+    op = PlanarElasticityOperator(mesh, MATERIAL, eps=1e-6)
+    full = hd.ElasticityOperator(mesh, MATERIAL, backend="hmatrix", eps=1e-6)
+    n, rng = mesh.n_elements, np.random.default_rng(1)
+    select = np.tile(np.eye(3), (n, 1, 1))
+    select[::3] = np.diag([1.0, 1.0, 0.0])  # every third element closed: its normal row replaced
+    direct = np.zeros((n, 3, 3))
+    direct[::3, 2, 2] = 1e12
+    rows = ContactRows(select, direct, np.zeros((n, 3)), "closed")
+    r = rng.normal(size=3 * n)
+    np.testing.assert_array_equal(op.modified_inverse(rows)(r), full.modified_inverse(rows)(r))
+
+
+def test_a_grown_planar_operator_matches_the_dense_one_and_reuses_the_last_border(pair):
+    mesh, dense = pair
+    n = mesh.n_elements
+    sizes = (n - 30, n - 12, n)  # the base, a first growth pass, a second
+    base = PlanarElasticityOperator(mesh.subset(np.arange(sizes[0])), MATERIAL, eps=1e-6)
+    first = PlanarExtendedOperator(base, mesh.subset(np.arange(sizes[1])))
+    grown = PlanarExtendedOperator(base, mesh, previous=first)
+    fresh = PlanarExtendedOperator(base, mesh)
+    assert grown._normal.n_reused == sizes[1] - sizes[0]
+    opening = (np.cos(mesh.centers[:, 0])[:, None] * mesh.normals).ravel()
+    x = np.random.default_rng(2).normal(size=3 * n)
+    for vector, parts in ((opening, None), (x, "shear")):
+        exact = dense @ vector
+        product = grown @ vector
+        assert np.linalg.norm(product - exact) <= 1e-5 * np.linalg.norm(exact)
+        np.testing.assert_allclose(product, fresh @ vector, rtol=0, atol=1e-12 * np.abs(exact).max())
+        assert (grown._shear is None) == (parts is None)
+    index = np.arange(n)
+    np.testing.assert_array_equal(grown.element_diagonal_blocks(), dense.reshape(n, 3, n, 3)[index, :, index, :])
+    rhs = dense @ x
+    solution, info = grown.solve(rhs, rtol=1e-10)
+    assert info["converged"] and np.linalg.norm(solution - x) <= 1e-5 * np.linalg.norm(x)
+    # contact rows: the whole-tensor extension of the same base
+    select = np.tile(np.eye(3), (n, 1, 1))
+    select[::4] = np.diag([1.0, 1.0, 0.0])
+    direct = np.zeros((n, 3, 3))
+    direct[::4, 2, 2] = 1e12
+    rows = ContactRows(select, direct, np.zeros((n, 3)), "closed")
+    np.testing.assert_array_equal(grown.modified_inverse(rows)(x), ExtendedElasticityOperator(base, mesh).modified_inverse(rows)(x))
+
+
+def test_refuses_what_does_not_split():
+    with pytest.raises(InputError, match="one plane"):
+        PlanarElasticityOperator(hd.mesh.concatenate([_mesh("horizontal"), _mesh("tilted")]), MATERIAL)
+    with pytest.raises(InputError, match="backend"):
+        PlanarElasticityOperator(_mesh("horizontal"), MATERIAL, backend="dense")
+    medium = hd.LayeredMedium([10.0], [10e9, 20e9], [0.25, 0.25])
+    with pytest.raises(InputError, match="homogeneous"):
+        PlanarElasticityOperator(_mesh("horizontal"), medium)
+
+
+def test_a_growing_planar_run_is_the_same_with_the_parts_apart_or_together(monkeypatch):
+    """The simulation builds the split operator for a planar mesh; the run matches the one
+    with the 3 x 3 operator to the GMRES tolerance (the H-matrices differ within eps)."""
+    runs = {"grown": []}
+    grow = growing_operator.GrowingOperator.__call__
+
+    def recorded(self, mesh):
+        operator = grow(self, mesh)
+        runs["grown"].append(operator)
+        return operator
+
+    monkeypatch.setattr(growing_operator.GrowingOperator, "__call__", recorded)
+    for split in (True, False):
+        monkeypatch.setattr(growing_operator, "SPLIT_PLANAR_MODES", split)
+        start = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 6.0, 6.0, 3, 3)
+        simulation = hd.Simulation(start, hd.Elastic(24e9, 0.25), hd.Fluid(1e-3, 4.4e-10),
+                                   [hd.Cluster((0, 0, 0), 0.01, 0.005)], far_field_stress=np.diag([0, 0, -8e6]),
+                                   time_step=1.0, propagation=hd.Propagation(toughness=5e6),
+                                   initial_pressure=10e6, initial_opening=1e-5, backend="hmatrix", eps=1e-6)
+        records = simulation.run(6.0)
+        runs[split] = records, simulation.operators.base
+    (split_records, split_base), (whole_records, whole_base) = runs[True], runs[False]
+    assert isinstance(split_base, PlanarElasticityOperator) and split_base.shear_hmatrix is None
+    assert any(isinstance(o, PlanarExtendedOperator) for o in runs["grown"])
+    assert not isinstance(whole_base, PlanarElasticityOperator)
+    assert split_records[-1]["n_elements"] > 9  # it grew
+    assert [r["n_elements"] for r in split_records] == [r["n_elements"] for r in whole_records]
+    for a, b in zip(split_records, whole_records):
+        np.testing.assert_allclose(a["wellbore_pressure"], b["wellbore_pressure"], rtol=1e-6)
+        np.testing.assert_allclose(a["max_opening"], b["max_opening"], rtol=1e-5)
+
+
+def _planar_run(**kwargs):
+    start = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 6.0, 6.0, 3, 3)
+    return hd.Simulation(start, hd.Elastic(24e9, 0.25), hd.Fluid(1e-3, 4.4e-10), [hd.Cluster((0, 0, 0), 0.01, 0.005)],
+                         far_field_stress=np.diag([0, 0, -8e6]), time_step=1.0,
+                         propagation=hd.Propagation(toughness=5e6), initial_pressure=10e6, initial_opening=1e-5,
+                         backend="hmatrix", eps=1e-6, **kwargs)
+
+
+@pytest.mark.parametrize("split", [True, False])
+def test_a_resumed_planar_run_repeats_the_uninterrupted_one(tmp_path, monkeypatch, split):
+    """The resumed run rebuilds the interrupted run's split base (GrowingOperator.restore)."""
+    monkeypatch.setattr(growing_operator, "SPLIT_PLANAR_MODES", split)
+    whole = _planar_run().run(6.0)
+    _planar_run(checkpoint_dir=tmp_path).run(3.0)
+    resumed = _planar_run(checkpoint_dir=tmp_path).run(6.0, resume=True)
+    assert [r["step"] for r in resumed] == [r["step"] for r in whole]
+    assert resumed[-1]["n_elements"] == whole[-1]["n_elements"] > 9
+    for a, b in zip(whole, resumed):
+        assert a["wellbore_pressure"] == b["wellbore_pressure"] and a["max_opening"] == b["max_opening"]

@@ -1,0 +1,98 @@
+"""Level-set front inside tip elements (hmatddm.fracture.front): geometry checks against
+exact areas and integrals, and the grid of a planar fracture."""
+import numpy as np
+import pytest
+
+import hmatddm as hd
+from hmatddm.errors import InputError
+from hmatddm.fracture.front import FrontField, PlanarGrid, fill, front_radii, level_set
+from hmatddm.analytical.tip_asymptote import TipAsymptote
+
+
+class _Toughness(TipAsymptote):
+    """The toughness vertex w = K' s^(1/2)/E' (zero viscosity)."""
+
+    def __init__(self):
+        super().__init__(64e9, 1e6, 1e-30)
+
+
+def test_level_set_is_the_distance_to_a_circle():
+    points = np.array([[0.0, 0.0], [3.0, 0.0], [0.0, -1.0], [2.0, 2.0]])
+    phi, nearest = level_set(points, np.array([[0.0, 0.0]]), np.array([2.0]))
+    np.testing.assert_allclose(phi, [-2.0, 1.0, -1.0, np.sqrt(8.0) - 2.0])
+    np.testing.assert_array_equal(nearest, 0)
+
+
+def _straight_front(k, h, s, angle=0.0):
+    """A field whose ribbon is every cell with x-index <= 0 ... of a straight front at angle."""
+    n = 12
+    axes = [np.arange(-n, n + 1)] * k
+    cells = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, k)
+    normal = np.array([np.cos(angle), np.sin(angle)])[:k]
+    depth = cells @ normal * h
+    channel = cells[depth <= 0.0]
+    ribbon = channel[depth[depth <= 0.0] > -1.5 * h]
+    distance = s - ribbon @ normal * h
+    return FrontField(ribbon, distance, np.zeros(len(ribbon)), channel, h, margin=4), normal
+
+
+@pytest.mark.parametrize("angle", [0.0, np.pi / 8, np.pi / 4, 0.3])
+def test_fast_marching_is_exact_for_a_straight_front(angle):
+    # the upwind eikonal update reproduces a straight front in any direction
+    h, s = 0.5, 0.7
+    field, normal = _straight_front(2, h, s, angle)
+    points = np.random.default_rng(0).uniform(-2.0, 2.0, (200, 2))
+    np.testing.assert_allclose(field(points), points @ normal - s, atol=1e-6)
+
+
+def test_filled_fraction_and_mean_opening_of_a_half_filled_segment():
+    # 2D: the front at the centre of a segment of length h: filled fraction 1/2, mean
+    # opening (1/h) int_0^(h/2) K' s^(1/2)/E' ds = K'/E' (2/3) (h/2)^(3/2) / h
+    h = 1.0
+    asymptote = _Toughness()
+    field, _ = _straight_front(1, h, h)  # front at x = h, the centre of cell 1: half full
+    fraction, width, full = fill(np.array([[1]]), field, asymptote, n_sub=64)
+    exact = asymptote.k_prime / asymptote.e_prime * (2.0 / 3.0) * (h / 2) ** 1.5 / h
+    assert fraction[0] == pytest.approx(0.5) and not full[0]
+    assert width[0] == pytest.approx(exact, rel=2e-3)
+    fraction, _, full = fill(np.array([[0]]), field, asymptote)
+    assert fraction[0] == 1.0 and full[0]
+
+
+def test_filled_fraction_of_a_square_cut_diagonally():
+    # a straight front at 45 degrees through the centre of a cell fills half of it
+    field, _ = _straight_front(2, 1.0, 0.0, np.pi / 4)
+    fraction, _, full = fill(np.array([[0, 0]]), field, _Toughness(), n_sub=41)
+    assert fraction[0] == pytest.approx(0.5, abs=0.02) and not full[0]
+
+
+def test_front_radii_of_a_round_front():
+    # ribbon: cells within 6 of the centre; front a circle of radius 7.3: the marched
+    # field's front is round to well within the 5% circularity target
+    h = 1.0
+    axes = [np.arange(-12, 13)] * 2
+    cells = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 2)
+    r = np.linalg.norm(cells, axis=1)
+    channel = cells[r <= 6.0]
+    ribbon = channel[r[r <= 6.0] > 5.0]
+    distance = 7.3 - np.linalg.norm(ribbon, axis=1)
+    field = FrontField(ribbon, distance, np.zeros(len(ribbon)), channel, h, margin=5)
+    radii = front_radii(np.zeros(2), field, n_rays=72)
+    assert radii.max() / radii.min() < 1.02
+    np.testing.assert_allclose(radii, 7.3, rtol=0.02)
+
+
+def test_planar_grid_maps_cells_and_rejects_other_meshes():
+    mesh = hd.mesh.rectangle([1.0, 2.0, 3.0], [1, 0, 0], [0, 1, 0], 3.0, 2.0, 3, 2)
+    grid = PlanarGrid(mesh)
+    cells = grid.cells(mesh.centers)
+    np.testing.assert_allclose(grid.centers(cells), mesh.centers, atol=1e-12)
+    assert grid.h == pytest.approx(1.0) and grid.k == 2
+    with pytest.raises(InputError, match="square"):
+        PlanarGrid(hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 3.0, 2.0, 3, 4))
+    tilted = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 0.6, 0.8], 2.0, 2.0, 2, 2)
+    with pytest.raises(InputError, match="planar"):
+        PlanarGrid(hd.mesh.concatenate([mesh, tilted.subset(np.arange(4))]))
+    line = hd.mesh.line([-1.5, 0.0], [1.5, 0.0], 3)
+    grid = PlanarGrid(line)
+    assert grid.k == 1 and grid.h == pytest.approx(1.0)
