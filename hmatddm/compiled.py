@@ -10,6 +10,8 @@ kernel's data, cached on disk, and calls the kernel through a pointer. The H-mat
 (assembly.py), the one-shot product (product.py), the ACA entry points (aca.py) and the
 kernel drivers' self-block maxima are compiled this way.
 """
+from types import FunctionType
+
 import numba
 from numba import njit, types
 
@@ -39,3 +41,22 @@ def compiled_for_data(function, data, argument_types, result_type=None):
         compiled = njit(signature, cache=True, nogil=True)(function)
         _COMPILED[key] = compiled
     return compiled
+
+
+def serial_twin(dispatcher, **options):
+    """The Python function of the ``parallel=True`` ``dispatcher`` compiled again without
+    parallel launches (``njit(**options)``), under its own name ``<name>_serial``: the
+    one-thread path of an operation skips the threading layer's fork and join.
+
+    The twin must not be the same Python function: numba keys its on-disk cache by the
+    function's qualified name, line and signature, not by the ``parallel`` flag, so a
+    twin of the same function shares the parallel one's cache entries, and whichever
+    compiles first is loaded for both. That made every H-matrix product serial once a
+    small (serial) product had been compiled first (issue 40); a renamed copy has a cache
+    of its own."""
+    function = dispatcher.py_func
+    twin = FunctionType(function.__code__, function.__globals__, function.__name__ + "_serial",
+                        function.__defaults__, function.__closure__)
+    twin.__qualname__ = function.__qualname__ + "_serial"
+    twin.__doc__ = f"The serial twin of :func:`{function.__name__}` (:func:`hmatddm.compiled.serial_twin`)."
+    return njit(**options)(twin)

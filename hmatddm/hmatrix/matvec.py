@@ -7,6 +7,7 @@ on one thread (:func:`_matmat_serial`).
 import numpy as np
 from numba import njit, prange
 
+from ..compiled import serial_twin
 from .fastmath import FAST
 
 
@@ -99,5 +100,6 @@ def _matmat_permuted(dof, col_dof, n_rows, dense_col_start, dense_row_start, den
 
 
 # The same loops compiled without parallel launches: the one-thread path skips the
-# threading layer's fork/join (~0.5 ms per call measured under load at N = 1024).
-_matmat_serial = njit(cache=True, fastmath=FAST)(_matmat_permuted.py_func)
+# threading layer's fork/join (~0.5 ms per call measured under load at N = 1024). A
+# renamed twin, with a numba cache of its own (hmatddm.compiled.serial_twin, issue 40).
+_matmat_serial = serial_twin(_matmat_permuted, cache=True, fastmath=FAST)

@@ -11,7 +11,8 @@ import scipy.sparse.linalg as spla
 
 from ..errors import InputError
 
-from .block_ilu import block_ilu0, block_ilu_solve
+from .block_ilu import block_ilu0, block_ilu_solve, block_ilu_solve_staged
+from .dissection import dissection_depth, nested_dissection, permuted_pattern
 
 logger = logging.getLogger(__name__)
 
@@ -107,36 +108,63 @@ def near_field_lu(hmatrix, part="near"):
     return spla.LinearOperator(hmatrix.shape, matvec=factor.solve, dtype=np.float64)
 
 
-def near_field_block_ilu(hmatrix, threshold=0.0, part="near"):
+def near_field_block_ilu(hmatrix, threshold=0.0, part="near", depth=None):
     """Block ILU(0) (d x d element blocks) of the near-field matrix.
 
     The pattern is that of ``HMatrix.near_field_bsr(part, threshold)`` (element
     blocks below ``threshold`` of their diagonal blocks dropped, by Frobenius norm),
-    factored without fill-in in the original element order, with whole-block pivots:
-    the preconditioner commutes with rotations of the element frames (see
-    :mod:`hmatddm.hmatrix.block_ilu`). Setup O(kept blocks * neighbours * d^3),
-    application O(kept blocks * d^2), memory one copy of the kept blocks.
+    factored without fill-in, with whole-block pivots: the preconditioner commutes with
+    rotations of the element frames (see :mod:`hmatddm.hmatrix.block_ilu`). Setup
+    O(kept blocks * neighbours * d^3), application O(kept blocks * d^2), memory one copy
+    of the kept blocks.
+
+    ``depth`` (default :func:`~hmatddm.hmatrix.dissection.dissection_depth`: 0 below
+    5000 elements): with ``depth > 0`` the factors are in the nested-dissection order of
+    the top ``depth`` cuts of the cluster tree (:mod:`hmatddm.hmatrix.dissection`), and
+    an application runs on the threads the matvec would use, with the same result on
+    any number of them; with 0, in the original element order, on one thread.
 
     Raises RuntimeError when a pivot block is missing or singular.
     """
+    from ._threads import SERIAL_MATVEC_ENTRIES, threads_for
+
     _check_hmatrix(hmatrix)
     matrix = hmatrix.near_field_bsr(part=part, threshold=threshold)
     indptr = matrix.indptr.astype(np.int64)
     indices = matrix.indices.astype(np.int64)
-    values, inverse_diagonal, diagonal_position, failed = block_ilu0(indptr, indices, np.ascontiguousarray(matrix.data))
+    data = np.ascontiguousarray(matrix.data)
+    n_elements, d = hmatrix.n_elements, hmatrix.dof
+    depth = dissection_depth(n_elements) if depth is None else int(depth)
+    dissection = None
+    if depth > 0:
+        dissection = nested_dissection(hmatrix.tree, indptr, indices, depth)
+        indptr, indices, data = permuted_pattern(indptr, indices, data, dissection.order)
+    values, inverse_diagonal, diagonal_position, failed = block_ilu0(indptr, indices, data)
     if failed >= 0:
-        raise RuntimeError(f"block ILU: the pivot block of element {failed} is missing or singular")
+        element = failed if dissection is None else int(dissection.order[failed])
+        raise RuntimeError(f"block ILU: the pivot block of element {element} is missing or singular")
     n = hmatrix.shape[0]
+
+    def solve_one(rhs):
+        if dissection is None:
+            return block_ilu_solve(indptr, indices, values, inverse_diagonal, diagonal_position, rhs)
+        permuted = np.ascontiguousarray(rhs.reshape(n_elements, d)[dissection.order].reshape(-1))
+        with threads_for(values.size, SERIAL_MATVEC_ENTRIES):
+            solution = block_ilu_solve_staged(indptr, indices, values, inverse_diagonal, diagonal_position, permuted,
+                                              dissection.stage_ptr, dissection.range_start, dissection.range_stop)
+        out = np.empty_like(solution)
+        out.reshape(n_elements, d)[dissection.order] = solution.reshape(n_elements, d)
+        return out
 
     def apply(x):
         x = np.ascontiguousarray(x, dtype=np.float64)
         if x.ndim == 1:
-            return block_ilu_solve(indptr, indices, values, inverse_diagonal, diagonal_position, x)
-        return np.column_stack([block_ilu_solve(indptr, indices, values, inverse_diagonal, diagonal_position,
-                                                np.ascontiguousarray(column)) for column in x.reshape(n, -1).T])
+            return solve_one(x)
+        return np.column_stack([solve_one(np.ascontiguousarray(column)) for column in x.reshape(n, -1).T])
 
     operator = spla.LinearOperator(hmatrix.shape, matvec=apply, matmat=apply, dtype=np.float64)
     operator.nbytes = int(values.nbytes + inverse_diagonal.nbytes + indices.nbytes + indptr.nbytes)
+    operator.dissection = dissection
     return operator
 
 
