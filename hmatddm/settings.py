@@ -38,7 +38,8 @@ def show(value):
 class Setting:
     """One setting: its kind, default, range, unit and description (``doc``).
 
-    kind: ``number``, ``integer``, ``boolean``, ``string``, ``choice`` (one of ``choices``),
+    kind: ``number``, ``number_or_auto`` (a number, or the string ``"auto"``), ``integer``,
+    ``boolean``, ``string``, ``choice`` (one of ``choices``),
     ``point`` (``length`` numbers; ``length="dim"`` is the scene dimension),
     ``numbers`` (a non-empty list of numbers, or one number), ``integers`` (a list of
     integers >= 0), ``matrix`` (dim x dim numbers), ``pairs`` (a list of [low, high]).
@@ -104,6 +105,12 @@ class Setting:
     def check(self, path, value, dim):
         kind = self.kind
         if kind == "number":
+            return self._number(path, value)
+        if kind == "number_or_auto":
+            if value == "auto":
+                return value
+            if isinstance(value, str):
+                raise InputError(f"{path} must be a number ({self.range_text()}) or \"auto\", got {show(value)}")
             return self._number(path, value)
         if kind == "integer":
             return self._integer(path, value)
@@ -172,7 +179,9 @@ class Setting:
         ``name`` is how the message names it; ``None`` passes when the setting has no default."""
         if value is None and self.default is ABSENT:
             return None
-        if self.kind == "number" and (isinstance(value, bool) or not isinstance(value, Real)):
+        if self.kind == "number_or_auto" and value == "auto":
+            return value
+        if self.kind in ("number", "number_or_auto") and (isinstance(value, bool) or not isinstance(value, Real)):
             try:  # a 0-d array, or a string of a number, as hmatddm._validation.finite_scalar takes them
                 value = float(value)
             except (TypeError, ValueError):
@@ -293,8 +302,17 @@ OPERATOR = {  # -> hmatddm.elasticity.operator.ElasticityOperator (the H-matrix 
 }
 
 NUMERICS = {  # [numerics] of a scene -> hmatddm.Simulation, its operator and its SchemeSettings
-    "time_step": Setting("number", 1.0, low=0.0, low_open=True, unit="s"),
+    "time_step": Setting("number_or_auto", 1.0, low=0.0, low_open=True, unit="s",
+                         doc='"auto": steps that follow the front (hmatddm.simulation.step_control)'),
     "end_time": Setting("number", REQUIRED, low=0.0, low_open=True, unit="s"),
+    "step_advance": Setting("number", 1.0, low=0.0, low_open=True, high=10.0,
+                            doc='time_step = "auto": element rows the front should cross per step'),
+    "first_time_step": Setting("number", 0.1, low=0.0, low_open=True, unit="s",
+                               doc='time_step = "auto": the first step'),
+    "min_time_step": Setting("number", 1e-3, low=0.0, low_open=True, unit="s",
+                             doc='time_step = "auto": the shortest step'),
+    "max_time_step": Setting("number", low=0.0, low_open=True, unit="s",
+                             doc='time_step = "auto": the longest step (default: no bound)'),
     "backend": Setting("choice", "hmatrix", choices=BACKENDS),
     **{key: OPERATOR[key] for key in ("eps", "eta", "leaf_size")},
     **SCHEME,

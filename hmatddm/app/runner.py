@@ -119,13 +119,13 @@ class SceneRun:
         self._prepare_folder(simulation)
         self.simulation = simulation
         start_time = simulation.state.time
-        self.progress = Progress(numerics["end_time"], numerics["time_step"], stream=self.stream,
+        self.progress = Progress(numerics["end_time"], simulation.time_step, stream=self.stream,
                                  enabled=not self.quiet, start_time=start_time)
         step = simulation.state.step
         if step == 0 or (step % scene["output"]["every"] == 0 and self._last_vtu_step != step):
             self._write_vtu(simulation.state)  # t = 0, or a step whose .vtu an interruption cut off
         self._write_summary()
-        if start_time > numerics["end_time"] + 1e-9 * numerics["time_step"]:
+        if start_time > numerics["end_time"] + 1e-9 * simulation.time_step:
             raise InputError(f"the run in {str(self.out)!r} is already at t = {start_time:g} s, past "
                              f"numerics.end_time = {numerics['end_time']:g} s; give a later end time (--set "
                              "numerics.end_time=...) or --overwrite to start over")
@@ -220,7 +220,7 @@ class SceneRun:
 
     def _is_last(self, record):
         numerics = self.scene.data["numerics"]
-        return record["time"] >= numerics["end_time"] - 1e-9 * numerics["time_step"]
+        return record["time"] >= numerics["end_time"] - 1e-9 * record["time_step"]
 
     def _after_step(self, simulation, record):
         every = self.scene.data["output"]["every"]

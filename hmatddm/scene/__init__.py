@@ -79,7 +79,11 @@ The format, annotated (``=`` values are the defaults unless marked REQUIRED)::
     pore_pressure = 0.0            # Pa
 
     [numerics]
-    time_step = 1.0                # s, > 0
+    time_step = 1.0                # s, > 0, or "auto": steps that follow the front (then:)
+    # step_advance = 1.0           # element rows the front crosses per step, (0, 10]
+    # first_time_step = 0.1        # s, > 0
+    # min_time_step = 1e-3         # s, > 0
+    # max_time_step = 10.0         # s, > 0 (default: no bound)
     end_time = 30.0                # REQUIRED, s, > 0
     backend = "hmatrix"            # "hmatrix" or "dense"
     eps = 1e-4                     # H-matrix tolerance, (0, 1)

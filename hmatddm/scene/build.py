@@ -109,7 +109,23 @@ def build_simulation(scene, checkpoint_dir=None):
         checkpoint_dir=checkpoint_dir, keep_checkpoints=numerics["keep_checkpoints"],
         natural_fractures=natural_mesh(scene), natural=natural_properties(scene),
         remote_failure=scene.get("network", {}).get("remote_failure", True), contact=numerics["contact"],
-        max_elements=numerics.get("max_elements"))
+        max_elements=numerics.get("max_elements"), step_control=step_control(numerics))
+
+
+def step_control(numerics):
+    """The :class:`~hmatddm.simulation.step_control.StepControl` of ``[numerics]`` with
+    ``time_step = "auto"``, else None."""
+    if numerics["time_step"] != "auto":
+        return None
+    from ..simulation.step_control import StepControl
+
+    return StepControl(advance=numerics["step_advance"], first=numerics["first_time_step"],
+                       minimum=numerics["min_time_step"], maximum=numerics.get("max_time_step"))
+
+
+def first_time_step(numerics):
+    """The first step of ``[numerics]`` (s): ``time_step``, or ``first_time_step`` with "auto"."""
+    return numerics["first_time_step"] if numerics["time_step"] == "auto" else numerics["time_step"]
 
 
 def natural_properties(scene):
@@ -184,7 +200,7 @@ def reference_curves(scene, end_time=None, samples=200):
     if "reference" not in scene:
         return None
     end_time = scene["numerics"]["end_time"] if end_time is None else end_time
-    start = min(0.25 * scene["numerics"]["time_step"], 0.5 * end_time)
+    start = min(0.25 * first_time_step(scene["numerics"]), 0.5 * end_time)
     curves = _closed_form(scene, np.linspace(start, end_time, samples))
     curves.pop("dimensionless_toughness")
     return curves

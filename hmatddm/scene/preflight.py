@@ -173,6 +173,12 @@ def _operator_bytes(n, dim):
     return dense, min(dense / 2.0, _H_BYTES * 8.0 * dim * dim * n * math.log2(max(n, 2)))
 
 
+#: Steps a front-following run (numerics.time_step = "auto") is estimated to take once
+#: its steps have grown from the first one: a radial fracture grown from a few elements to
+#: ~30 element rows of radius takes about that many.
+_AUTO_STEPS = 30
+
+
 def estimate(scene):
     """An :class:`Estimate` of a validated scene, from its numbers (nothing is built)."""
     dim = scene["dimension"]
@@ -197,7 +203,11 @@ def estimate(scene):
         memory = hmatrix
         build = _H_BUILD_SECONDS * scale * n * log_n
         matvec = _H_MATVEC_SECONDS * scale * n * log_n
-    steps = max(1, math.ceil(numerics["end_time"] / numerics["time_step"] - 1e-9))
+    if numerics["time_step"] == "auto":  # a rough count: the steps' ramp up, then AUTO_STEPS
+        ramp = math.log2(max(2.0, numerics["end_time"] / numerics["first_time_step"]))
+        steps = math.ceil(ramp + _AUTO_STEPS / numerics["step_advance"])
+    else:
+        steps = max(1, math.ceil(numerics["end_time"] / numerics["time_step"] - 1e-9))
     return Estimate(elements=elements, natural_elements=natural, unknowns=unknowns, dense_bytes=dense,
                     hmatrix_bytes=hmatrix, backend=backend, memory_bytes=_BASE_BYTES + 1.15 * memory,
                     available_bytes=available_memory(), build_seconds=build,

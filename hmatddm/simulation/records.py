@@ -50,7 +50,8 @@ def step_record(simulation, flow, width, tally, relaxation, seconds):
     mesh = s.mesh
     area = float(np.sum(flow.areas))
     record = dict(
-        step=s.step, time=s.time, n_elements=int(mesh.n_elements), injected_volume=s.injected_volume,
+        step=s.step, time=s.time, time_step=float(s.time - (sim.records[-1]["time"] if sim.records else 0.0)),
+        n_elements=int(mesh.n_elements), injected_volume=s.injected_volume,
         fracture_volume=float(np.sum(flow.areas * width)), fracture_area=area, max_opening=float(np.max(width)),
         wellbore_pressure=[float(s.pressure[i]) for i in sim.injection_elements],
         nonlinear_iterations=int(tally.nonlinear_iterations), linear_iterations=int(tally.linear_iterations),

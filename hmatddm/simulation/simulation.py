@@ -41,6 +41,8 @@ from .natural import natural_network
 from .records import RECORD_KEYS, StepTally, output_view, step_record
 from .settings import group_options
 from .state import Origin, State, StepStart, mesh_arrays
+from .step_control import StepControl, advance_of_step, front_elements
+from .step_solve import mesh_topology
 
 __all__ = ["RECORD_KEYS", "Simulation", "State"]
 
@@ -121,8 +123,8 @@ class Simulation:
     def __init__(self, mesh, material, fluid, clusters, far_field_stress, time_step, propagation=None,
                  leak_off=None, initial_pressure=0.0, initial_opening=1e-5, minimum_width=None, height=1.0, *,
                  scheme="krylov", growing_fractures=None, natural_fractures=None, natural=None, remote_failure=True,
-                 contact="natural", max_elements=None, operator_settings=None, rebuild_settings=None,
-                 checkpoint_settings=None, **options):
+                 contact="natural", max_elements=None, step_control=None, operator_settings=None,
+                 rebuild_settings=None, checkpoint_settings=None, **options):
         if not isinstance(mesh, (Mesh2D, Mesh3D)):
             raise InputError(f"mesh must be a Mesh2D or Mesh3D, got {type(mesh).__name__}")
         check_mesh(mesh)
@@ -166,7 +168,18 @@ class Simulation:
         self.material, self.fluid, self.clusters, self.leak_off = material, fluid, clusters, leak_off
         self.propagation = propagation
         # the ranges a scene's [numerics] declares (hmatddm.settings.NUMERICS)
-        self.time_step = NUMERICS["time_step"].value("time_step", time_step)
+        time_step = NUMERICS["time_step"].value("time_step", time_step)
+        if time_step == "auto":  # steps that follow the front (hmatddm.simulation.step_control)
+            self.step_control = StepControl() if step_control is None else step_control
+            if not isinstance(self.step_control, StepControl):
+                raise InputError(f"step_control must be an hmatddm.simulation.StepControl, got "
+                                 f"{type(self.step_control).__name__}")
+            time_step = self.step_control.first
+        elif step_control is not None:
+            raise InputError('step_control is for time_step = "auto"; a fixed time_step takes none')
+        else:
+            self.step_control = None
+        self.time_step = time_step  # the first step (each step, unless "auto")
         self.initial_pressure = NUMERICS["initial_pressure"].value("initial_pressure", initial_pressure)
         self.initial_opening = NUMERICS["initial_opening"].value("initial_opening", initial_opening)
         minimum_width = self.initial_opening if minimum_width is None else minimum_width
@@ -201,7 +214,7 @@ class Simulation:
         if self.front is not None:
             front = dict(zip(("front_distance", "front_velocity", "front_class"), self.front.initial(mesh)))
         return State(mesh, dd, pressure, np.zeros(mesh.n_elements), 0.0, 0, self.settings.relaxation, 0.0, 0.0,
-                     origin=np.full(mesh.n_elements, Origin.HYDRAULIC, np.int64),
+                     time_step=self.time_step, origin=np.full(mesh.n_elements, Origin.HYDRAULIC, np.int64),
                      natural_index=-np.ones(mesh.n_elements, np.int64), intact=np.ones(n_natural, bool),
                      failed=np.zeros(n_natural, bool), extra_faces=np.zeros((0, 6)), **front)
 
@@ -211,6 +224,7 @@ class Simulation:
                      clusters=[asdict(c) for c in self.clusters], leak_off=asdict(self.leak_off),
                      propagation=None if self.propagation is None else repr(self.propagation),
                      far_field_stress=self.far_field_stress.tolist(), time_step=self.time_step,
+                     step_control=None if self.step_control is None else asdict(self.step_control),
                      initial_pressure=self.initial_pressure, initial_opening=self.initial_opening,
                      minimum_width=self.minimum_width, height=self.height, operator=asdict(self.operator_settings),
                      settings=repr(self.settings), contact=self.contact, remote_failure=self.remote_failure,
@@ -326,11 +340,13 @@ class Simulation:
         return record
 
     def step_times(self, end_time=None):
-        """``(t_old, t_new)`` of the next step: one ``time_step``, shortened to end exactly at
-        ``end_time`` when it would reach or pass it (within 1e-9 of a step)."""
+        """``(t_old, t_new)`` of the next step: one ``time_step`` (with ``"auto"``, the step
+        the last one chose: :mod:`~hmatddm.simulation.step_control`), shortened to end
+        exactly at ``end_time`` when it would reach or pass it (within 1e-9 of a step)."""
         t_old = self.state.time
-        t_new = t_old + self.time_step
-        if end_time is not None and t_new >= end_time - 1e-9 * self.time_step:
+        step = self.state.time_step
+        t_new = t_old + step
+        if end_time is not None and t_new >= end_time - 1e-9 * step:
             t_new = float(end_time)
         return t_old, t_new
 
@@ -380,7 +396,13 @@ class Simulation:
         next_relaxation = relaxation
         if tally.restarts == 0:  # an easy step: let alpha grow back (SchemeSettings.relaxation_growth)
             next_relaxation = min(self.settings.relaxation, relaxation * self.settings.relaxation_growth)
-        return replace(trial, time=t_new, step=begin.step + 1, relaxation=next_relaxation,
+        next_step = begin.time_step
+        if self.step_control is not None:
+            # the front at the step's end: the topology of the last solve's mesh, already computed
+            faces = mesh_topology(trial.mesh, self.height)[1]
+            front = front_elements(faces, trial.mesh.n_elements, 4 if trial.mesh.dim == 3 else 2)
+            next_step = self.step_control.next_step(dt, advance_of_step(tally.elements_added, front))
+        return replace(trial, time=t_new, step=begin.step + 1, relaxation=next_relaxation, time_step=next_step,
                        injected_volume=begin.injected_volume + dt * sum(c.rate for c in self.clusters),
                        leaked_volume=begin.leaked_volume + float(np.sum(leak)) * dt, failed=failed)
 
@@ -417,7 +439,7 @@ class Simulation:
             shown = Progress(end_time, self.time_step, stream=None if progress is True else progress,
                              start_time=self.state.time)
         try:
-            while self.state.time < end_time - 1e-9 * self.time_step:
+            while self.state.time < end_time - 1e-9 * self.state.time_step:
                 record = self.step(end_time)
                 if self.checkpoint_dir is not None:
                     self.save_checkpoint()
@@ -447,6 +469,8 @@ class Simulation:
                 f"the checkpoints in {str(self.checkpoint_dir)!r} belong to a different run "
                 "(settings or initial mesh differ); use another checkpoint folder")
         self.state = State.from_checkpoint(arrays, metadata)
+        if self.state.time_step is None:  # a checkpoint written before steps were recorded in it
+            self.state.time_step = self.time_step
         self.records = list(metadata["records"])
         # rebuild the compressed base exactly as the interrupted run had it, so the
         # resumed run applies the same operator (bit for bit)

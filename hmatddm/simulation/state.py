@@ -119,7 +119,7 @@ def mesh_from_arrays(arrays):
     return Mesh2D(arrays["centers"], arrays["frames"], arrays["half_length"], arrays["fracture_id"].astype(np.int64))
 
 
-_SCALARS = ("time", "step", "relaxation", "injected_volume", "leaked_volume")
+_SCALARS = ("time", "step", "relaxation", "injected_volume", "leaked_volume", "time_step")
 _ALWAYS = ("dd", "pressure", "creation_time", "origin", "natural_index", "intact", "failed", "extra_faces",
            "contact_status", "slip_direction", "failure_pressure")
 _FRONT = ("front_distance", "front_velocity", "front_class")
@@ -149,6 +149,7 @@ class State:
     front_distance: np.ndarray = None  # (N,) asymptotic front: ribbon distance to the front (NaN elsewhere)
     front_velocity: np.ndarray = None  # (N,) asymptotic front: ribbon front velocity (NaN elsewhere)
     front_class: np.ndarray = None     # (N,) asymptotic front: channel, tip, empty, filled (hmatddm.fracture.front)
+    time_step: float = None            # the next step's length, s (hmatddm.simulation.step_control)
 
     def __post_init__(self):
         n, d = self.dd.shape
@@ -213,6 +214,7 @@ class State:
         return cls(mesh_from_arrays(arrays), arrays["dd"], arrays["pressure"], arrays["creation_time"],
                    float(metadata["time"]), int(metadata["step"]), float(metadata["relaxation"]),
                    float(metadata["injected_volume"]), float(metadata["leaked_volume"]),
+                   time_step=None if metadata.get("time_step") is None else float(metadata["time_step"]),
                    **{name: arrays.get(name) for name in _ALWAYS[3:] + _FRONT})
 
 

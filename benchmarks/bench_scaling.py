@@ -1,0 +1,120 @@
+"""The whole simulation at growing sizes: cost against elements, with the error beside it.
+
+    python benchmarks/bench_scaling.py                           # radial-k at h = 1, 0.5, 0.25 m
+    python benchmarks/bench_scaling.py --scenes radial-k,radial-m --sizes 1,0.5,0.25,0.125
+    python benchmarks/bench_scaling.py --steps fixed,auto        # both step rules, side by side
+
+Each row is one ``hmatddm run SCENE --set initial_fracture[0].element_size=h`` in a child
+process (its own CPU time and peak memory), with fixed 1 s steps or front-following steps
+(``numerics.time_step = "auto"``, hmatddm/simulation/step_control.py). It prints the final
+elements, steps, growth passes, nonlinear and GMRES iterations, operator builds, wall and
+CPU time, peak memory and the errors against the scene's closed form at the end, then the
+cost exponent between consecutive sizes (log CPU ratio over log elements ratio), and saves
+a plot of CPU time against elements (``benchmarks/scaling.png``).
+"""
+import argparse
+import json
+import math
+import os
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+
+_RUN = """
+import sys
+from hmatddm.app.cli import main
+sys.exit(main(sys.argv[1:]))
+"""
+
+
+def run(scene, h, steps, folder):
+    """One run in a child process: its summary totals, wall and CPU time, peak memory."""
+    out = os.path.join(folder, f"{scene}-{h}-{steps}")
+    arguments = ["run", scene, "--out", out, "--quiet", "--set", f"initial_fracture[0].element_size={h}"]
+    if steps == "auto":
+        arguments += ["--set", "numerics.time_step=auto"]
+    environment = dict(os.environ, PYTHONPATH=os.pathsep.join([ROOT, os.environ.get("PYTHONPATH", "")]))
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    start = time.perf_counter()
+    subprocess.run([sys.executable, "-c", _RUN] + arguments, env=environment, check=True)
+    wall = time.perf_counter() - start
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    summary = json.load(open(os.path.join(out, "summary.json")))
+    records = summary["steps"]
+
+    def total(key):
+        return sum(record.get(key) or 0 for record in records)
+
+    error = summary["reference"][-1]["relative_error"] if summary.get("reference") else {}
+    return dict(scene=scene, h=h, steps=steps, elements=records[-1]["n_elements"], n_steps=len(records),
+                passes=total("growth_passes"), nonlinear=total("nonlinear_iterations"),
+                gmres=total("linear_iterations"), builds=total("operator_builds"), wall=wall,
+                cpu=(after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime),
+                peak_mb=after.ru_maxrss / 1024.0, error=error)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--scenes", default="radial-k")
+    parser.add_argument("--sizes", default="1,0.5,0.25", help="element sizes h (m)")
+    parser.add_argument("--steps", default="fixed,auto", help="step rules: fixed, auto or both")
+    parser.add_argument("--plot", default=os.path.join(HERE, "scaling.png"))
+    args = parser.parse_args()
+    sys.path.insert(0, HERE)
+    from _common import machine, markdown_table
+
+    print(f"Machine: {machine()}", flush=True)
+    rows = []
+    with tempfile.TemporaryDirectory() as folder:
+        for scene in args.scenes.split(","):
+            for h in [float(s) for s in args.sizes.split(",")]:
+                for steps in args.steps.split(","):
+                    rows.append(run(scene, h, steps, folder))
+                    print(rows[-1], flush=True)
+    header = ["scene", "h (m)", "steps rule", "elements", "steps", "growth passes", "nonlinear its", "GMRES its",
+              "builds", "wall (s)", "CPU (s)", "peak RSS (MB)", "R error", "w0 error", "p error",
+              "CPU exponent vs previous h"]
+    body = []
+    for row in rows:
+        previous = [r for r in rows if r["scene"] == row["scene"] and r["steps"] == row["steps"]
+                    and r["elements"] < row["elements"]]
+        exponent = ""
+        if previous:
+            p = max(previous, key=lambda r: r["elements"])
+            exponent = f"{math.log(row['cpu'] / p['cpu']) / math.log(row['elements'] / p['elements']):.2f}"
+        error = row["error"]
+        body.append([row["scene"], f"{row['h']:g}", row["steps"], row["elements"], row["n_steps"], row["passes"],
+                     row["nonlinear"], row["gmres"], row["builds"], f"{row['wall']:.1f}", f"{row['cpu']:.1f}",
+                     f"{row['peak_mb']:.0f}"] + [f"{100 * error[k]:+.2f}%" if k in error else "-"
+                                                for k in ("radius", "max_opening", "net_pressure")] + [exponent])
+    print()
+    print(markdown_table(header, body))
+    print(f"Calibration at the end: {machine()}")
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        return
+    figure, axes = plt.subplots(figsize=(6, 4))
+    for scene in args.scenes.split(","):
+        for steps in args.steps.split(","):
+            chosen = [r for r in rows if r["scene"] == scene and r["steps"] == steps]
+            axes.loglog([r["elements"] for r in chosen], [r["cpu"] for r in chosen], "o-", label=f"{scene}, {steps}")
+    axes.set_xlabel("elements at the end")
+    axes.set_ylabel("CPU time of the whole run (s)")
+    axes.legend()
+    axes.grid(True, which="both", alpha=0.3)
+    figure.tight_layout()
+    figure.savefig(args.plot, dpi=120)
+    print(f"plot: {args.plot}")
+
+
+if __name__ == "__main__":
+    main()

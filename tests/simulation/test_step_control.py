@@ -1,0 +1,108 @@
+"""Time steps that follow the front (numerics.time_step = "auto",
+hmatddm/simulation/step_control.py): the controller, the front count, bad settings, a
+KGD run against its closed form and the fixed-step run, and a resume that takes the
+same steps."""
+import numpy as np
+import pytest
+
+import hmatddm as hd
+from hmatddm.errors import InputError
+from hmatddm.mesh import topology
+from hmatddm.scene import build_simulation, load_scene
+from hmatddm.simulation.step_control import GROWTH, StepControl, advance_of_step, front_elements
+
+KGD = dict(shear_modulus=10e9, poisson_ratio=0.25, toughness=5e6, viscosity=1e-4, rate=5e-4)
+
+
+def kgd(time_step="auto", checkpoint_dir=None, **control):
+    mat = hd.Elastic(KGD["shear_modulus"], KGD["poisson_ratio"])
+    mesh = hd.mesh.line([-0.375, 0], [0.375, 0], 3)
+    return hd.Simulation(mesh, mat, hd.Fluid(KGD["viscosity"], 4.5e-10), [hd.Cluster((0, 0), KGD["rate"], 0.01)],
+                         far_field_stress=np.diag([0.0, -0.5e6]), time_step=time_step,
+                         propagation=hd.Propagation(toughness=KGD["toughness"]), initial_pressure=0.6e6,
+                         initial_opening=1e-5, backend="dense", checkpoint_dir=checkpoint_dir,
+                         step_control=StepControl(**control) if control else None)
+
+
+def test_the_next_step_follows_the_front_within_its_bounds():
+    control = StepControl(advance=1.0, first=0.1, minimum=0.05, maximum=3.0)
+    assert control.next_step(1.0, 1.0) == 1.0           # on target
+    assert control.next_step(1.0, 4.0) == 1.0 / GROWTH  # too fast: at most halved
+    assert control.next_step(1.0, 0.8) == pytest.approx(1.25)
+    assert control.next_step(1.0, 0.0) == GROWTH        # no growth: doubled
+    assert control.next_step(2.0, 0.0) == 3.0           # ... up to the longest step
+    assert control.next_step(0.06, 10.0) == 0.05        # ... down to the shortest
+
+
+def test_front_elements_are_those_with_an_uncovered_edge():
+    mesh = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 3.0, 3.0, 3, 3)
+    faces = topology.element_faces(mesh, topology.element_edges(mesh, 1.0))
+    assert front_elements(faces, mesh.n_elements, 4) == 8  # all but the centre
+    assert advance_of_step(16, 8) == 2.0 and advance_of_step(3, 0) == 0.0
+
+
+@pytest.mark.parametrize("settings, key", [
+    (dict(advance=0.0), "step_advance"), (dict(advance=-1.0), "step_advance"),
+    (dict(minimum=-1.0), "min_time_step"), (dict(maximum=0.0), "max_time_step"),
+    (dict(first=0.0), "first_time_step"), (dict(minimum=2.0, maximum=1.0), "min_time_step"),
+    (dict(first=5.0, maximum=1.0), "first_time_step"),
+])
+def test_bad_step_settings_are_refused_naming_the_key(settings, key):
+    with pytest.raises(InputError, match=key):
+        StepControl(**settings)
+
+
+def test_bad_step_settings_in_a_scene_name_the_key():
+    with pytest.raises(InputError, match="numerics.step_advance"):
+        load_scene("kgd", overrides=["numerics.time_step=auto", "numerics.step_advance=0"])
+    with pytest.raises(InputError, match="numerics.time_step"):
+        load_scene("kgd", overrides=["numerics.time_step=soon"])
+    with pytest.raises(InputError, match="step_control"):
+        kgd(time_step=1.0, advance=1.0)
+
+
+def test_auto_steps_reproduce_the_closed_form_and_the_fixed_steps():
+    fixed = kgd(time_step=1.0).run(20.0)
+    auto_simulation = kgd(first=0.1)
+    auto = auto_simulation.run(20.0)
+    steps = np.array([r["time_step"] for r in auto])
+    assert auto[-1]["time"] == 20.0 and np.isclose(steps.sum(), 20.0)
+    assert steps[0] == 0.1 and steps.max() <= GROWTH * 20.0
+    assert np.all(steps[1:-1] <= GROWTH * steps[:-2] + 1e-12)
+    mat = auto_simulation.material
+    length, width, _ = hd.analytical.kgd_k_vertex(20.0, KGD["rate"], KGD["toughness"], mat)
+    for records in (fixed, auto):
+        assert abs(records[-1]["half_length"] / length - 1) < 0.06
+        assert abs(records[-1]["max_opening"] / width - 1) < 0.06
+    assert abs(auto[-1]["max_opening"] / fixed[-1]["max_opening"] - 1) < 0.03
+    # the front crosses about one element per step: growth passes stay few per step
+    growing = [r for r in auto if r["elements_added"] > 0]
+    assert np.mean([r["growth_passes"] for r in growing]) <= 3
+
+
+class _Stop(Exception):
+    pass
+
+
+def test_a_run_stopped_after_a_checkpoint_resumes_with_the_same_steps(tmp_path):
+    full = kgd(first=0.1).run(12.0)
+
+    def stop_at_step_6(simulation, record):  # the checkpoint of step 6 is on disk
+        if record["step"] == 6:
+            raise _Stop
+
+    with pytest.raises(_Stop):
+        kgd(first=0.1, checkpoint_dir=tmp_path).run(12.0, callback=stop_at_step_6)
+    records = kgd(first=0.1, checkpoint_dir=tmp_path).run(12.0, resume=True)
+    assert [r["time"] for r in records] == [r["time"] for r in full]
+    assert [r["time_step"] for r in records] == [r["time_step"] for r in full]
+    assert [r["max_opening"] for r in records] == [r["max_opening"] for r in full]
+
+
+def test_a_scene_runs_with_auto_steps(tmp_path):
+    scene = load_scene("kgd", overrides=["numerics.time_step=auto", "numerics.first_time_step=0.5",
+                                         "numerics.end_time=6"])
+    simulation = build_simulation(scene.data)
+    records = simulation.run(6.0)
+    assert simulation.step_control.first == 0.5 and records[0]["time_step"] == 0.5
+    assert records[-1]["time"] == 6.0
