@@ -16,7 +16,6 @@ import argparse
 import json
 import math
 import os
-import resource
 import subprocess
 import sys
 import tempfile
@@ -39,11 +38,13 @@ def run(scene, h, steps, folder):
     if steps == "auto":
         arguments += ["--set", "numerics.time_step=auto"]
     environment = dict(os.environ, PYTHONPATH=os.pathsep.join([ROOT, os.environ.get("PYTHONPATH", "")]))
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
-    subprocess.run([sys.executable, "-c", _RUN] + arguments, env=environment, check=True)
+    child = subprocess.Popen([sys.executable, "-c", _RUN] + arguments, env=environment)
+    _, status, usage = os.wait4(child.pid, 0)  # this child's own CPU time and peak memory
+    child.returncode = os.waitstatus_to_exitcode(status)
     wall = time.perf_counter() - start
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    if child.returncode != 0:
+        raise RuntimeError(f"hmatddm {' '.join(arguments)} exited {child.returncode}")
     summary = json.load(open(os.path.join(out, "summary.json")))
     records = summary["steps"]
 
@@ -54,8 +55,7 @@ def run(scene, h, steps, folder):
     return dict(scene=scene, h=h, steps=steps, elements=records[-1]["n_elements"], n_steps=len(records),
                 passes=total("growth_passes"), nonlinear=total("nonlinear_iterations"),
                 gmres=total("linear_iterations"), builds=total("operator_builds"), wall=wall,
-                cpu=(after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime),
-                peak_mb=after.ru_maxrss / 1024.0, error=error)
+                cpu=usage.ru_utime + usage.ru_stime, peak_mb=usage.ru_maxrss / 1024.0, error=error)
 
 
 def main():
