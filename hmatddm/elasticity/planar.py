@@ -158,6 +158,12 @@ class PlanarElasticityOperator(ElasticityOperator):
         return hmatrix
 
     @property
+    def border_entries_per_pair(self):
+        """Border entries a grown mesh stores per (old, new) element pair: 1 for the opening
+        part, 4 more once the shear part is built (the whole operator would store 9)."""
+        return 1 + (0 if self._shear is None else 4)
+
+    @property
     def shear_hmatrix(self):
         """The shear operator ``A_ss`` (2N x 2N), None until a product needed it."""
         return self._shear

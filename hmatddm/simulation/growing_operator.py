@@ -48,7 +48,8 @@ class GrowingOperator:
         if extends and n == base.mesh.n_elements:
             operator = base
         elif (extends and self.operator_settings.backend == "hmatrix"
-              and self.rebuild_settings.border_fits(base.mesh.n_elements, n - base.mesh.n_elements, base.dof)):
+              and self.rebuild_settings.border_fits(base.mesh.n_elements, n - base.mesh.n_elements, base.dof,
+                                                    getattr(base, "border_entries_per_pair", None))):
             # the border blocks of the elements the last operator had are copied, not re-evaluated
             grown = (PlanarExtendedOperator if isinstance(base, PlanarElasticityOperator) and is_planar(mesh)
                      else ExtendedElasticityOperator)

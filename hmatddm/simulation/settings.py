@@ -48,10 +48,13 @@ class RebuildSettings:
         object.__setattr__(self, "rebuild_fraction", fraction)
         object.__setattr__(self, "max_border_bytes", finite_scalar("max_border_bytes", self.max_border_bytes))
 
-    def border_fits(self, compressed, added, dof):
+    def border_fits(self, compressed, added, dof, entries_per_pair=None):
         """Whether ``added`` elements may join ``compressed`` ones (``dof`` unknowns per
-        element) as exact border blocks."""
-        border_bytes = 8.0 * dof * dof * (2 * compressed * added + added * added)
+        element) as exact border blocks; ``entries_per_pair``: the border entries an element
+        pair stores (default ``dof**2``; a planar crack's split operator stores 1 for its
+        opening part, 4 more once its shear part is built)."""
+        entries = dof * dof if entries_per_pair is None else entries_per_pair
+        border_bytes = 8.0 * entries * (2 * compressed * added + added * added)
         return added <= self.rebuild_fraction * compressed and border_bytes <= self.max_border_bytes
 
 

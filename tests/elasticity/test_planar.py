@@ -183,3 +183,14 @@ def test_a_resumed_planar_run_repeats_the_uninterrupted_one(tmp_path, monkeypatc
     assert resumed[-1]["n_elements"] == whole[-1]["n_elements"] > 9
     for a, b in zip(whole, resumed):
         assert a["wellbore_pressure"] == b["wellbore_pressure"] and a["max_opening"] == b["max_opening"]
+
+
+def test_the_border_of_a_grown_planar_crack_is_counted_by_the_parts_built():
+    """A grown planar operator's border stores 1 entry per element pair for the opening
+    part (and 4 more with the shear part), not the whole tensor's 9: the rebuild rule
+    (RebuildSettings.border_fits) counts what is stored."""
+    mesh = _mesh("horizontal")
+    op = PlanarElasticityOperator(mesh, MATERIAL, eps=1e-6)
+    assert op.border_entries_per_pair == 1
+    op @ np.ones(op.shape[1])  # a product with shear: the shear part is built
+    assert op.shear_hmatrix is not None and op.border_entries_per_pair == 5

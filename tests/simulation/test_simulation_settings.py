@@ -49,3 +49,4 @@ def test_border_blocks_fit_by_count_and_by_bytes():
     assert rebuild.border_fits(100, 25, dof=2)      # 25 <= 0.25 * 100, bytes exactly at the limit
     assert not rebuild.border_fits(100, 26, dof=2)  # too many
     assert not rebuild.border_fits(100, 25, dof=3)  # too many bytes
+    assert rebuild.border_fits(100, 25, dof=3, entries_per_pair=4)  # a planar split border: fewer entries
