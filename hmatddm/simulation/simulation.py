@@ -67,8 +67,9 @@ class Simulation:
     far_field_stress : (d, d) array
         In-situ stress tensor, tension positive (a 8 MPa minimum horizontal stress
         along x is ``-8e6`` in entry ``[0, 0]``), Pa.
-    time_step : float
-        dt, s.
+    time_step : float or "auto"
+        dt, s; ``"auto"``: each step chosen so that the front crosses about
+        ``step_control.advance`` element rows (:mod:`~hmatddm.simulation.step_control`).
     propagation : Propagation or None
         None: the mesh is fixed.
     leak_off : LeakOff
@@ -107,6 +108,10 @@ class Simulation:
     max_elements : int or None
         A step whose growth would take the mesh past it raises SizeLimitError (a
         resource limit: a run stopped by it resumes with a higher one).
+    step_control : StepControl or None
+        With ``time_step="auto"``: the target advance and the bounds of the steps
+        (:class:`hmatddm.simulation.StepControl`; default: one element row per step,
+        first step 0.1 s, steps of at least 1 ms).
     operator_settings : OperatorSettings or None
         Or its keywords ``backend, eps, eta, leaf_size, singular_correction, alpha``; passed to
         :class:`~hmatddm.ElasticityOperator`.
@@ -401,7 +406,11 @@ class Simulation:
             # the front at the step's end: the topology of the last solve's mesh, already computed
             faces = mesh_topology(trial.mesh, self.height)[1]
             front = front_elements(faces, trial.mesh.n_elements, 4 if trial.mesh.dim == 3 else 2)
-            next_step = self.step_control.next_step(dt, advance_of_step(tally.elements_added, front))
+            advance = advance_of_step(tally.elements_added, front)
+            planned = begin.time_step
+            if dt < planned:  # shortened to end at a run's end time: the front's pace over the planned step
+                advance *= planned / dt
+            next_step = self.step_control.next_step(max(dt, planned), advance)
         return replace(trial, time=t_new, step=begin.step + 1, relaxation=next_relaxation, time_step=next_step,
                        injected_volume=begin.injected_volume + dt * sum(c.rate for c in self.clusters),
                        leaked_volume=begin.leaked_volume + float(np.sum(leak)) * dt, failed=failed)

@@ -106,3 +106,17 @@ def test_a_scene_runs_with_auto_steps(tmp_path):
     records = simulation.run(6.0)
     assert simulation.step_control.first == 0.5 and records[0]["time_step"] == 0.5
     assert records[-1]["time"] == 6.0
+
+
+def test_a_run_continued_past_its_end_time_keeps_the_pace_of_its_steps():
+    """A step shortened to end at ``end_time`` does not shrink the next run's steps."""
+    reference = kgd(first=0.1).run(8.0)
+    k = len(reference) // 2
+    planned = reference[k]["time_step"]
+    end = reference[k - 1]["time"] + 0.05 * planned  # step k cut to 5% of its length
+    simulation = kgd(first=0.1)
+    simulation.run(end)
+    assert simulation.records[-1]["time_step"] == pytest.approx(0.05 * planned)
+    simulation.run(8.0)
+    after = [r["time_step"] for r in simulation.records if r["time"] > end]
+    assert after[0] >= 0.5 * planned  # without the planned step: at most 2 x 5%
