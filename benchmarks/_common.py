@@ -62,6 +62,14 @@ def markdown_table(header, rows):
     return "\n".join(lines)
 
 
+def print_table(header, rows):
+    """Print a blank line, the markdown table and the machine's calibration now (the
+    closing lines of a benchmark: its calibration at the start and at the end)."""
+    print()
+    print(markdown_table(header, rows))
+    print(f"Calibration at the end: {machine()}")
+
+
 def peak_rss_bytes():
     """Peak resident memory of this process so far."""
     import resource

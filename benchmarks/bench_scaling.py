@@ -66,7 +66,7 @@ def main():
     parser.add_argument("--plot", default=os.path.join(HERE, "scaling.png"))
     args = parser.parse_args()
     sys.path.insert(0, HERE)
-    from _common import machine, markdown_table
+    from _common import machine, print_table
 
     print(f"Machine: {machine()}", flush=True)
     rows = []
@@ -92,9 +92,7 @@ def main():
                      row["nonlinear"], row["gmres"], row["builds"], f"{row['wall']:.1f}", f"{row['cpu']:.1f}",
                      f"{row['peak_mb']:.0f}"] + [f"{100 * error[k]:+.2f}%" if k in error else "-"
                                                 for k in ("radius", "max_opening", "net_pressure")] + [exponent])
-    print()
-    print(markdown_table(header, body))
-    print(f"Calibration at the end: {machine()}")
+    print_table(header, body)
     try:
         import matplotlib
 

@@ -46,7 +46,7 @@ def main():
     parser.add_argument("--sizes", default="10000,40000,100000")
     args = parser.parse_args()
     sys.path.insert(0, HERE)
-    from _common import machine, markdown_table
+    from _common import machine, print_table
 
     print(f"Machine: {machine()}", flush=True)
     rows = []
@@ -59,9 +59,7 @@ def main():
              f"{r['solve_wall']:.1f} / {r['solve_cpu']:.1f}", r["iterations"], f"{r['residual']:.1e}",
              f"{(r['setup_wall'] + r['solve_wall']) / r['build_wall']:.2f}", f"{r['solve_wall'] / r['build_wall']:.2f}"]
             for r in rows]
-    print()
-    print(markdown_table(header, body))
-    print(f"Calibration at the end: {machine()}")
+    print_table(header, body)
 
 
 if __name__ == "__main__":

@@ -163,7 +163,7 @@ def main():
     parser.add_argument("--cache-check", action="store_true", help="reproduce issue 40 (see the docstring)")
     args = parser.parse_args()
     sys.path.insert(0, HERE)
-    from _common import machine, markdown_table
+    from _common import machine, markdown_table, print_table
 
     print(f"Machine: {machine()}", flush=True)
     if args.cache_check:
@@ -185,9 +185,7 @@ def main():
              f"{r['wall_1'] / (r['threads'] * r['wall_t']):.2f}", f"{1e3 * r['cpu_1']:.2f}",
              f"{1e3 * r['cpu_t']:.2f}", f"{r['load_1']:.2f} / {r['load_t']:.2f}", "yes" if r["identical"] else "NO"]
             for r in rows]
-    print()
-    print(markdown_table(header, body))
-    print(f"Calibration at the end: {machine()}")
+    print_table(header, body)
 
 
 if __name__ == "__main__":
