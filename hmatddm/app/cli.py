@@ -173,8 +173,10 @@ def _run(args):
     run = SceneRun(scene, out, resume=args.resume, overwrite=args.overwrite, quiet=args.quiet)
     if not args.quiet:
         numerics = scene.numerics
+        dt = (f"dt = auto from {numerics['first_time_step']:g} s" if numerics["time_step"] == "auto" else
+              f"dt = {numerics['time_step']:g} s")
         print(f"hmatddm: running {scene.name!r} ({scene.source}) to t = {numerics['end_time']:g} s, "
-              f"dt = {numerics['time_step']:g} s, backend {numerics['backend']}, into {out}", file=sys.stderr)
+              f"{dt}, backend {numerics['backend']}, into {out}", file=sys.stderr)
     try:
         summary = run.execute()
     except KeyboardInterrupt:

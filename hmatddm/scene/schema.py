@@ -281,6 +281,15 @@ def validate(raw, name=None):
     if numerics["min_relaxation"] > numerics["relaxation"]:
         raise InputError(f"numerics.min_relaxation must be <= numerics.relaxation = {show(numerics['relaxation'])}, "
                          f"got {show(numerics['min_relaxation'])}")
+    if numerics["time_step"] == "auto":  # the bounds of front-following steps (hmatddm.simulation.step_control)
+        longest = numerics.get("max_time_step", math.inf)
+        if numerics["min_time_step"] > longest:
+            raise InputError(f"numerics.min_time_step must be <= numerics.max_time_step = {show(longest)} s, "
+                             f"got {show(numerics['min_time_step'])}")
+        if not numerics["min_time_step"] <= numerics["first_time_step"] <= longest:
+            raise InputError(f"numerics.first_time_step must lie in [numerics.min_time_step, numerics.max_time_step] "
+                             f"= [{show(numerics['min_time_step'])}, {show(longest)}] s, "
+                             f"got {show(numerics['first_time_step'])}")
     propagation = scene.get("propagation")
     if propagation is not None:
         if "bounds" in propagation and len(propagation["bounds"]) > dim:

@@ -379,3 +379,12 @@ def test_simulation_run_prints_progress_when_asked(tiny):
     assert "t 2/2 s" in lines[-1] and "elements" in lines[-1]
     quiet = hs.build_simulation(hs.load_scene(str(tiny)).data)
     assert len(quiet.run(1.0)) == 1  # silent by default
+
+
+def test_run_with_auto_steps_says_so_and_records_the_steps(tmp_path, capsys):
+    out = tmp_path / "auto"
+    assert cli.main(["run", "kgd", "--out", str(out), "--set", "numerics.end_time=2",
+                     "--set", "numerics.time_step=auto", "--set", "numerics.first_time_step=0.5"]) == cli.EXIT_OK
+    assert "dt = auto from 0.5 s" in capsys.readouterr().err
+    steps = json.loads((out / "summary.json").read_text())["steps"]
+    assert steps[0]["time_step"] == 0.5 and steps[-1]["time"] == 2.0

@@ -59,6 +59,11 @@ def test_bad_step_settings_in_a_scene_name_the_key():
         load_scene("kgd", overrides=["numerics.time_step=soon"])
     with pytest.raises(InputError, match="step_control"):
         kgd(time_step=1.0, advance=1.0)
+    with pytest.raises(InputError, match="numerics.first_time_step must lie in"):  # refused before a build
+        load_scene("kgd", overrides=["numerics.time_step=auto", "numerics.min_time_step=2"])
+    with pytest.raises(InputError, match="numerics.min_time_step must be <= numerics.max_time_step"):
+        load_scene("kgd", overrides=["numerics.time_step=auto", "numerics.min_time_step=2",
+                                     "numerics.max_time_step=1"])
 
 
 def test_auto_steps_reproduce_the_closed_form_and_the_fixed_steps():
