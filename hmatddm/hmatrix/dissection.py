@@ -92,6 +92,8 @@ def nested_dissection(tree, indptr, indices, depth):
     block_row = np.repeat(np.arange(n, dtype=np.int64), counts)
     row_position = tree_position[block_row]
     col_position = tree_position[np.asarray(indices, dtype=np.int64)]
+    by_row = np.argsort(row_position, kind="stable")  # a cluster's blocks: one slice of these
+    row_position, col_position = row_position[by_row], col_position[by_row]
     in_separator = np.zeros(n, dtype=bool)  # by tree position
     # cuts[k]: (cluster, separator positions) of the cuts at depth k
     cuts = [[] for _ in range(depth)]
@@ -105,9 +107,10 @@ def nested_dissection(tree, indptr, indices, depth):
         # the first half's elements coupled to the second half, neither in a separator yet
         a0, a1 = tree.start[first], tree.stop[first]
         b0, b1 = tree.start[second], tree.stop[second]
-        across = ((row_position >= a0) & (row_position < a1) & (col_position >= b0) & (col_position < b1))
-        across &= ~in_separator[row_position] & ~in_separator[col_position]
-        separator = np.unique(row_position[across])
+        blocks = slice(*np.searchsorted(row_position, [a0, a1]))  # the rows of the first half
+        rows, cols = row_position[blocks], col_position[blocks]
+        across = (cols >= b0) & (cols < b1) & ~in_separator[rows] & ~in_separator[cols]
+        separator = np.unique(rows[across])
         in_separator[separator] = True
         cuts[level].append(separator)
         visit(first, level + 1)

@@ -42,6 +42,7 @@ from .records import RECORD_KEYS, StepTally, output_view, step_record
 from .settings import group_options
 from .state import Origin, State, StepStart, mesh_arrays
 from .step_control import StepControl, advance_of_step, front_elements
+from .linking import with_links
 from .step_solve import mesh_topology
 
 __all__ = ["RECORD_KEYS", "Simulation", "State"]
@@ -404,7 +405,7 @@ class Simulation:
         next_step = begin.time_step
         if self.step_control is not None:
             # the front at the step's end: the topology of the last solve's mesh, already computed
-            faces = mesh_topology(trial.mesh, self.height)[1]
+            faces = with_links(mesh_topology(trial.mesh, self.height)[1], trial.extra_faces)
             front = front_elements(faces, trial.mesh.n_elements, 4 if trial.mesh.dim == 3 else 2)
             advance = advance_of_step(tally.elements_added, front)
             planned = begin.time_step
