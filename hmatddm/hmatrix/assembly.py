@@ -205,7 +205,8 @@ def assemble(generator, tree, blocks, eps, n_threads=None, factor_dtype=np.float
     d, dc = generator.dof, generator.column_dof
     col_tree = tree if col_tree is None else col_tree
     n_threads = numba.get_num_threads() if n_threads is None else int(n_threads)
-    permutation, col_permutation = tree.permutation, col_tree.permutation
+    # the kernel's element indices (the generator's offsets); the stores are laid out by tree order
+    permutation, col_permutation = generator.kernel_rows(tree.permutation), generator.kernel_cols(col_tree.permutation)
     kernel, data = generator.kernel, generator.data
 
     far_rows_start = tree.start[blocks.admissible_rows]

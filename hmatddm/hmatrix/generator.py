@@ -41,6 +41,11 @@ class BlockGenerator:
         The column elements of a rectangular matrix (centres (N_c, dim), radii, unknowns
         per element d_c); None (default): the columns are the row elements (a square
         operator, d_c = d_r).
+    row_offset, col_offset : int >= 0
+        The kernel's index of row element ``i`` is ``row_offset + i`` (of column element
+        ``j``: ``col_offset + j``): a matrix over consecutive slices of the elements of a
+        larger kernel data, e.g. the border blocks between the old and the added elements
+        of a grown mesh (:mod:`hmatddm.elasticity.extended`). Default 0.
     """
 
     kernel: object
@@ -51,6 +56,8 @@ class BlockGenerator:
     col_points: np.ndarray = None
     col_radii: np.ndarray = None
     col_dof: int = None
+    row_offset: int = 0
+    col_offset: int = 0
 
     def __post_init__(self):
         if not hasattr(self.kernel, "py_func"):
@@ -71,6 +78,13 @@ class BlockGenerator:
             object.__setattr__(self, "col_points", col_points)
             object.__setattr__(self, "col_radii", col_radii)
             object.__setattr__(self, "col_dof", col_dof)
+        for name in ("row_offset", "col_offset"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
+                raise InputError(f"{name} must be an integer >= 0, got {value!r}")
+            object.__setattr__(self, name, int(value))
+        if self.col_offset and not self.rectangular:
+            raise InputError("col_offset needs the column elements of a rectangular matrix (col_points)")
 
     @property
     def rectangular(self):
@@ -97,13 +111,23 @@ class BlockGenerator:
         """Shape ``(N*d_r, N_c*d_c)`` of the full matrix."""
         return (self.n_elements * self.dof, self.n_col_elements * self.column_dof)
 
+    def kernel_rows(self, rows):
+        """The kernel's indices (int64, C order) of row elements ``rows``."""
+        rows = np.ascontiguousarray(rows, dtype=np.int64).ravel()
+        return rows + self.row_offset if self.row_offset else rows
+
+    def kernel_cols(self, cols):
+        """The kernel's indices (int64, C order) of column elements ``cols``."""
+        cols = np.ascontiguousarray(cols, dtype=np.int64).ravel()
+        offset = self.col_offset if self.rectangular else self.row_offset
+        return cols + offset if offset else cols
+
     def fill(self, rows, cols):
         """Return the dense sub-matrix for element lists ``rows`` x ``cols``.
 
         Costs one kernel call: O(len(rows) * len(cols) * d_r * d_c).
         """
-        rows = np.ascontiguousarray(rows, dtype=np.int64).ravel()
-        cols = np.ascontiguousarray(cols, dtype=np.int64).ravel()
+        rows, cols = self.kernel_rows(rows), self.kernel_cols(cols)
         out = np.empty((rows.size * self.dof, cols.size * self.column_dof), dtype=np.float64)
         if out.size:
             self.kernel(self.data, rows, cols, out)

@@ -23,7 +23,7 @@ from ..errors import InputError
 
 from .assembly import assemble
 from .block_tree import block_tree
-from .cluster_tree import cluster_tree
+from .cluster_tree import ClusterTree, cluster_tree
 from .generator import BlockGenerator
 from .near_field import _bsr_pass, _csr_pass, _element_norms, _sort_block_rows
 from .storage import KIND_DENSE, KIND_LOWRANK
@@ -105,7 +105,7 @@ class HMatrix(LinearOperator):
     # ------------------------------------------------------------------ construction
     @classmethod
     def build(cls, generator, eps=1e-4, eta=3.0, leaf_size=64, factor_dtype=None, check_finite=False, groups=None,
-              col_leaf_size=None, near_dtype=np.float64, boxes="axis"):
+              col_leaf_size=None, near_dtype=np.float64, boxes="axis", row_tree=None, col_tree=None):
         """Cluster, partition and compress the matrix of ``generator``.
 
         Parameters
@@ -146,6 +146,12 @@ class HMatrix(LinearOperator):
             Leaf size of the column tree of a rectangular generator (default
             ``leaf_size``); the row tree is built on ``generator.points``, the column
             tree on ``generator.col_points``.
+        row_tree, col_tree : ClusterTree, optional
+            Cluster trees already built on ``generator.points`` (and, for a rectangular
+            generator, ``generator.col_points``), used instead of new ones: the border
+            blocks of a grown mesh reuse the tree of the operator they border
+            (:mod:`hmatddm.elasticity.extended`). ``leaf_size`` / ``groups`` then apply
+            only to the trees that are built.
 
         Cost: O(N log N) for the trees, kernel evaluations of the near field plus
         O((m + n) k) per far block, run on numba's thread count.
@@ -158,10 +164,16 @@ class HMatrix(LinearOperator):
         dtype, fixed_point = _factor_format(factor_dtype, eps)
         near_dtype = _float_dtype(near_dtype, "near_dtype")
         started = time.perf_counter()
-        tree = cluster_tree(generator.points, generator.radii, int(leaf_size), groups=groups)
+        given_col_tree = col_tree
+        tree = (cluster_tree(generator.points, generator.radii, int(leaf_size), groups=groups) if row_tree is None
+                else _checked_tree(row_tree, generator.n_elements, "row_tree"))
         col_tree = tree
         if generator.rectangular:
-            col_tree = cluster_tree(generator.col_points, generator.col_radii, int(col_leaf_size))
+            col_tree = (cluster_tree(generator.col_points, generator.col_radii, int(col_leaf_size))
+                        if given_col_tree is None else
+                        _checked_tree(given_col_tree, generator.n_col_elements, "col_tree"))
+        elif given_col_tree is not None:
+            raise InputError("col_tree is for a rectangular generator (col_points); a square one has one tree")
         blocks = block_tree(tree, float(eta), col_tree=col_tree, boxes=boxes)
         try:
             storage = assemble(generator, tree, blocks, float(eps), factor_dtype=dtype, col_tree=col_tree,
@@ -425,6 +437,14 @@ class HMatrix(LinearOperator):
             f"eta={self.eta:g} leaf_size={self.leaf_size} compression={st['compression']:.2f} "
             f"max_rank={st['max_rank']}>"
         )
+
+
+def _checked_tree(tree, n_elements, name):
+    """``tree`` when it is a ClusterTree over ``n_elements`` elements, else InputError."""
+    if not isinstance(tree, ClusterTree) or tree.n_elements != n_elements:
+        raise InputError(f"{name} must be a ClusterTree over the generator's {n_elements} elements, got "
+                         f"{type(tree).__name__}" + (f" over {tree.n_elements}" if isinstance(tree, ClusterTree) else ""))
+    return tree
 
 
 def _unknowns(permutation, dof):

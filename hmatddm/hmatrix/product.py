@@ -108,6 +108,8 @@ def build_free_product(generator, x, eps, eta=3.0, leaf_size=64, col_leaf_size=N
     col_leaf_size = leaf_size if col_leaf_size is None else col_leaf_size
     _check_parameters(eps, eta, leaf_size)
     _check_parameters(eps, eta, col_leaf_size)
+    if generator.row_offset or generator.col_offset:  # the driver indexes x and y by the kernel's indices
+        raise InputError("build_free_product takes a generator without row_offset or col_offset")
     d, dc = generator.dof, generator.column_dof
     tree = cluster_tree(generator.points, generator.radii, int(leaf_size))
     col_tree = tree
