@@ -12,6 +12,12 @@ the base operator once the border is large (see ``Simulation``). The preconditio
 is block lower-triangular: the base near-field preconditioner for the old unknowns,
 then an exact LU of ``A_nn`` for the new ones.
 
+Large borders are compressed: once the base is an H-matrix of a few thousand elements,
+a chunk of added elements gets ``A_on`` and ``A_no`` as rectangular H-matrices (the base's
+cluster tree against a tree of the chunk, same ``eps`` and ``eta`` as the base), so a
+border costs ``O((N + m) k)`` entries instead of ``N m`` and a mesh can grow by a large
+fraction of itself before the base is rebuilt (see :data:`COMPRESS_MIN_BASE`).
+
 Growth passes share work (a pass adds a few elements to the last pass's mesh): the border
 is kept as one chunk of ``A_on`` columns and ``A_no`` rows per batch of added elements,
 so the chunks of the elements a pass shares with the previous one are reused as they are
@@ -32,15 +38,29 @@ from ..errors import InputError
 from ..hmatrix.preconditioners import DEFAULT_ILU
 from ..kernels.drivers import traction_block
 from .inverse import solve_with_inverse
-from .operator import ElasticityOperator, influence_data, refuse_singular
+from .operator import ElasticityOperator, ProductCounter, influence_data, refuse_singular
 
 
 #: Border blocks the block-triangular preconditioner keeps (relative Frobenius norm, as the
 #: base's near-field block ILU keeps its blocks).
 NEAR_THRESHOLD = DEFAULT_ILU["threshold"]
 
+#: A chunk of added elements gets compressed border blocks (rectangular H-matrices over
+#: the base's cluster tree) when the base is an H-matrix of at least this many elements
+#: and the chunk's dense border would hold at least :data:`COMPRESS_MIN_PAIRS` element
+#: pairs; smaller chunks stay dense (an ACA of a few columns saves nothing).
+COMPRESS_MIN_BASE = 2048
+COMPRESS_MIN_PAIRS = 2**18
 
-class ExtendedElasticityOperator(LinearOperator):
+#: The near field of a compressed chunk's rows (the blocks :data:`NEAR_THRESHOLD` keeps)
+#: is looked for among the old elements within this many times the sum of the two largest
+#: element radii. On a planar square grid the kept blocks lie within 3.2 element sides
+#: (4.5 radii) of the receiver, for the opening, shear and whole-tensor kernels alike; the
+#: search reaches 6 x 2 radii = 8.5 sides.
+NEAR_SEARCH_RADII = 6.0
+
+
+class ExtendedElasticityOperator(ProductCounter, LinearOperator):
     """``base`` (an ElasticityOperator of the first ``n0`` elements of ``mesh``) plus
     exact border blocks for elements ``n0..N-1``.
 
@@ -75,14 +95,14 @@ class ExtendedElasticityOperator(LinearOperator):
         data = influence_data(mesh, base.material, base.singular_correction, base.alpha,
                               n_images=base.stats.get("n_images"))  # layered: the base's images
         self._data = data
-        self.n_reused = self._shared_new_elements(previous)
         shares = isinstance(previous, ExtendedElasticityOperator) and previous.base is base
         self._base_blocks = previous._base_blocks if shares else None  # the base's element self blocks
-        self.chunks, self.nn = self._border_blocks(previous, self.n_reused)
+        self._base_search = previous._base_search if shares else None  # a k-d tree of the base's centres
+        self.chunks, self.nn, self.n_reused = self._border_blocks(previous, self._shared_new_elements(previous))
         self._base_product = previous._base_product if shares else _LastProduct(base.matvec)
         self._nn_levels = GrowingBlockLU(self.nn, previous._nn_levels.prefix(self.n_reused * self.dof)
                                          if self.n_reused else None)
-        self.border_bytes = sum(c.on_t.nbytes + c.no.nbytes for c in self.chunks) + self.nn.nbytes
+        self.border_bytes = sum(chunk.nbytes for chunk in self.chunks) + self.nn.nbytes
 
     def _shared_new_elements(self, previous):
         """How many of ``previous``'s border elements are elements ``n0, n0 + 1, ...`` of
@@ -106,48 +126,134 @@ class ExtendedElasticityOperator(LinearOperator):
         return max(shared - n0, 0)
 
     def _border_blocks(self, previous, reused):
-        """(chunks, A_nn): the chunks (:class:`BorderChunk`) of the first ``reused`` new
-        elements taken from ``previous`` (views, not copies), one chunk evaluated for the
-        rest; ``A_nn`` with its shared block copied from ``previous``."""
+        """(chunks, A_nn, reused): the chunks (:class:`BorderChunk`) of the first ``reused``
+        new elements taken from ``previous`` (views, not copies; a compressed chunk only
+        whole: ``reused`` drops to its start when the shared run ends inside it), one chunk
+        evaluated for the rest; ``A_nn`` with its shared block copied from ``previous``."""
         d, n0, n = self.dof, self.n_base, self.mesh.n_elements
         old = np.arange(n0, dtype=np.int64)
         new = np.arange(n0, n, dtype=np.int64)
-        added = new[reused:]
         k = reused * d
         chunks = []
-        nn = np.empty((new.size * d, new.size * d))
         if reused:
             for chunk in previous.chunks:
                 if chunk.start >= k:
                     break
                 keep = min(chunk.stop, k) - chunk.start
-                chunks.append(chunk if keep == chunk.stop - chunk.start else
-                              BorderChunk(chunk.start, chunk.start + keep, chunk.on_t[:keep], chunk.no[:keep],
-                                          chunk.near[:keep]))
+                if keep == chunk.stop - chunk.start:
+                    chunks.append(chunk)
+                elif chunk.compressed:
+                    k = chunk.start
+                    break
+                else:
+                    chunks.append(BorderChunk(chunk.start, chunk.start + keep, chunk.on_t[:keep], chunk.no[:keep],
+                                              chunk.near[:keep]))
+            reused = k // d
+        added = new[reused:]
+        nn = np.empty((new.size * d, new.size * d))
+        if reused:
             nn[:k, :k] = previous.nn[:k, :k]
             nn[:k, k:] = self._block(self._data, new[:reused], added)
             nn[k:, :k] = self._block(self._data, added, new[:reused])
         if added.size:
-            on, no = self._block(self._data, old, added), self._block(self._data, added, old)
-            if not (np.all(np.isfinite(on)) and np.all(np.isfinite(no))):
-                refuse_singular()
             nn[k:, k:] = self._block(self._data, added, added)
-            # A_on stored transposed: a product with a few columns of a C-ordered A_on runs
-            # ~1.4x slower (short BLAS rows) than with the rows of its transpose
-            chunks.append(BorderChunk(k, new.size * d, np.ascontiguousarray(on.T), no, self._near_rows(no, nn[k:, k:])))
+            if not np.all(np.isfinite(nn[k:, k:])):
+                refuse_singular()
+            if self._compresses(added.size):
+                chunks.append(self._compressed_chunk(k, added, nn[k:, k:]))
+            else:
+                on, no = self._block(self._data, old, added), self._block(self._data, added, old)
+                if not (np.all(np.isfinite(on)) and np.all(np.isfinite(no))):
+                    refuse_singular()
+                # A_on stored transposed: a product with a few columns of a C-ordered A_on runs
+                # ~1.4x slower (short BLAS rows) than with the rows of its transpose
+                chunks.append(BorderChunk(k, new.size * d, np.ascontiguousarray(on.T), no,
+                                          self._near_rows(no, nn[k:, k:])))
         if not (np.all(np.isfinite(nn[:, k:])) and np.all(np.isfinite(nn[k:]))):
             refuse_singular()
-        return chunks, nn
+        return chunks, nn, reused
+
+    def _compresses(self, m):
+        """Whether a chunk of ``m`` added elements gets compressed border blocks."""
+        return compresses_borders(self.base) and self.n_base * m >= COMPRESS_MIN_PAIRS and m >= 2
+
+    @property
+    def chunk_bytes(self):
+        """Bytes of the border chunks (``A_on`` and ``A_no``, without ``A_nn``)."""
+        return sum(chunk.nbytes for chunk in self.chunks)
+
+    def _compressed_chunk(self, k, added, nn_added):
+        """A :class:`BorderChunk` of the ``added`` elements (unknowns ``k..`` of the new
+        ones) whose ``A_on`` and ``A_no`` are rectangular H-matrices: the rows (columns) of
+        the old elements clustered by the base's tree, the added ones by a tree of their
+        own, compressed with the base's ``eps``, ``eta`` and leaf size."""
+        from ..hmatrix import BlockGenerator, HMatrix
+        from ..hmatrix.cluster_tree import cluster_tree
+
+        base = self.base.hmatrix
+        mesh, d, n0 = self.mesh, self.dof, self.n_base
+        first = int(added[0])
+        if not np.array_equal(added, np.arange(first, first + added.size)):
+            raise AssertionError("added elements are consecutive")  # appended by construction
+        old_points, old_radii = mesh.centers[:n0], mesh.radii[:n0]
+        new_points, new_radii = mesh.centers[added], mesh.radii[added]
+        new_tree = cluster_tree(new_points, new_radii, base.leaf_size)
+        options = dict(eps=base.eps, eta=base.eta, leaf_size=base.leaf_size)
+        try:
+            on = HMatrix.build(BlockGenerator(self._kernel, self._data, old_points, old_radii, d, new_points, new_radii,
+                                              d, row_offset=0, col_offset=first),
+                               row_tree=base.tree, col_tree=new_tree, **options)
+            no = HMatrix.build(BlockGenerator(self._kernel, self._data, new_points, new_radii, d, old_points, old_radii,
+                                              d, row_offset=first, col_offset=0),
+                               row_tree=new_tree, col_tree=base.tree, **options)
+        except InputError:  # NaN or inf in a far block
+            refuse_singular()
+        if not (on.is_finite() and no.is_finite()):
+            refuse_singular()
+        near = self._near_rows_searched(added, nn_added)
+        return BorderChunk(k, k + added.size * d, on, no, near)
+
+    def _near_rows_searched(self, added, nn_added):
+        """The near field of the border rows of ``added`` (as :meth:`_near_rows`), its
+        blocks looked for among the old elements within :data:`NEAR_SEARCH_RADII` element
+        radii (the border itself is compressed)."""
+        import scipy.spatial
+
+        d, n0, mesh = self.dof, self.n_base, self.mesh
+        if self._base_search is None:
+            self._base_search = scipy.spatial.cKDTree(mesh.centers[:n0])
+        reach = NEAR_SEARCH_RADII * (mesh.radii[added] + float(mesh.radii[:n0].max()))
+        candidates = self._base_search.query_ball_point(mesh.centers[added], reach, return_sorted=True)
+        m = added.size
+        old_norms = np.linalg.norm(self._base_diagonal_blocks(), axis=(1, 2))
+        index = np.arange(m)
+        new_norms = np.linalg.norm(nn_added.reshape(m, d, m, d)[index, :, index, :], axis=(1, 2))
+        columns, values, counts = [], [], np.zeros(m, dtype=np.int64)
+        for a in range(m):
+            cols = np.asarray(candidates[a], dtype=np.int64)
+            if cols.size == 0:
+                continue
+            blocks = self._block(self._data, added[a:a + 1], cols).reshape(d, cols.size, d).transpose(1, 0, 2)
+            norms = np.sqrt(np.einsum("jpq,jpq->j", blocks, blocks))
+            keep = norms >= NEAR_THRESHOLD * np.sqrt(new_norms[a] * old_norms[cols])
+            columns.append(cols[keep])
+            values.append(blocks[keep])
+            counts[a] = int(np.count_nonzero(keep))
+        indptr = np.concatenate([[0], np.cumsum(counts)])
+        cols = np.concatenate(columns) if columns else np.zeros(0, dtype=np.int64)
+        blocks = np.concatenate(values) if values else np.zeros((0, d, d))
+        return sp.bsr_matrix((blocks, cols, indptr), shape=(m * d, n0 * d), blocksize=(d, d)).tocsr()
 
     @property
     def on(self):
-        """``A_on`` (old rows, new columns) as one array (assembled from the chunks)."""
-        return np.concatenate([chunk.on_t.T for chunk in self.chunks], axis=1)
+        """``A_on`` (old rows, new columns) as one array (assembled from the chunks;
+        compressed chunks as their H-matrices' dense arrays)."""
+        return np.concatenate([chunk.dense_on() for chunk in self.chunks], axis=1)
 
     @property
     def no(self):
         """``A_no`` (new rows, old columns) as one array (assembled from the chunks)."""
-        return np.concatenate([chunk.no for chunk in self.chunks], axis=0)
+        return np.concatenate([chunk.dense_no() for chunk in self.chunks], axis=0)
 
     def _near_rows(self, no, nn):
         """The near field of the border rows ``no`` (new elements x old elements; ``nn``: the
@@ -183,7 +289,7 @@ class ExtendedElasticityOperator(LinearOperator):
         top, bottom = out[:k], out[k:]
         top[:] = self._base_product(x_old)
         for chunk in self.chunks:
-            top += x_new[chunk.start:chunk.stop] @ chunk.on_t
+            chunk.add_column_product(x_new[chunk.start:chunk.stop], top)
         self._border_rows(x_old, bottom)
         bottom += self.nn @ x_new
         return out
@@ -191,7 +297,7 @@ class ExtendedElasticityOperator(LinearOperator):
     def _border_rows(self, x_old, out):
         """``out = A_no x_old``, chunk by chunk."""
         for chunk in self.chunks:
-            np.dot(chunk.no, x_old, out=out[chunk.start:chunk.stop])
+            chunk.row_product(x_old, out[chunk.start:chunk.stop])
         return out
 
     #: The block-triangular inverse ignores ``A_on``: never exact, a solve iterates.
@@ -250,6 +356,12 @@ class ExtendedElasticityOperator(LinearOperator):
         return self._base_blocks
 
 
+def compresses_borders(base):
+    """Whether the border chunks of operators grown from ``base`` may be compressed: an
+    H-matrix base of at least :data:`COMPRESS_MIN_BASE` elements."""
+    return getattr(base, "hmatrix", None) is not None and base.mesh.n_elements >= COMPRESS_MIN_BASE
+
+
 def _flat_arrays(data):
     """The arrays of kernel data (a tuple or named tuple, possibly nested; scalars as
     0-d arrays), in order."""
@@ -260,13 +372,46 @@ def _flat_arrays(data):
 
 class BorderChunk(NamedTuple):
     """The border of the new unknowns ``start:stop`` (counted from the first new one):
-    ``on_t`` = ``A_on[:, start:stop]`` transposed (C order), ``no`` = ``A_no[start:stop]``."""
+    ``on_t`` = ``A_on[:, start:stop]`` transposed (C order), ``no`` = ``A_no[start:stop]``;
+    in a compressed chunk, ``on_t`` is the rectangular H-matrix of ``A_on[:, start:stop]``
+    (not transposed) and ``no`` that of ``A_no[start:stop]``."""
 
     start: int
     stop: int
-    on_t: np.ndarray
-    no: np.ndarray
+    on_t: object
+    no: object
     near: object  # the near field of ``no`` (scipy CSR), which the preconditioner uses
+
+    @property
+    def compressed(self):
+        return not isinstance(self.no, np.ndarray)
+
+    @property
+    def nbytes(self):
+        """Bytes the border blocks hold (an H-matrix's stored factors and blocks)."""
+        if self.compressed:
+            return int(self.on_t.stats["memory_bytes"] + self.no.stats["memory_bytes"])
+        return self.on_t.nbytes + self.no.nbytes
+
+    def add_column_product(self, x, out):
+        """``out += A_on[:, start:stop] x``."""
+        if self.compressed:
+            out += self.on_t.matvec(x)
+        else:
+            out += x @ self.on_t
+
+    def row_product(self, x_old, out):
+        """``out[:] = A_no[start:stop] x_old``."""
+        if self.compressed:
+            out[:] = self.no.matvec(x_old)
+        else:
+            np.dot(self.no, x_old, out=out)
+
+    def dense_on(self):
+        return self.on_t.to_dense() if self.compressed else self.on_t.T
+
+    def dense_no(self):
+        return self.no.to_dense() if self.compressed else self.no
 
 
 class _LastProduct:

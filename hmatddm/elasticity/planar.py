@@ -37,7 +37,7 @@ from ..kernels.drivers import self_blocks, traction_block
 from ..material import Elastic
 from ..mesh import Mesh3D
 from .inverse import solve_with_inverse
-from .operator import ElasticityOperator
+from .operator import ElasticityOperator, ProductCounter
 
 #: Relative flatness asked of a planar mesh: every centre within this fraction of the
 #: mesh's extent of the plane of the first element, every normal parallel to its normal
@@ -303,7 +303,7 @@ class OperatorPart:
         raise InputError("contact rows act on whole elements: use the PlanarExtendedOperator's modified_inverse")
 
 
-class PlanarExtendedOperator(LinearOperator):
+class PlanarExtendedOperator(ProductCounter, LinearOperator):
     """A planar crack's operator (``base``, a :class:`PlanarElasticityOperator`) grown by
     elements in its plane: each part extended by its own exact border blocks
     (:class:`~hmatddm.elasticity.extended.ExtendedElasticityOperator` over
@@ -338,6 +338,11 @@ class PlanarExtendedOperator(LinearOperator):
     @property
     def border_bytes(self):
         return self._normal.border_bytes + (0 if self._shear is None else self._shear.border_bytes)
+
+    @property
+    def chunk_bytes(self):
+        """Bytes of the parts' border chunks (without their ``A_nn``)."""
+        return self._normal.chunk_bytes + (0 if self._shear is None else self._shear.chunk_bytes)
 
     def _shear_operator(self):
         if self._shear is None:

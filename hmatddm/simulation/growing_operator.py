@@ -13,7 +13,7 @@ from dataclasses import asdict
 import numpy as np
 
 from ..errors import MeshQualityWarning
-from ..elasticity.extended import ExtendedElasticityOperator
+from ..elasticity.extended import ExtendedElasticityOperator, compresses_borders
 from ..material import Elastic
 from ..elasticity.operator import ElasticityOperator
 from ..elasticity.planar import PlanarElasticityOperator, PlanarExtendedOperator, is_planar
@@ -49,7 +49,8 @@ class GrowingOperator:
             operator = base
         elif (extends and self.operator_settings.backend == "hmatrix"
               and self.rebuild_settings.border_fits(base.mesh.n_elements, n - base.mesh.n_elements, base.dof,
-                                                    getattr(base, "border_entries_per_pair", None))):
+                                                    getattr(base, "border_entries_per_pair", None),
+                                                    self._border_bytes_per_element(base))):
             # the border blocks of the elements the last operator had are copied, not re-evaluated
             grown = (PlanarExtendedOperator if isinstance(base, PlanarElasticityOperator) and is_planar(mesh)
                      else ExtendedElasticityOperator)
@@ -58,6 +59,17 @@ class GrowingOperator:
             operator = self.build(mesh)
         self._operator, self._mesh = operator, mesh
         return operator
+
+    def _border_bytes_per_element(self, base):
+        """Bytes of compressed border blocks per added element: measured on the last grown
+        operator of ``base``, else expected from the base's own memory per element (twice:
+        ``A_on`` and ``A_no``); None when borders of ``base`` stay dense."""
+        if not compresses_borders(base):
+            return None
+        last = self._operator
+        if getattr(last, "base", None) is base and last.n_new:
+            return last.chunk_bytes / last.n_new
+        return 2.0 * base.stats["memory_bytes"] / base.mesh.n_elements
 
     def build(self, mesh):
         """A full build of the operator of ``mesh``, which becomes the base."""

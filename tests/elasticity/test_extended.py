@@ -180,3 +180,62 @@ def test_growth_passes_share_border_chunks_and_the_base_product(grown, material)
     x[0] += 1.0
     counted @ x
     assert len(calls) == 2
+
+
+@pytest.fixture()
+def compressed_border(monkeypatch, material):
+    """A planar crack's opening part (dof 1) grown from 400 elements by rings, with the
+    border compression thresholds lowered so that it applies at this size."""
+    from hmatddm.elasticity import extended as extended_module
+    from hmatddm.elasticity.planar import PlanarElasticityOperator
+
+    monkeypatch.setattr(extended_module, "COMPRESS_MIN_BASE", 300)
+    monkeypatch.setattr(extended_module, "COMPRESS_MIN_PAIRS", 2000)
+    full = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 28.0, 28.0, 28, 28)
+    order = np.argsort(np.linalg.norm(full.centers, axis=1), kind="stable")  # a growing disc
+    mesh = full.subset(order)
+    planar = PlanarElasticityOperator(mesh.subset(np.arange(400)), material, eps=1e-6, leaf_size=16)
+    return mesh, planar.part("normal")
+
+
+def test_compressed_border_chunks_match_the_dense_border(compressed_border):
+    """Chunks of many added elements get rectangular H-matrices over the base's tree: the
+    grown operator's product equals the dense one's to the compression's accuracy, the
+    border holds far fewer entries than the dense border, the preconditioner's near rows
+    are those of the dense border (the same blocks kept), and a chain of passes reuses
+    whole compressed chunks and re-evaluates a chunk that a changed element cuts."""
+    from hmatddm.elasticity.extended import ExtendedElasticityOperator
+    from hmatddm.elasticity.operator import influence_data
+    from hmatddm.elasticity.planar import normal_traction_block
+
+    mesh, base = compressed_border
+    data = influence_data(mesh, base.material, "none", None)
+    dense = np.empty((mesh.n_elements, mesh.n_elements))
+    normal_traction_block(data, np.arange(mesh.n_elements), np.arange(mesh.n_elements), dense)
+    rng = np.random.default_rng(5)
+    previous = None
+    for n in (520, 523, 650):
+        grown = ExtendedElasticityOperator(base, mesh.subset(np.arange(n)), previous=previous)
+        assert grown.chunks[-1].compressed == (n != 523)  # 3 x 400 pairs: a dense chunk
+        x = rng.normal(size=n)
+        reference = dense[:n, :n] @ x
+        np.testing.assert_allclose(grown @ x, reference, rtol=0, atol=2e-5 * np.abs(reference).max())
+        if n == 650:
+            assert grown.chunks[-1].on_t.stats["n_admissible"] > 0 and grown.chunks[-1].no.stats["n_admissible"] > 0
+        # the near rows of a chunk: the blocks the dense border's threshold keeps
+        chunk = grown.chunks[-1]
+        rows = np.arange(400 + chunk.start, 400 + chunk.stop)
+        dense_chunk = ExtendedElasticityOperator.__new__(ExtendedElasticityOperator)
+        dense_chunk.dof, dense_chunk.n_base, dense_chunk._base_blocks = 1, 400, grown._base_blocks
+        near = dense_chunk._near_rows(dense[rows][:, :400], dense[rows][:, rows])
+        assert (near != chunk.near).nnz == 0 and near.nnz > 0
+        if previous is not None:
+            assert grown.n_reused == previous.mesh.n_elements - 400
+            assert all(mine is theirs for mine, theirs in zip(grown.chunks, previous.chunks))
+        previous = grown
+    order = np.concatenate([np.arange(600), np.arange(600, 650)[::-1]])  # cuts the chunk 523..650
+    cut = ExtendedElasticityOperator(base, mesh.subset(order), previous=previous)
+    assert cut.n_reused == 123 and len(cut.chunks) == 3
+    x = rng.normal(size=650)
+    reference = dense[np.ix_(order, order)] @ x
+    np.testing.assert_allclose(cut @ x, reference, rtol=0, atol=2e-5 * np.abs(reference).max())
