@@ -7,7 +7,8 @@
 Each row is one ``hmatddm run SCENE --set initial_fracture[0].element_size=h`` in a child
 process (its own CPU time and peak memory), with fixed 1 s steps or front-following steps
 (``numerics.time_step = "auto"``, hmatddm/simulation/step_control.py). It prints the final
-elements, steps, growth passes, nonlinear and GMRES iterations, operator builds, wall and
+elements, steps, growth passes, nonlinear and GMRES iterations, elasticity products
+(matvecs, all and per step), operator builds, wall and
 CPU time, peak memory and the errors against the scene's closed form at the end, then the
 cost exponent between consecutive sizes (log CPU ratio over log elements ratio), and saves
 a plot of CPU time against elements (``benchmarks/scaling.png``).
@@ -54,7 +55,7 @@ def run(scene, h, steps, folder):
     error = summary["reference"][-1]["relative_error"] if summary.get("reference") else {}
     return dict(scene=scene, h=h, steps=steps, elements=records[-1]["n_elements"], n_steps=len(records),
                 passes=total("growth_passes"), nonlinear=total("nonlinear_iterations"),
-                gmres=total("linear_iterations"), builds=total("operator_builds"), wall=wall,
+                gmres=total("linear_iterations"), matvecs=total("matvecs"), builds=total("operator_builds"), wall=wall,
                 cpu=usage.ru_utime + usage.ru_stime, peak_mb=usage.ru_maxrss / 1024.0, error=error)
 
 
@@ -77,7 +78,7 @@ def main():
                     rows.append(run(scene, h, steps, folder))
                     print(rows[-1], flush=True)
     header = ["scene", "h (m)", "steps rule", "elements", "steps", "growth passes", "nonlinear its", "GMRES its",
-              "builds", "wall (s)", "CPU (s)", "peak RSS (MB)", "R error", "w0 error", "p error",
+              "matvecs", "matvecs/step", "builds", "wall (s)", "CPU (s)", "peak RSS (MB)", "R error", "w0 error", "p error",
               "CPU exponent vs previous h"]
     body = []
     for row in rows:
@@ -89,7 +90,8 @@ def main():
             exponent = f"{math.log(row['cpu'] / p['cpu']) / math.log(row['elements'] / p['elements']):.2f}"
         error = row["error"]
         body.append([row["scene"], f"{row['h']:g}", row["steps"], row["elements"], row["n_steps"], row["passes"],
-                     row["nonlinear"], row["gmres"], row["builds"], f"{row['wall']:.1f}", f"{row['cpu']:.1f}",
+                     row["nonlinear"], row["gmres"], row["matvecs"], f"{row['matvecs'] / row['n_steps']:.0f}",
+                     row["builds"], f"{row['wall']:.1f}", f"{row['cpu']:.1f}",
                      f"{row['peak_mb']:.0f}"] + [f"{100 * error[k]:+.2f}%" if k in error else "-"
                                                 for k in ("radius", "max_opening", "net_pressure")] + [exponent])
     print_table(header, body)

@@ -160,11 +160,19 @@ def _converged(stopping, change, history):
     return rho <= 0.5 and CONTRACTION_SAFETY * change * rho / (1.0 - rho) < 1.0
 
 
+def _products(problem):
+    """Products the step problem's elasticity operator has made so far
+    (:class:`hmatddm.elasticity.operator.ProductCounter`; 0 for an operator that does not
+    count them)."""
+    return int(getattr(getattr(problem.elastic, "operator", None), "products", 0))
+
+
 def solve_step(problem, settings, dd_guess, p_guess, relaxation, provisional=False):
     """Iterate one time step to convergence (ref. Eqs 4.43-4.44).
 
     Returns ``(dd, p, info)``; ``info`` has ``nonlinear_iterations`` (all attempts),
-    ``linear_iterations`` (GMRES iterations), ``relaxation`` (the alpha that
+    ``linear_iterations`` (GMRES iterations), ``elastic_products`` (products with the
+    elasticity operator: GMRES iterations, residuals, segregated solves), ``relaxation`` (the alpha that
     converged), ``restarts``, ``solve_seconds``, ``contact_changes`` (active-set
     changes over the step) and ``pending``. Raises ConvergenceError when even
     ``min_relaxation`` fails.
@@ -192,6 +200,7 @@ class PendingSolve:
         self.coupled = settings.scheme in COUPLED_SCHEMES
         self.iterate = _coupled_iteration if self.coupled else _segregated_iteration
         self.counters = {"nonlinear": 0, "linear": 0}
+        self._products_before = _products(problem)  # elasticity products, counted by the operator
         self.reported = {}  # the counts already reported by a provisional return
         self.alpha = relaxation
         self.restarts = 0
@@ -333,7 +342,8 @@ class PendingSolve:
 
     def _finished(self, pending):
         counts = dict(nonlinear_iterations=self.counters["nonlinear"], linear_iterations=self.counters["linear"],
-                      restarts=self.restarts, contact_changes=self.contact_changes)
+                      restarts=self.restarts, contact_changes=self.contact_changes,
+                      elastic_products=_products(self.problem) - self._products_before)
         info = {key: value - self.reported.get(key, 0) for key, value in counts.items()}
         self.reported.update(counts)
         seconds = time.perf_counter() - self._begin

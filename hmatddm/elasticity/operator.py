@@ -30,7 +30,22 @@ from ..options import (AVERAGE_SHIFT, BACKENDS, DEFAULT_EPS, DEFAULT_ETA, DEFAUL
 from ..settings import OPERATOR
 
 
-class ElasticityOperator(LinearOperator):
+class ProductCounter:
+    """Counts the products of an operator (``products``: calls of :meth:`matvec`, columns
+    of :meth:`matmat`), the cost unit of a solve that a simulation records per step."""
+
+    products = 0
+
+    def matvec(self, x):
+        self.products += 1
+        return super().matvec(x)
+
+    def matmat(self, X):
+        self.products += int(np.shape(X)[1]) if np.ndim(X) == 2 else 1
+        return super().matmat(X)
+
+
+class ElasticityOperator(ProductCounter, LinearOperator):
     """DDM influence operator of a mesh in a homogeneous elastic medium.
 
     Parameters

@@ -11,7 +11,7 @@ from .state import Origin, StepEvents
 
 RECORD_KEYS = ("time", "n_elements", "injected_volume", "fracture_volume", "fracture_area", "max_opening",
                "wellbore_pressure", "nonlinear_iterations", "linear_iterations", "solve_seconds")
-_SOLVE_COUNTS = ("nonlinear_iterations", "linear_iterations", "restarts", "contact_changes")
+_SOLVE_COUNTS = ("nonlinear_iterations", "linear_iterations", "elastic_products", "restarts", "contact_changes")
 
 
 class ViewState(IntEnum):
@@ -29,6 +29,7 @@ class StepTally:
 
     nonlinear_iterations: int = 0
     linear_iterations: int = 0
+    elastic_products: int = 0
     restarts: int = 0
     contact_changes: int = 0
     elements_added: int = 0
@@ -55,7 +56,7 @@ def step_record(simulation, flow, width, tally, relaxation, seconds):
         fracture_volume=float(np.sum(flow.areas * width)), fracture_area=area, max_opening=float(np.max(width)),
         wellbore_pressure=[float(s.pressure[i]) for i in sim.injection_elements],
         nonlinear_iterations=int(tally.nonlinear_iterations), linear_iterations=int(tally.linear_iterations),
-        solve_seconds=float(seconds), leaked_volume=s.leaked_volume, relaxation=float(relaxation),
+        matvecs=int(tally.elastic_products), solve_seconds=float(seconds), leaked_volume=s.leaked_volume, relaxation=float(relaxation),
         restarts=int(tally.restarts), elements_added=int(tally.elements_added),
         growth_passes=int(tally.growth_passes), operator_builds=int(tally.operator_builds))
     record["junctions"] = int(tally.events.junctions)

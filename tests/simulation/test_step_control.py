@@ -125,3 +125,19 @@ def test_a_run_continued_past_its_end_time_keeps_the_pace_of_its_steps():
     simulation.run(8.0)
     after = [r["time_step"] for r in simulation.records if r["time"] > end]
     assert after[0] >= 0.5 * planned  # without the planned step: at most 2 x 5%
+
+
+def test_every_step_records_its_elasticity_products(monkeypatch):
+    """``matvecs`` of a record counts the products with the elasticity operator its solves
+    made: at least one per GMRES iteration, and all of them, against a count of the dense
+    operator's products made apart (its ``_matvec``, patched here) over the run."""
+    from hmatddm.elasticity.operator import ElasticityOperator
+
+    calls = []
+    original = ElasticityOperator._matvec
+    monkeypatch.setattr(ElasticityOperator, "_matvec", lambda self, x: calls.append(1) or original(self, x))
+    simulation = kgd(time_step=0.5)
+    calls.clear()
+    records = [simulation.step() for _ in range(4)]
+    assert all(r["matvecs"] >= r["linear_iterations"] > 0 for r in records)
+    assert sum(r["matvecs"] for r in records) == len(calls)
