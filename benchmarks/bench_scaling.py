@@ -3,6 +3,7 @@
     python benchmarks/bench_scaling.py                           # radial-k at h = 1, 0.5, 0.25 m
     python benchmarks/bench_scaling.py --scenes radial-k,radial-m --sizes 1,0.5,0.25,0.125
     python benchmarks/bench_scaling.py --steps fixed,auto        # both step rules, side by side
+    python benchmarks/bench_scaling.py --compare ../previous     # and another source tree, run by run
 
 Each row is one ``hmatddm run SCENE --set initial_fracture[0].element_size=h`` in a child
 process (its own CPU time and peak memory), with fixed 1 s steps or front-following steps
@@ -32,13 +33,16 @@ sys.exit(main(sys.argv[1:]))
 """
 
 
-def run(scene, h, steps, folder):
-    """One run in a child process: its summary totals, wall and CPU time, peak memory."""
-    out = os.path.join(folder, f"{scene}-{h}-{steps}")
+def run(scene, h, steps, folder, source=ROOT, label="this", extra=()):
+    """One run in a child process (the package of the source tree ``source``): its
+    summary totals, wall and CPU time, peak memory."""
+    out = os.path.join(folder, f"{label}-{scene}-{h}-{steps}")
     arguments = ["run", scene, "--out", out, "--quiet", "--set", f"initial_fracture[0].element_size={h}"]
     if steps == "auto":
         arguments += ["--set", "numerics.time_step=auto"]
-    environment = dict(os.environ, PYTHONPATH=os.pathsep.join([ROOT, os.environ.get("PYTHONPATH", "")]))
+    for setting in extra:
+        arguments += ["--set", setting]
+    environment = dict(os.environ, PYTHONPATH=os.pathsep.join([source, os.environ.get("PYTHONPATH", "")]))
     start = time.perf_counter()
     child = subprocess.Popen([sys.executable, "-c", _RUN] + arguments, env=environment)
     _, status, usage = os.wait4(child.pid, 0)  # this child's own CPU time and peak memory
@@ -53,7 +57,7 @@ def run(scene, h, steps, folder):
         return sum(record.get(key) or 0 for record in records)
 
     error = summary["reference"][-1]["relative_error"] if summary.get("reference") else {}
-    return dict(scene=scene, h=h, steps=steps, elements=records[-1]["n_elements"], n_steps=len(records),
+    return dict(version=label, scene=scene, h=h, steps=steps, elements=records[-1]["n_elements"], n_steps=len(records),
                 passes=total("growth_passes"), nonlinear=total("nonlinear_iterations"),
                 gmres=total("linear_iterations"), matvecs=total("matvecs"), builds=total("operator_builds"), wall=wall,
                 cpu=usage.ru_utime + usage.ru_stime, peak_mb=usage.ru_maxrss / 1024.0, error=error)
@@ -65,31 +69,38 @@ def main():
     parser.add_argument("--sizes", default="1,0.5,0.25", help="element sizes h (m)")
     parser.add_argument("--steps", default="fixed,auto", help="step rules: fixed, auto or both")
     parser.add_argument("--plot", default=os.path.join(HERE, "scaling.png"))
+    parser.add_argument("--compare", default=None, metavar="DIR",
+                        help="also run the package of another source tree (e.g. a git worktree of the previous "
+                             "version) in the same session, row by row")
     args = parser.parse_args()
+    sources = [("this", ROOT)] + ([("previous", os.path.abspath(args.compare))] if args.compare else [])
     sys.path.insert(0, HERE)
     from _common import machine, print_table
 
     print(f"Machine: {machine()}", flush=True)
     rows = []
     with tempfile.TemporaryDirectory() as folder:
+        for label, source in sources:  # compile (or load the numba cache) before anything is timed
+            run(args.scenes.split(",")[0], 1.0, "fixed", folder, source, f"warm-{label}", ["numerics.end_time=2"])
         for scene in args.scenes.split(","):
             for h in [float(s) for s in args.sizes.split(",")]:
                 for steps in args.steps.split(","):
-                    rows.append(run(scene, h, steps, folder))
-                    print(rows[-1], flush=True)
-    header = ["scene", "h (m)", "steps rule", "elements", "steps", "growth passes", "nonlinear its", "GMRES its",
+                    for label, source in sources:
+                        rows.append(run(scene, h, steps, folder, source, label))
+                        print(rows[-1], flush=True)
+    header = ["version", "scene", "h (m)", "steps rule", "elements", "steps", "growth passes", "nonlinear its", "GMRES its",
               "matvecs", "matvecs/step", "builds", "wall (s)", "CPU (s)", "peak RSS (MB)", "R error", "w0 error", "p error",
               "CPU exponent vs previous h"]
     body = []
     for row in rows:
-        previous = [r for r in rows if r["scene"] == row["scene"] and r["steps"] == row["steps"]
-                    and r["elements"] < row["elements"]]
+        previous = [r for r in rows if r["version"] == row["version"] and r["scene"] == row["scene"]
+                    and r["steps"] == row["steps"] and r["elements"] < row["elements"]]
         exponent = ""
         if previous:
             p = max(previous, key=lambda r: r["elements"])
             exponent = f"{math.log(row['cpu'] / p['cpu']) / math.log(row['elements'] / p['elements']):.2f}"
         error = row["error"]
-        body.append([row["scene"], f"{row['h']:g}", row["steps"], row["elements"], row["n_steps"], row["passes"],
+        body.append([row["version"], row["scene"], f"{row['h']:g}", row["steps"], row["elements"], row["n_steps"], row["passes"],
                      row["nonlinear"], row["gmres"], row["matvecs"], f"{row['matvecs'] / row['n_steps']:.0f}",
                      row["builds"], f"{row['wall']:.1f}", f"{row['cpu']:.1f}",
                      f"{row['peak_mb']:.0f}"] + [f"{100 * error[k]:+.2f}%" if k in error else "-"
@@ -105,8 +116,10 @@ def main():
     figure, axes = plt.subplots(figsize=(6, 4))
     for scene in args.scenes.split(","):
         for steps in args.steps.split(","):
-            chosen = [r for r in rows if r["scene"] == scene and r["steps"] == steps]
-            axes.loglog([r["elements"] for r in chosen], [r["cpu"] for r in chosen], "o-", label=f"{scene}, {steps}")
+            for label, _ in sources:
+                chosen = [r for r in rows if r["scene"] == scene and r["steps"] == steps and r["version"] == label]
+                axes.loglog([r["elements"] for r in chosen], [r["cpu"] for r in chosen], "o-",
+                            label=f"{scene}, {steps}" + (f" ({label})" if len(sources) > 1 else ""))
     axes.set_xlabel("elements at the end")
     axes.set_ylabel("CPU time of the whole run (s)")
     axes.legend()

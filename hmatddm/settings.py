@@ -302,8 +302,9 @@ OPERATOR = {  # -> hmatddm.elasticity.operator.ElasticityOperator (the H-matrix 
 }
 
 NUMERICS = {  # [numerics] of a scene -> hmatddm.Simulation, its operator and its SchemeSettings
-    "time_step": Setting("number_or_auto", 1.0, low=0.0, low_open=True, unit="s",
-                         doc='"auto": steps that follow the front (hmatddm.simulation.step_control)'),
+    "time_step": Setting("number_or_auto", "auto", low=0.0, low_open=True, unit="s",
+                         doc='"auto" (default): steps that follow the front (hmatddm.simulation.step_control); '
+                             'a number: fixed steps'),
     "end_time": Setting("number", REQUIRED, low=0.0, low_open=True, unit="s"),
     "step_advance": Setting("number", 1.0, low=0.0, low_open=True, high=10.0,
                             doc='time_step = "auto": element rows the front should cross per step'),

@@ -26,6 +26,7 @@ element_size = 1.0
 [propagation]
 toughness = 5e6
 [numerics]
+time_step = 1.0
 end_time = 2.0
 backend = "dense"
 initial_pressure = 10e6
@@ -58,4 +59,5 @@ element_size = 0.25
 [propagation]
 toughness = 5e6
 [numerics]
+time_step = 1.0
 """

@@ -79,7 +79,7 @@ The format, annotated (``=`` values are the defaults unless marked REQUIRED)::
     pore_pressure = 0.0            # Pa
 
     [numerics]
-    time_step = 1.0                # s, > 0, or "auto": steps that follow the front (then:)
+    time_step = "auto"             # "auto" (default): steps that follow the front (then:), or s > 0
     # step_advance = 1.0           # element rows the front crosses per step, (0, 10]
     # first_time_step = 0.1        # s, > 0
     # min_time_step = 1e-3         # s, > 0

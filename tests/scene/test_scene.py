@@ -36,6 +36,7 @@ element_size = 1.0
 [propagation]
 toughness = 5e6
 [numerics]
+time_step = 1.0
 end_time = 3.0
 """
 
@@ -197,9 +198,11 @@ def test_kgd_scene_is_toughness_dominated():
 
 
 def test_defaults_are_filled_and_numbers_are_floats():
-    scene = validate(raw())
+    data = raw()
+    del data["numerics"]["time_step"]  # a scene without time_step follows the front
+    scene = validate(data)
     assert scene["dimension"] == 3 and "height" not in scene
-    assert scene["numerics"]["time_step"] == 1.0 and scene["numerics"]["scheme"] == "krylov"
+    assert scene["numerics"]["time_step"] == "auto" and scene["numerics"]["scheme"] == "krylov"
     assert scene["leak_off"] == {"coefficient": 0.0, "pore_pressure": 0.0}
     assert scene["output"]["every"] == 1 and scene["output"]["snapshots"] is True
     assert scene["initial_fracture"][0]["shape"] == "rectangle"
