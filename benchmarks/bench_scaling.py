@@ -44,7 +44,8 @@ def run(scene, h, steps, folder, source=ROOT, label="this", extra=()):
         arguments += ["--set", setting]
     environment = dict(os.environ, PYTHONPATH=os.pathsep.join([source, os.environ.get("PYTHONPATH", "")]))
     start = time.perf_counter()
-    child = subprocess.Popen([sys.executable, "-c", _RUN] + arguments, env=environment)
+    # -P: not the working directory first on sys.path, so that PYTHONPATH picks the source tree
+    child = subprocess.Popen([sys.executable, "-P", "-c", _RUN] + arguments, env=environment)
     _, status, usage = os.wait4(child.pid, 0)  # this child's own CPU time and peak memory
     child.returncode = os.waitstatus_to_exitcode(status)
     wall = time.perf_counter() - start
