@@ -4,6 +4,7 @@
     python benchmarks/bench_scaling.py --scenes radial-k,radial-m --sizes 1,0.5,0.25,0.125
     python benchmarks/bench_scaling.py --steps fixed,auto        # both step rules, side by side
     python benchmarks/bench_scaling.py --compare ../previous     # and another source tree, run by run
+    python benchmarks/bench_scaling.py --sizes "" --steps fixed --dfn-areas 1,4   # the network at 1x, 4x area
 
 Each row is one ``hmatddm run SCENE --set initial_fracture[0].element_size=h`` in a child
 process (its own CPU time and peak memory), with fixed 1 s steps or front-following steps
@@ -36,8 +37,10 @@ sys.exit(main(sys.argv[1:]))
 def run(scene, h, steps, folder, source=ROOT, label="this", extra=()):
     """One run in a child process (the package of the source tree ``source``): its
     summary totals, wall and CPU time, peak memory."""
-    out = os.path.join(folder, f"{label}-{scene}-{h}-{steps}")
-    arguments = ["run", scene, "--out", out, "--quiet", "--set", f"initial_fracture[0].element_size={h}"]
+    out = os.path.join(folder, f"{label}-{scene}-{h}-{steps}-{len(extra)}")
+    arguments = ["run", scene, "--out", out, "--quiet"]
+    if h is not None:
+        arguments += ["--set", f"initial_fracture[0].element_size={h}"]
     if steps == "auto":
         arguments += ["--set", "numerics.time_step=auto"]
     for setting in extra:
@@ -70,6 +73,10 @@ def main():
     parser.add_argument("--sizes", default="1,0.5,0.25", help="element sizes h (m)")
     parser.add_argument("--steps", default="fixed,auto", help="step rules: fixed, auto or both")
     parser.add_argument("--plot", default=os.path.join(HERE, "scaling.png"))
+    parser.add_argument("--dfn-areas", default="", metavar="A,B,...",
+                        help="also run dfn-3cluster with its network region scaled to these multiples of its area "
+                             "and its injection lengthened so that the fractures span the same share of it "
+                             "(end time x area^0.75: plane-strain length ~ t^(2/3))")
     parser.add_argument("--compare", default=None, metavar="DIR",
                         help="also run the package of another source tree (e.g. a git worktree of the previous "
                              "version) in the same session, row by row")
@@ -84,11 +91,19 @@ def main():
         for label, source in sources:  # compile (or load the numba cache) before anything is timed
             run(args.scenes.split(",")[0], 1.0, "fixed", folder, source, f"warm-{label}", ["numerics.end_time=2"])
         for scene in args.scenes.split(","):
-            for h in [float(s) for s in args.sizes.split(",")]:
+            for h in [float(s) for s in args.sizes.split(",") if s]:
                 for steps in args.steps.split(","):
                     for label, source in sources:
                         rows.append(run(scene, h, steps, folder, source, label))
                         print(rows[-1], flush=True)
+        for area in [float(a) for a in args.dfn_areas.split(",") if a]:
+            side = math.sqrt(area)
+            extra = [f"network.region=[{-50 * side}, {50 * side}, {-100 * side}, {100 * side}]",
+                     f"numerics.end_time={70.0 * area ** 0.75:.6g}"]
+            for steps in args.steps.split(","):
+                for label, source in sources:
+                    rows.append(dict(run("dfn-3cluster", None, steps, folder, source, label, extra), area=area))
+                    print(rows[-1], flush=True)
     header = ["version", "scene", "h (m)", "steps rule", "elements", "steps", "growth passes", "nonlinear its", "GMRES its",
               "matvecs", "matvecs/step", "builds", "wall (s)", "CPU (s)", "peak RSS (MB)", "R error", "w0 error", "p error",
               "CPU exponent vs previous h"]
@@ -96,12 +111,18 @@ def main():
     for row in rows:
         previous = [r for r in rows if r["version"] == row["version"] and r["scene"] == row["scene"]
                     and r["steps"] == row["steps"] and r["elements"] < row["elements"]]
+        if "area" in row:  # the network runs: cost against area, the first area the baseline
+            first = [r for r in rows if r.get("area") and r["version"] == row["version"] and r["steps"] == row["steps"]]
+            previous = [first[0]] if first[0] is not row else []
         exponent = ""
         if previous:
             p = max(previous, key=lambda r: r["elements"])
             exponent = f"{math.log(row['cpu'] / p['cpu']) / math.log(row['elements'] / p['elements']):.2f}"
+            if "area" in row:
+                exponent += f" ({row['cpu'] / p['cpu']:.1f}x CPU for {row['area'] / p['area']:g}x area)"
         error = row["error"]
-        body.append([row["version"], row["scene"], f"{row['h']:g}", row["steps"], row["elements"], row["n_steps"], row["passes"],
+        size = f"{row['h']:g}" if row["h"] is not None else f"area x{row['area']:g}"
+        body.append([row["version"], row["scene"], size, row["steps"], row["elements"], row["n_steps"], row["passes"],
                      row["nonlinear"], row["gmres"], row["matvecs"], f"{row['matvecs'] / row['n_steps']:.0f}",
                      row["builds"], f"{row['wall']:.1f}", f"{row['cpu']:.1f}",
                      f"{row['peak_mb']:.0f}"] + [f"{100 * error[k]:+.2f}%" if k in error else "-"
@@ -118,7 +139,8 @@ def main():
     for scene in args.scenes.split(","):
         for steps in args.steps.split(","):
             for label, _ in sources:
-                chosen = [r for r in rows if r["scene"] == scene and r["steps"] == steps and r["version"] == label]
+                chosen = [r for r in rows if r["scene"] == scene and r["steps"] == steps and r["version"] == label
+                          and "area" not in r]
                 axes.loglog([r["elements"] for r in chosen], [r["cpu"] for r in chosen], "o-",
                             label=f"{scene}, {steps}" + (f" ({label})" if len(sources) > 1 else ""))
     axes.set_xlabel("elements at the end")
