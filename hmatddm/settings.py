@@ -261,8 +261,19 @@ MATERIAL = {  # -> hmatddm.material.Elastic
 }
 
 FLUID = {  # -> hmatddm.flow.fluid.Fluid (ref. Eqs 4.22-4.24)
-    "viscosity": Setting("number", REQUIRED, low=0.0, low_open=True, unit="Pa s"),
+    "viscosity": Setting("number", ABSENT, low=0.0, low_open=True, unit="Pa s",
+                         doc="Newtonian viscosity mu (required when rheology = 'newtonian')"),
     "compressibility": Setting("number", 0.0, low=0.0, unit="1/Pa"),
+    # power-law fluids (issue 34, beyond the reference: ref. Sec. 8.2 item 3)
+    "rheology": Setting("choice", "newtonian", choices=("newtonian", "power-law"),
+                        doc="newtonian (viscosity) or power-law (consistency K, flow_index n: tau = K rate^n)"),
+    "consistency": Setting("number", ABSENT, low=0.0, low_open=True, unit="Pa s^n",
+                           doc="power-law consistency index K (required when rheology = 'power-law')"),
+    "flow_index": Setting("number", 1.0, low=0.0, high=1.0, low_open=True,
+                          doc="power-law flow behaviour index n (1: Newtonian, < 1: shear thinning)"),
+    "minimum_shear_rate": Setting("number", 1e-3, low=0.0, low_open=True, unit="1/s",
+                                  doc="power-law: below this wall shear rate the fluid flows as a Newtonian "
+                                      "one of the apparent viscosity there (keeps a still fluid's conductivity)"),
 }
 
 CLUSTER = {  # -> hmatddm.flow.fluid.Cluster (ref. Eqs 4.34-4.35)

@@ -80,7 +80,7 @@ class _Diverged(Exception):
 
 
 def _segregated_iteration(problem, settings, dd, p, alpha, counters, first=False):
-    matrix, rhs = problem.flow_matrices(dd)
+    matrix, rhs = problem.flow_matrices(dd, p)
     rhs = rhs - problem.coupling @ dd
     if settings.scheme == "fracture-compliance" and settings.omega > 0.0:
         correction = settings.omega * problem.compliance_term
@@ -108,7 +108,7 @@ def _coupled_iteration(problem, settings, dd, p, alpha, counters, first=False, p
     the iterate returned is the first paused one, and a
     :class:`~hmatddm.coupled.paused.PausedIterate` appended to ``pause``
     continues the same solve (nothing appended when it ended before a pause)."""
-    matrix, flow_rhs = problem.flow_matrices(dd)
+    matrix, flow_rhs = problem.flow_matrices(dd, p)
     if not (np.all(np.isfinite(matrix.data)) and np.all(np.isfinite(flow_rhs))):
         raise _Diverged("non-finite flow matrix")
     try:

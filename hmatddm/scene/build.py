@@ -44,7 +44,7 @@ def layered_medium(scene):
 
 
 def fluid(scene):
-    return Fluid(viscosity=scene["fluid"]["viscosity"], compressibility=scene["fluid"]["compressibility"])
+    return Fluid(**scene["fluid"])  # the echo's keys are the fields (hmatddm.settings.FLUID)
 
 
 def clusters(scene):
@@ -167,10 +167,18 @@ def _closed_form(scene, times):
     kind = scene["reference"]["kind"]
     mat = material(scene)
     rate = scene["cluster"][0]["rate"]
-    viscosity = scene["fluid"]["viscosity"]
     toughness = scene["propagation"]["toughness"]
     times = np.asarray(times, dtype=float)
     curves = {"time": times}
+    if scene["fluid"]["rheology"] == "power-law":  # kgd-m only (schema): Adachi and Detournay (2002)
+        from ..analytical import power_law
+
+        args = (times, rate / scene["height"], scene["fluid"]["consistency"], scene["fluid"]["flow_index"])
+        curves["half_length"], curves["max_opening"], curves["net_pressure"] = power_law.kgd_power_law_vertex(
+            *args, mat)
+        curves["dimensionless_toughness"] = power_law.kgd_power_law_regime(*args, toughness, mat)
+        return curves
+    viscosity = scene["fluid"]["viscosity"]
     if kind.startswith("radial"):
         if kind == "radial-k":
             curves["radius"], curves["max_opening"], curves["net_pressure"] = analytical.radial_k_vertex(
