@@ -68,3 +68,26 @@ def test_coupled_schemes_converge_to_the_same_power_law_step():
         assert b["half_length"] == pytest.approx(a["half_length"], rel=1e-4)
         assert b["max_opening"] == pytest.approx(a["max_opening"], rel=1e-4)
         assert a["nonlinear_iterations"] > 0 and b["nonlinear_iterations"] > 0
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("flow_index, consistency, radius_tolerance, opening_tolerance", [
+    (0.5, 0.03, 0.025, 0.04), (0.8, 5e-3, 0.02, 0.025)])
+def test_power_law_radial_m_vertex(flow_index, consistency, radius_tolerance, opening_tolerance):
+    # ref. Table 4.1's radial setup (3 x 3 elements of 1 m, asymptotic front, dense), K_Ic 0.3 MPa
+    # m^1/2 (K_m 0.23 / 0.16), 12 s (R ~ 12 elements), against the power-law radial M-vertex of
+    # hmatddm.analytical.power_law.radial_power_law_vertex. Measured: radius -1.7% / -1.1%,
+    # opening at the injection point +2.9% / +1.5% (the Newtonian run: -2.0% / +1.7% at 6 s)
+    material = hd.Elastic(24e9, 0.25)
+    mesh = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 3.0, 3.0, 3, 3)
+    sim = hd.Simulation(mesh, material, power_law_fluid(consistency, flow_index), [hd.Cluster((0, 0, 0), 0.01, 0.005)],
+                        far_field_stress=np.diag([0, 0, -8e6]), time_step=1.0,
+                        propagation=hd.Propagation(toughness=0.3e6, front="asymptotic"), initial_pressure=10e6,
+                        initial_opening=4e-6, backend="dense")
+    records = sim.run(12.0)
+    radius, opening = power_law.radial_power_law_vertex(12.0, 0.01, consistency, flow_index, material)
+    injection = sim.injection_elements[0]
+    centre = float(sim.state.dd[injection] @ sim.state.mesh.normals[injection])
+    assert abs(records[-1]["radius"] / radius - 1.0) < radius_tolerance
+    assert abs(centre / opening - 1.0) < opening_tolerance
+    assert records[-1]["front_circularity"] < 1.05
