@@ -170,13 +170,25 @@ def _closed_form(scene, times):
     toughness = scene["propagation"]["toughness"]
     times = np.asarray(times, dtype=float)
     curves = {"time": times}
-    if scene["fluid"]["rheology"] == "power-law":  # kgd-m only (schema): Adachi and Detournay (2002)
+    if scene["fluid"]["rheology"] == "power-law":  # the power-law vertices (hmatddm.analytical.power_law)
         from ..analytical import power_law
 
-        args = (times, rate / scene["height"], scene["fluid"]["consistency"], scene["fluid"]["flow_index"])
-        curves["half_length"], curves["max_opening"], curves["net_pressure"] = power_law.kgd_power_law_vertex(
-            *args, mat)
-        curves["dimensionless_toughness"] = power_law.kgd_power_law_regime(*args, toughness, mat)
+        args = (scene["fluid"]["consistency"], scene["fluid"]["flow_index"])
+        if kind.startswith("radial"):  # radial-m or radial-k (radial-km is refused by the schema)
+            if kind == "radial-k":
+                curves["radius"], curves["max_opening"], curves["net_pressure"] = analytical.radial_k_vertex(
+                    times, rate, toughness, mat)
+            else:
+                curves["radius"], curves["max_opening"] = power_law.radial_power_law_vertex(times, rate, *args, mat)
+            curves["dimensionless_toughness"] = power_law.radial_power_law_regime(times, rate, *args, toughness, mat)
+            return curves
+        rate = rate / scene["height"]
+        if kind == "kgd-k":
+            values = analytical.kgd_k_vertex(times, rate, toughness, mat)
+        else:
+            values = power_law.kgd_power_law_vertex(times, rate, *args, mat)
+        curves["half_length"], curves["max_opening"], curves["net_pressure"] = values
+        curves["dimensionless_toughness"] = power_law.kgd_power_law_regime(times, rate, *args, toughness, mat)
         return curves
     viscosity = scene["fluid"]["viscosity"]
     if kind.startswith("radial"):

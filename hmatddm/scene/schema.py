@@ -227,9 +227,10 @@ def _check_reference(scene):
                          "cluster(s)")
     if "propagation" not in scene:
         raise InputError(f"{where} compares a growing fracture: the scene needs a [propagation] section")
-    if scene["fluid"]["rheology"] == "power-law" and kind != "kgd-m":
-        raise InputError(f"{where} is a Newtonian closed form; a power-law fluid (fluid.rheology = 'power-law') "
-                         "is compared with kind = 'kgd-m' (Adachi and Detournay 2002)")
+    if scene["fluid"]["rheology"] == "power-law" and kind == "radial-km":
+        raise InputError(f"{where} is a Newtonian closed form (Dontsov 2016); a power-law fluid "
+                         "(fluid.rheology = 'power-law') is compared with kind = 'radial-m', 'radial-k', 'kgd-m' "
+                         "or 'kgd-k'")
     if scene["leak_off"]["coefficient"] != 0.0:
         raise InputError(f"{where} assumes no leak-off: leak_off.coefficient must be 0, got "
                          f"{show(scene['leak_off']['coefficient'])}")
