@@ -4,7 +4,9 @@
     [ C  D ] [p ] = [g]        C, D, g: lubrication (hmatddm.flow.lubrication)
 
 ``D`` and ``g`` depend on the widths, so the system is iterated (Picard, widths lagged)
-until the changes of ``p`` and ``DD`` fall below the tolerances of ref. Eqs 4.43-4.44.
+until the changes of ``p`` and ``DD`` fall below the tolerances of ref. Eqs 4.43-4.44. For a
+power-law fluid they depend on the pressure too: every scheme assembles them at the iterate
+``(DD, p)``, the flux linearised in the pressure (Newton, :mod:`hmatddm.flow.lubrication`).
 Four schemes:
 
 * ``"fixed-width"`` (ref. Eq. 4.46): ``p = D^-1 (g - C DD^k)``, then ``DD = A^-1 (f - B p)``.
