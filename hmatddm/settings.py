@@ -276,6 +276,19 @@ FLUID = {  # -> hmatddm.flow.fluid.Fluid (ref. Eqs 4.22-4.24)
                                       "one of the apparent viscosity there (keeps a still fluid's conductivity)"),
 }
 
+PROPPANT = {  # -> hmatddm.flow.proppant.Proppant (issue 34, beyond the reference: ref. Sec. 8.2 item 2)
+    "diameter": Setting("number", REQUIRED, low=0.0, low_open=True, unit="m", doc="particle diameter d"),
+    "density": Setting("number", 2650.0, low=0.0, low_open=True, unit="kg/m^3", doc="particle density"),
+    "fluid_density": Setting("number", 1000.0, low=0.0, low_open=True, unit="kg/m^3",
+                             doc="carrier fluid density"),
+    "packing_limit": Setting("number", 0.6, low=0.0, high=1.0, low_open=True, high_open=True,
+                             doc="volume fraction c_max of a packed bed"),
+    "bridging_factor": Setting("number", 3.0, low=1.0,
+                               doc="faces narrower than this many particle diameters carry no proppant"),
+    "hindrance_exponent": Setting("number", 4.65, low=0.0,
+                                  doc="m of the hindered settling velocity v_Stokes (1 - c)^m (Richardson-Zaki)"),
+}
+
 CLUSTER = {  # -> hmatddm.flow.fluid.Cluster (ref. Eqs 4.34-4.35)
     "position": Setting("point", REQUIRED, length="dim", unit="m"),
     "rate": Setting("number", REQUIRED, low=0.0, unit="m^3/s"),
