@@ -13,8 +13,9 @@ semi-infinite crack opens by
 (the m-vertex: lubrication ``p' = M' V^n / w^(n+1)`` with the elastic pressure of
 ``w = B s^alpha``, ``p = -(E'/4) alpha |cot(pi alpha)| B s^(alpha-1)``, ``alpha = 2/(n+2)``;
 at n = 1 ``beta_m^3 = 18 sqrt(3)`` of :mod:`hmatddm.analytical.tip_asymptote`). Between the
-two, Dontsov and Kresse (2018, J. Fluid Mech. 837:210-229, the power-law generalisation of
-the zero-order k-m transition) approximate the opening by
+two, Dontsov and Kresse (2018, J. Fluid Mech.; the power-law generalisation of the zero-order
+k-m transition, with the fitted ``theta(n)`` as the EPFL PyFrac code's power-law tip inversion
+uses it; the paper itself was not consulted here) approximate the opening by
 
     w~ = (1 + (beta_mn^(n+2) x~^(2-n))^(1/(1+theta)))^((1+theta)/(n+2)),
     w~ = E' w / (K' s^(1/2)),  x~ = (s / l)^(1/2),  l = (K'^(n+2) / (M' V^n E'^(n+1)))^(2/(2-n)),
