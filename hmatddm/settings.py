@@ -261,8 +261,32 @@ MATERIAL = {  # -> hmatddm.material.Elastic
 }
 
 FLUID = {  # -> hmatddm.flow.fluid.Fluid (ref. Eqs 4.22-4.24)
-    "viscosity": Setting("number", REQUIRED, low=0.0, low_open=True, unit="Pa s"),
+    "viscosity": Setting("number", ABSENT, low=0.0, low_open=True, unit="Pa s",
+                         doc="Newtonian viscosity mu (required when rheology = 'newtonian')"),
     "compressibility": Setting("number", 0.0, low=0.0, unit="1/Pa"),
+    # power-law fluids (issue 34, beyond the reference: ref. Sec. 8.2 item 3)
+    "rheology": Setting("choice", "newtonian", choices=("newtonian", "power-law"),
+                        doc="newtonian (viscosity) or power-law (consistency K, flow_index n: tau = K rate^n)"),
+    "consistency": Setting("number", ABSENT, low=0.0, low_open=True, unit="Pa s^n",
+                           doc="power-law consistency index K (required when rheology = 'power-law')"),
+    "flow_index": Setting("number", 1.0, low=0.0, high=1.0, low_open=True,
+                          doc="power-law flow behaviour index n (1: Newtonian, < 1: shear thinning)"),
+    "minimum_shear_rate": Setting("number", 1e-3, low=0.0, low_open=True, unit="1/s",
+                                  doc="power-law: below this wall shear rate the fluid flows as a Newtonian "
+                                      "one of the apparent viscosity there (keeps a still fluid's conductivity)"),
+}
+
+PROPPANT = {  # -> hmatddm.flow.proppant.Proppant (issue 34, beyond the reference: ref. Sec. 8.2 item 2)
+    "diameter": Setting("number", REQUIRED, low=0.0, low_open=True, unit="m", doc="particle diameter d"),
+    "density": Setting("number", 2650.0, low=0.0, low_open=True, unit="kg/m^3", doc="particle density"),
+    "fluid_density": Setting("number", 1000.0, low=0.0, low_open=True, unit="kg/m^3",
+                             doc="carrier fluid density"),
+    "packing_limit": Setting("number", 0.6, low=0.0, high=1.0, low_open=True, high_open=True,
+                             doc="volume fraction c_max of a packed bed"),
+    "bridging_factor": Setting("number", 3.0, low=1.0,
+                               doc="faces narrower than this many particle diameters carry no proppant"),
+    "hindrance_exponent": Setting("number", 4.65, low=0.0,
+                                  doc="m of the hindered settling velocity v_Stokes (1 - c)^m (Richardson-Zaki)"),
 }
 
 CLUSTER = {  # -> hmatddm.flow.fluid.Cluster (ref. Eqs 4.34-4.35)

@@ -4,7 +4,9 @@
     [ C  D ] [p ] = [g]        C, D, g: lubrication (hmatddm.flow.lubrication)
 
 ``D`` and ``g`` depend on the widths, so the system is iterated (Picard, widths lagged)
-until the changes of ``p`` and ``DD`` fall below the tolerances of ref. Eqs 4.43-4.44.
+until the changes of ``p`` and ``DD`` fall below the tolerances of ref. Eqs 4.43-4.44. For a
+power-law fluid they depend on the pressure too: every scheme assembles them at the iterate
+``(DD, p)``, the flux linearised in the pressure (Newton, :mod:`hmatddm.flow.lubrication`).
 Four schemes:
 
 * ``"fixed-width"`` (ref. Eq. 4.46): ``p = D^-1 (g - C DD^k)``, then ``DD = A^-1 (f - B p)``.
@@ -80,7 +82,7 @@ class _Diverged(Exception):
 
 
 def _segregated_iteration(problem, settings, dd, p, alpha, counters, first=False):
-    matrix, rhs = problem.flow_matrices(dd)
+    matrix, rhs = problem.flow_matrices(dd, p)
     rhs = rhs - problem.coupling @ dd
     if settings.scheme == "fracture-compliance" and settings.omega > 0.0:
         correction = settings.omega * problem.compliance_term
@@ -108,7 +110,7 @@ def _coupled_iteration(problem, settings, dd, p, alpha, counters, first=False, p
     the iterate returned is the first paused one, and a
     :class:`~hmatddm.coupled.paused.PausedIterate` appended to ``pause``
     continues the same solve (nothing appended when it ended before a pause)."""
-    matrix, flow_rhs = problem.flow_matrices(dd)
+    matrix, flow_rhs = problem.flow_matrices(dd, p)
     if not (np.all(np.isfinite(matrix.data)) and np.all(np.isfinite(flow_rhs))):
         raise _Diverged("non-finite flow matrix")
     try:

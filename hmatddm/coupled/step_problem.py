@@ -145,9 +145,11 @@ class StepProblem:
     def b_times(self, p):
         return (self.normals * p[:, None]).ravel()
 
-    def flow_matrices(self, dd):
+    def flow_matrices(self, dd, p=None):
+        """``D`` and ``g`` at the iterate ``dd`` (widths lagged) and ``p`` (where a power-law
+        flux is linearised, :mod:`hmatddm.flow.lubrication`; default the old pressure)."""
         matrix, rhs = self.flow.assemble(self.width(dd), self.width_old, self.pressure_old, self.dt,
-                                         self.leak_off_rate)
+                                         self.leak_off_rate, pressure_iterate=p)
         if np.any(self.fixed):  # drained elements: p_i = p_fixed, scaled like the other rows
             diagonal = matrix.diagonal()
             scale = float(np.mean(np.abs(diagonal[~self.fixed]))) if np.any(~self.fixed) else 1.0

@@ -10,28 +10,86 @@ from ..settings import CLUSTER, FLUID, LEAK_OFF
 
 @dataclass(frozen=True)
 class Fluid:
-    """Slightly compressible Newtonian fluid (ref. Eqs 4.22-4.24).
+    """Slightly compressible fracturing fluid (ref. Eqs 4.22-4.24): Newtonian, or a
+    power-law fluid (beyond the reference, which names it as its next step, ref. Sec. 8.2).
 
     Parameters
     ----------
     viscosity : float
-        Dynamic viscosity mu_f in Pa s, > 0 (1 cP = 1e-3 Pa s). The lubrication
-        equation uses mu' = 12 mu_f (cubic law, ref. Eq. 4.24).
+        Newtonian dynamic viscosity mu_f in Pa s, > 0 (1 cP = 1e-3 Pa s); required for
+        ``rheology="newtonian"``, not taken by a power-law fluid. The lubrication equation
+        uses mu' = 12 mu_f (cubic law, ref. Eq. 4.24).
     compressibility : float
         c_f in 1/Pa, >= 0 (ref. Eq. 4.22; 4.4e-4 1/MPa = 4.4e-10 1/Pa).
+    rheology : ``"newtonian"`` or ``"power-law"``
+        A power-law (Ostwald-de Waele) fluid has the shear stress ``tau = K gamma_dot^n``.
+    consistency : float
+        K in Pa s^n, > 0, for ``rheology="power-law"`` (a Newtonian fluid is n = 1, K = mu; a
+        power-law fluid given a ``viscosity`` instead takes K = viscosity).
+    flow_index : float
+        n in (0, 1] (power-law only; 1 for a Newtonian fluid).
+    minimum_shear_rate : float
+        gamma_0 in 1/s, > 0 (power-law only): where the wall shear rate of the parallel-plate
+        flow falls below it, the fluid flows as a Newtonian one of the apparent viscosity
+        ``K gamma_0^(n-1)`` (a truncated power law: a still fluid keeps a finite
+        conductivity, :mod:`hmatddm.flow.lubrication`). Default 1e-3 1/s, far below the
+        shear rates of fracture flow (~1-1e4 1/s).
+
+    The parallel-plate flux of a power-law fluid (Adachi and Detournay 2002, their Eq. 5)
+    is ``q = -(w^(2n+1) / M')^(1/n) |dp/dx|^(1/n - 1) dp/dx`` with
+    ``M' = 2^(n+1) (2n+1)^n / n^n K`` (:attr:`viscosity_prime`), which is the cubic law with
+    ``mu' = 12 mu`` at n = 1.
     """
 
-    viscosity: float
+    viscosity: float = None
     compressibility: float = 0.0
+    rheology: str = "newtonian"
+    consistency: float = None
+    flow_index: float = 1.0
+    minimum_shear_rate: float = FLUID["minimum_shear_rate"].default
 
     def __post_init__(self):
-        for name in ("viscosity", "compressibility"):
-            object.__setattr__(self, name, FLUID[name].value(name, getattr(self, name)))
+        rheology = FLUID["rheology"].value("fluid.rheology", self.rheology)
+        object.__setattr__(self, "rheology", rheology)
+        for name in ("compressibility", "flow_index", "minimum_shear_rate"):
+            object.__setattr__(self, name, FLUID[name].value(f"fluid.{name}", getattr(self, name)))
+        if rheology == "newtonian":
+            if self.viscosity is None:
+                raise InputError("fluid.viscosity (Pa s) is required for fluid.rheology = 'newtonian'")
+            if self.consistency is not None or self.flow_index != 1.0:
+                raise InputError("fluid.consistency and fluid.flow_index describe a power-law fluid: set "
+                                 "fluid.rheology = 'power-law' (a Newtonian fluid takes fluid.viscosity)")
+            object.__setattr__(self, "viscosity", FLUID["viscosity"].value("fluid.viscosity", self.viscosity))
+        else:
+            if self.consistency is None and self.viscosity is None:
+                raise InputError("fluid.consistency (Pa s^n) is required for fluid.rheology = 'power-law'")
+            if self.consistency is not None and self.viscosity is not None:
+                raise InputError("fluid.viscosity is the Newtonian viscosity; a power-law fluid takes "
+                                 "fluid.consistency and fluid.flow_index instead (n = 1, K = mu is Newtonian)")
+            if self.consistency is None:  # K = mu (a Newtonian fluid is n = 1, K = mu)
+                object.__setattr__(self, "consistency", self.viscosity)
+                object.__setattr__(self, "viscosity", None)
+            object.__setattr__(self, "consistency", FLUID["consistency"].value("fluid.consistency",
+                                                                                self.consistency))
+
+    @property
+    def power_law(self):
+        """Whether the fluid is a power-law fluid (``rheology="power-law"``, any n)."""
+        return self.rheology == "power-law"
+
+    @property
+    def consistency_index(self):
+        """K in Pa s^n (the viscosity of a Newtonian fluid)."""
+        return self.consistency if self.power_law else self.viscosity
 
     @property
     def viscosity_prime(self):
-        """mu' = 12 mu_f (ref. Eq. 4.24)."""
-        return 12.0 * self.viscosity
+        """mu' = 12 mu_f (ref. Eq. 4.24); for a power-law fluid Adachi and Detournay's (2002)
+        ``M' = 2^(n+1) (2n+1)^n / n^n K`` (Pa s^n), which is 12 K at n = 1."""
+        if not self.power_law:
+            return 12.0 * self.viscosity
+        n = self.flow_index
+        return 2.0 ** (n + 1.0) * (2.0 * n + 1.0) ** n / n**n * self.consistency
 
 
 @dataclass(frozen=True)

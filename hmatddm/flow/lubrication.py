@@ -23,6 +23,25 @@ for equal neighbours. The flux is antisymmetric, so mass is conserved across siz
 jumps. (A harmonic mean of ``w^3`` would throttle the flow into a freshly created tip
 element to its floor width and lock a viscosity-dominated front; measured.)
 
+Power-law fluids (beyond the reference, ref. Sec. 8.2; :class:`~hmatddm.flow.fluid.Fluid`):
+the flux across a face is the parallel-plate flux of Adachi and Detournay (2002),
+``F_e = c_e |dp_e|^(m-1) dp_e`` with ``dp_e = p_i - p_j``, ``m = 1/n`` and
+``c_e = l (w_e^(2n+1) / M')^(1/n) / (d_i + d_j)^m`` (the same face width ``w_e``). The
+conductivity depends on the pressure difference: :meth:`LubricationModel.assemble` linearises
+the flux at the pressure iterate ``dp^k`` (Newton in ``dp``, the widths lagged as above)::
+
+    F_e ~ k_e dp_e - r_e,   k_e = m c_e |dp^k|^(m-1),   r_e = (m - 1) c_e |dp^k|^(m-1) dp^k,
+
+so the face's ``k_e`` enters ``D`` like a transmissibility and ``r_e`` enters ``g``; at the
+fixed point ``dp = dp^k`` the flux is exact. (Lagging ``|dp|^(m-1)`` instead, a Picard
+iteration, maps a gradient error ``e`` to ``-(m - 1) e``: it oscillates without contraction
+at n = 1/2.) Below the wall shear rate ``gamma_0`` (``Fluid.minimum_shear_rate``), i.e. for
+``|dp_e| < dp_0 = 2 K gamma_0^n (d_i + d_j) / w_e`` (wall shear stress ``w |grad p| / 2``),
+the flux is linear, ``F_e = c_e dp_0^(m-1) dp_e`` (a Newtonian fluid of the apparent
+viscosity there, continuous at ``dp_0``): a still fluid keeps a finite conductivity and
+the first iterate of a uniform pressure is defined. At n = 1 the linearisation is the
+Newtonian row itself (``k_e = c_e``, ``r_e = 0``).
+
 Carter leak-off over a step is integrated exactly: ``Lambda_i dt = 2 c_l
 (sqrt(t^{n+1} - tau_i) - sqrt(max(t^n - tau_i, 0)))``, finite for elements created
 during the step (``t - tau -> 0`` in ref. Eq. 4.25).
@@ -81,13 +100,49 @@ class LubricationModel:
     def effective_width(self, width):
         return np.maximum(width, self.minimum_width)
 
-    def transmissibility(self, width):
-        """K_e of every face (ref. Eq. 4.36) for element widths ``width``."""
+    def face_width(self, width):
+        """``(w_e, d_i + d_j)`` of every face: the width interpolated linearly between the two
+        centres (module docstring) and the centre-to-centre distance."""
         w = self.effective_width(width)
         f = self.faces
         distance = f.first_distance + f.second_distance
-        face_width = (f.second_distance * w[f.first] + f.first_distance * w[f.second]) / distance
-        return f.length * face_width**3 / (self.fluid.viscosity_prime * distance)
+        return (f.second_distance * w[f.first] + f.first_distance * w[f.second]) / distance, distance
+
+    def transmissibility(self, width):
+        """K_e of every face (ref. Eq. 4.36) for element widths ``width`` (Newtonian fluid)."""
+        if self.fluid.power_law:
+            raise ValueError("a power-law fluid's conductivity depends on the pressure: use "
+                             "power_law_conductance(width, pressure)")
+        face_width, distance = self.face_width(width)
+        return self.faces.length * face_width**3 / (self.fluid.viscosity_prime * distance)
+
+    def power_law_conductance(self, width, pressure):
+        """``(k_e, r_e)`` of every face: the power-law flux linearised at ``pressure`` (module
+        docstring), ``F_e ~ k_e (p_i - p_j) - r_e`` from the first element to the second."""
+        fluid = self.fluid
+        n = fluid.flow_index
+        m = 1.0 / n
+        f = self.faces
+        face_width, distance = self.face_width(width)
+        coefficient = f.length * (face_width ** (2.0 * n + 1.0) / fluid.viscosity_prime) ** m / distance**m
+        difference = pressure[f.first] - pressure[f.second]
+        floor = 2.0 * fluid.consistency * fluid.minimum_shear_rate**n * distance / face_width
+        magnitude = np.abs(difference)
+        sheared = magnitude > floor
+        scale = coefficient * np.maximum(magnitude, floor) ** (m - 1.0)
+        conductance = np.where(sheared, m * scale, scale)
+        correction = np.where(sheared, (m - 1.0) * scale * difference, 0.0)
+        return conductance, correction
+
+    def face_flux(self, width, pressure):
+        """Volume flux of every face from its first element to its second, m^3/s (the exact
+        flux law, Newtonian or power-law, at ``width`` and ``pressure``)."""
+        f = self.faces
+        difference = pressure[f.first] - pressure[f.second]
+        if not self.fluid.power_law:
+            return self.transmissibility(width) * difference
+        conductance, correction = self.power_law_conductance(width, pressure)
+        return conductance * difference - correction
 
     def leak_off_rate(self, creation_time, time_old, time_new):
         """Lambda_i, the step-averaged Carter coefficient (1/s per Pa scale: m/(s Pa))."""
@@ -119,18 +174,25 @@ class LubricationModel:
         values = (self.areas[:, None] / dt * self.normals).ravel()
         return sp.csr_matrix((values, (rows, cols)), shape=(n, n * d))
 
-    def assemble(self, width_iterate, width_old, pressure_old, dt, leak_off_rate):
+    def assemble(self, width_iterate, width_old, pressure_old, dt, leak_off_rate, pressure_iterate=None):
         """``D`` (sparse CSR, N x N) and ``g`` (N,) of ref. Eqs 4.39-4.40.
 
         ``width_iterate`` is w^{n+1,k} (lags the nonlinear terms), ``width_old`` w^n,
         ``pressure_old`` p^n, ``leak_off_rate`` Lambda from :meth:`leak_off_rate`.
+        ``pressure_iterate`` p^{n+1,k}: where a power-law flux is linearised (module
+        docstring; default ``pressure_old``); a Newtonian fluid does not read it.
         """
         n = self.n_elements
         c_f = self.fluid.compressibility
         storage = c_f * (self.areas * self.effective_width(width_iterate) + self.wellbore_storage()) / dt
         leak = self.areas * leak_off_rate
-        k = self.transmissibility(width_iterate)
         f = self.faces
+        correction = None
+        if self.fluid.power_law:
+            at = pressure_old if pressure_iterate is None else pressure_iterate
+            k, correction = self.power_law_conductance(width_iterate, np.asarray(at, dtype=np.float64))
+        else:
+            k = self.transmissibility(width_iterate)
         diagonal = storage + leak
         np.add.at(diagonal, f.first, k)
         np.add.at(diagonal, f.second, k)
@@ -140,4 +202,7 @@ class LubricationModel:
         matrix = sp.csr_matrix((values, (rows, cols)), shape=(n, n))
         rhs = (self.injection() + storage * pressure_old + self.areas * width_old / dt
                + leak * self.leak_off.pore_pressure)
+        if correction is not None:  # the linearised power-law flux: F_e = k_e dp_e - r_e
+            np.add.at(rhs, f.first, correction)
+            np.subtract.at(rhs, f.second, correction)
         return matrix, rhs

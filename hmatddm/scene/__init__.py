@@ -36,8 +36,13 @@ The format, annotated (``=`` values are the defaults unless marked REQUIRED)::
     poisson_ratio = 0.25           # REQUIRED, [0, 0.5)
 
     [fluid]
-    viscosity = 1e-3               # REQUIRED, Pa s, > 0 (1 cP = 1e-3 Pa s)
+    viscosity = 1e-3               # REQUIRED (Newtonian), Pa s, > 0 (1 cP = 1e-3 Pa s)
     compressibility = 4.4e-10      # 1/Pa, >= 0 (default 0)
+    rheology = "newtonian"         # "newtonian" or "power-law" (tau = K gamma_dot^n)
+    # consistency = 0.1            # power-law: K, Pa s^n, > 0 (default: viscosity, i.e. K = mu)
+    # flow_index = 0.5             # power-law: n, (0, 1] (default 1); a viscosity beside a
+                                   # consistency is dropped from the echo
+    # minimum_shear_rate = 1e-3    # power-law: 1/s, > 0; slower shear flows as Newtonian
 
     [stress]                       # compressive positive, Pa; EITHER principal values:
     s_hmin = 8e6                   #   minimum horizontal stress

@@ -44,7 +44,7 @@ def layered_medium(scene):
 
 
 def fluid(scene):
-    return Fluid(viscosity=scene["fluid"]["viscosity"], compressibility=scene["fluid"]["compressibility"])
+    return Fluid(**scene["fluid"])  # the echo's keys are the fields (hmatddm.settings.FLUID)
 
 
 def clusters(scene):
@@ -167,10 +167,30 @@ def _closed_form(scene, times):
     kind = scene["reference"]["kind"]
     mat = material(scene)
     rate = scene["cluster"][0]["rate"]
-    viscosity = scene["fluid"]["viscosity"]
     toughness = scene["propagation"]["toughness"]
     times = np.asarray(times, dtype=float)
     curves = {"time": times}
+    if scene["fluid"]["rheology"] == "power-law":  # the power-law vertices (hmatddm.analytical.power_law)
+        from ..analytical import power_law
+
+        args = (scene["fluid"]["consistency"], scene["fluid"]["flow_index"])
+        if kind.startswith("radial"):  # radial-m or radial-k (radial-km is refused by the schema)
+            if kind == "radial-k":
+                curves["radius"], curves["max_opening"], curves["net_pressure"] = analytical.radial_k_vertex(
+                    times, rate, toughness, mat)
+            else:
+                curves["radius"], curves["max_opening"] = power_law.radial_power_law_vertex(times, rate, *args, mat)
+            curves["dimensionless_toughness"] = power_law.radial_power_law_regime(times, rate, *args, toughness, mat)
+            return curves
+        rate = rate / scene["height"]
+        if kind == "kgd-k":
+            values = analytical.kgd_k_vertex(times, rate, toughness, mat)
+        else:
+            values = power_law.kgd_power_law_vertex(times, rate, *args, mat)
+        curves["half_length"], curves["max_opening"], curves["net_pressure"] = values
+        curves["dimensionless_toughness"] = power_law.kgd_power_law_regime(times, rate, *args, toughness, mat)
+        return curves
+    viscosity = scene["fluid"]["viscosity"]
     if kind.startswith("radial"):
         if kind == "radial-k":
             curves["radius"], curves["max_opening"], curves["net_pressure"] = analytical.radial_k_vertex(

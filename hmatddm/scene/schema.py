@@ -192,6 +192,29 @@ def _check_network(echo, given):
     return echo
 
 
+def _check_fluid(echo):
+    """The keys a rheology takes (issue 34; :class:`hmatddm.flow.Fluid`): a Newtonian fluid its
+    viscosity; a power-law fluid its consistency K and flow index n. A power-law fluid without
+    a consistency takes K = viscosity (n = 1, K = mu is the Newtonian fluid), and a viscosity
+    beside a consistency is dropped from the echo, so that ``--set fluid.rheology=power-law
+    --set fluid.consistency=... --set fluid.flow_index=...`` turns a Newtonian scene into a
+    power-law one. Returns the echo."""
+    if echo["rheology"] == "newtonian":
+        if "viscosity" not in echo:
+            raise InputError("fluid.viscosity (Pa s) is required for fluid.rheology = 'newtonian'")
+        if "consistency" in echo or echo["flow_index"] != 1.0:
+            raise InputError("fluid.consistency and fluid.flow_index describe a power-law fluid: set "
+                             "fluid.rheology = 'power-law' (a Newtonian fluid takes fluid.viscosity)")
+        return echo
+    viscosity = echo.pop("viscosity", None)
+    if "consistency" not in echo:
+        if viscosity is None:
+            raise InputError("fluid.consistency (Pa s^n) is required for fluid.rheology = 'power-law'")
+        echo["consistency"] = viscosity
+    return {key: echo[key] for key in ("compressibility", "rheology", "consistency", "flow_index",
+                                       "minimum_shear_rate")}
+
+
 def _check_reference(scene):
     kind = scene["reference"]["kind"]
     dim = scene["dimension"]
@@ -204,6 +227,10 @@ def _check_reference(scene):
                          "cluster(s)")
     if "propagation" not in scene:
         raise InputError(f"{where} compares a growing fracture: the scene needs a [propagation] section")
+    if scene["fluid"]["rheology"] == "power-law" and kind == "radial-km":
+        raise InputError(f"{where} is a Newtonian closed form (Dontsov 2016); a power-law fluid "
+                         "(fluid.rheology = 'power-law') is compared with kind = 'radial-m', 'radial-k', 'kgd-m' "
+                         "or 'kgd-k'")
     if scene["leak_off"]["coefficient"] != 0.0:
         raise InputError(f"{where} assumes no leak-off: leak_off.coefficient must be 0, got "
                          f"{show(scene['leak_off']['coefficient'])}")
@@ -269,6 +296,8 @@ def validate(raw, name=None):
         echo = _check_table(section, value, keys, dim)
         if section == "stress":
             echo = _check_stress(echo, dim)
+        elif section == "fluid":
+            echo = _check_fluid(echo)
         elif section == "network":
             echo = _check_network(echo, set(value))
         elif section == "microseismic":

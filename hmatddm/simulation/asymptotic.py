@@ -36,7 +36,7 @@ from ..coupled.contact import ContactRows
 from ..errors import ConvergenceError, InputError
 from ..flow import fracture_compliance
 from ..fracture.front import CHANNEL, EMPTY, FILLED, TIP, FrontField, PlanarGrid, fill, front_radii, level_set
-from ..analytical.tip_asymptote import TipAsymptote
+from ..analytical.power_law_tip import tip_asymptote
 from .records import StepTally, step_record
 from .step_solve import mesh_topology
 from .state import NewElements, StepStart
@@ -99,7 +99,9 @@ class AsymptoticFront:
         self.grid = PlanarGrid(sim.mesh0)
         if sim.growing_fractures is not None and int(sim.mesh0.fracture_id[0]) not in sim.growing_fractures:
             raise InputError("propagation.front = 'asymptotic': the fracture is not among growing_fractures")
-        self.asymptote = TipAsymptote(sim.material.plane_strain_modulus, prop.toughness, sim.fluid.viscosity_prime)
+        # a power-law fluid (n < 1): its own k-m asymptote (hmatddm.analytical.power_law_tip)
+        self.asymptote = tip_asymptote(sim.material.plane_strain_modulus, prop.toughness, sim.fluid.viscosity_prime,
+                                       sim.fluid.flow_index)
         self._solver = None
 
     # -- the front at t = 0 -------------------------------------------------------------
