@@ -379,3 +379,11 @@ NETWORK_GEOMETRY = {  # network.* of a scene: the vertical extent of the natural
     "height": Setting("number", 1.0, **_POSITIVE_LENGTH),
     "z_center": Setting("number", 0.0, unit="m"),
 }
+
+POROELASTIC = {  # [poroelastic] of a scene -> hmatddm.fracture.poroelastic.UndrainedRock (ref. Eqs 5.17-5.21)
+    "biot": Setting("number", REQUIRED, low=0.0, high=1.0, low_open=True,
+                    doc="Biot coefficient alpha = 1 - K/K_s (ref. Eq. 5.20); >= the porosity"),
+    "fluid_bulk_modulus": Setting("number", REQUIRED, low=0.0, low_open=True, unit="Pa",
+                                  doc="K_f of the reservoir fluid (ref. Table 5.2: oil 2.2 GPa, gas 30 MPa)"),
+    "porosity": Setting("number", REQUIRED, low=0.0, high=1.0, low_open=True, high_open=True, doc="phi"),
+}

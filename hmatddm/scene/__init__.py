@@ -174,6 +174,13 @@ The format, annotated (``=`` values are the defaults unless marked REQUIRED)::
     seed = 0                       # of the noise
     merge = false                  # one event per element (the reference), or merge neighbours
                                    # that fail in the same step
+
+    [poroelastic]                  # undrained rock (ref. Sec. 5.3.1): [material] holds the drained
+                                   # G and nu; the run uses the undrained nu_u (Eq. 5.19) and the
+                                   # remote-failure check B (Eq. 5.21); `--check` prints them
+    biot = 0.8                     # REQUIRED, alpha = 1 - K/K_s, in (0, 1], >= porosity
+    fluid_bulk_modulus = 2.2e9     # REQUIRED, K_f of the reservoir fluid, Pa (gas: 30e6)
+    porosity = 0.15                # REQUIRED, in (0, 1)
 '''
 import difflib
 import tomllib

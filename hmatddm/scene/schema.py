@@ -308,11 +308,26 @@ def validate(raw, name=None):
         _check_layers(scene)
     if "reference" in scene:
         _check_reference(scene)
+    if "poroelastic" in scene:
+        _check_poroelastic(scene)
     if has_natural_fractures(scene) and "contact" not in raw["numerics"]:
         # a hydraulic element squeezed between natural fractures can open negatively and stall
         # the Picard iteration with contact = "natural": in a network every element closes
         numerics["contact"] = "all"
     return scene
+
+
+def _check_poroelastic(scene):
+    """[poroelastic] turns [material]'s drained constants undrained (ref. Eqs 5.19-5.21):
+    one uniform rock, so no [[layer]] tables; biot >= porosity is checked here."""
+    if "layer" in scene:
+        raise InputError("[poroelastic] derives the undrained constants of the uniform [material]; a scene with "
+                         "[[layer]] tables cannot take it: remove one of them")
+    from ..fracture.poroelastic import UndrainedRock
+
+    poro, rock = scene["poroelastic"], scene["material"]
+    UndrainedRock.from_poisson_ratio(rock["shear_modulus"], rock["poisson_ratio"], poro["biot"],
+                                     poro["fluid_bulk_modulus"], poro["porosity"])
 
 
 def _check_layers(scene):

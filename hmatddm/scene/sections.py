@@ -110,5 +110,6 @@ SECTIONS = {
     "natural_fracture": (NATURAL_FRACTURE, True, False),
     "microseismic": (MICROSEISMIC, False, False),
     "layer": (LAYER, True, False),
+    "poroelastic": (settings.POROELASTIC, False, False),  # undrained rock (ref. Sec. 5.3.1): build.material
 }
 FILLED_WHEN_ABSENT = ("leak_off", "output")  # optional sections echoed with their defaults
