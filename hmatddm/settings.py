@@ -387,3 +387,7 @@ POROELASTIC = {  # [poroelastic] of a scene -> hmatddm.fracture.poroelastic.Undr
                                   doc="K_f of the reservoir fluid (ref. Table 5.2: oil 2.2 GPa, gas 30 MPa)"),
     "porosity": Setting("number", REQUIRED, low=0.0, high=1.0, low_open=True, high_open=True, doc="phi"),
 }
+
+MONITOR = {  # a [[monitor]] of a scene -> hmatddm.app.monitor (displacement and tilt, ref. Eqs 2.43, 2.55-2.57)
+    "position": Setting("point", REQUIRED, length="dim", unit="m", doc="where the displacement and tilt are recorded"),
+}

@@ -181,6 +181,9 @@ The format, annotated (``=`` values are the defaults unless marked REQUIRED)::
     biot = 0.8                     # REQUIRED, alpha = 1 - K/K_s, in (0, 1], >= porosity
     fluid_bulk_modulus = 2.2e9     # REQUIRED, K_f of the reservoir fluid, Pa (gas: 30e6)
     porosity = 0.15                # REQUIRED, in (0, 1)
+
+    [[monitor]]                    # displacement and tilt at a point after every step: DIR/monitor.csv
+    position = [0.0, 0.0, 50.0]    # and DIR/monitor.png (hmatddm.app.monitor); uniform rock only
 '''
 import difflib
 import tomllib

@@ -310,6 +310,9 @@ def validate(raw, name=None):
         _check_reference(scene)
     if "poroelastic" in scene:
         _check_poroelastic(scene)
+    if "monitor" in scene and "layer" in scene:
+        raise InputError("[[monitor]] needs the displacement kernels of a uniform rock; the layered kernels "
+                         "(ref. Ch. 3) give stresses only: remove the [[monitor]] or the [[layer]] tables")
     if has_natural_fractures(scene) and "contact" not in raw["numerics"]:
         # a hydraulic element squeezed between natural fractures can open negatively and stall
         # the Picard iteration with contact = "natural": in a network every element closes

@@ -111,5 +111,6 @@ SECTIONS = {
     "microseismic": (MICROSEISMIC, False, False),
     "layer": (LAYER, True, False),
     "poroelastic": (settings.POROELASTIC, False, False),  # undrained rock (ref. Sec. 5.3.1): build.material
+    "monitor": (settings.MONITOR, True, False),  # displacement and tilt at points: hmatddm.app.monitor
 }
 FILLED_WHEN_ABSENT = ("leak_off", "output")  # optional sections echoed with their defaults
