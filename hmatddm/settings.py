@@ -274,6 +274,11 @@ CLUSTER = {  # -> hmatddm.flow.fluid.Cluster (ref. Eqs 4.34-4.35)
 LEAK_OFF = {  # -> hmatddm.flow.fluid.LeakOff (ref. Eqs 4.25-4.26)
     "coefficient": Setting("number", 0.0, low=0.0, unit="m/(s^0.5 Pa)"),
     "pore_pressure": Setting("number", 0.0, unit="Pa"),
+    # or the coefficient from the reservoir (ref. Eq. 4.26, both faces): hmatddm.flow.carter_coefficient
+    "permeability": Setting("number", low=0.0, low_open=True, unit="m^2", doc="k_r (1 mD = 9.869e-16 m^2)"),
+    "porosity": Setting("number", low=0.0, high=1.0, low_open=True, high_open=True),
+    "reservoir_compressibility": Setting("number", low=0.0, low_open=True, unit="1/Pa", doc="total c_t"),
+    "reservoir_viscosity": Setting("number", low=0.0, low_open=True, unit="Pa s", doc="of the reservoir fluid"),
 }
 
 #: network.* in a scene and the defaults of hmatddm.fracture.crossing.NaturalFractureProperties

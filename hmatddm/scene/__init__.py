@@ -75,8 +75,13 @@ The format, annotated (``=`` values are the defaults unless marked REQUIRED)::
     # growing_fractures = [0]      # fracture ids allowed to grow (default: all)
 
     [leak_off]                     # Carter leak-off (default: none)
-    coefficient = 0.0              # m/(s^0.5 Pa), >= 0
+    coefficient = 0.0              # m/(s^0.5 Pa), >= 0 (through both faces)
     pore_pressure = 0.0            # Pa
+    # or, instead of coefficient, the reservoir it comes from (ref. Eq. 4.26, both faces):
+    # permeability = 1e-16         # m^2, > 0 (1 mD = 9.869e-16 m^2)
+    # porosity = 0.1               # (0, 1)
+    # reservoir_compressibility = 1e-9   # 1/Pa, > 0, total
+    # reservoir_viscosity = 1e-3   # Pa s, > 0, of the reservoir fluid
 
     [numerics]
     time_step = 1.0                # s, > 0, or "auto": steps that follow the front (then:)

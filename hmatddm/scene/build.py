@@ -84,7 +84,16 @@ def propagation(scene):
 
 
 def leak_off(scene):
-    return LeakOff(coefficient=scene["leak_off"]["coefficient"], pore_pressure=scene["leak_off"]["pore_pressure"])
+    """The :class:`LeakOff` of ``[leak_off]``: its coefficient, or the one the reservoir keys
+    give (ref. Eq. 4.26, both faces, :func:`hmatddm.flow.carter_coefficient`)."""
+    section = scene["leak_off"]
+    coefficient = section["coefficient"]
+    if "permeability" in section:
+        from ..flow import carter_coefficient
+
+        coefficient = carter_coefficient(section["permeability"], section["porosity"],
+                                         section["reservoir_compressibility"], section["reservoir_viscosity"])
+    return LeakOff(coefficient=coefficient, pore_pressure=section["pore_pressure"])
 
 
 def scheme_settings(scene):

@@ -310,6 +310,7 @@ def validate(raw, name=None):
         _check_reference(scene)
     if "poroelastic" in scene:
         _check_poroelastic(scene)
+    _check_leak_off_reservoir(scene)
     if "monitor" in scene and "layer" in scene:
         raise InputError("[[monitor]] needs the displacement kernels of a uniform rock; the layered kernels "
                          "(ref. Ch. 3) give stresses only: remove the [[monitor]] or the [[layer]] tables")
@@ -318,6 +319,25 @@ def validate(raw, name=None):
         # the Picard iteration with contact = "natural": in a network every element closes
         numerics["contact"] = "all"
     return scene
+
+
+RESERVOIR_KEYS = ("permeability", "porosity", "reservoir_compressibility", "reservoir_viscosity")
+
+
+def _check_leak_off_reservoir(scene):
+    """[leak_off] takes the coefficient, or the four reservoir keys it comes from (ref.
+    Eq. 4.26, :func:`hmatddm.flow.carter_coefficient`), not both."""
+    section = scene["leak_off"]
+    given = [key for key in RESERVOIR_KEYS if key in section]
+    if not given:
+        return
+    missing = [key for key in RESERVOIR_KEYS if key not in section]
+    if missing:
+        raise InputError(f"leak_off.{missing[0]} is required with leak_off.{given[0]}: the coefficient from the "
+                         f"reservoir (ref. Eq. 4.26) needs {', '.join('leak_off.' + k for k in RESERVOIR_KEYS)}")
+    if section["coefficient"] != 0.0:
+        raise InputError("leak_off.coefficient must be left out when the reservoir gives it (leak_off."
+                         f"{given[0]} ...), got {show(section['coefficient'])}")
 
 
 def _check_poroelastic(scene):
