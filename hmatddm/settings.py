@@ -293,6 +293,10 @@ NATURAL_FRACTURE = {
                                doc="r_c of the Mohr-Coulomb crossing criterion (ref. Table 6.2: characteristic "
                                    "length)"),
     "skempton": Setting("number", 0.0, low=0.0, high=1.0, doc="Skempton's B (ref. Eq. 5.18)"),
+    "shear_toughness": Setting("number", 0.0, low=0.0, unit="Pa m^0.5",
+                               doc="K_IIc of the natural fractures (ref. Eqs 5.15-5.16; energy crossing criterion)"),
+    "rock_shear_toughness": Setting("number", 0.0, low=0.0, unit="Pa m^0.5",
+                                    doc="K_IIc of the rock (ref. Eqs 5.15-5.16; energy crossing criterion)"),
 }
 
 _POSITIVE_LENGTH = dict(low=0.0, low_open=True, unit="m")

@@ -142,6 +142,8 @@ The format, annotated (``=`` values are the defaults unless marked REQUIRED)::
     tensile_strength = 0.0         # Pa, >= 0
     toughness = 0.5e6              # Pa m^0.5, > 0
     critical_radius = 0.005        # m, > 0
+    shear_toughness = 0.0          # Pa m^0.5, >= 0, K_IIc of the natural fractures (energy criterion)
+    rock_shear_toughness = 0.0     # Pa m^0.5, >= 0, K_IIc of the rock (energy criterion)
     crossing = "mohr-coulomb"      # "mohr-coulomb", "energy-release-rate", "stress-intensity"
     remote_failure = true
     element_size = 1.0             # m

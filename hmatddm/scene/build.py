@@ -163,7 +163,8 @@ def natural_properties(scene):
     return NaturalFractureProperties(
         friction=value["friction_coefficient"], cohesion=value["cohesion"],
         tensile_strength=value["tensile_strength"], toughness=value["toughness"],
-        critical_radius=value["critical_radius"],
+        critical_radius=value["critical_radius"], shear_toughness=value["shear_toughness"],
+        rock_shear_toughness=value["rock_shear_toughness"],
         crossing=_CROSSING_NAMES[settings.get("crossing", "mohr-coulomb")],
         pore_pressure=scene["leak_off"]["pore_pressure"], skempton=0.0 if rock is None else rock.skempton)
 

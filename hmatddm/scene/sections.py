@@ -78,6 +78,8 @@ NETWORK_MECHANICS = {  # defaults: ref. Table 6.2 (natural-fracture properties)
     "tensile_strength": NATURAL_FRACTURE["tensile_strength"],
     "toughness": NATURAL_FRACTURE["toughness"],
     "critical_radius": NATURAL_FRACTURE["critical_radius"],
+    "shear_toughness": NATURAL_FRACTURE["shear_toughness"],
+    "rock_shear_toughness": NATURAL_FRACTURE["rock_shear_toughness"],
     "crossing": Key("choice", "mohr-coulomb", choices=CROSSING_CRITERIA),
     "remote_failure": Key("boolean", True),
     "element_size": Key("number", 1.0, **_POSITIVE_LENGTH),
