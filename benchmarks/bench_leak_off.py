@@ -18,6 +18,9 @@ percent only), compared at every step with:
   dominates, whatever the viscosity -- the M~ case has a viscosity-dominated fracture
   (K_m below 1), compared with it alone.
 
+And radial fractures (3D, 0.25 m elements, 20 s) against the radial K vertex and the
+radial K-K~ edge (:func:`hmatddm.analytical.radial_toughness_leak_off_edge`).
+
 Also the leak-off coefficient from the reservoir (ref. Eq. 4.26,
 :func:`hmatddm.flow.carter_coefficient`) for the reference's Table 5.2 / 6.2 rock (shown,
 not run: with ``k_r = 0`` it is zero).
@@ -43,7 +46,8 @@ from _common import machine, print_table  # noqa: E402
 
 import hmatddm as hd  # noqa: E402
 from hmatddm.analytical import (kgd_k_vertex, kgd_leak_off_half_length, kgd_regime,  # noqa: E402
-                                kgd_toughness_leak_off_edge)
+                                kgd_toughness_leak_off_edge, radial_k_vertex, radial_leak_off_radius,
+                                radial_toughness_leak_off_edge)
 from hmatddm.flow import carter_coefficient  # noqa: E402
 
 MATERIAL = hd.Elastic(1e9, 0.25)
@@ -89,6 +93,36 @@ def run_case(name, rate, c_l, toughness, viscosity, end_time, dt):
     return {"name": name, "t": t, "length": length, "edge": edge, "edge_net": edge_net, "vertex": vertex,
             "net": pressure, "leaked": 1.0 - stored / injected, "wall": wall, "cpu": cpu, "k_m": k_m,
             "c_l": c_l, "rate": rate, "viscous": viscosity > 1e-2, "elements": records[-1]["n_elements"]}
+
+
+#: radial (3D, dense): name, injection rate (m^3/s), c_l; K_Ic 1 MPa m^1/2, mu 1e-5 Pa s, 20 s
+RADIAL_CASES = (("radial K (no leak-off)", 1e-3, 0.0), ("radial K to K~", 1e-3, 7e-12),
+                ("radial K~", 1e-3, 3e-11))
+
+
+def run_radial(name, rate, c_l, end_time=20.0, toughness=1e6):
+    """A horizontal radial fracture (0.25 m elements, 1 m x 1 m initial square, sigma_v = 20
+    MPa above p_r = 0) against the radial K vertex or the radial K-K~ edge."""
+    mesh = hd.mesh.rectangle([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], 1.0, 1.0, 4, 4)
+    sim = hd.Simulation(mesh, MATERIAL, hd.Fluid(viscosity=1e-5), [hd.Cluster((0.0, 0.0, 0.0), rate=rate)],
+                        -np.diag([2 * S_HMIN, 2 * S_HMIN, S_HMIN]), 1.0, propagation=hd.Propagation(toughness=toughness),
+                        leak_off=hd.LeakOff(coefficient=c_l, pore_pressure=PORE),
+                        initial_pressure=S_HMIN + 0.9 * np.sqrt(np.pi) * toughness / (2 * np.sqrt(0.5)),
+                        initial_opening=1e-5, backend="dense")
+    wall, cpu = time.perf_counter(), time.process_time()
+    records = sim.run(end_time=end_time)
+    wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
+    t = np.array([r["time"] for r in records])
+    radius = np.array([r["radius"] for r in records])
+    if c_l > 0.0:
+        reference, _ = radial_toughness_leak_off_edge(t, rate, c_l, S_HMIN - PORE, toughness,
+                                                      MATERIAL.plane_strain_modulus)
+        vertex = radial_leak_off_radius(t, rate, c_l * (S_HMIN - PORE))
+    else:
+        reference, vertex = radial_k_vertex(t, rate, toughness, MATERIAL)[0], np.full_like(t, np.nan)
+    leaked = 1.0 - np.array([r["fracture_volume"] / r["injected_volume"] for r in records])
+    return {"name": name, "t": t, "radius": radius, "reference": reference, "vertex": vertex, "leaked": leaked,
+            "cpu": cpu, "wall": wall, "elements": records[-1]["n_elements"], "c_l": c_l}
 
 
 def plot(results, path):
@@ -145,6 +179,15 @@ def main(argv=None):
               f"{r['elements']} elements at the end; CPU {r['cpu']:.1f} s, wall {r['wall']:.1f} s")
         print_table(["t (s)", "l DDM (m)", "l K-K~ edge (m)", "l leak-off vertex (m)", "error", "leaked",
                      "net p DDM (MPa)", "net p edge (MPa)"], rows)
+    for r in [run_radial(*case, end_time=8.0 if args.quick else 20.0) for case in RADIAL_CASES]:
+        pick = np.unique(np.clip(np.searchsorted(r["t"], [2, 5, 10, 15, 20]), 0, len(r["t"]) - 1))
+        rows = [[f"{r['t'][i]:g}", f"{r['radius'][i]:.3f}", f"{r['reference'][i]:.3f}",
+                 f"{r['vertex'][i]:.3f}" if r["c_l"] > 0 else "-", f"{100 * (r['radius'][i] / r['reference'][i] - 1):+.1f}%",
+                 f"{100 * r['leaked'][i]:.0f}%"] for i in pick]
+        print(f"\n{r['name']}: c_l = {r['c_l']:g}; {r['elements']} elements at the end; CPU {r['cpu']:.1f} s, "
+              f"wall {r['wall']:.1f} s")
+        print_table(["t (s)", "R DDM (m)", "R K vertex / K-K~ edge (m)", "R leak-off vertex (m)", "error", "leaked"],
+                    rows)
     plot(results, args.plot)
     print(f"plot: {args.plot}")
 

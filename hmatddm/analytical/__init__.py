@@ -19,7 +19,8 @@ _SOLUTIONS = (
     "radial_m_vertex_pressure", "kgd_m_vertex_profile", "kgd_m_vertex", "radial_regime", "kgd_regime",
     "radial_transition_profile", "radial_transition",
 )
-_LEAK_OFF = ("kgd_leak_off_half_length", "radial_leak_off_radius", "kgd_toughness_leak_off_edge")
+_LEAK_OFF = ("kgd_leak_off_half_length", "radial_leak_off_radius", "kgd_toughness_leak_off_edge",
+             "radial_toughness_leak_off_edge")
 _EXPORTS = {**{name: ".solutions" for name in _SOLUTIONS}, **{name: ".leak_off" for name in _LEAK_OFF}}
 __getattr__, __dir__ = attach(__name__, _EXPORTS)
 

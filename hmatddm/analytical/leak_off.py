@@ -16,7 +16,8 @@ The toughness and the viscosity set the opening and the pressure at these vertic
 the size. :func:`kgd_toughness_leak_off_edge` is the whole K-K~ edge of a plane-strain
 fracture (zero viscosity, any leak-off): uniform net pressure ``K_Ic / (pi l)^(1/2)``,
 Griffith's opening, and mass balance with the storage ``2 pi p l^2 / E'`` (per unit
-height) integrated in time -- the transition from the K vertex (storage) to K~ (leak-off).
+height) integrated in time -- the transition from the K vertex (storage) to K~ (leak-off);
+:func:`radial_toughness_leak_off_edge` is the same for a radial fracture (Sneddon's penny).
 """
 import numpy as np
 
@@ -45,61 +46,42 @@ def radial_leak_off_radius(t, injection_rate, carter):
     return np.sqrt(2.0 * q * np.sqrt(np.asarray(t, float)) / c) / np.pi
 
 
-def kgd_toughness_leak_off_edge(times, injection_rate, carter_per_pressure, pressure_excess, toughness,
-                                plane_strain_modulus, substeps=4000):
-    """Half-length ``l(t)`` and net pressure of a zero-viscosity plane-strain fracture with
-    Carter leak-off ``c_l (p - p_r) / (t - t_0)^(1/2)`` (both faces), the K-K~ edge.
-
-    ``carter_per_pressure`` c_l (m/(s^1/2 Pa)); ``pressure_excess`` ``sigma_0 - p_r``, the
-    confining stress above the reservoir pressure (Pa): the fluid pressure is ``sigma_0 +
-    p_net`` with ``p_net = K_Ic / (pi l)^(1/2)``, so the leak-off rate of a point reached at
-    ``t_0`` is ``c_l (sigma_0 - p_r + p_net(t)) / (t - t_0)^(1/2)``. Mass balance per unit
-    height: ``Q t = 2 pi p_net l^2 / E' + int_0^t int_{-l(t')}^{l(t')} c_l (...) / (t' -
-    t_0(x))^(1/2) dx dt'``, stepped in ``substeps`` steps up to ``max(times)`` (geometric,
-    from the K vertex at ``1e-6 min(times)``): the front moves linearly in time within a
-    step, each strip it sweeps leaks Carter's rate integrated exactly over its arrival
-    times, the net pressure is lagged one step, and the front is found by bisection. 1000
-    steps agree with 16000 to 0.2 % (tested).
-    Returns ``(l, p_net)`` at ``times``.
-    """
-    q = _positive("injection_rate", injection_rate)
-    c_l = _positive("carter_per_pressure", carter_per_pressure)
-    excess = finite_scalar("pressure_excess", pressure_excess)
-    k_ic, e_prime = _positive("toughness", toughness), _positive("plane_strain_modulus", plane_strain_modulus)
+def _edge(times, q, c_l, excess, k_ic, e_prime, substeps, net, storage, area, start_size):
+    """The K-K~ edge stepper shared by the plane-strain and radial forms: ``net(L)`` the
+    uniform net pressure, ``storage(L)`` the fracture volume, ``area(L_lo, L_hi)`` the
+    fracture area between two front positions, ``start_size(t)`` the K vertex."""
     times = np.asarray(times, float)
-    if np.any(times <= 0.0):
-        raise InputError("times must be > 0")
+    if times.size == 0 or np.any(~np.isfinite(times)) or np.any(times <= 0.0):
+        raise InputError("times must be finite and > 0")
     # a geometric grid from 1e-6 of the first time (where the leak-off is still ~1e-3 of the
-    # storage: the K vertex, l = (E' Q t / (2 pi^1/2 K_Ic))^(2/3), is the start)
+    # storage: the K vertex is the start)
     start = 1e-6 * times.min()
     grid = np.concatenate([[0.0], np.geomspace(start, times.max(), substeps)])
-    l_start = (e_prime * q * start / (2.0 * np.sqrt(np.pi) * k_ic)) ** (2.0 / 3.0)
-    # strips of the fracture plane (one wing) swept by the front: width, and the times the
-    # front entered and left each (it moves linearly in time within a step)
-    widths, entered, left = [l_start], [0.0], [start]
+    size = start_size(start)
+    # bands of the fracture plane swept by the front: area, and the times the front
+    # entered and left each (it moves linearly in time within a step)
+    areas, entered, left = [area(0.0, size)], [0.0], [start]
     leaked = 0.0
 
     def mean_root(t, t_lo, t_hi):
         """Mean over arrival times uniform in [t_lo, t_hi] of (t - t_a)^(1/2), t >= t_hi."""
         return (2.0 / 3.0) * ((t - t_lo) ** 1.5 - (t - t_hi) ** 1.5) / (t_hi - t_lo)
 
-    def storage(length):
-        return 2.0 * np.pi * k_ic / np.sqrt(np.pi * length) * length * length / e_prime
-
-    lengths = np.zeros(grid.size)
-    lengths[1] = length = l_start
+    sizes = np.zeros(grid.size)
+    sizes[1] = size
     for n in range(2, grid.size):
         t_old, t_new = grid[n - 1], grid[n]
-        carter = 2.0 * c_l * (excess + k_ic / np.sqrt(np.pi * length))  # two faces' rate, times (t - t_a)^(1/2)
-        w, lo_t, hi_t = np.asarray(widths), np.asarray(entered), np.asarray(left)
-        leaked += 2.0 * carter * float(np.sum(w * (mean_root(t_new, lo_t, hi_t) - mean_root(t_old, lo_t, hi_t))))
+        # Carter's rate c_l (p - p_r) / (t - t_a)^(1/2) integrates to 2 c_l (p - p_r) (t - t_a)^(1/2)
+        rate = 2.0 * c_l * (excess + net(size))
+        band, lo_t, hi_t = np.asarray(areas), np.asarray(entered), np.asarray(left)
+        leaked += rate * float(np.sum(band * (mean_root(t_new, lo_t, hi_t) - mean_root(t_old, lo_t, hi_t))))
         target = q * t_new - leaked
-        fresh = 2.0 * carter * mean_root(t_new, t_old, t_new)  # two wings, per unit width of the new strip
+        fresh = rate * mean_root(t_new, t_old, t_new)  # per unit area of the band swept in this step
 
         def excess_volume(candidate):
-            return storage(candidate) + fresh * (candidate - length) - target
+            return storage(candidate) + fresh * area(size, candidate) - target
 
-        lo, hi = length, 2.0 * length
+        lo, hi = size, 2.0 * size
         while excess_volume(hi) < 0.0:
             hi *= 2.0
         for _ in range(80):
@@ -109,15 +91,65 @@ def kgd_toughness_leak_off_edge(times, injection_rate, carter_per_pressure, pres
             else:
                 hi = mid
         new = 0.5 * (lo + hi)
-        if new > length:
-            widths.append(new - length)
+        if new > size:
+            areas.append(area(size, new))
             entered.append(t_old)
             left.append(t_new)
-            leaked += fresh * (new - length)
-            length = new
-        lengths[n] = length
-    l_at = np.interp(times, grid, lengths)
-    return l_at, k_ic / np.sqrt(np.pi * np.maximum(l_at, 1e-300))
+            leaked += fresh * area(size, new)
+            size = new
+        sizes[n] = size
+    at = np.interp(times, grid, sizes)
+    return at, net(np.maximum(at, 1e-300))
 
 
-__all__ = ["kgd_leak_off_half_length", "radial_leak_off_radius", "kgd_toughness_leak_off_edge"]
+def _edge_inputs(injection_rate, carter_per_pressure, pressure_excess, toughness, plane_strain_modulus):
+    return (_positive("injection_rate", injection_rate), _positive("carter_per_pressure", carter_per_pressure),
+            finite_scalar("pressure_excess", pressure_excess), _positive("toughness", toughness),
+            _positive("plane_strain_modulus", plane_strain_modulus))
+
+
+def kgd_toughness_leak_off_edge(times, injection_rate, carter_per_pressure, pressure_excess, toughness,
+                                plane_strain_modulus, substeps=4000):
+    """Half-length ``l(t)`` and net pressure of a zero-viscosity plane-strain fracture with
+    Carter leak-off ``c_l (p - p_r) / (t - t_0)^(1/2)`` per unit fracture area (both faces),
+    the K-K~ edge.
+
+    ``injection_rate`` Q per unit height into both wings (m^2/s); ``carter_per_pressure``
+    c_l (m/(s^1/2 Pa)); ``pressure_excess`` ``sigma_0 - p_r``, the confining stress above the
+    reservoir pressure (Pa): the fluid pressure is ``sigma_0 + p_net`` with ``p_net = K_Ic /
+    (pi l)^(1/2)``, so a point reached at ``t_0`` leaks ``c_l (sigma_0 - p_r + p_net(t)) / (t -
+    t_0)^(1/2)``. Mass balance per unit height: ``Q t = 2 pi p_net l^2 / E' + int_0^t
+    int_{-l(t')}^{l(t')} c_l (...) / (t' - t_0(x))^(1/2) dx dt'``, stepped in ``substeps``
+    steps up to ``max(times)`` (geometric, from the K vertex ``l = (E' Q t / (2 pi^1/2
+    K_Ic))^(2/3)`` at ``1e-6 min(times)``): the front moves linearly in time within a step,
+    each strip it sweeps leaks Carter's rate integrated exactly over its arrival times, the
+    net pressure is lagged one step, and the front is found by bisection. 1000 steps agree
+    with 16000 to 0.2 % (tested). Returns ``(l, p_net)`` at ``times``.
+    """
+    q, c_l, excess, k_ic, e_prime = _edge_inputs(injection_rate, carter_per_pressure, pressure_excess, toughness,
+                                                 plane_strain_modulus)
+    return _edge(times, q, c_l, excess, k_ic, e_prime, substeps,
+                 net=lambda l: k_ic / np.sqrt(np.pi * l),
+                 storage=lambda l: 2.0 * np.pi * k_ic / np.sqrt(np.pi * l) * l * l / e_prime,
+                 area=lambda lo, hi: 2.0 * (hi - lo),  # both wings, per unit height
+                 start_size=lambda t: (e_prime * q * t / (2.0 * np.sqrt(np.pi) * k_ic)) ** (2.0 / 3.0))
+
+
+def radial_toughness_leak_off_edge(times, injection_rate, carter_per_pressure, pressure_excess, toughness,
+                                   plane_strain_modulus, substeps=4000):
+    """Radius ``R(t)`` and net pressure of a zero-viscosity radial fracture with Carter
+    leak-off (the radial K-K~ edge): as :func:`kgd_toughness_leak_off_edge` with Sneddon's
+    penny, ``p_net = pi^(1/2) K_Ic / (2 R^(1/2))`` and volume ``16 p_net R^3 / (3 E')``, the
+    K vertex ``R = (3 E' Q t / (8 pi^(1/2) K_Ic))^(2/5)`` at the start, and annuli
+    ``pi (R_hi^2 - R_lo^2)`` swept by the front. Returns ``(R, p_net)`` at ``times``."""
+    q, c_l, excess, k_ic, e_prime = _edge_inputs(injection_rate, carter_per_pressure, pressure_excess, toughness,
+                                                 plane_strain_modulus)
+    return _edge(times, q, c_l, excess, k_ic, e_prime, substeps,
+                 net=lambda r: np.sqrt(np.pi) * k_ic / (2.0 * np.sqrt(r)),
+                 storage=lambda r: 16.0 * np.sqrt(np.pi) * k_ic / (2.0 * np.sqrt(r)) * r**3 / (3.0 * e_prime),
+                 area=lambda lo, hi: np.pi * (hi * hi - lo * lo),
+                 start_size=lambda t: (3.0 * e_prime * q * t / (8.0 * np.sqrt(np.pi) * k_ic)) ** 0.4)
+
+
+__all__ = ["kgd_leak_off_half_length", "radial_leak_off_radius", "kgd_toughness_leak_off_edge",
+           "radial_toughness_leak_off_edge"]

@@ -47,5 +47,17 @@ def test_edge_joins_the_k_and_k_tilde_vertices():
 def test_bad_input():
     with pytest.raises(InputError, match="carter"):
         kgd_leak_off_half_length(1.0, 1e-3, 0.0)
-    with pytest.raises(InputError, match="times must be > 0"):
+    with pytest.raises(InputError, match="times must be finite and > 0"):
         kgd_toughness_leak_off_edge([0.0, 1.0], 1e-3, 1e-11, 1e6, 1e6, 1e10)
+
+
+def test_radial_edge_joins_the_k_and_k_tilde_vertices():
+    from hmatddm.analytical import radial_k_vertex, radial_toughness_leak_off_edge
+
+    t = np.array([1.0, 10.0, 100.0, 1e3, 1e4])
+    q, k_ic, e = 1e-3, 1e6, MAT.plane_strain_modulus
+    radius, _ = radial_toughness_leak_off_edge(t, q, 1e-24, 5e6, k_ic, e, substeps=1000)
+    np.testing.assert_allclose(radius, radial_k_vertex(t, q, k_ic, MAT)[0], rtol=1e-4)
+    radius, net = radial_toughness_leak_off_edge(t, q, 1e-9, 5e6, k_ic, e, substeps=1000)
+    ratio = radius / np.array([float(radial_leak_off_radius(ti, q, 1e-9 * (5e6 + pi))) for ti, pi in zip(t, net)])
+    assert np.all(ratio < 1.0) and np.all(np.diff(ratio) > 0) and ratio[-1] > 0.97
