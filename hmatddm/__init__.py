@@ -37,6 +37,7 @@ _EXPORTS = {
     "Mesh2D": ".mesh", "Mesh3D": ".mesh", "ElasticityOperator": ".elasticity", "CheckpointError": ".simulation",
     "Simulation": ".simulation", "mean_stress_at": ".elasticity", "opening": ".elasticity", "slip": ".elasticity",
     "solve": ".elasticity", "stress_at": ".elasticity", "opening_at": ".elasticity", "LayeredMedium": ".layered",
+    "UndrainedRock": ".fracture", "displacement_at": ".elasticity",
 }
 # the rooms (docs/architecture.md), and the short names that modules now in a room had
 # at the package root, kept so that ``hd.topology``, ``hd.operators``, ... still work
@@ -54,5 +55,5 @@ __all__ = [
     "Elastic", "Mesh2D", "Mesh3D", "ElasticityOperator", "solve", "opening", "opening_at", "slip", "stress_at",
     "mean_stress_at", "mesh", "analytical", "kernels", "topology", "HmatddmError", "InputError", "ConvergenceError", "OutputError",
     "Fluid", "LeakOff", "Cluster", "Propagation", "NaturalFractureProperties", "network", "SchemeSettings", "Simulation", "CheckpointError",
-    "LayeredMedium", "layered",
+    "LayeredMedium", "layered", "UndrainedRock", "displacement_at",
 ]

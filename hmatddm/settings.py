@@ -298,6 +298,11 @@ CLUSTER = {  # -> hmatddm.flow.fluid.Cluster (ref. Eqs 4.34-4.35)
 LEAK_OFF = {  # -> hmatddm.flow.fluid.LeakOff (ref. Eqs 4.25-4.26)
     "coefficient": Setting("number", 0.0, low=0.0, unit="m/(s^0.5 Pa)"),
     "pore_pressure": Setting("number", 0.0, unit="Pa"),
+    # or the coefficient from the reservoir (ref. Eq. 4.26, both faces): hmatddm.flow.carter_coefficient
+    "permeability": Setting("number", low=0.0, low_open=True, unit="m^2", doc="k_r (1 mD = 9.869e-16 m^2)"),
+    "porosity": Setting("number", low=0.0, high=1.0, low_open=True, high_open=True),
+    "reservoir_compressibility": Setting("number", low=0.0, low_open=True, unit="1/Pa", doc="total c_t"),
+    "reservoir_viscosity": Setting("number", low=0.0, low_open=True, unit="Pa s", doc="of the reservoir fluid"),
 }
 
 #: network.* in a scene and the defaults of hmatddm.fracture.crossing.NaturalFractureProperties
@@ -312,6 +317,10 @@ NATURAL_FRACTURE = {
                                doc="r_c of the Mohr-Coulomb crossing criterion (ref. Table 6.2: characteristic "
                                    "length)"),
     "skempton": Setting("number", 0.0, low=0.0, high=1.0, doc="Skempton's B (ref. Eq. 5.18)"),
+    "shear_toughness": Setting("number", 0.0, low=0.0, unit="Pa m^0.5",
+                               doc="K_IIc of the natural fractures (ref. Eqs 5.15-5.16; energy crossing criterion)"),
+    "rock_shear_toughness": Setting("number", 0.0, low=0.0, unit="Pa m^0.5",
+                                    doc="K_IIc of the rock (ref. Eqs 5.15-5.16; energy crossing criterion)"),
 }
 
 _POSITIVE_LENGTH = dict(low=0.0, low_open=True, unit="m")
@@ -403,4 +412,16 @@ NETWORK_GENERATOR = {  # network.* of a scene -> hmatddm.network.NetworkSpec (re
 NETWORK_GEOMETRY = {  # network.* of a scene: the vertical extent of the natural fractures in 3D
     "height": Setting("number", 1.0, **_POSITIVE_LENGTH),
     "z_center": Setting("number", 0.0, unit="m"),
+}
+
+POROELASTIC = {  # [poroelastic] of a scene -> hmatddm.fracture.poroelastic.UndrainedRock (ref. Eqs 5.17-5.21)
+    "biot": Setting("number", REQUIRED, low=0.0, high=1.0, low_open=True,
+                    doc="Biot coefficient alpha = 1 - K/K_s (ref. Eq. 5.20); >= the porosity"),
+    "fluid_bulk_modulus": Setting("number", REQUIRED, low=0.0, low_open=True, unit="Pa",
+                                  doc="K_f of the reservoir fluid (ref. Table 5.2: oil 2.2 GPa, gas 30 MPa)"),
+    "porosity": Setting("number", REQUIRED, low=0.0, high=1.0, low_open=True, high_open=True, doc="phi"),
+}
+
+MONITOR = {  # a [[monitor]] of a scene -> hmatddm.app.monitor (displacement and tilt, ref. Eqs 2.43, 2.55-2.57)
+    "position": Setting("point", REQUIRED, length="dim", unit="m", doc="where the displacement and tilt are recorded"),
 }

@@ -5,6 +5,8 @@ the validation table and the scenes' ``[reference]`` blocks compare with.
   (K and M), their regime numbers and the radial K-M transition (Dontsov 2016).
 * :mod:`.tip_asymptote`: the universal tip asymptote (Dontsov and Peirce 2015), inverted
   by the asymptotic front.
+* :mod:`.leak_off`: leak-off-dominated sizes (the K~ and M~ vertices) and the plane-strain
+  K-K~ edge.
 
 Names of :mod:`.solutions` are exported here (``hd.analytical.radial_k_vertex``), loaded
 on first use (scipy.special is not imported with the package).
@@ -17,7 +19,9 @@ _SOLUTIONS = (
     "radial_m_vertex_pressure", "kgd_m_vertex_profile", "kgd_m_vertex", "radial_regime", "kgd_regime",
     "radial_transition_profile", "radial_transition",
 )
-_EXPORTS = {name: ".solutions" for name in _SOLUTIONS}
+_LEAK_OFF = ("kgd_leak_off_half_length", "radial_leak_off_radius", "kgd_toughness_leak_off_edge",
+             "radial_toughness_leak_off_edge")
+_EXPORTS = {**{name: ".solutions" for name in _SOLUTIONS}, **{name: ".leak_off" for name in _LEAK_OFF}}
 __getattr__, __dir__ = attach(__name__, _EXPORTS)
 
-__all__ = list(_SOLUTIONS)
+__all__ = list(_SOLUTIONS) + list(_LEAK_OFF)

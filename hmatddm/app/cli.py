@@ -148,6 +148,15 @@ def _stopped_at_size_limit(args, out, run, error):
     return EXIT_BAD_INPUT
 
 
+def _say_undrained(scene):
+    """The undrained constants a [poroelastic] section derives (ref. Eqs 5.19-5.21), on stderr."""
+    from ..scene.build import undrained_rock
+
+    rock = undrained_rock(scene)
+    if rock is not None:
+        print(f"hmatddm: poroelastic: {rock.summary()}; the run uses nu_u and B", file=sys.stderr)
+
+
 def _run(args):
     import warnings
 
@@ -166,6 +175,7 @@ def _run(args):
         _say(args, json.dumps(scene.to_dict(), indent=1))
         if not args.quiet:
             print("hmatddm: estimate: " + "\nhmatddm: estimate: ".join(size.lines()), file=sys.stderr)
+            _say_undrained(scene.data)
         return EXIT_OK
     warnings.simplefilter("ignore", NoInjectionWarning)  # said above, once
     from .runner import SceneRun

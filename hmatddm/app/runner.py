@@ -19,6 +19,8 @@ The folder (``--out DIR``) holds::
                         traces, coloured by the largest opening over the height)
     history.png         size, opening and wellbore pressure against time, with the
                         closed form overlaid when the scene has a [reference]
+    monitor.csv, .png   with [[monitor]] tables: displacement and tilt at their
+                        positions after every step (:mod:`hmatddm.app.monitor`)
 
 Progress goes to stderr (:class:`Progress`); nothing is printed with ``quiet=True``.
 The folder's names, fields, pictures and reading a run back are :mod:`hmatddm.app.run_folder`'s
@@ -79,6 +81,7 @@ class SceneRun:
         self._started = None
         self._last_vtu_step = None
         self._stress = None
+        self._monitor = None
 
     # -- public -----------------------------------------------------------------------
     @property
@@ -118,6 +121,12 @@ class SceneRun:
         self._stress = simulation.far_field_stress
         self._prepare_folder(simulation)
         self.simulation = simulation
+        if "monitor" in scene:  # displacement and tilt at points (hmatddm.app.monitor)
+            from .monitor import Monitor
+
+            self._monitor = Monitor(self.out, scene["monitor"], simulation.state.mesh.dim, note=self.note)
+            if self.resume:
+                self._monitor.resume(simulation.state.step)
         start_time = simulation.state.time
         self.progress = Progress(numerics["end_time"], simulation.time_step, stream=self.stream,
                                  enabled=not self.quiet, start_time=start_time)
@@ -158,6 +167,7 @@ class SceneRun:
         """Remove the files an earlier run wrote (only ours, by name)."""
         names = [self.out / SUMMARY, self.out / PVD, self.out / HISTORY, self.out / SCENE_FILE]
         names += [self.out / name for name in ("events.csv", "microseismic_map.png")]  # hmatddm.microseismic
+        names += [self.out / name for name in ("monitor.csv", "monitor.png")]  # hmatddm.app.monitor
         folder = self.out / CHECKPOINT_DIR
         names += list(folder.glob("step-*.json")) + list(folder.glob("step-*.npz"))
         names += list((self.out / VTU_DIR).glob("step-*.vtu")) + list((self.out / SNAPSHOT_DIR).glob("step-*.png"))
@@ -226,6 +236,8 @@ class SceneRun:
         every = self.scene.data["output"]["every"]
         if record["step"] % every == 0 or self._is_last(record):
             self._write_vtu(simulation.state)
+        if self._monitor is not None:
+            self._monitor.record(simulation, record)
         self._write_summary()
         self.progress.update(record)
 
@@ -260,6 +272,8 @@ class SceneRun:
                 self.note(f"hmatddm: warning: no snapshots written: {error}")
         if output["history_plot"]:
             self.written["history"] = write_history(self.out, self.records, self.scene.data)
+        if self._monitor is not None:
+            self.written["monitor"] = self._monitor.plot(self.scene.name)
         if "microseismic" in self.scene.data:  # events.csv and the event map (ref. Ch. 7)
             from .catalogue import write_catalogue
 

@@ -9,7 +9,8 @@ stresses and openings, over the kernels, the layered media and the H-matrix comp
 * :mod:`.solve`: :func:`solve`, :func:`opening`, :func:`slip`, :func:`stress_at`,
   :func:`mean_stress_at`.
 * :mod:`.fields`, :mod:`.field_kernels`, :mod:`.field_bound`: stresses at points, direct or
-  compressed, and the bound on a far field that lets a stress target be skipped.
+  compressed, and the bound on a far field that lets a stress target be skipped;
+  :func:`displacement_at` and :mod:`.displacement_kernels`: displacements at points.
 * :mod:`.nodal`: nodal values of linear and quadratic 2D elements (ref. App. B).
 """
 from .._lazy import attach
@@ -18,6 +19,7 @@ _EXPORTS = {
     "ElasticityOperator": ".operator", "solve": ".solve", "opening": ".solve", "slip": ".solve",
     "stress_at": ".solve", "mean_stress_at": ".solve", "opening_at": ".nodal",
     "PlanarElasticityOperator": ".planar", "ExtendedElasticityOperator": ".extended",
+    "displacement_at": ".fields",
 }
 __getattr__, __dir__ = attach(__name__, _EXPORTS)
 

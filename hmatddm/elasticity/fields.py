@@ -34,8 +34,9 @@ from .field_kernels import FieldSources, contribution_block, direct_sum, field_b
 from ..material import Elastic
 from ..mesh import Mesh2D, Mesh3D, check_mesh
 
-#: What a field holds at each point.
-QUANTITIES = ("stress", "mean")
+#: What a field holds at each point ("displacement": ref. Eqs 2.43, 2.55-2.57, the kernels
+#: of :mod:`hmatddm.elasticity.displacement_kernels`).
+QUANTITIES = ("stress", "mean", "displacement")
 METHODS = ("auto", "direct", "tree")
 #: Relative Frobenius accuracy asked of every compressed block (``method="tree"``, and
 #: ``"auto"`` on large problems): the largest error of any component is then about
@@ -57,8 +58,20 @@ FIELD_MIN_ACA = 64
 
 
 def n_components(dim, quantity):
-    """Values per point: 6 (3D) or 3 (2D) stress components, 1 for the mean stress."""
+    """Values per point: 6 (3D) or 3 (2D) stress components, 1 for the mean stress, d
+    displacement components."""
+    if quantity == "displacement":
+        return dim
     return 1 if quantity == "mean" else (6 if dim == 3 else 3)
+
+
+def _kernels(quantity):
+    """(contribution_block, field_block, direct_sum) of ``quantity``."""
+    if quantity == "displacement":
+        from . import displacement_kernels as k
+
+        return k.contribution_block, k.field_block, k.direct_sum
+    return contribution_block, field_block, direct_sum
 
 
 # ---------------------------------------------------------------------------- fields
@@ -120,6 +133,7 @@ class StressField:
         self.mesh = mesh
         self.points = np.ascontiguousarray(finite_array("points", points, (None, mesh.dim)))
         self.n_out = n_components(mesh.dim, quantity)
+        self.quantity = quantity
         self.eps = float(eps)
         self.near_fraction = near_fraction
         self.contracted = dd is not None
@@ -150,7 +164,8 @@ class StressField:
         from ..hmatrix import BlockGenerator
 
         mesh = self.mesh
-        kernel, col_dof = (contribution_block, 1) if self.contracted else (field_block, mesh.dim)
+        contribution, unit_dd, _ = _kernels(self.quantity)
+        kernel, col_dof = (contribution, 1) if self.contracted else (unit_dd, mesh.dim)
         return BlockGenerator(kernel, self.sources, self.points, 0.0, self.n_out, col_points=mesh.centers,
                               col_radii=mesh.radii, col_dof=col_dof)
 
@@ -203,7 +218,7 @@ class StressField:
             out = self.hmatrix.matvec(x).reshape(m, self.n_out)
         else:
             out = np.empty((m, self.n_out))
-            direct_sum(sources, out)
+            _kernels(self.quantity)[2](sources, out)
         self.info["apply_seconds"] = time.perf_counter() - started
         return out
 
@@ -225,10 +240,13 @@ def _dd_array(mesh, dd):
     return np.ascontiguousarray(dd.reshape(mesh.n_elements, mesh.dim), dtype=np.float64)
 
 
-def refuse_singular(values, near_fraction):
+def refuse_singular(values, near_fraction, quantity="stress"):
     """InputError naming the first point whose value is singular (NaN: on an edge, or
     within ``near_fraction`` of one, without ``singular_correction='average'``)."""
     bad = np.flatnonzero(~np.all(np.isfinite(values), axis=1))
+    if bad.size and quantity == "displacement":
+        raise InputError(f"points[{int(bad[0])}] lies on an element edge, where the displacement is singular; "
+                         "move it")
     if bad.size:
         where = "on an element edge" if near_fraction == 0.0 else \
             f"on an element edge or within near_fraction = {near_fraction:g} half sizes of one"
@@ -246,9 +264,31 @@ def induced(mesh, material, dd, points, quantity, singular_correction="none", me
     values = field()
     if info is not None:
         info.update(field.info, seconds=time.perf_counter() - started)
-    refuse_singular(values, field.near_fraction)
+    refuse_singular(values, field.near_fraction, quantity)
     return values
 
 
-__all__ = ["StressField", "as_tensors", "FieldSources", "field_sources", "field_block", "contribution_block", "direct_sum", "induced", "refuse_singular", "n_components",
+def displacement_at(mesh, material, dd, points, method="auto", eps=None, info=None):
+    """Displacement (M, d) induced at ``points`` (M, d) by the DDs ``dd`` (global frame,
+    (N, d) or (N*d,)) of the constant elements of ``mesh`` in a homogeneous ``material``
+    (ref. Eqs 2.43, 2.55-2.57; 2D: the in-plane components of plane strain).
+
+    The far-field displacement decays as 1/r^2 (3D; 1/r in 2D) where the stress decays
+    as 1/r^3 (1/r^2): a tiltmeter or a GPS station sees it far from the fracture. On an
+    element's face the value is its ``+`` side's (the side its normal points to; the
+    displacement jumps by the DD across it); a point on an element edge (an end in 2D),
+    where it is log-singular, raises InputError. ``method``, ``eps`` and ``info``: as
+    :func:`hmatddm.stress_at` (``"tree"``: the build-free product of a rectangular
+    H-matrix, whose far blocks are compressed to ``eps``). A layered medium has no
+    displacement kernel: refused.
+    """
+    from ..layered.medium import LayeredMedium
+
+    if isinstance(material, LayeredMedium):
+        raise InputError("displacement_at takes a homogeneous hmatddm.Elastic: the layered kernels (ref. Ch. 3) "
+                         "give stresses, not displacements")
+    return induced(mesh, material, dd, points, "displacement", "none", method, eps, info)
+
+
+__all__ = ["displacement_at", "StressField", "as_tensors", "FieldSources", "field_sources", "field_block", "contribution_block", "direct_sum", "induced", "refuse_singular", "n_components",
            "DEFAULT_STRESS_EPS", "AUTO_TREE_PAIRS", "FIELD_ETA", "FIELD_LEAF_SIZE", "FIELD_MIN_ACA", "METHODS", "QUANTITIES"]

@@ -11,9 +11,12 @@ along its length and the hydraulic fracture leaves from its end):
 * ``"sif"`` (ref. Sec. 5.2.3): crosses when ``K-bar_I(theta_0) / K_Ic,rock >
   K-bar_I(phi) / K_Ic,NF``.
 * ``"energy"`` (ref. Eqs 5.11-5.16): crosses when ``G(theta_0) / G_c,rock >
-  G(phi) / G_c,NF`` with ``G = (K-bar_I^2 + K-bar_II^2) / E'`` (the squares are
-  missing in the printed Eq. 5.11) and ``G_c = K_Ic^2 / E'`` (rock and natural
-  fracture have the same E' here, Eq. 5.12).
+  G(phi) / G_c,NF`` with ``G = (K-bar_I^2 + K-bar_II^2) / E'`` and ``G_c = (K_Ic^2 +
+  K_IIc^2) / E'`` (the squares are missing in the printed Eqs 5.11 and 5.15), K_Ic and
+  K_IIc those of the rock ahead (``theta_0``) and of the natural fracture along it
+  (``phi``, Eq. 5.16). The modulus E'(theta) of Eq. 5.12 (the natural fracture's along
+  ``phi``) divides both ``G`` and ``G_c`` of one direction, so it cancels from each ratio:
+  the criterion does not depend on it, and no separate modulus is taken.
 
 Angles live in the tip frame of :mod:`hmatddm.fracture.criteria`: ``x`` ahead,
 ``y`` the hydraulic fracture's normal. A natural fracture through the tip runs in
@@ -53,6 +56,9 @@ class NaturalFractureProperties:
     crossing : {"mohr-coulomb", "sif", "energy"}
     skempton : float in [0, 1], Skempton's B of the undrained pore-pressure change
         ``dp = -B d sigma_m`` (ref. Eq. 5.18) used by the remote-failure check
+    shear_toughness, rock_shear_toughness : float, K_IIc of the natural fractures and of
+        the rock in Pa m^1/2 (>= 0; ref. Eqs 5.15-5.16), read by the energy criterion only
+        (0: ``G_c = K_Ic^2 / E'``)
     """
 
     friction: float = NATURAL_FRACTURE["friction_coefficient"].default
@@ -63,9 +69,12 @@ class NaturalFractureProperties:
     pore_pressure: float = 0.0
     crossing: str = "mohr-coulomb"
     skempton: float = NATURAL_FRACTURE["skempton"].default
+    shear_toughness: float = NATURAL_FRACTURE["shear_toughness"].default
+    rock_shear_toughness: float = NATURAL_FRACTURE["rock_shear_toughness"].default
 
     def __post_init__(self):
-        for name in ("friction", "cohesion", "tensile_strength", "toughness", "critical_radius", "skempton"):
+        for name in ("friction", "cohesion", "tensile_strength", "toughness", "critical_radius", "skempton",
+                     "shear_toughness", "rock_shear_toughness"):
             setting = NATURAL_FRACTURE["friction_coefficient" if name == "friction" else name]
             object.__setattr__(self, name, setting.value(f"natural.{name}", getattr(self, name)))
         object.__setattr__(self, "pore_pressure", finite_scalar("natural.pore_pressure", self.pore_pressure))
@@ -124,4 +133,5 @@ def crosses(k_1, k_2, theta_0, phi, far_field_tip, rock_toughness, natural):
         return ahead / rock_toughness > along / natural.toughness
     ahead_g = ahead**2 + _equivalent_mode_two(k_1, k_2, theta_0) ** 2
     along_g = max(equivalent_mode_one(k_1, k_2, a) ** 2 + _equivalent_mode_two(k_1, k_2, a) ** 2 for a in branches)
-    return ahead_g / rock_toughness**2 > along_g / natural.toughness**2
+    return ahead_g / (rock_toughness**2 + natural.rock_shear_toughness**2) > \
+        along_g / (natural.toughness**2 + natural.shear_toughness**2)

@@ -80,8 +80,13 @@ The format, annotated (``=`` values are the defaults unless marked REQUIRED)::
     # growing_fractures = [0]      # fracture ids allowed to grow (default: all)
 
     [leak_off]                     # Carter leak-off (default: none)
-    coefficient = 0.0              # m/(s^0.5 Pa), >= 0
+    coefficient = 0.0              # m/(s^0.5 Pa), >= 0 (through both faces)
     pore_pressure = 0.0            # Pa
+    # or, instead of coefficient, the reservoir it comes from (ref. Eq. 4.26, both faces):
+    # permeability = 1e-16         # m^2, > 0 (1 mD = 9.869e-16 m^2)
+    # porosity = 0.1               # (0, 1)
+    # reservoir_compressibility = 1e-9   # 1/Pa, > 0, total
+    # reservoir_viscosity = 1e-3   # Pa s, > 0, of the reservoir fluid
 
     [numerics]
     time_step = "auto"             # "auto" (default): steps that follow the front (then:), or s > 0
@@ -142,6 +147,8 @@ The format, annotated (``=`` values are the defaults unless marked REQUIRED)::
     tensile_strength = 0.0         # Pa, >= 0
     toughness = 0.5e6              # Pa m^0.5, > 0
     critical_radius = 0.005        # m, > 0
+    shear_toughness = 0.0          # Pa m^0.5, >= 0, K_IIc of the natural fractures (energy criterion)
+    rock_shear_toughness = 0.0     # Pa m^0.5, >= 0, K_IIc of the rock (energy criterion)
     crossing = "mohr-coulomb"      # "mohr-coulomb", "energy-release-rate", "stress-intensity"
     remote_failure = true
     element_size = 1.0             # m
@@ -179,6 +186,16 @@ The format, annotated (``=`` values are the defaults unless marked REQUIRED)::
     seed = 0                       # of the noise
     merge = false                  # one event per element (the reference), or merge neighbours
                                    # that fail in the same step
+
+    [poroelastic]                  # undrained rock (ref. Sec. 5.3.1): [material] holds the drained
+                                   # G and nu; the run uses the undrained nu_u (Eq. 5.19) and the
+                                   # remote-failure check B (Eq. 5.21); `--check` prints them
+    biot = 0.8                     # REQUIRED, alpha = 1 - K/K_s, in (0, 1], >= porosity
+    fluid_bulk_modulus = 2.2e9     # REQUIRED, K_f of the reservoir fluid, Pa (gas: 30e6)
+    porosity = 0.15                # REQUIRED, in (0, 1)
+
+    [[monitor]]                    # displacement and tilt at a point after every step: DIR/monitor.csv
+    position = [0.0, 0.0, 50.0]    # and DIR/monitor.png (hmatddm.app.monitor); uniform rock only
 '''
 import difflib
 import tomllib

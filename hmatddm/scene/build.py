@@ -21,8 +21,22 @@ def material(scene):
     ``[[layer]]`` tables (2D, y up; per-layer s_hmin and toughness where given)."""
     if "layer" in scene:
         return layered_medium(scene)
+    rock = undrained_rock(scene)
     return Elastic(shear_modulus=scene["material"]["shear_modulus"],
-                   poisson_ratio=scene["material"]["poisson_ratio"])
+                   poisson_ratio=scene["material"]["poisson_ratio"] if rock is None else rock.undrained_poisson_ratio)
+
+
+def undrained_rock(scene):
+    """The :class:`hmatddm.fracture.poroelastic.UndrainedRock` of ``[poroelastic]`` (the
+    drained constants of ``[material]``), or None: with it the DDM runs with the undrained
+    Poisson's ratio and the remote-failure check with its Skempton B (ref. Sec. 5.3.1)."""
+    if "poroelastic" not in scene:
+        return None
+    from ..fracture.poroelastic import UndrainedRock
+
+    poro, rock = scene["poroelastic"], scene["material"]
+    return UndrainedRock.from_poisson_ratio(rock["shear_modulus"], rock["poisson_ratio"], poro["biot"],
+                                            poro["fluid_bulk_modulus"], poro["porosity"])
 
 
 def layered_medium(scene):
@@ -70,7 +84,16 @@ def propagation(scene):
 
 
 def leak_off(scene):
-    return LeakOff(coefficient=scene["leak_off"]["coefficient"], pore_pressure=scene["leak_off"]["pore_pressure"])
+    """The :class:`LeakOff` of ``[leak_off]``: its coefficient, or the one the reservoir keys
+    give (ref. Eq. 4.26, both faces, :func:`hmatddm.flow.carter_coefficient`)."""
+    section = scene["leak_off"]
+    coefficient = section["coefficient"]
+    if "permeability" in section:
+        from ..flow import carter_coefficient
+
+        coefficient = carter_coefficient(section["permeability"], section["porosity"],
+                                         section["reservoir_compressibility"], section["reservoir_viscosity"])
+    return LeakOff(coefficient=coefficient, pore_pressure=section["pore_pressure"])
 
 
 def scheme_settings(scene):
@@ -136,12 +159,14 @@ def natural_properties(scene):
         return None
     settings = scene.get("network", {})
     value = {key: settings.get(key, setting.default) for key, setting in NATURAL_FRACTURE.items()}
+    rock = undrained_rock(scene)
     return NaturalFractureProperties(
         friction=value["friction_coefficient"], cohesion=value["cohesion"],
         tensile_strength=value["tensile_strength"], toughness=value["toughness"],
-        critical_radius=value["critical_radius"],
+        critical_radius=value["critical_radius"], shear_toughness=value["shear_toughness"],
+        rock_shear_toughness=value["rock_shear_toughness"],
         crossing=_CROSSING_NAMES[settings.get("crossing", "mohr-coulomb")],
-        pore_pressure=scene["leak_off"]["pore_pressure"])
+        pore_pressure=scene["leak_off"]["pore_pressure"], skempton=0.0 if rock is None else rock.skempton)
 
 
 def confining_stress(scene, normal=None):

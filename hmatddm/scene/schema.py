@@ -337,11 +337,49 @@ def validate(raw, name=None):
         _check_layers(scene)
     if "reference" in scene:
         _check_reference(scene)
+    if "poroelastic" in scene:
+        _check_poroelastic(scene)
+    _check_leak_off_reservoir(scene)
+    if "monitor" in scene and "layer" in scene:
+        raise InputError("[[monitor]] needs the displacement kernels of a uniform rock; the layered kernels "
+                         "(ref. Ch. 3) give stresses only: remove the [[monitor]] or the [[layer]] tables")
     if has_natural_fractures(scene) and "contact" not in raw["numerics"]:
         # a hydraulic element squeezed between natural fractures can open negatively and stall
         # the Picard iteration with contact = "natural": in a network every element closes
         numerics["contact"] = "all"
     return scene
+
+
+RESERVOIR_KEYS = ("permeability", "porosity", "reservoir_compressibility", "reservoir_viscosity")
+
+
+def _check_leak_off_reservoir(scene):
+    """[leak_off] takes the coefficient, or the four reservoir keys it comes from (ref.
+    Eq. 4.26, :func:`hmatddm.flow.carter_coefficient`), not both."""
+    section = scene["leak_off"]
+    given = [key for key in RESERVOIR_KEYS if key in section]
+    if not given:
+        return
+    missing = [key for key in RESERVOIR_KEYS if key not in section]
+    if missing:
+        raise InputError(f"leak_off.{missing[0]} is required with leak_off.{given[0]}: the coefficient from the "
+                         f"reservoir (ref. Eq. 4.26) needs {', '.join('leak_off.' + k for k in RESERVOIR_KEYS)}")
+    if section["coefficient"] != 0.0:
+        raise InputError("leak_off.coefficient must be left out when the reservoir gives it (leak_off."
+                         f"{given[0]} ...), got {show(section['coefficient'])}")
+
+
+def _check_poroelastic(scene):
+    """[poroelastic] turns [material]'s drained constants undrained (ref. Eqs 5.19-5.21):
+    one uniform rock, so no [[layer]] tables; biot >= porosity is checked here."""
+    if "layer" in scene:
+        raise InputError("[poroelastic] derives the undrained constants of the uniform [material]; a scene with "
+                         "[[layer]] tables cannot take it: remove one of them")
+    from ..fracture.poroelastic import UndrainedRock
+
+    poro, rock = scene["poroelastic"], scene["material"]
+    UndrainedRock.from_poisson_ratio(rock["shear_modulus"], rock["poisson_ratio"], poro["biot"],
+                                     poro["fluid_bulk_modulus"], poro["porosity"])
 
 
 def _check_layers(scene):

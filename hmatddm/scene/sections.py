@@ -78,6 +78,8 @@ NETWORK_MECHANICS = {  # defaults: ref. Table 6.2 (natural-fracture properties)
     "tensile_strength": NATURAL_FRACTURE["tensile_strength"],
     "toughness": NATURAL_FRACTURE["toughness"],
     "critical_radius": NATURAL_FRACTURE["critical_radius"],
+    "shear_toughness": NATURAL_FRACTURE["shear_toughness"],
+    "rock_shear_toughness": NATURAL_FRACTURE["rock_shear_toughness"],
     "crossing": Key("choice", "mohr-coulomb", choices=CROSSING_CRITERIA),
     "remote_failure": Key("boolean", True),
     "element_size": Key("number", 1.0, **_POSITIVE_LENGTH),
@@ -110,5 +112,7 @@ SECTIONS = {
     "natural_fracture": (NATURAL_FRACTURE, True, False),
     "microseismic": (MICROSEISMIC, False, False),
     "layer": (LAYER, True, False),
+    "poroelastic": (settings.POROELASTIC, False, False),  # undrained rock (ref. Sec. 5.3.1): build.material
+    "monitor": (settings.MONITOR, True, False),  # displacement and tilt at points: hmatddm.app.monitor
 }
 FILLED_WHEN_ABSENT = ("leak_off", "output")  # optional sections echoed with their defaults

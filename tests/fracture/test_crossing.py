@@ -179,3 +179,36 @@ def test_two_tips_reaching_one_natural_element_activate_it_once(monkeypatch, hyd
     assert {1, 2} in [{int(a), int(b)} for a, b in zip(plain.first, plain.second)]
     faces = linking.with_links(plain, links)
     assert len(faces.first) == len(plain.first) + len(deflected)
+
+
+def test_energy_criterion_with_mode_two_toughness():
+    """G / G_c in each direction with G_c = (K_Ic^2 + K_IIc^2) / E' (ref. Eqs 5.11-5.16,
+    squares restored), written out here from Nuismer's K-bar (ref. Eqs 5.13-5.14); E'
+    cancels from each ratio."""
+    from hmatddm.fracture.crossing import crosses
+
+    def k_bar(k1, k2, theta):
+        c = 0.5 * np.cos(0.5 * theta)
+        return (c * (k1 * (1 + np.cos(theta)) - 3 * k2 * np.sin(theta)),
+                c * (k1 * np.sin(theta) + k2 * (3 * np.cos(theta) - 1)))
+
+    k1, k2, theta_0, phi = 1.0e6, 0.2e6, -0.2, np.radians(60.0)
+    rock_kic, nf_kic = 2.0e6, 1.0e6
+    far = np.zeros((2, 2))
+
+    def expected(nf_kiic, rock_kiic):
+        ahead = sum(v**2 for v in k_bar(k1, k2, theta_0)) / (rock_kic**2 + rock_kiic**2)
+        along = max(sum(v**2 for v in k_bar(k1, k2, a)) for a in (phi, phi - np.pi)) / (nf_kic**2 + nf_kiic**2)
+        return ahead > along
+
+    outcomes = set()
+    for nf_kiic in (0.0, 1.0e6, 3.0e6):
+        for rock_kiic in (0.0, 2.0e6):
+            props = NaturalFractureProperties(crossing="energy", toughness=nf_kic, shear_toughness=nf_kiic,
+                                              rock_shear_toughness=rock_kiic)
+            got = crosses(k1, k2, theta_0, phi, far, rock_kic, props)
+            assert got == expected(nf_kiic, rock_kiic)
+            outcomes.add(got)
+    assert outcomes == {True, False}  # the mode II toughness decides between crossing and deflection here
+    with pytest.raises(InputError, match="natural.shear_toughness"):
+        NaturalFractureProperties(shear_toughness=-1.0)

@@ -1,0 +1,196 @@
+"""Carter leak-off (ref. Eq. 4.25) against the leak-off-dominated and transition closed
+forms of a plane-strain (KGD) fracture.
+
+    python benchmarks/bench_leak_off.py              # the cases below, 2D, dense
+    python benchmarks/bench_leak_off.py --quick      # shorter runs
+
+Each case is a KGD fracture (element switch front, 0.1 m elements, a 0.4 m initial
+fracture, G 1 GPa, nu 0.25, the fluid pressure ``sigma_0 + p_net`` leaking at ``c_l (p - p_r) / (t -
+tau)^(1/2)`` with ``sigma_0 - p_r`` = 20 MPa, so the net pressure changes the leak-off rate by a few
+percent only), compared at every step with:
+
+* the K-K~ edge, :func:`hmatddm.analytical.kgd_toughness_leak_off_edge` (zero viscosity,
+  Griffith's opening at uniform net pressure, Carter's leak-off with the net pressure in
+  it, mass balance integrated in time): the toughness cases from the K vertex (storage)
+  through the transition to the K~ vertex;
+* the leak-off vertex size ``Q t^(1/2) / (pi C')`` with ``C' = c_l (sigma_0 - p_r + p_net)``
+  (K~ and M~ alike), :func:`hmatddm.analytical.kgd_leak_off_half_length`: where leak-off
+  dominates, whatever the viscosity -- the M~ case has a viscosity-dominated fracture
+  (K_m below 1), compared with it alone.
+
+And radial fractures (3D, 0.25 m elements, 20 s) against the radial K vertex and the
+radial K-K~ edge (:func:`hmatddm.analytical.radial_toughness_leak_off_edge`).
+
+Also the leak-off coefficient from the reservoir (ref. Eq. 4.26,
+:func:`hmatddm.flow.carter_coefficient`) for the reference's Table 5.2 / 6.2 rock (shown,
+not run: with ``k_r = 0`` it is zero).
+
+Prints a table per case (time, half-length, the closed form, the error, the share of the
+injected volume that leaked off, wellbore net pressure), the CPU and wall time of each run,
+and saves ``leak_off_kgd.png`` next to this script unless --plot says otherwise.
+"""
+import os
+
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+
+import argparse  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+
+from _common import machine, print_table  # noqa: E402
+
+import hmatddm as hd  # noqa: E402
+from hmatddm.analytical import (kgd_k_vertex, kgd_leak_off_half_length, kgd_regime,  # noqa: E402
+                                kgd_toughness_leak_off_edge, radial_k_vertex, radial_leak_off_radius,
+                                radial_toughness_leak_off_edge)
+from hmatddm.flow import carter_coefficient  # noqa: E402
+
+MATERIAL = hd.Elastic(1e9, 0.25)
+S_HMIN, PORE = 20.0e6, 0.0
+ELEMENT = 0.1
+INITIAL = 0.4
+
+#: name, injection rate per unit height (m^2/s), c_l (m/(s^1/2 Pa)), K_Ic (Pa m^1/2),
+#: viscosity (Pa s), end time (s), time step (s)
+CASES = (
+    ("K (no leak-off)", 1e-3, 0.0, 1e6, 1e-5, 40.0, 1.0),
+    ("K to K~ transition", 1e-3, 1e-11, 1e6, 1e-5, 40.0, 1.0),
+    ("K~ (leak-off dominated)", 4e-3, 5e-11, 1e6, 1e-5, 40.0, 1.0),
+    ("M~ (viscous, leak-off dominated)", 4e-3, 5e-11, 0.1e6, 0.02, 40.0, 1.0),
+)
+
+
+def run_case(name, rate, c_l, toughness, viscosity, end_time, dt):
+    mesh = hd.mesh.line([-0.5 * INITIAL, 0.0], [0.5 * INITIAL, 0.0], int(round(INITIAL / ELEMENT)))
+    net = toughness / np.sqrt(np.pi * 0.5 * INITIAL)
+    sim = hd.Simulation(mesh, MATERIAL, hd.Fluid(viscosity=viscosity, compressibility=0.0),
+                        [hd.Cluster((0.0, 0.0), rate=rate)], -np.diag([2 * S_HMIN, S_HMIN]), dt,
+                        propagation=hd.Propagation(toughness=toughness),
+                        leak_off=hd.LeakOff(coefficient=c_l, pore_pressure=PORE),
+                        initial_pressure=S_HMIN + 0.9 * net, initial_opening=1e-5, backend="dense")
+    wall, cpu = time.perf_counter(), time.process_time()
+    records = sim.run(end_time=end_time)
+    wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
+    t = np.array([r["time"] for r in records])
+    length = np.array([r["half_length"] for r in records])
+    pressure = np.array([r["wellbore_pressure"][0] for r in records]) - S_HMIN
+    stored = np.array([r["fracture_volume"] for r in records])
+    injected = np.array([r["injected_volume"] for r in records])
+    e_prime = MATERIAL.plane_strain_modulus
+    if c_l > 0.0:
+        edge, edge_net = kgd_toughness_leak_off_edge(t, rate, c_l, S_HMIN - PORE, toughness, e_prime)
+        # the leak-off vertex with the run's own net pressure in C'
+        vertex = kgd_leak_off_half_length(t, rate, 1.0) * np.pi / (np.pi * c_l * (S_HMIN - PORE + pressure))
+    else:
+        edge, _, edge_net = kgd_k_vertex(t, rate, toughness, MATERIAL)
+        vertex = np.full_like(t, np.nan)
+    k_m = float(kgd_regime(rate, viscosity, toughness, MATERIAL))
+    return {"name": name, "t": t, "length": length, "edge": edge, "edge_net": edge_net, "vertex": vertex,
+            "net": pressure, "leaked": 1.0 - stored / injected, "wall": wall, "cpu": cpu, "k_m": k_m,
+            "c_l": c_l, "rate": rate, "viscous": viscosity > 1e-2, "elements": records[-1]["n_elements"]}
+
+
+#: radial (3D, dense): name, injection rate (m^3/s), c_l; K_Ic 1 MPa m^1/2, mu 1e-5 Pa s, 20 s
+RADIAL_CASES = (("radial K (no leak-off)", 1e-3, 0.0), ("radial K to K~", 1e-3, 7e-12),
+                ("radial K~", 1e-3, 3e-11))
+
+
+def run_radial(name, rate, c_l, end_time=20.0, toughness=1e6):
+    """A horizontal radial fracture (0.25 m elements, 1 m x 1 m initial square, sigma_v = 20
+    MPa above p_r = 0) against the radial K vertex or the radial K-K~ edge."""
+    mesh = hd.mesh.rectangle([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], 1.0, 1.0, 4, 4)
+    sim = hd.Simulation(mesh, MATERIAL, hd.Fluid(viscosity=1e-5), [hd.Cluster((0.0, 0.0, 0.0), rate=rate)],
+                        -np.diag([2 * S_HMIN, 2 * S_HMIN, S_HMIN]), 1.0, propagation=hd.Propagation(toughness=toughness),
+                        leak_off=hd.LeakOff(coefficient=c_l, pore_pressure=PORE),
+                        initial_pressure=S_HMIN + 0.9 * np.sqrt(np.pi) * toughness / (2 * np.sqrt(0.5)),
+                        initial_opening=1e-5, backend="dense")
+    wall, cpu = time.perf_counter(), time.process_time()
+    records = sim.run(end_time=end_time)
+    wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
+    t = np.array([r["time"] for r in records])
+    radius = np.array([r["radius"] for r in records])
+    if c_l > 0.0:
+        reference, _ = radial_toughness_leak_off_edge(t, rate, c_l, S_HMIN - PORE, toughness,
+                                                      MATERIAL.plane_strain_modulus)
+        vertex = radial_leak_off_radius(t, rate, c_l * (S_HMIN - PORE))
+    else:
+        reference, vertex = radial_k_vertex(t, rate, toughness, MATERIAL)[0], np.full_like(t, np.nan)
+    leaked = 1.0 - np.array([r["fracture_volume"] / r["injected_volume"] for r in records])
+    return {"name": name, "t": t, "radius": radius, "reference": reference, "vertex": vertex, "leaked": leaked,
+            "cpu": cpu, "wall": wall, "elements": records[-1]["n_elements"], "c_l": c_l}
+
+
+def plot(results, path):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 5))
+    for k, r in enumerate(results):
+        color = f"C{k}"
+        ax.loglog(r["t"], r["length"], "o", ms=3, color=color, label=f"{r['name']}: DDM")
+        if not r["viscous"]:
+            ax.loglog(r["t"], r["edge"], "-", color=color, lw=1,
+                      label="K vertex" if r["c_l"] == 0 else "K-K~ edge (zero viscosity)")
+        if r["c_l"] > 0:
+            ax.loglog(r["t"], r["vertex"], "--", color=color, lw=1, label="leak-off vertex Q t^1/2/(pi C')")
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel("half-length (m)")
+    ax.set_title("KGD with Carter leak-off")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--quick", action="store_true", help="10 s runs")
+    parser.add_argument("--plot", default=os.path.join(HERE, "leak_off_kgd.png"))
+    args = parser.parse_args(argv)
+    print(f"Machine: {machine()}")
+    # ref. Eq. 4.26 for a shale and a tight sand (reservoir fluid: oil 1 cP; c_t 1e-9 1/Pa)
+    md = 9.869233e-16
+    for label, k_r in (("shale, 1e-4 mD", 1e-4), ("tight sand, 0.1 mD", 0.1)):
+        both = carter_coefficient(k_r * md, 0.15, 1e-9, 1e-3)
+        print(f"ref. Eq. 4.26, {label}, phi 0.15: c_l = {both:.3g} m/(s^1/2 Pa) for both faces "
+              f"({0.5 * both:.3g} for one, the reference's reading); at 5 MPa C' = {5e6 * both:.3g} m/s^1/2")
+    results = []
+    for case in CASES:
+        name, rate, c_l, toughness, viscosity, end_time, dt = case
+        results.append(run_case(name, rate, c_l, toughness, viscosity, 10.0 if args.quick else end_time, dt))
+    for r in results:
+        pick = np.unique(np.clip(np.searchsorted(r["t"], [1, 2, 5, 10, 20, 40]), 0, len(r["t"]) - 1))
+        rows = []
+        for i in pick:
+            reference = r["vertex"][i] if r["viscous"] else r["edge"][i]
+            rows.append([f"{r['t'][i]:g}", f"{r['length'][i]:.3f}", f"{r['edge'][i]:.3f}" if not r["viscous"] else "-",
+                         f"{r['vertex'][i]:.3f}" if r["c_l"] > 0 else "-",
+                         f"{100 * (r['length'][i] / reference - 1):+.1f}%", f"{100 * r['leaked'][i]:.0f}%",
+                         f"{r['net'][i] / 1e6:.3f}", f"{r['edge_net'][i] / 1e6:.3f}" if not r["viscous"] else "-"])
+        print(f"\n{r['name']}: Q = {r['rate']:g} m^2/s, c_l = {r['c_l']:g}, K_m = {r['k_m']:.2f}; "
+              f"{r['elements']} elements at the end; CPU {r['cpu']:.1f} s, wall {r['wall']:.1f} s")
+        print_table(["t (s)", "l DDM (m)", "l K-K~ edge (m)", "l leak-off vertex (m)", "error", "leaked",
+                     "net p DDM (MPa)", "net p edge (MPa)"], rows)
+    for r in [run_radial(*case, end_time=8.0 if args.quick else 20.0) for case in RADIAL_CASES]:
+        pick = np.unique(np.clip(np.searchsorted(r["t"], [2, 5, 10, 15, 20]), 0, len(r["t"]) - 1))
+        rows = [[f"{r['t'][i]:g}", f"{r['radius'][i]:.3f}", f"{r['reference'][i]:.3f}",
+                 f"{r['vertex'][i]:.3f}" if r["c_l"] > 0 else "-", f"{100 * (r['radius'][i] / r['reference'][i] - 1):+.1f}%",
+                 f"{100 * r['leaked'][i]:.0f}%"] for i in pick]
+        print(f"\n{r['name']}: c_l = {r['c_l']:g}; {r['elements']} elements at the end; CPU {r['cpu']:.1f} s, "
+              f"wall {r['wall']:.1f} s")
+        print_table(["t (s)", "R DDM (m)", "R K vertex / K-K~ edge (m)", "R leak-off vertex (m)", "error", "leaked"],
+                    rows)
+    plot(results, args.plot)
+    print(f"plot: {args.plot}")
+
+
+if __name__ == "__main__":
+    main()

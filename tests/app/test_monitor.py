@@ -1,0 +1,81 @@
+"""[[monitor]]: displacement and tilt at points through a run (monitor.csv, monitor.png),
+the values of hmatddm.displacement_at on the run's state, resumable."""
+import csv
+
+import numpy as np
+import pytest
+
+import hmatddm as hd
+import hmatddm.scene as hs
+from hmatddm.app import runner
+from hmatddm.app.monitor import displacement_and_tilt
+from hmatddm.errors import InputError
+from scene_texts import KGD_2D_HEAD, RADIAL_3D_BODY
+
+# the 3 m x 3 m horizontal sill of the runner tests, two steps, three monitor points
+MONITORED = 'name = "monitored"\n' + RADIAL_3D_BODY + """
+[output]
+snapshots = false
+history_plot = false
+[[monitor]]
+position = [0.0, 0.0, 4.0]
+[[monitor]]
+position = [5.0, 1.0, 3.0]
+[[monitor]]
+position = [-2.0, -2.0, -6.0]
+"""
+
+
+def _rows(path):
+    with open(path, newline="") as handle:
+        return list(csv.DictReader(handle))
+
+
+def test_a_run_writes_displacement_and_tilt(tmp_path):
+    from PIL import Image
+
+    out = tmp_path / "run"
+    summary = runner.run_scene(hs.parse_scene(MONITORED), out, quiet=True)
+    rows = _rows(out / "monitor.csv")
+    assert [(int(r["step"]), int(r["monitor"])) for r in rows] == [(s, k) for s in (1, 2) for k in range(3)]
+    assert [float(r["time"]) for r in rows[::3]] == [s["time"] for s in summary["steps"]]
+    last = {int(r["monitor"]): r for r in rows if int(r["step"]) == 2}
+    # the values are those of hd.displacement_at on the last state (its checkpoint)
+    from hmatddm.app.run_folder import latest_state
+
+    mesh, fields, step, _ = latest_state(out)
+    assert step == 2
+    positions = np.array([[0.0, 0.0, 4.0], [5.0, 1.0, 3.0], [-2.0, -2.0, -6.0]])
+    material = hd.Elastic(24e9, 0.25)
+    expected = hd.displacement_at(mesh, material, fields["dd"], positions)
+    got = np.array([[float(last[k][f"u_{a}"]) for a in "xyz"] for k in range(3)])
+    np.testing.assert_allclose(got, expected, rtol=1e-8, atol=1e-15)
+    # above the opening sill the ground rises, below it sinks; on its axis no tilt
+    assert got[0, 2] > 0 and got[2, 2] < 0
+    assert abs(float(last[0]["tilt_x"])) < 1e-3 * abs(float(last[1]["tilt_x"]))
+    # tilt: the slope of u_z, checked by a coarser difference of displacement_at
+    h = 1e-2
+    du = hd.displacement_at(mesh, material, fields["dd"], positions[1:2] + [[h, 0, 0]])[0, 2] - \
+        hd.displacement_at(mesh, material, fields["dd"], positions[1:2] - [[h, 0, 0]])[0, 2]
+    assert float(last[1]["tilt_x"]) == pytest.approx(du / (2 * h), rel=1e-3)
+    image = np.asarray(Image.open(out / "monitor.png").convert("RGB"), dtype=float)
+    assert image.std() > 5.0
+
+
+def test_monitor_rows_are_cut_back_on_resume(tmp_path):
+    out = tmp_path / "run"
+    text = MONITORED.replace("end_time = 2.0", "end_time = 1.0")
+    runner.run_scene(hs.parse_scene(text), out, quiet=True)
+    assert {int(r["step"]) for r in _rows(out / "monitor.csv")} == {1}
+    runner.run_scene(hs.parse_scene(MONITORED), out, quiet=True, resume=True)
+    assert [int(r["step"]) for r in _rows(out / "monitor.csv")] == [1, 1, 1, 2, 2, 2]
+
+
+def test_2d_tilt_and_refusals():
+    mesh = hd.mesh.line([-1.0, 0.0], [1.0, 0.0], 4)
+    dd = np.tile([0.0, 1e-3], (4, 1))
+    u, tilt = displacement_and_tilt(mesh, hd.Elastic(1e9, 0.25), dd, np.array([[0.5, 2.0], [1.0, 0.0]]))
+    assert tilt.shape == (2, 1) and np.all(np.isfinite(u[0])) and u[0, 1] > 0 and tilt[0, 0] < 0
+    assert np.all(np.isnan(u[1])) and np.all(np.isnan(tilt[1]))  # on the crack's end: singular, blank in the csv
+    with pytest.raises(InputError, match=r"monitor\[0\]\.position must be a list of 2"):
+        hs.parse_scene('name = "m"\n' + KGD_2D_HEAD + 'end_time = 1.0\n[[monitor]]\nposition = [0.0, 1.0, 2.0]\n')
