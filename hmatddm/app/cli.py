@@ -192,23 +192,40 @@ def _run(args):
               "try a smaller numerics.time_step, a lower numerics.relaxation or another numerics.scheme",
               file=sys.stderr)
         return EXIT_NOT_CONVERGED
-    last = summary["steps"][-1] if summary["steps"] else None
+    steps = [step for step in summary["steps"] if step.get("step", 1) > 0]  # step 0: the initial state
+    last = steps[-1] if steps else None
     if not args.quiet:
-        state = (f"t = {last['time']:g} s, {last['n_elements']} elements, {len(summary['steps'])} steps"
+        state = (f"t = {last['time']:g} s, {last['n_elements']} elements, {len(steps)} steps"
                  if last else "no step")
         reference = summary["reference"]
         comparison = ""
-        if reference:
-            errors = reference[-1]["relative_error"]
+        errors = (reference[-1].get("relative_error") or {}) if reference and last else {}
+        if any(value is not None for value in errors.values()):
             comparison = "; vs closed form: " + ", ".join(
                 f"{key} {100 * value:+.1f}%" for key, value in errors.items() if value is not None)
-        print(f"hmatddm: done in {summary['wall_seconds']:.1f} s ({state}{comparison}); outputs in {out}")
+        seconds = f"{summary['wall_seconds']:.1f} s"
+        if run.resumed:
+            seconds = f"{run.session_seconds:.1f} s ({summary['wall_seconds']:.1f} s in all, with the earlier sessions)"
+        print(f"hmatddm: done in {seconds} ({state}{comparison}); outputs in {out}")
+        print(f"hmatddm: {_budget_line(summary['steps'])}")
     return EXIT_OK
 
 
 # ---------------------------------------------------------------------------------
 # bench, render
 # ---------------------------------------------------------------------------------
+
+def _budget_line(steps):
+    """The end-of-run line of the fluid budget: its worst residual against the fluid moved."""
+    from ..simulation.records import worst_budget_residual
+
+    worst = worst_budget_residual(steps)
+    if worst is None:
+        return "fluid budget: no record has one"
+    residual, moved, step = worst
+    return (f"fluid budget (volume at the reference density): worst residual {residual:+.2e} m^3 = "
+            f"{abs(residual) / moved if moved > 0 else 0.0:.1e} of the fluid moved ({moved:.4g} m^3, step {step})")
+
 
 def _bench(args):
     from .bench import format_table, run_bench

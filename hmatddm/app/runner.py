@@ -2,10 +2,13 @@
 
 The folder (``--out DIR``) holds::
 
-    summary.json        scene (validated echo, SI), versions, steps (one record per
-                        step), reference (closed form at each step, or null),
-                        wall_seconds; rewritten atomically after every step, so a
-                        partial or interrupted run is always readable
+    summary.json        scene (validated echo, SI), versions, steps (the record of the
+                        initial state, step 0, then one record per step, each with its
+                        fluid budget), reference (closed form at each step, or null;
+                        null values at t = 0, where the closed forms are singular),
+                        wall_seconds (every session of the run together); rewritten
+                        atomically after every step, so a partial or interrupted run
+                        is always readable
     scene.toml          the validated scene (every default filled in); `--resume`
                         without a SCENE reads it
     fractures.pvd       ParaView time series of the .vtu files
@@ -79,6 +82,8 @@ class SceneRun:
         self._started = None
         self._last_vtu_step = None
         self._stress = None
+        self._initial = None  # the record of step 0 (hmatddm.simulation.records.initial_record)
+        self.resumed = False  # whether this session continued a run from a checkpoint
 
     # -- public -----------------------------------------------------------------------
     @property
@@ -88,6 +93,16 @@ class SceneRun:
     @property
     def last_record(self):
         return self.records[-1] if self.records else None
+
+    @property
+    def steps(self):
+        """The records of summary.json: the initial state (step 0), then every step."""
+        return ([] if self._initial is None else [self._initial]) + list(self.records)
+
+    @property
+    def session_seconds(self):
+        """Wall seconds of this session of the run (a resumed run's own time)."""
+        return time.perf_counter() - self._started if self._started else 0.0
 
     def note(self, text):
         if self.progress is not None:
@@ -118,6 +133,9 @@ class SceneRun:
         self._stress = simulation.far_field_stress
         self._prepare_folder(simulation)
         self.simulation = simulation
+        from ..simulation.records import initial_record
+
+        self._initial = initial_record(simulation)
         start_time = simulation.state.time
         self.progress = Progress(numerics["end_time"], simulation.time_step, stream=self.stream,
                                  enabled=not self.quiet, start_time=start_time)
@@ -152,7 +170,7 @@ class SceneRun:
             summary = read_summary(self.out)
         except InputError:  # unreadable: not ours to judge, keep it
             return True
-        return bool(summary and summary.get("steps"))
+        return any(int(step.get("step", 1)) > 0 for step in (summary or {}).get("steps") or ())
 
     def _clear(self):
         """Remove the files an earlier run wrote (only ours, by name)."""
@@ -177,6 +195,7 @@ class SceneRun:
         has_checkpoint = bool(checkpoints.list_checkpoints(out / CHECKPOINT_DIR))
         if self.resume and has_checkpoint:
             simulation.load_checkpoint()
+            self.resumed = True
             step = simulation.state.step
             summary = read_summary(out)
             if summary is not None:
@@ -232,9 +251,17 @@ class SceneRun:
     def summary(self):
         from ..scene import reference_values
 
-        wall = self._wall_before + (time.perf_counter() - self._started if self._started else 0.0)
-        return {"scene": self.scene.to_dict(), "versions": versions(), "steps": self.records,
-                "reference": reference_values(self.scene.data, self.records), "wall_seconds": wall}
+        wall = self._wall_before + self.session_seconds
+        reference = reference_values(self.scene.data, self.records)
+        if reference is not None and self._initial is not None:  # the closed forms are singular at t = 0
+            keys = reference[0] if reference else {"time": None}
+            initial = {key: None for key in keys}
+            initial["time"] = 0.0
+            if "relative_error" in keys:
+                initial["relative_error"] = {key: None for key in keys["relative_error"]}
+            reference = [initial] + reference
+        return {"scene": self.scene.to_dict(), "versions": versions(), "steps": self.steps,
+                "reference": reference, "wall_seconds": wall}
 
     def _write_summary(self):
         document = self.summary()
@@ -259,7 +286,7 @@ class SceneRun:
             except HmatddmError as error:  # e.g. no offscreen OpenGL on this machine
                 self.note(f"hmatddm: warning: no snapshots written: {error}")
         if output["history_plot"]:
-            self.written["history"] = write_history(self.out, self.records, self.scene.data)
+            self.written["history"] = write_history(self.out, self.steps, self.scene.data)
         if "microseismic" in self.scene.data:  # events.csv and the event map (ref. Ch. 7)
             from .catalogue import write_catalogue
 

@@ -3,7 +3,10 @@
 :func:`plot_history` draws three panels against time: the fracture size (radius,
 half-length, or the equivalent radius ``sqrt(area / pi)``), the maximum opening (mm)
 and the wellbore pressure of each cluster (MPa), with closed-form solutions overlaid
-as dashed lines.
+as dashed lines; and, when the records carry a fluid ``budget``
+(:func:`hmatddm.simulation.records.fluid_budget`), a fourth panel: where the fluid is
+(fractures, leaked off, stored in the wellbores since t = 0, stacked) against the fluid
+injected plus the fluid of the initial fractures.
 """
 from pathlib import Path
 
@@ -132,6 +135,36 @@ def _draw_pressure(axis, time, records, curves, confining_stress):
     axis.set_xlabel("time (s)")
 
 
+def _budgets(records):
+    """``(time, budgets)`` of the records with a budget, when there are at least two."""
+    rows = [(record["time"], record["budget"]) for record in records if record.get("budget")]
+    return rows if len(rows) >= 2 else None
+
+
+def _draw_budget(axis, rows):
+    """Stacked: fluid in the fractures, leaked off, and the change of the wellbores'
+    fluid since the first record (negative when the wellbores gave fluid back); dashed:
+    injected plus the fluid in the fractures at the first record. The stack reaches the
+    dashed line when the budget closes (the worst residual is in the legend)."""
+    time = np.array([row[0] for row in rows], dtype=float)
+
+    def column(key):
+        return np.array([_finite_number(row[1].get(key, 0.0), f"budget[{key!r}]") for row in rows])
+
+    fractures, leaked, wellbore = column("fractures"), column("leaked"), column("wellbore")
+    sources = column("injected") + column("initial") + column("natural") - wellbore[0]
+    stored = wellbore - wellbore[0]
+    residual = column("residual")
+    moved = np.maximum(column("injected"), fractures)
+    worst = float(np.max(np.abs(residual) / np.where(moved > 0.0, moved, np.inf)))
+    axis.stackplot(time, fractures, leaked, stored, labels=("in the fractures", "leaked off",
+                                                            "stored in the wellbores since t0"),
+                   colors=("tab:blue", "tab:orange", "tab:green"), alpha=0.6)
+    axis.plot(time, sources, color="black", linestyle="--", linewidth=1.2,
+              label=f"injected + initial fractures (worst residual {worst:.1e} of the fluid moved)")
+    _finish(axis, "fluid volume (m³, reference density)")
+
+
 def plot_history(records, path, reference=None, confining_stress=0.0):
     """Plot a simulation history as a three-panel PNG.
 
@@ -141,7 +174,8 @@ def plot_history(records, path, reference=None, confining_stress=0.0):
         One dict per time step with at least ``time`` (s), ``fracture_area`` (m²),
         ``max_opening`` (m) and ``wellbore_pressure`` (Pa; a list, one value per
         cluster, or a scalar); optionally ``radius`` or ``half_length`` (m), plotted
-        instead of the equivalent radius ``sqrt(area / pi)`` when every record has it.
+        instead of the equivalent radius ``sqrt(area / pi)`` when every record has it,
+        and a fluid ``budget`` (a fourth panel, when at least two records have one).
     path : str or Path
         Output PNG (folder created if missing; written atomically).
     reference : dict of arrays, optional
@@ -166,12 +200,18 @@ def plot_history(records, path, reference=None, confining_stress=0.0):
     curves = _check_reference(reference)
     confining_stress = _finite_number(confining_stress, "confining_stress")
     time = _column(records, "time")
-    figure = Figure(figsize=(7.0, 9.0), dpi=110, layout="constrained")
+    budgets = _budgets(records)
+    panels = 3 if budgets is None else 4
+    figure = Figure(figsize=(7.0, 3.0 * panels), dpi=110, layout="constrained")
     FigureCanvasAgg(figure)
-    size_axis, opening_axis, pressure_axis = figure.subplots(3, 1, sharex=True)
-    _draw_size(size_axis, time, records, curves)
-    _draw_opening(opening_axis, time, records, curves)
-    _draw_pressure(pressure_axis, time, records, curves, confining_stress)
+    axes = figure.subplots(panels, 1, sharex=True)
+    _draw_size(axes[0], time, records, curves)
+    _draw_opening(axes[1], time, records, curves)
+    _draw_pressure(axes[2], time, records, curves, confining_stress)
+    if budgets is not None:
+        axes[2].set_xlabel("")
+        _draw_budget(axes[3], budgets)
+        axes[3].set_xlabel("time (s)")
     path = Path(path)
     with atomic_output(path) as temporary:
         figure.savefig(temporary, format="png")
