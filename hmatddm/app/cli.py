@@ -8,7 +8,7 @@ before numba or the engine load, so refusals come within a second. The command s
     hmatddm scenes [NAME]             list the embedded scenes, or print one as TOML
     hmatddm validate [--json]         closed-form checks as a table of error and time
     hmatddm bench [--quick] [--json]  H-matrix against dense: build time, memory, matvec time, error
-    hmatddm render DIR                snapshots and history plot of a finished or partial run
+    hmatddm render DIR [--movie]      snapshots, profiles and history plot of a finished or partial run
     hmatddm sweep [--realizations N]  natural-fracture network ensembles on Dask (ref. Fig. 6.9)
     hmatddm microseismic DIR          event catalogue (events.csv) and map of a finished run (ref. Ch. 7)
 
@@ -241,7 +241,7 @@ def _bench(args):
 def _render(args):
     from .runner import render_folder
 
-    written = render_folder(args.dir)
+    written = render_folder(args.dir, movie=args.movie)
     for path in written:
         _say(args, f"wrote {path}")
     return EXIT_OK
@@ -325,8 +325,11 @@ def build_parser():
     bench.add_argument("--quiet", action="store_true", help="no progress")
     bench.set_defaults(handler=_bench)
 
-    render = sub.add_parser("render", help="snapshots and history plot of a finished or partial run")
+    render = sub.add_parser("render", help="snapshots, profile pictures of every saved step and history plot of "
+                                           "a finished or partial run (--movie: an animated GIF of the profiles)")
     render.add_argument("dir", metavar="DIR", help="the --out folder of `hmatddm run`")
+    render.add_argument("--movie", action="store_true",
+                        help="also write DIR/movie.gif, the profile pictures of the saved steps in turn")
     render.add_argument("--quiet", action="store_true", help="do not list the written files")
     render.set_defaults(handler=_render)
     microseismic = sub.add_parser("microseismic", help="event catalogue (events.csv) and map of a finished run "

@@ -20,6 +20,10 @@ The folder (``--out DIR``) holds::
     snapshots/step-NNNNNN_plan.png, _oblique.png   views of the last state (plan
                         only in 2D; the plan view of vertical 3D fractures shows their
                         traces, coloured by the largest opening over the height)
+    snapshots/step-NNNNNN_profile.png   every saved step (those with a .vtu): the
+                        opening and net pressure along each fracture (2D) or along
+                        both in-plane axes through the injection point (3D), with
+                        the closed form of a [reference] and its relative error
     history.png         size, opening and wellbore pressure against time, with the
                         closed form overlaid when the scene has a [reference]
 
@@ -34,12 +38,14 @@ from pathlib import Path
 from ..errors import HmatddmError, InputError, OutputError
 from ..io import atomic_output, write_pvd, write_vtu
 from ..simulation.progress import Progress
-from .run_folder import (CHECKPOINT_DIR, HISTORY, PVD,  # noqa: F401  (re-exported)
+from .run_folder import (CHECKPOINT_DIR, HISTORY, MOVIE, PVD,  # noqa: F401  (re-exported)
                          SCENE_FILE, SNAPSHOT_DIR, SUMMARY, SUMMARY_KEYS, VTU_DIR,
                          cell_fields, latest_state, layer_interfaces, mesh_from_vtu, read_pvd_entries,
                          read_summary, render_folder, snapshot_title, snapshot_views, versions, vtu_name,
                          vtu_steps, write_history, write_json, write_snapshots)
 from ..simulation import checkpoint as checkpoints
+
+PROFILE_SHARE = 0.03  # the largest share of a run's CPU time its profile pictures may take
 
 
 # ---------------------------------------------------------------------------------
@@ -81,9 +87,14 @@ class SceneRun:
         self._wall_before = 0.0
         self._started = None
         self._last_vtu_step = None
+        self._last_saved_step = None
         self._stress = None
         self._initial = None  # the record of step 0 (hmatddm.simulation.records.initial_record)
         self.resumed = False  # whether this session continued a run from a checkpoint
+        self._plotter = None  # the ProfilePlotter of the profile pictures, made at the first
+        self._started_cpu = time.process_time()
+        self._profile_cpu = 0.0  # CPU seconds spent on profile pictures (_draws_profile)
+        self._last_profile_cpu = 0.0
 
     # -- public -----------------------------------------------------------------------
     @property
@@ -127,6 +138,7 @@ class SceneRun:
             raise InputError("--resume continues the run in the folder and --overwrite starts it over: give one "
                              "of them, not both")
         self._started = time.perf_counter()
+        self._started_cpu = time.process_time()
         scene = self.scene.data
         numerics = scene["numerics"]
         simulation = build_simulation(scene, checkpoint_dir=self.out / CHECKPOINT_DIR)
@@ -174,7 +186,7 @@ class SceneRun:
 
     def _clear(self):
         """Remove the files an earlier run wrote (only ours, by name)."""
-        names = [self.out / SUMMARY, self.out / PVD, self.out / HISTORY, self.out / SCENE_FILE]
+        names = [self.out / SUMMARY, self.out / PVD, self.out / HISTORY, self.out / SCENE_FILE, self.out / MOVIE]
         names += [self.out / name for name in ("events.csv", "microseismic_map.png")]  # hmatddm.microseismic
         folder = self.out / CHECKPOINT_DIR
         names += list(folder.glob("step-*.json")) + list(folder.glob("step-*.npz"))
@@ -225,17 +237,58 @@ class SceneRun:
             temporary.write_text(to_toml(self.scene.data, header), encoding="utf-8")
 
     # -- per step ------------------------------------------------------------------------
-    def _write_vtu(self, state):
-        if not self.scene.data["output"]["vtu"]:
+    def _write_vtu(self, state, last=False):
+        """The .vtu file (``output.vtu``) and the profile picture (``output.snapshots``,
+        :meth:`_draws_profile`) of a saved step; ``last``: the run's last state."""
+        output = self.scene.data["output"]
+        profile = output["snapshots"] and self._draws_profile(last)
+        if not (output["vtu"] or profile):
             return
         mesh, dd, pressure, codes = self.simulation.view()
         fields = cell_fields(mesh, dd, pressure, self._stress, codes)
+        if profile:
+            self._write_profile(mesh, fields, state)
+        self._last_saved_step = state.step
+        if not output["vtu"]:
+            return
         write_vtu(self.out / vtu_name(state.step), mesh, fields)
         self._pvd_entries = [(t, name) for t, name in self._pvd_entries if name != vtu_name(state.step)]
         self._pvd_entries.append((state.time, vtu_name(state.step)))
         write_pvd(self.out / PVD, self._pvd_entries)
         self._last_vtu_step = state.step
         self.written["vtu"] += 1
+
+    def _draws_profile(self, last):
+        """Whether a saved step gets its profile picture: the last state always, the others
+        while the pictures have cost at most :data:`PROFILE_SHARE` of the run's CPU time so
+        far (the next one counted at the cost of the last), so that pictures never slow a
+        run down by more than that; ``hmatddm render DIR`` draws every saved step."""
+        if last or self._profile_cpu == 0.0:
+            return True
+        spent = time.process_time() - self._started_cpu
+        return self._profile_cpu + self._last_profile_cpu <= PROFILE_SHARE * spent
+
+    def _write_profile(self, mesh, fields, state):
+        from ..render.profiles import ProfilePlotter
+        from .profiles import write_profile
+
+        clock = time.process_time()
+        if self._plotter is None:
+            self._plotter = ProfilePlotter()
+        title = snapshot_title(self.scene.name, state.time, mesh, fields.get("state"))
+        try:
+            path = write_profile(self.out, mesh, fields, state.step, state.time, self.scene.data, title,
+                                 plotter=self._plotter)
+        except OutputError:
+            raise
+        except HmatddmError as error:  # a picture that cannot be drawn does not stop the run
+            self.note(f"hmatddm: warning: no profile picture of step {state.step}: {error}")
+            return
+        finally:
+            self._last_profile_cpu = time.process_time() - clock
+            self._profile_cpu += self._last_profile_cpu
+        if path is not None:
+            self.written.setdefault("profiles", []).append(path)
 
     def _is_last(self, record):
         numerics = self.scene.data["numerics"]
@@ -244,7 +297,7 @@ class SceneRun:
     def _after_step(self, simulation, record):
         every = self.scene.data["output"]["every"]
         if record["step"] % every == 0 or self._is_last(record):
-            self._write_vtu(simulation.state)
+            self._write_vtu(simulation.state, last=self._is_last(record))
         self._write_summary()
         self.progress.update(record)
 
@@ -273,14 +326,17 @@ class SceneRun:
         """Last VTU, snapshots and history of the last converged state; final summary."""
         state = self.simulation.state
         output = self.scene.data["output"]
-        if output["vtu"] and self._last_vtu_step != state.step:
-            self._write_vtu(state)
+        if self._last_saved_step != state.step:  # the last converged state's .vtu and profile
+            self._write_vtu(state, last=True)
         if output["snapshots"]:
             mesh, dd, pressure, codes = self.simulation.view()
             fields = cell_fields(mesh, dd, pressure, self._stress, codes)
             try:
+                front = None if state.front_class is None else (state.front_distance, state.front_velocity,
+                                                                    state.front_class)
                 self.written["snapshots"] = write_snapshots(self.out, mesh, fields, state.step, state.time,
-                                                            self.scene.name, layer_interfaces(self.scene.data))
+                                                            self.scene.name, layer_interfaces(self.scene.data),
+                                                            self.scene.data, front)
             except OutputError:
                 raise
             except HmatddmError as error:  # e.g. no offscreen OpenGL on this machine
