@@ -94,10 +94,31 @@ def _load_run_scene(args):
         stored = Path(args.out) / SCENE_FILE
     if stored is not None and stored.is_file():
         scene = load_scene(str(stored), overrides=overrides)  # the scene the run in DIR was started with
+    elif args.scene is not None and Path(args.scene).is_dir():
+        scene = load_scene(str(_scene_in_folder(args, Path(args.scene))), overrides=overrides)
     else:
         scene = load_scene(args.scene or DEFAULT_SCENE, overrides=overrides)
     out = Path(args.out) if args.out else Path(DEFAULT_OUT_ROOT) / scene.name
     return scene, out
+
+
+def _scene_in_folder(args, folder):
+    """The scene file of a folder given as SCENE: its scene.toml (the scene an `hmatddm run`
+    stored there) or its only .toml file, said on stderr; InputError otherwise."""
+    from ..errors import InputError
+    from .runner import SCENE_FILE
+
+    stored = folder / SCENE_FILE
+    files = sorted(folder.glob("*.toml"))
+    chosen = stored if stored.is_file() else (files[0] if len(files) == 1 else None)
+    if chosen is None:
+        listed = (f"it holds {len(files)} .toml files: {', '.join(p.name for p in files[:6])}"
+                  f"{', ...' if len(files) > 6 else ''}; give one of them" if files else "it holds no .toml file")
+        raise InputError(f"SCENE {str(folder)!r} is a folder, not a scene: {listed} (or an embedded scene name; "
+                         "to continue a run in a folder: hmatddm run --out DIR --resume)")
+    if not getattr(args, "quiet", False):
+        print(f"hmatddm: {str(folder)!r} is a folder: running its scene file {chosen}", file=sys.stderr)
+    return chosen
 
 
 def _output_failed(out, error, args):

@@ -17,7 +17,7 @@ from ..errors import InputError
 from ..io import atomic_output
 
 REQUIRED_KEYS = ("time", "fracture_area", "max_opening", "wellbore_pressure")
-REFERENCE_KEYS = ("time", "radius", "half_length", "max_opening", "net_pressure")
+REFERENCE_KEYS = ("time", "radius", "half_length", "max_opening", "net_pressure", "top", "bottom")
 CLOSED_FORM_STYLE = dict(color="black", linestyle="--", linewidth=1.2, label="closed form")
 
 
@@ -89,7 +89,8 @@ def _check_reference(reference):
 
 def _size_series(records):
     """(values, axis label) of the fracture size: radius, half-length or equivalent radius."""
-    for key, label in (("radius", "radius (m)"), ("half_length", "half-length (m)")):
+    for key, label in (("height", "height, bottom to top (m)"), ("radius", "radius (m)"),
+                       ("half_length", "half-length (m)")):
         if all(key in record for record in records):
             return _column(records, key), label
     area = _column(records, "fracture_area")
@@ -165,7 +166,19 @@ def _draw_budget(axis, rows):
     _finish(axis, "fluid volume (m³, reference density)")
 
 
-def plot_history(records, path, reference=None, confining_stress=0.0):
+def _draw_tips(axis, time, records, curves, interfaces):
+    """Height growth in layers: the top and bottom of the fractures against time, the layer
+    interfaces as grey lines, the closed form's tips (``top``, ``bottom``) dashed."""
+    axis.plot(time, _column(records, "top"), marker=".", color="tab:red", label="top")
+    axis.plot(time, _column(records, "bottom"), marker=".", color="tab:purple", label="bottom")
+    for key in ("top", "bottom"):
+        _overlay(axis, curves, key)
+    for index, height in enumerate(interfaces):
+        axis.axhline(height, color="grey", linewidth=1.0, label="layer interfaces" if index == 0 else None)
+    _finish(axis, "fracture tips, vertical (m)")
+
+
+def plot_history(records, path, reference=None, confining_stress=0.0, interfaces=()):
     """Plot a simulation history as a three-panel PNG.
 
     Parameters
@@ -175,7 +188,8 @@ def plot_history(records, path, reference=None, confining_stress=0.0):
         ``max_opening`` (m) and ``wellbore_pressure`` (Pa; a list, one value per
         cluster, or a scalar); optionally ``radius`` or ``half_length`` (m), plotted
         instead of the equivalent radius ``sqrt(area / pi)`` when every record has it,
-        and a fluid ``budget`` (a fourth panel, when at least two records have one).
+        and a fluid ``budget`` (a panel, when at least two records have one); ``top`` and
+        ``bottom`` (m, in a layered medium: a panel of the tips against ``interfaces``).
     path : str or Path
         Output PNG (folder created if missing; written atomically).
     reference : dict of arrays, optional
@@ -188,6 +202,8 @@ def plot_history(records, path, reference=None, confining_stress=0.0):
         closed-form curve on the pressure panel is
         ``confining_stress + net_pressure``, so it compares with the absolute
         wellbore pressure; leave 0 when the records hold net pressures.
+    interfaces : sequence of float
+        Heights of the layer interfaces (m), drawn in the panel of the tips.
 
     Returns
     -------
@@ -201,17 +217,23 @@ def plot_history(records, path, reference=None, confining_stress=0.0):
     confining_stress = _finite_number(confining_stress, "confining_stress")
     time = _column(records, "time")
     budgets = _budgets(records)
-    panels = 3 if budgets is None else 4
+    tips = all("top" in record and "bottom" in record for record in records)
+    panels = 3 + (budgets is not None) + tips
     figure = Figure(figsize=(7.0, 3.0 * panels), dpi=110, layout="constrained")
     FigureCanvasAgg(figure)
     axes = figure.subplots(panels, 1, sharex=True)
     _draw_size(axes[0], time, records, curves)
     _draw_opening(axes[1], time, records, curves)
     _draw_pressure(axes[2], time, records, curves, confining_stress)
+    extra = 3
+    if tips:
+        _draw_tips(axes[extra], time, records, curves, [float(h) for h in interfaces])
+        extra += 1
     if budgets is not None:
-        axes[2].set_xlabel("")
-        _draw_budget(axes[3], budgets)
-        axes[3].set_xlabel("time (s)")
+        _draw_budget(axes[extra], budgets)
+    for axis in axes[:-1]:
+        axis.set_xlabel("")
+    axes[-1].set_xlabel("time (s)")
     path = Path(path)
     with atomic_output(path) as temporary:
         figure.savefig(temporary, format="png")

@@ -92,7 +92,34 @@ def _state_record(sim, s, flow, width, tally, relaxation, seconds, previous_time
         record["radius"] = float(np.sqrt(area / np.pi))
     else:
         record["half_length"] = float(np.sum(mesh.areas) / 2.0)
+    if sim.medium is not None:
+        record.update(height_growth(mesh, s.origin, sim.medium))
     return record
+
+
+def height_growth(mesh, origin, medium):
+    """How far the hydraulic fractures reach up and down in a layered medium (ref. Ch. 3),
+    along the vertical axis (z in 3D, the second coordinate in 2D, docs/conventions.md §3):
+    ``top`` and ``bottom`` (m, the highest and lowest point of a hydraulic element),
+    ``height = top - bottom``, the layer of the element at each (``top_layer``,
+    ``bottom_layer``: 0 the top layer; :meth:`~hmatddm.layered.LayeredMedium.layer_of` of its
+    centre) and ``interfaces_crossed`` (interfaces strictly between bottom and top)."""
+    hydraulic = np.flatnonzero(origin == Origin.HYDRAULIC)
+    if hydraulic.size == 0:
+        return {}
+    axis = mesh.dim - 1
+    if mesh.dim == 3:
+        points = mesh.subset(hydraulic).corners()[..., axis]          # (n, 4)
+    else:
+        ends = mesh.subset(hydraulic).endpoints
+        points = np.stack([ends[0][:, axis], ends[1][:, axis]], axis=1)  # (n, 2)
+    highest, lowest = np.max(points, axis=1), np.min(points, axis=1)
+    top_element, bottom_element = hydraulic[np.argmax(highest)], hydraulic[np.argmin(lowest)]
+    top, bottom = float(np.max(highest)), float(np.min(lowest))
+    layers = medium.layer_of(mesh.centers[[top_element, bottom_element], axis])
+    interfaces = np.asarray(medium.interfaces, dtype=float)
+    return dict(height=top - bottom, top=top, bottom=bottom, top_layer=int(layers[0]), bottom_layer=int(layers[1]),
+                interfaces_crossed=int(np.count_nonzero((interfaces < top) & (interfaces > bottom))))
 
 
 # ---------------------------------------------------------------------------------
