@@ -85,12 +85,12 @@ def wells(scene):
     return np.array([cluster["position"] for cluster in scene.get("cluster", [])], dtype=float)
 
 
-def write_profile(out, mesh, fields, step, time_value, scene, title, plotter=None):
-    """``snapshots/step-NNNNNN_profile.png`` of one state (``fields``: :func:`cell_fields`;
+def write_profile(folder, mesh, fields, step, time_value, scene, title, plotter=None):
+    """``folder/step-NNNNNN_profile.png`` (a run's ``snapshots`` folder) of one state
+    (``fields``: :func:`hmatddm.app.run_folder.cell_fields`;
     ``plotter``: a :class:`hmatddm.render.profiles.ProfilePlotter` to reuse); returns its
     path, or None when the state has no hydraulic element to draw."""
     from ..render.profiles import fracture_sections, plot_profiles
-    from .run_folder import SNAPSHOT_DIR
 
     points = wells(scene) if scene is not None else np.zeros((0, mesh.dim))
     sections = fracture_sections(mesh, fields["opening"], fields["net_pressure"], fields.get("state"), points)
@@ -103,7 +103,7 @@ def write_profile(out, mesh, fields, step, time_value, scene, title, plotter=Non
     label = "distance from the injection point along the section (m)"
     if mesh.dim == 2:
         label = "arc length along the fracture from the injection point (m)"
-    return plot_profiles(sections, Path(out) / SNAPSHOT_DIR / f"step-{step:06d}_profile.png", reference=reference,
+    return plot_profiles(sections, Path(folder) / f"step-{step:06d}_profile.png", reference=reference,
                          title=title, position_label=label, plotter=plotter)
 
 

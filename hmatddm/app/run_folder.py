@@ -291,7 +291,7 @@ def write_profiles(out, scene, name):
     plotter, written = ProfilePlotter(), []
     for mesh, fields, step, time_value in saved_states(out):
         title = snapshot_title(name, time_value, mesh, fields["state"])
-        path = write_profile(out, mesh, fields, step, time_value, scene, title, plotter=plotter)
+        path = write_profile(Path(out) / SNAPSHOT_DIR, mesh, fields, step, time_value, scene, title, plotter=plotter)
         if path is not None:
             written.append(path)
     return written
@@ -337,7 +337,7 @@ def render_folder(out, movie=False):
     if step not in vtu_steps(out) and "net_pressure" in fields:  # the newest state is a checkpoint's
         from .profiles import write_profile
 
-        newest = write_profile(out, mesh, fields, step, time_value, scene,
+        newest = write_profile(out / SNAPSHOT_DIR, mesh, fields, step, time_value, scene,
                                snapshot_title(name, time_value, mesh, fields.get("state")))
         profiles += [newest] if newest is not None else []
     written += profiles

@@ -277,8 +277,8 @@ class SceneRun:
             self._plotter = ProfilePlotter()
         title = snapshot_title(self.scene.name, state.time, mesh, fields.get("state"))
         try:
-            path = write_profile(self.out, mesh, fields, state.step, state.time, self.scene.data, title,
-                                 plotter=self._plotter)
+            path = write_profile(self.out / SNAPSHOT_DIR, mesh, fields, state.step, state.time, self.scene.data,
+                                 title, plotter=self._plotter)
         except OutputError:
             raise
         except HmatddmError as error:  # a picture that cannot be drawn does not stop the run

@@ -300,6 +300,7 @@ def plan_traces(mesh, opening=None, state=None, slip=None):
     return traces, line_opening, line_state, line_slip, column
 
 
-__all__ = ["Curve", "check_curves", "dashes", "plan_ticks", "HYDRAULIC", "INTACT_NATURAL", "FAILED_NATURAL", "VIEWS", "PLAN_STYLES", "opening_colour_range",
+__all__ = ["Curve", "check_curves", "dashes", "plan_ticks",
+           "HYDRAULIC", "INTACT_NATURAL", "FAILED_NATURAL", "VIEWS", "PLAN_STYLES", "opening_colour_range",
            "legend_labels", "slip_arrow_length", "plan_frame", "plan_scale_bar", "scale_bar_length",
            "vertical_elements", "is_mostly_vertical", "plan_traces"]

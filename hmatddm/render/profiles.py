@@ -214,4 +214,5 @@ def plot_profiles(sections, path, reference=None, title=None, position_label=Non
     return (plotter or ProfilePlotter()).draw(sections, path, reference, title, position_label)
 
 
-__all__ = ["Section", "ProfilePlotter", "fracture_sections", "sections_2d", "sections_3d", "relative_error", "plot_profiles"]
+__all__ = ["Section", "ProfilePlotter", "fracture_sections", "sections_2d", "sections_3d", "relative_error",
+           "plot_profiles"]

@@ -120,7 +120,9 @@ def test_interrupted_run_is_readable_and_resumes_to_the_same_result(tmp_path, mo
 
     # render reads a partial run (newest checkpoint)
     written = runner.render_folder(tmp_path / "part")
-    assert [p.name for p in written] == ["step-000003_plan.png", "history.png"]
+    # the plan view of the newest state (a checkpoint), the profiles of the saved steps (every 2) and of it
+    assert [p.name for p in written] == ["step-000003_plan.png", "step-000000_profile.png", "step-000002_profile.png",
+                                         "step-000003_profile.png", "history.png"]
     assert all(png_is_not_blank(p) for p in written)
 
     resumed = runner.run_scene(scene, tmp_path / "part", resume=True, quiet=True)
