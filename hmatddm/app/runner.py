@@ -45,7 +45,7 @@ from .run_folder import (CHECKPOINT_DIR, HISTORY, MOVIE, PVD,  # noqa: F401  (re
                          vtu_steps, write_history, write_json, write_snapshots)
 from ..simulation import checkpoint as checkpoints
 
-PROFILE_SHARE = 0.03  # the largest share of a run's CPU time its profile pictures may take
+PROFILE_SHARE = 0.02  # the largest share of a run's CPU time its profile pictures may take
 
 
 # ---------------------------------------------------------------------------------
