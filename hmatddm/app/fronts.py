@@ -109,4 +109,44 @@ def front_curves(mesh, state, scene, time_value, front_arrays=None):
     return curves
 
 
-__all__ = ["asymptotic_front", "element_front", "reference_front", "front_curves"]
+def tip_regime(mesh, opening, front_distance, well, toughness, plane_strain_modulus):
+    """The regime of the universal tip asymptote at each ribbon element of an asymptotic front
+    (Dontsov and Peirce 2015; no leak-off, as the asymptotic front has none): ``K^ = K'
+    s^(1/2) / (E' w)`` with ``s`` the element's distance to the front, ``w`` its opening and
+    ``K' = 4 (2/pi)^(1/2) K_Ic`` (ref. Eq. 4.68): 1 at the toughness limit, falling to 0 as
+    viscosity takes over. Returns ``(angle, k_hat)`` sorted by the angle (degrees, from the
+    in-plane axis e1 about the normal) of each ribbon centre round ``well``; None without a
+    ribbon or for a Mesh2D."""
+    from ..analytical import toughness_scale
+
+    ribbon = np.flatnonzero(np.isfinite(front_distance))
+    if not isinstance(mesh, Mesh3D) or ribbon.size == 0:
+        return None
+    e1, e2, _ = mesh.frames[ribbon[0]]
+    offset = mesh.centers[ribbon] - np.asarray(well, dtype=float)
+    angle = np.degrees(np.arctan2(offset @ e2, offset @ e1)) % 360.0
+    width = np.maximum(np.asarray(opening, dtype=float)[ribbon], 1e-300)
+    k_hat = toughness_scale(toughness) * np.sqrt(np.asarray(front_distance)[ribbon]) / (plane_strain_modulus * width)
+    order = np.argsort(angle)
+    return angle[order], np.clip(k_hat[order], 0.0, None)
+
+
+def write_tip_regime(folder, mesh, fields, front, scene, step, time_value, title):
+    """``folder/step-NNNNNN_front.png``: the tip regime along an asymptotic front
+    (:func:`tip_regime`); None when there is no asymptotic front to draw."""
+    from pathlib import Path
+
+    from ..render.profiles import plot_tip_regime
+    from ..scene.build import material
+
+    if front is None or front[0] is None or scene is None or "material" not in scene:
+        return None
+    well = scene["cluster"][0]["position"]
+    regime = tip_regime(mesh, fields["opening"], front[0], well, scene["propagation"]["toughness"],
+                        material(scene).plane_strain_modulus)
+    if regime is None:
+        return None
+    return plot_tip_regime(*regime, Path(folder) / f"step-{step:06d}_front.png", title=title)
+
+
+__all__ = ["asymptotic_front", "element_front", "reference_front", "front_curves", "tip_regime", "write_tip_regime"]

@@ -333,6 +333,12 @@ def render_folder(out, movie=False):
     name = scene["name"] if scene is not None else out.name
     written = list(write_snapshots(out, mesh, fields, step, time_value, name, layer_interfaces(scene), scene,
                                    fields.get("front")))
+    if fields.get("front") is not None:  # the tip regime along an asymptotic front
+        from .fronts import write_tip_regime
+
+        regime = write_tip_regime(out / SNAPSHOT_DIR, mesh, fields, fields["front"], scene, step, time_value,
+                                  snapshot_title(name, time_value, mesh))
+        written += [regime] if regime is not None else []
     profiles = write_profiles(out, scene, name)
     if step not in vtu_steps(out) and "net_pressure" in fields:  # the newest state is a checkpoint's
         from .profiles import write_profile

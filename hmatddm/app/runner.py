@@ -24,6 +24,9 @@ The folder (``--out DIR``) holds::
                         opening and net pressure along each fracture (2D) or along
                         both in-plane axes through the injection point (3D), with
                         the closed form of a [reference] and its relative error
+    snapshots/step-NNNNNN_front.png     the last state of an asymptotic front: the tip
+                        regime K^ = K' s^(1/2) / (E' w) of its ribbon elements round
+                        the injection point (1 toughness, 0 viscosity)
     history.png         size, opening and wellbore pressure against time, with the
                         closed form overlaid when the scene has a [reference]
 
@@ -342,6 +345,12 @@ class SceneRun:
                 self.written["snapshots"] = write_snapshots(self.out, mesh, fields, state.step, state.time,
                                                             self.scene.name, layer_interfaces(self.scene.data),
                                                             self.scene.data, front)
+                from .fronts import write_tip_regime
+
+                regime = write_tip_regime(self.out / SNAPSHOT_DIR, mesh, fields, front, self.scene.data, state.step,
+                                          state.time, snapshot_title(self.scene.name, state.time, mesh))
+                if regime is not None:
+                    self.written["snapshots"].append(regime)
             except OutputError:
                 raise
             except HmatddmError as error:  # e.g. no offscreen OpenGL on this machine

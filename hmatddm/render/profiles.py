@@ -214,5 +214,36 @@ def plot_profiles(sections, path, reference=None, title=None, position_label=Non
     return (plotter or ProfilePlotter()).draw(sections, path, reference, title, position_label)
 
 
-__all__ = ["Section", "ProfilePlotter", "fracture_sections", "sections_2d", "sections_3d", "relative_error",
+def plot_tip_regime(angle, k_hat, path, title=None):
+    """The regime of the tip asymptote along a front: ``K^`` (1 toughness, 0 viscosity)
+    against the angle round the injection point (degrees), one dot per ribbon element.
+    Returns the path of the PNG (written atomically)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    angle = finite_array("angle", angle)
+    k_hat = finite_array("k_hat", k_hat, angle.shape)
+    figure = Figure(figsize=(7.0, 3.2), dpi=100)
+    FigureCanvasAgg(figure)
+    figure.subplots_adjust(left=0.1, right=0.97, top=0.86, bottom=0.16)
+    axis = figure.subplots()
+    axis.scatter(angle, k_hat, c=k_hat, cmap="coolwarm", vmin=0.0, vmax=1.0, s=14)
+    axis.set_xlim(0.0, 360.0)
+    axis.set_ylim(-0.02, 1.05)
+    axis.set_xticks(np.arange(0.0, 361.0, 45.0))
+    axis.set_xlabel("angle round the injection point, from x (degrees)")
+    axis.set_ylabel("K^ = K' s^(1/2) / (E' w)")
+    axis.axhline(1.0, color="grey", linewidth=0.8)
+    axis.text(2.0, 0.97, "toughness", va="top", fontsize="small", color="tab:red")
+    axis.text(2.0, 0.03, "viscosity", va="bottom", fontsize="small", color="tab:blue")
+    axis.grid(True, alpha=0.3)
+    figure.suptitle(("" if title is None else f"{title}: ") + "tip regime along the front (ribbon elements)",
+                    fontsize="medium")
+    path = Path(path)
+    with atomic_output(path) as temporary:
+        figure.savefig(temporary, format="png")
+    return path
+
+
+__all__ = ["plot_tip_regime", "Section", "ProfilePlotter", "fracture_sections", "sections_2d", "sections_3d", "relative_error",
            "plot_profiles"]

@@ -9,9 +9,10 @@ from PIL import Image
 import hmatddm as hd
 import hmatddm.scene as hs
 from hmatddm.app import cli, runner
-from hmatddm.app.fronts import asymptotic_front, element_front, reference_front
+from hmatddm.app.fronts import asymptotic_front, element_front, reference_front, tip_regime
 from hmatddm.app.height import height_reference, three_layer_stack
 from hmatddm.app.profiles import closed_form_profile
+from hmatddm.render.profiles import plot_tip_regime
 from scene_texts import KGD_2D_HEAD
 
 TINY_2D = 'name = "tiny-kgd"\n' + KGD_2D_HEAD + """end_time = 3.0
@@ -77,6 +78,18 @@ def test_the_tracked_asymptotic_front_is_the_run_s_radius(tmp_path):
     record = simulation.records[-1]
     assert record["front_radius_min"] - 0.05 <= radius.min() and radius.max() <= record["front_radius_max"] + 0.05
     assert np.mean(radius) == pytest.approx(record["radius"], rel=0.03)
+    # the tip regime at the ribbon elements: K^ = K' s^(1/2) / (E' w), K' = sqrt(32/pi) K_Ic
+    opening = np.sum(state.dd * state.mesh.normals, axis=1)
+    angle, k_hat = tip_regime(state.mesh, opening, state.front_distance, [0.0, 0.0, 0.0], 1e6,
+                              simulation.material.plane_strain_modulus)
+    ribbon = np.flatnonzero(np.isfinite(state.front_distance))
+    assert len(k_hat) == ribbon.size and np.all(np.diff(angle) >= 0) and np.all((0 < k_hat) & (k_hat < 1))
+    first = ribbon[np.argmin(np.degrees(np.arctan2(state.mesh.centers[ribbon, 1], state.mesh.centers[ribbon, 0]))
+                             % 360.0)]
+    expected = np.sqrt(32.0 / np.pi) * 1e6 * np.sqrt(state.front_distance[first]) / (
+        simulation.material.plane_strain_modulus * opening[first])
+    assert k_hat[0] == pytest.approx(expected, rel=1e-12)
+    assert not_blank(plot_tip_regime(angle, k_hat, tmp_path / "front.png", title="radial-m"))
 
 
 def test_layered_height_reports_its_height_tips_and_the_closed_form(tmp_path):
