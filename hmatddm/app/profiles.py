@@ -103,8 +103,25 @@ def write_profile(folder, mesh, fields, step, time_value, scene, title, plotter=
     label = "distance from the injection point along the section (m)"
     if mesh.dim == 2:
         label = "arc length along the fracture from the injection point (m)"
+    marks = interface_crossings(mesh, sections, scene)
     return plot_profiles(sections, Path(folder) / f"step-{step:06d}_profile.png", reference=reference,
-                         title=title, position_label=label, plotter=plotter)
+                         title=title, position_label=label, plotter=plotter, marks=marks)
+
+
+def interface_crossings(mesh, sections, scene):
+    """Positions along the sections where they cross a layer interface of ``scene`` (the
+    vertical coordinate through the element centres, linear between them)."""
+    interfaces = [float(layer["bottom"]) for layer in ((scene or {}).get("layer") or [])[:-1]]
+    axis = mesh.dim - 1
+    marks = []
+    for section in sections:
+        height = mesh.centers[section.elements, axis]
+        for level in interfaces:
+            crossing = np.flatnonzero((height[:-1] - level) * (height[1:] - level) < 0.0)
+            for i in crossing:
+                fraction = (level - height[i]) / (height[i + 1] - height[i])
+                marks.append(section.position[i] + fraction * (section.position[i + 1] - section.position[i]))
+    return marks
 
 
 __all__ = ["closed_form_profile", "wells", "write_profile"]

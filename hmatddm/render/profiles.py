@@ -48,8 +48,8 @@ def _axis_name(direction):
 def sections_2d(mesh, opening, net_pressure, state=None, wells=()):
     """One :class:`Section` per hydraulic fracture of a Mesh2D (at most
     :data:`MAX_SECTIONS`): its elements ordered along the fracture's principal direction,
-    ``position`` the arc length through their centres, 0 at the element nearest a well on
-    it (``wells``: points, m), else at its middle."""
+    ``position`` the arc length through their centres, 0 at a well on it (``wells``:
+    points, m; projected on the element nearest it), else at its middle."""
     wells = np.asarray(wells, dtype=float).reshape(-1, 2)
     kept = np.ones(mesh.n_elements, bool) if state is None else state == HYDRAULIC
     sections = []
@@ -70,8 +70,8 @@ def sections_2d(mesh, opening, net_pressure, state=None, wells=()):
         if len(wells):
             distance = np.linalg.norm(centres[:, None, :] - wells[None, :, :], axis=2)
             nearest = np.unravel_index(np.argmin(distance), distance.shape)
-            if distance[nearest] <= 1.01 * float(np.max(mesh.half_length[members])):
-                origin = arc[nearest[0]]
+            if distance[nearest] <= 1.01 * float(np.max(mesh.half_length[members])):  # the well's projection
+                origin = arc[nearest[0]] + float((wells[nearest[1]] - centres[nearest[0]]) @ direction)
         sections.append(Section(f"fracture {int(fracture)} (along {_axis_name(direction)})", arc - origin,
                                 opening[members], net_pressure[members], members))
     return sections
@@ -167,7 +167,7 @@ class ProfilePlotter:
         self.figure.subplots_adjust(left=0.1, right=0.97, top=0.94, bottom=0.08, hspace=0.06)
         self.axes = self.figure.subplots(2, 1, sharex=True)
 
-    def draw(self, sections, path, reference=None, title=None, position_label=None):
+    def draw(self, sections, path, reference=None, title=None, position_label=None, marks=()):
         """See :func:`plot_profiles`."""
         sections = list(sections)
         if not sections:
@@ -190,6 +190,10 @@ class ProfilePlotter:
                           linewidth=1.2, label=label)
         if any(curve is not None for curve in references):
             opening_axis.plot([], [], color="black", linestyle="--", linewidth=1.2, label="closed form (dashed)")
+        for index, position in enumerate(finite_array("marks", marks).ravel() if len(marks) else ()):
+            for axis in self.axes:
+                axis.axvline(position, color="grey", linestyle=":", linewidth=1.5,
+                             label="layer interfaces" if index == 0 and axis is opening_axis else None)
         for axis, label in ((opening_axis, "opening (mm)"), (pressure_axis, "net pressure (MPa)")):
             axis.set_ylabel(label)
             axis.grid(True, alpha=0.3)
@@ -204,14 +208,16 @@ class ProfilePlotter:
         return path
 
 
-def plot_profiles(sections, path, reference=None, title=None, position_label=None, plotter=None):
+def plot_profiles(sections, path, reference=None, title=None, position_label=None, plotter=None, marks=()):
     """Two panels against the position along each :class:`Section` (m): the opening (mm)
     and the net pressure (MPa, the fluid pressure minus the compressive normal in-situ
     stress); ``reference``: per section None or a dict with ``position`` (m), ``opening``
     (m) and/or ``net_pressure`` (Pa) arrays and a ``label``, drawn dashed with the
-    section's :func:`relative_error` in the legend. ``plotter``: a :class:`ProfilePlotter`
-    to draw on (a new one by default). Returns the path of the PNG (written atomically)."""
-    return (plotter or ProfilePlotter()).draw(sections, path, reference, title, position_label)
+    section's :func:`relative_error` in the legend; ``marks``: positions (m) along the
+    sections drawn as dotted vertical lines (layer interfaces). ``plotter``: a
+    :class:`ProfilePlotter` to draw on (a new one by default). Returns the path of the PNG
+    (written atomically)."""
+    return (plotter or ProfilePlotter()).draw(sections, path, reference, title, position_label, marks)
 
 
 def plot_tip_regime(angle, k_hat, path, title=None):

@@ -165,3 +165,14 @@ def test_resume_prints_this_session_s_time_and_the_total(tmp_path, capsys, monke
     lines = capsys.readouterr().out.splitlines()
     assert "s in all, with the earlier sessions)" in lines[0]
     assert lines[1].startswith("hmatddm: fluid budget (volume at the reference density): worst residual")
+
+
+def test_the_profile_of_a_layered_section_marks_its_interfaces():
+    from hmatddm.app.profiles import interface_crossings
+    from hmatddm.render.profiles import fracture_sections
+
+    mesh = hd.mesh.line([0.0, -5.0], [0.0, 5.0], 20)  # a vertical fracture, 0.5 m elements
+    sections = fracture_sections(mesh, np.ones(20), np.ones(20), wells=[[0.0, 0.1]])
+    assert sections[0].position[10] == pytest.approx(0.25 - 0.1)  # arc length from the well itself
+    scene = {"layer": [{"bottom": 3.0}, {"bottom": -3.0}, {}]}
+    assert np.allclose(sorted(interface_crossings(mesh, sections, scene)), [-3.1, 2.9])
