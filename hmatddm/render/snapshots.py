@@ -273,6 +273,26 @@ def _plan_axes(plotter, limits, box, window_size, lift, diagonal):
                      color="dimgrey")
 
 
+def _add_interface_planes(plotter, mesh, interfaces):
+    """The layer interfaces ``z = d`` of a 3D side (oblique) view: translucent grey planes over
+    the fractures' horizontal extent (padded by a fifth), those within a mesh diagonal of
+    the fractures, named in a line of text."""
+    pyvista = offscreen_pyvista()
+    corners = mesh.corners().reshape(-1, 3)
+    low, high = corners.min(axis=0), corners.max(axis=0)
+    diagonal = mesh_diagonal(mesh)
+    span = np.maximum(high[:2] - low[:2], 0.2 * diagonal) * 1.4
+    centre = 0.5 * (low[:2] + high[:2])
+    shown = [d for d in interfaces if low[2] - diagonal <= d <= high[2] + diagonal]
+    for height in shown:
+        plane = pyvista.Plane(center=(centre[0], centre[1], height), direction=(0.0, 0.0, 1.0), i_size=span[0],
+                              j_size=span[1], i_resolution=1, j_resolution=1)
+        plotter.add_mesh(plane, color="grey", opacity=0.25, show_edges=True, edge_color="dimgrey")
+    if shown:
+        plotter.add_text("grey planes: layer interfaces (" + ", ".join(f"z = {d:g} m" for d in shown) + ")",
+                         position="lower_left", font_size=10, color="dimgrey")
+
+
 def _draw(plotter, mesh, opening, state, slip, curves=()):
     every = np.arange(mesh.n_elements)
     if state is None:
@@ -367,9 +387,10 @@ def snapshot(mesh, path, opening=None, state=None, slip=None, view="oblique", ti
     window_size : (width, height)
         Image size in pixels.
     interfaces : sequence of float, optional
-        Heights (m, the vertical second coordinate) of layer interfaces, drawn in a 2D
-        vertical section as grey lines across the picture (docs/conventions.md §3).
-        Ignored for a Mesh3D.
+        Heights (m, the vertical coordinate, docs/conventions.md §3) of layer interfaces,
+        drawn in a 2D vertical section as grey lines across the picture and in the
+        oblique view of a Mesh3D as translucent horizontal planes (not in its plan view,
+        which looks down on them).
     curves : sequence of Curve, optional
         Lines drawn over the fractures and named in the legend (the tracked front, the
         closed-form front dashed), points in metres (2D: x, y).
@@ -414,6 +435,7 @@ def snapshot(mesh, path, opening=None, state=None, slip=None, view="oblique", ti
             plotter.add_text(str(title), position="upper_edge", font_size=12)
         if view == "oblique" and isinstance(mesh, Mesh3D):
             plotter.add_axes()  # a plan view has x to the right and y up, and a length scale instead
+            _add_interface_planes(plotter, mesh, interfaces)
         if view == "plan" or isinstance(mesh, Mesh2D):
             _frame_plan(plotter, mesh, window_size, colour_bar=opening is not None, title=title is not None,
                         interfaces=interfaces if isinstance(mesh, Mesh2D) else ())

@@ -108,3 +108,12 @@ def test_the_history_plot_gets_a_budget_panel(tmp_path):
     without = matplotlib.image.imread(plot_history([{k: v for k, v in r.items() if k != "budget"} for r in records],
                                                    tmp_path / "without.png"))
     assert with_budget.shape[0] > 1.25 * without.shape[0]  # a fourth panel
+
+
+def test_a_3d_side_view_draws_the_layer_interfaces(tmp_path):
+    mesh = hd.mesh.rectangle([0, 0, 0], [0, 1, 0], [0, 0, 1], 6, 6, 6, 6)  # vertical, across z = +-2
+    plain = _picture(snapshot(mesh, tmp_path / "plain.png", opening=np.full(36, 1e-3), window_size=(600, 450)))
+    layered = _picture(snapshot(mesh, tmp_path / "layers.png", opening=np.full(36, 1e-3), window_size=(600, 450),
+                                interfaces=[2.0, -2.0]))
+    changed = np.mean(np.any(np.abs(layered - plain) > 0.05, axis=2))
+    assert changed > 0.02  # two translucent planes and their caption
