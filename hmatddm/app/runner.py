@@ -28,7 +28,9 @@ The folder (``--out DIR``) holds::
                         regime K^ = K' s^(1/2) / (E' w) of its ribbon elements round
                         the injection point (1 toughness, 0 viscosity)
     history.png         size, opening and wellbore pressure against time, with the
-                        closed form overlaid when the scene has a [reference]
+                        closed form overlaid when the scene has a [reference]; the
+                        tips against the interfaces in a layered run; the fluid budget
+    movie.gif           (hmatddm render DIR --movie) the profile pictures in turn
 
 Progress goes to stderr (:class:`Progress`); nothing is printed with ``quiet=True``.
 The folder's names, fields, pictures and reading a run back are :mod:`hmatddm.app.run_folder`'s
