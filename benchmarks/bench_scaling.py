@@ -55,7 +55,7 @@ def run(scene, h, steps, folder, source=ROOT, label="this", extra=()):
     if child.returncode != 0:
         raise RuntimeError(f"hmatddm {' '.join(arguments)} exited {child.returncode}")
     summary = json.load(open(os.path.join(out, "summary.json")))
-    records = summary["steps"]
+    records = [record for record in summary["steps"] if record["step"] > 0]  # step 0: the initial state
 
     def total(key):
         return sum(record.get(key) or 0 for record in records)

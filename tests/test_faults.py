@@ -129,13 +129,13 @@ def _same_run(steps, reference):
 
 # which write fails: (name, predicate on the target path, the newest complete checkpoint
 # after the failure, the steps summary.json holds after the failure)
-FAULTS = {
-    "checkpoint arrays": (lambda p, t: p.name == f"step-{FAILING_STEP:06d}.npz", 2, [1, 2]),
-    "checkpoint metadata": (lambda p, t: p.name == f"step-{FAILING_STEP:06d}.json", 2, [1, 2]),
-    "summary.json": (lambda p, t: p.name == "summary.json" and len(json.loads(t.read_text())["steps"]) == 3,
-                     3, [1, 2]),
-    "vtu": (lambda p, t: p.name == "step-000004.vtu", 4, [1, 2, 3]),
-    "snapshot png": (lambda p, t: p.suffix == ".png" and p.parent.name == "snapshots", 4, [1, 2, 3, 4]),
+FAULTS = {  # (summary.json starts with step 0, the initial state)
+    "checkpoint arrays": (lambda p, t: p.name == f"step-{FAILING_STEP:06d}.npz", 2, [0, 1, 2]),
+    "checkpoint metadata": (lambda p, t: p.name == f"step-{FAILING_STEP:06d}.json", 2, [0, 1, 2]),
+    "summary.json": (lambda p, t: p.name == "summary.json" and len(json.loads(t.read_text())["steps"]) == 4,
+                     3, [0, 1, 2]),
+    "vtu": (lambda p, t: p.name == "step-000004.vtu", 4, [0, 1, 2, 3]),
+    "snapshot png": (lambda p, t: p.name.endswith("_plan.png") and p.parent.name == "snapshots", 4, [0, 1, 2, 3, 4]),
 }
 
 

@@ -8,7 +8,7 @@ before numba or the engine load, so refusals come within a second. The command s
     hmatddm scenes [NAME]             list the embedded scenes, or print one as TOML
     hmatddm validate [--json]         closed-form checks as a table of error and time
     hmatddm bench [--quick] [--json]  H-matrix against dense: build time, memory, matvec time, error
-    hmatddm render DIR                snapshots and history plot of a finished or partial run
+    hmatddm render DIR [--movie]      snapshots, profiles and history plot of a finished or partial run
     hmatddm sweep [--realizations N]  natural-fracture network ensembles on Dask (ref. Fig. 6.9)
     hmatddm microseismic DIR          event catalogue (events.csv) and map of a finished run (ref. Ch. 7)
 
@@ -94,10 +94,31 @@ def _load_run_scene(args):
         stored = Path(args.out) / SCENE_FILE
     if stored is not None and stored.is_file():
         scene = load_scene(str(stored), overrides=overrides)  # the scene the run in DIR was started with
+    elif args.scene is not None and Path(args.scene).is_dir():
+        scene = load_scene(str(_scene_in_folder(args, Path(args.scene))), overrides=overrides)
     else:
         scene = load_scene(args.scene or DEFAULT_SCENE, overrides=overrides)
     out = Path(args.out) if args.out else Path(DEFAULT_OUT_ROOT) / scene.name
     return scene, out
+
+
+def _scene_in_folder(args, folder):
+    """The scene file of a folder given as SCENE: its scene.toml (the scene an `hmatddm run`
+    stored there) or its only .toml file, said on stderr; InputError otherwise."""
+    from ..errors import InputError
+    from .runner import SCENE_FILE
+
+    stored = folder / SCENE_FILE
+    files = sorted(folder.glob("*.toml"))
+    chosen = stored if stored.is_file() else (files[0] if len(files) == 1 else None)
+    if chosen is None:
+        listed = (f"it holds {len(files)} .toml files: {', '.join(p.name for p in files[:6])}"
+                  f"{', ...' if len(files) > 6 else ''}; give one of them" if files else "it holds no .toml file")
+        raise InputError(f"SCENE {str(folder)!r} is a folder, not a scene: {listed} (or an embedded scene name; "
+                         "to continue a run in a folder: hmatddm run --out DIR --resume)")
+    if not getattr(args, "quiet", False):
+        print(f"hmatddm: {str(folder)!r} is a folder: running its scene file {chosen}", file=sys.stderr)
+    return chosen
 
 
 def _output_failed(out, error, args):
@@ -202,23 +223,40 @@ def _run(args):
               "try a smaller numerics.time_step, a lower numerics.relaxation or another numerics.scheme",
               file=sys.stderr)
         return EXIT_NOT_CONVERGED
-    last = summary["steps"][-1] if summary["steps"] else None
+    steps = [step for step in summary["steps"] if step.get("step", 1) > 0]  # step 0: the initial state
+    last = steps[-1] if steps else None
     if not args.quiet:
-        state = (f"t = {last['time']:g} s, {last['n_elements']} elements, {len(summary['steps'])} steps"
+        state = (f"t = {last['time']:g} s, {last['n_elements']} elements, {len(steps)} steps"
                  if last else "no step")
         reference = summary["reference"]
         comparison = ""
-        if reference:
-            errors = reference[-1]["relative_error"]
+        errors = (reference[-1].get("relative_error") or {}) if reference and last else {}
+        if any(value is not None for value in errors.values()):
             comparison = "; vs closed form: " + ", ".join(
                 f"{key} {100 * value:+.1f}%" for key, value in errors.items() if value is not None)
-        print(f"hmatddm: done in {summary['wall_seconds']:.1f} s ({state}{comparison}); outputs in {out}")
+        seconds = f"{summary['wall_seconds']:.1f} s"
+        if run.resumed:
+            seconds = f"{run.session_seconds:.1f} s ({summary['wall_seconds']:.1f} s in all, with the earlier sessions)"
+        print(f"hmatddm: done in {seconds} ({state}{comparison}); outputs in {out}")
+        print(f"hmatddm: {_budget_line(summary['steps'])}")
     return EXIT_OK
 
 
 # ---------------------------------------------------------------------------------
 # bench, render
 # ---------------------------------------------------------------------------------
+
+def _budget_line(steps):
+    """The end-of-run line of the fluid budget: its worst residual against the fluid moved."""
+    from ..simulation.records import worst_budget_residual
+
+    worst = worst_budget_residual(steps)
+    if worst is None:
+        return "fluid budget: no record has one"
+    residual, moved, step = worst
+    return (f"fluid budget (volume at the reference density): worst residual {residual:+.2e} m^3 = "
+            f"{abs(residual) / moved if moved > 0 else 0.0:.1e} of the fluid moved ({moved:.4g} m^3, step {step})")
+
 
 def _bench(args):
     from .bench import format_table, run_bench
@@ -234,7 +272,7 @@ def _bench(args):
 def _render(args):
     from .runner import render_folder
 
-    written = render_folder(args.dir)
+    written = render_folder(args.dir, movie=args.movie)
     for path in written:
         _say(args, f"wrote {path}")
     return EXIT_OK
@@ -318,8 +356,11 @@ def build_parser():
     bench.add_argument("--quiet", action="store_true", help="no progress")
     bench.set_defaults(handler=_bench)
 
-    render = sub.add_parser("render", help="snapshots and history plot of a finished or partial run")
+    render = sub.add_parser("render", help="snapshots, profile pictures of every saved step and history plot of "
+                                           "a finished or partial run (--movie: an animated GIF of the profiles)")
     render.add_argument("dir", metavar="DIR", help="the --out folder of `hmatddm run`")
+    render.add_argument("--movie", action="store_true",
+                        help="also write DIR/movie.gif, the profile pictures of the saved steps in turn")
     render.add_argument("--quiet", action="store_true", help="do not list the written files")
     render.set_defaults(handler=_render)
     microseismic = sub.add_parser("microseismic", help="event catalogue (events.csv) and map of a finished run "

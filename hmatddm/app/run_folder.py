@@ -22,6 +22,7 @@ VTU_DIR = "vtu"
 CHECKPOINT_DIR = "checkpoints"
 SNAPSHOT_DIR = "snapshots"
 HISTORY = "history.png"
+MOVIE = "movie.gif"
 SUMMARY_KEYS = ("scene", "versions", "steps", "reference", "wall_seconds")
 HYDRAULIC = 0
 
@@ -140,15 +141,21 @@ def layer_interfaces(scene):
     return tuple(float(layer["bottom"]) for layer in layers[:-1])
 
 
-def write_snapshots(out, mesh, fields, step, time_value, title_prefix, interfaces=()):
+def write_snapshots(out, mesh, fields, step, time_value, title_prefix, interfaces=(), scene=None, front=None):
     """``snapshots/step-NNNNNN_{plan,oblique}.png`` of one state; returns the paths.
-    ``interfaces``: layer interface heights, drawn across a 2D section."""
+    ``interfaces``: layer interface heights, drawn across a 2D section. The plan view
+    draws the tracked front (``front``: the asymptotic front's arrays ``(front_distance,
+    front_velocity, front_class)``, else the element front) and the closed form's front
+    of ``scene``'s [reference] (:func:`hmatddm.app.fronts.front_curves`)."""
     from ..render import snapshot
+    from .fronts import front_curves
 
     title = snapshot_title(title_prefix, time_value, mesh, fields.get("state"))
     slip_vectors = _visible_slip(mesh, fields["slip"], fields["opening"])
+    curves = front_curves(mesh, fields.get("state"), scene, time_value, front)
     return [snapshot(mesh, Path(out) / SNAPSHOT_DIR / f"step-{step:06d}_{view}.png", opening=fields["opening"],
-                     state=fields.get("state"), slip=slip_vectors, view=view, title=title, interfaces=interfaces)
+                     state=fields.get("state"), slip=slip_vectors, view=view, title=title, interfaces=interfaces,
+                     curves=curves if view == "plan" else ())
             for view in snapshot_views(mesh)]
 
 
@@ -159,11 +166,36 @@ def write_history(out, records, scene):
 
     if not records:
         return None
-    reference = reference_curves(scene, end_time=max(r["time"] for r in records)) if scene is not None else None
+    interfaces = layer_interfaces(scene)
+    if scene is not None and "reference" not in scene:  # a symmetric three-layer stack: its equilibrium tips
+        from .height import three_layer_stack
+
+        stack = three_layer_stack(scene)
+        if stack is not None:
+            return plot_history(records, Path(out) / HISTORY, reference=_height_curves(scene, records),
+                                interfaces=interfaces)
+    end_time = max(r["time"] for r in records)
+    # (a run stopped in its first step has the initial state only: no closed form at t = 0)
+    reference = reference_curves(scene, end_time=end_time) if scene is not None and end_time > 0.0 else None
     confining = confining_stress(scene) if scene is not None and reference is not None else 0.0
     if reference is not None and "net_pressure" not in reference:
         confining = 0.0
-    return plot_history(records, Path(out) / HISTORY, reference=reference, confining_stress=confining)
+    return plot_history(records, Path(out) / HISTORY, reference=reference, confining_stress=confining,
+                        interfaces=interfaces)
+
+
+def _height_curves(scene, records):
+    """The equilibrium tips ``middle +- height/2`` of :func:`hmatddm.app.height.height_reference`
+    at the records where there is an equilibrium (None when there is none)."""
+    from .height import height_reference
+
+    rows = [row for row in height_reference(scene, records) if row["height"] is not None]
+    if not rows:
+        return None
+    layers = scene["layer"]
+    middle = 0.5 * (layers[0]["bottom"] + layers[1]["bottom"])
+    return {"time": [row["time"] for row in rows], "top": [middle + 0.5 * row["height"] for row in rows],
+            "bottom": [middle - 0.5 * row["height"] for row in rows]}
 
 
 # ---------------------------------------------------------------------------------
@@ -211,6 +243,8 @@ def latest_state(out):
             stress = np.zeros((mesh.dim, mesh.dim))
         state = np.where(arrays["origin"] >= 1, 2, 0).astype(np.int64) if "origin" in arrays else None
         fields = cell_fields(mesh, arrays["dd"], arrays["pressure"], stress, state)
+        if "front_class" in arrays:  # the asymptotic front's arrays (hmatddm.app.fronts)
+            fields["front"] = (arrays["front_distance"], arrays["front_velocity"], arrays["front_class"])
         return mesh, fields, int(metadata["step"]), float(metadata["time"])
     steps = vtu_steps(out)
     if not steps:
@@ -233,9 +267,61 @@ def read_pvd_entries(out):
     return [(name, time_value) for time_value, name in read_pvd(path)] if path.is_file() else []
 
 
-def render_folder(out):
-    """Snapshots of the newest state and the history plot of an output folder (a
-    finished or partial run); returns the written paths."""
+def saved_states(out):
+    """``(mesh, fields, step, time)`` of every saved step of an output folder, read from its
+    .vtu files (oldest first; ``fields``: opening, net_pressure, state; time from the .pvd,
+    NaN when it does not list the file)."""
+    out = Path(out)
+    times = dict(read_pvd_entries(out))
+    for step in vtu_steps(out):
+        points, cells, data = read_vtu(out / vtu_name(step))
+        mesh = mesh_from_vtu(points, cells, data)
+        fields = {"opening": np.asarray(data["opening"], dtype=float),
+                  "net_pressure": np.asarray(data["net_pressure"], dtype=float),
+                  "state": np.asarray(data.get("state", np.zeros(mesh.n_elements)), dtype=np.int64)}
+        yield mesh, fields, step, float(times.get(vtu_name(step), float("nan")))
+
+
+def write_profiles(out, scene, name):
+    """``snapshots/step-NNNNNN_profile.png`` of every saved step (:func:`saved_states`);
+    returns the paths."""
+    from ..render.profiles import ProfilePlotter
+    from .profiles import write_profile
+
+    plotter, written = ProfilePlotter(), []
+    for mesh, fields, step, time_value in saved_states(out):
+        title = snapshot_title(name, time_value, mesh, fields["state"])
+        path = write_profile(Path(out) / SNAPSHOT_DIR, mesh, fields, step, time_value, scene, title, plotter=plotter)
+        if path is not None:
+            written.append(path)
+    return written
+
+
+def write_movie(out, pictures, seconds_per_frame=0.4):
+    """``movie.gif``: the ``pictures`` (PNG paths, in order) as an animated GIF (Pillow, a
+    dependency of pyvista), each shown ``seconds_per_frame`` and the last one a second
+    longer; returns its path."""
+    from PIL import Image
+
+    from ..io import atomic_output
+
+    if not pictures:
+        raise InputError(f"{str(out)!r} holds no saved step to animate (no .vtu file)")
+    frames = [Image.open(path).convert("RGB") for path in pictures]
+    size = frames[0].size
+    frames = [frame if frame.size == size else frame.resize(size) for frame in frames]
+    durations = [int(1000 * seconds_per_frame)] * len(frames)
+    durations[-1] += 1000
+    path = Path(out) / MOVIE
+    with atomic_output(path) as temporary:
+        frames[0].save(temporary, format="GIF", save_all=True, append_images=frames[1:], duration=durations, loop=0)
+    return path
+
+
+def render_folder(out, movie=False):
+    """Snapshots and profile of the newest state, the profile pictures of every saved step,
+    the history plot of an output folder (a finished or partial run), and with
+    ``movie=True`` ``movie.gif`` of the profile pictures; returns the written paths."""
     from ..scene import scene_from_dict
 
     out = Path(out)
@@ -245,13 +331,30 @@ def render_folder(out):
     summary = read_summary(out)
     scene = scene_from_dict(summary["scene"]).data if summary is not None and "scene" in summary else None
     name = scene["name"] if scene is not None else out.name
-    written = list(write_snapshots(out, mesh, fields, step, time_value, name, layer_interfaces(scene)))
+    written = list(write_snapshots(out, mesh, fields, step, time_value, name, layer_interfaces(scene), scene,
+                                   fields.get("front")))
+    if fields.get("front") is not None:  # the tip regime along an asymptotic front
+        from .fronts import write_tip_regime
+
+        regime = write_tip_regime(out / SNAPSHOT_DIR, mesh, fields, fields["front"], scene, step, time_value,
+                                  snapshot_title(name, time_value, mesh))
+        written += [regime] if regime is not None else []
+    profiles = write_profiles(out, scene, name)
+    if step not in vtu_steps(out) and "net_pressure" in fields:  # the newest state is a checkpoint's
+        from .profiles import write_profile
+
+        newest = write_profile(out / SNAPSHOT_DIR, mesh, fields, step, time_value, scene,
+                               snapshot_title(name, time_value, mesh, fields.get("state")))
+        profiles += [newest] if newest is not None else []
+    written += profiles
     if summary is not None and summary.get("steps"):
         written.append(write_history(out, summary["steps"], scene))
+    if movie:
+        written.append(write_movie(out, profiles))
     return written
 
 
 __all__ = ["SUMMARY", "SCENE_FILE", "PVD", "VTU_DIR", "CHECKPOINT_DIR", "SNAPSHOT_DIR", "HISTORY", "SUMMARY_KEYS",
            "versions", "write_json", "read_summary", "vtu_name", "vtu_steps", "cell_fields", "snapshot_views",
            "snapshot_title", "layer_interfaces", "write_snapshots", "write_history", "mesh_from_vtu", "latest_state",
-           "read_pvd_entries", "render_folder"]
+           "read_pvd_entries", "render_folder", "saved_states", "write_profiles", "write_movie", "MOVIE"]

@@ -2,10 +2,13 @@
 
 The folder (``--out DIR``) holds::
 
-    summary.json        scene (validated echo, SI), versions, steps (one record per
-                        step), reference (closed form at each step, or null),
-                        wall_seconds; rewritten atomically after every step, so a
-                        partial or interrupted run is always readable
+    summary.json        scene (validated echo, SI), versions, steps (the record of the
+                        initial state, step 0, then one record per step, each with its
+                        fluid budget), reference (closed form at each step, or null;
+                        null values at t = 0, where the closed forms are singular),
+                        wall_seconds (every session of the run together); rewritten
+                        atomically after every step, so a partial or interrupted run
+                        is always readable
     scene.toml          the validated scene (every default filled in); `--resume`
                         without a SCENE reads it
     fractures.pvd       ParaView time series of the .vtu files
@@ -17,8 +20,17 @@ The folder (``--out DIR``) holds::
     snapshots/step-NNNNNN_plan.png, _oblique.png   views of the last state (plan
                         only in 2D; the plan view of vertical 3D fractures shows their
                         traces, coloured by the largest opening over the height)
+    snapshots/step-NNNNNN_profile.png   every saved step (those with a .vtu): the
+                        opening and net pressure along each fracture (2D) or along
+                        both in-plane axes through the injection point (3D), with
+                        the closed form of a [reference] and its relative error
+    snapshots/step-NNNNNN_front.png     the last state of an asymptotic front: the tip
+                        regime K^ = K' s^(1/2) / (E' w) of its ribbon elements round
+                        the injection point (1 toughness, 0 viscosity)
     history.png         size, opening and wellbore pressure against time, with the
-                        closed form overlaid when the scene has a [reference]
+                        closed form overlaid when the scene has a [reference]; the
+                        tips against the interfaces in a layered run; the fluid budget
+    movie.gif           (hmatddm render DIR --movie) the profile pictures in turn
     monitor.csv, .png   with [[monitor]] tables: displacement and tilt at their
                         positions after every step (:mod:`hmatddm.app.monitor`)
 
@@ -33,12 +45,14 @@ from pathlib import Path
 from ..errors import HmatddmError, InputError, OutputError
 from ..io import atomic_output, write_pvd, write_vtu
 from ..simulation.progress import Progress
-from .run_folder import (CHECKPOINT_DIR, HISTORY, PVD,  # noqa: F401  (re-exported)
+from .run_folder import (CHECKPOINT_DIR, HISTORY, MOVIE, PVD,  # noqa: F401  (re-exported)
                          SCENE_FILE, SNAPSHOT_DIR, SUMMARY, SUMMARY_KEYS, VTU_DIR,
                          cell_fields, latest_state, layer_interfaces, mesh_from_vtu, read_pvd_entries,
                          read_summary, render_folder, snapshot_title, snapshot_views, versions, vtu_name,
                          vtu_steps, write_history, write_json, write_snapshots)
 from ..simulation import checkpoint as checkpoints
+
+PROFILE_SHARE = 0.02  # the largest share of a run's CPU time its profile pictures may take
 
 
 # ---------------------------------------------------------------------------------
@@ -80,8 +94,15 @@ class SceneRun:
         self._wall_before = 0.0
         self._started = None
         self._last_vtu_step = None
+        self._last_saved_step = None
         self._stress = None
         self._monitor = None
+        self._initial = None  # the record of step 0 (hmatddm.simulation.records.initial_record)
+        self.resumed = False  # whether this session continued a run from a checkpoint
+        self._plotter = None  # the ProfilePlotter of the profile pictures, made at the first
+        self._started_cpu = time.process_time()
+        self._profile_cpu = 0.0  # CPU seconds spent on profile pictures (_draws_profile)
+        self._last_profile_cpu = 0.0
 
     # -- public -----------------------------------------------------------------------
     @property
@@ -91,6 +112,16 @@ class SceneRun:
     @property
     def last_record(self):
         return self.records[-1] if self.records else None
+
+    @property
+    def steps(self):
+        """The records of summary.json: the initial state (step 0), then every step."""
+        return ([] if self._initial is None else [self._initial]) + list(self.records)
+
+    @property
+    def session_seconds(self):
+        """Wall seconds of this session of the run (a resumed run's own time)."""
+        return time.perf_counter() - self._started if self._started else 0.0
 
     def note(self, text):
         if self.progress is not None:
@@ -115,6 +146,7 @@ class SceneRun:
             raise InputError("--resume continues the run in the folder and --overwrite starts it over: give one "
                              "of them, not both")
         self._started = time.perf_counter()
+        self._started_cpu = time.process_time()
         scene = self.scene.data
         numerics = scene["numerics"]
         simulation = build_simulation(scene, checkpoint_dir=self.out / CHECKPOINT_DIR)
@@ -127,6 +159,9 @@ class SceneRun:
             self._monitor = Monitor(self.out, scene["monitor"], simulation.state.mesh.dim, note=self.note)
             if self.resume:
                 self._monitor.resume(simulation.state.step)
+        from ..simulation.records import initial_record
+
+        self._initial = initial_record(simulation)
         start_time = simulation.state.time
         self.progress = Progress(numerics["end_time"], simulation.time_step, stream=self.stream,
                                  enabled=not self.quiet, start_time=start_time)
@@ -161,11 +196,11 @@ class SceneRun:
             summary = read_summary(self.out)
         except InputError:  # unreadable: not ours to judge, keep it
             return True
-        return bool(summary and summary.get("steps"))
+        return any(int(step.get("step", 1)) > 0 for step in (summary or {}).get("steps") or ())
 
     def _clear(self):
         """Remove the files an earlier run wrote (only ours, by name)."""
-        names = [self.out / SUMMARY, self.out / PVD, self.out / HISTORY, self.out / SCENE_FILE]
+        names = [self.out / SUMMARY, self.out / PVD, self.out / HISTORY, self.out / SCENE_FILE, self.out / MOVIE]
         names += [self.out / name for name in ("events.csv", "microseismic_map.png")]  # hmatddm.microseismic
         names += [self.out / name for name in ("monitor.csv", "monitor.png")]  # hmatddm.app.monitor
         folder = self.out / CHECKPOINT_DIR
@@ -187,6 +222,7 @@ class SceneRun:
         has_checkpoint = bool(checkpoints.list_checkpoints(out / CHECKPOINT_DIR))
         if self.resume and has_checkpoint:
             simulation.load_checkpoint()
+            self.resumed = True
             step = simulation.state.step
             summary = read_summary(out)
             if summary is not None:
@@ -216,17 +252,58 @@ class SceneRun:
             temporary.write_text(to_toml(self.scene.data, header), encoding="utf-8")
 
     # -- per step ------------------------------------------------------------------------
-    def _write_vtu(self, state):
-        if not self.scene.data["output"]["vtu"]:
+    def _write_vtu(self, state, last=False):
+        """The .vtu file (``output.vtu``) and the profile picture (``output.snapshots``,
+        :meth:`_draws_profile`) of a saved step; ``last``: the run's last state."""
+        output = self.scene.data["output"]
+        profile = output["snapshots"] and self._draws_profile(last)
+        if not (output["vtu"] or profile):
             return
         mesh, dd, pressure, codes = self.simulation.view()
         fields = cell_fields(mesh, dd, pressure, self._stress, codes)
+        if profile:
+            self._write_profile(mesh, fields, state)
+        self._last_saved_step = state.step
+        if not output["vtu"]:
+            return
         write_vtu(self.out / vtu_name(state.step), mesh, fields)
         self._pvd_entries = [(t, name) for t, name in self._pvd_entries if name != vtu_name(state.step)]
         self._pvd_entries.append((state.time, vtu_name(state.step)))
         write_pvd(self.out / PVD, self._pvd_entries)
         self._last_vtu_step = state.step
         self.written["vtu"] += 1
+
+    def _draws_profile(self, last):
+        """Whether a saved step gets its profile picture: the last state always, the others
+        while the pictures have cost at most :data:`PROFILE_SHARE` of the run's CPU time so
+        far (the next one counted at the cost of the last), so that pictures never slow a
+        run down by more than that; ``hmatddm render DIR`` draws every saved step."""
+        if last or self._profile_cpu == 0.0:
+            return True
+        spent = time.process_time() - self._started_cpu
+        return self._profile_cpu + self._last_profile_cpu <= PROFILE_SHARE * spent
+
+    def _write_profile(self, mesh, fields, state):
+        from ..render.profiles import ProfilePlotter
+        from .profiles import write_profile
+
+        clock = time.process_time()
+        if self._plotter is None:
+            self._plotter = ProfilePlotter()
+        title = snapshot_title(self.scene.name, state.time, mesh, fields.get("state"))
+        try:
+            path = write_profile(self.out / SNAPSHOT_DIR, mesh, fields, state.step, state.time, self.scene.data,
+                                 title, plotter=self._plotter)
+        except OutputError:
+            raise
+        except HmatddmError as error:  # a picture that cannot be drawn does not stop the run
+            self.note(f"hmatddm: warning: no profile picture of step {state.step}: {error}")
+            return
+        finally:
+            self._last_profile_cpu = time.process_time() - clock
+            self._profile_cpu += self._last_profile_cpu
+        if path is not None:
+            self.written.setdefault("profiles", []).append(path)
 
     def _is_last(self, record):
         numerics = self.scene.data["numerics"]
@@ -235,7 +312,7 @@ class SceneRun:
     def _after_step(self, simulation, record):
         every = self.scene.data["output"]["every"]
         if record["step"] % every == 0 or self._is_last(record):
-            self._write_vtu(simulation.state)
+            self._write_vtu(simulation.state, last=self._is_last(record))
         if self._monitor is not None:
             self._monitor.record(simulation, record)
         self._write_summary()
@@ -244,9 +321,22 @@ class SceneRun:
     def summary(self):
         from ..scene import reference_values
 
-        wall = self._wall_before + (time.perf_counter() - self._started if self._started else 0.0)
-        return {"scene": self.scene.to_dict(), "versions": versions(), "steps": self.records,
-                "reference": reference_values(self.scene.data, self.records), "wall_seconds": wall}
+        wall = self._wall_before + self.session_seconds
+        reference = reference_values(self.scene.data, self.records)
+        if reference is None:  # a symmetric three-layer stack: its equilibrium height (hmatddm.app.height)
+            from .height import height_reference
+
+            return {"scene": self.scene.to_dict(), "versions": versions(), "steps": self.steps,
+                    "reference": height_reference(self.scene.data, self.steps), "wall_seconds": wall}
+        if reference is not None and self._initial is not None:  # the closed forms are singular at t = 0
+            keys = reference[0] if reference else {"time": None}
+            initial = {key: None for key in keys}
+            initial["time"] = 0.0
+            if "relative_error" in keys:
+                initial["relative_error"] = {key: None for key in keys["relative_error"]}
+            reference = [initial] + reference
+        return {"scene": self.scene.to_dict(), "versions": versions(), "steps": self.steps,
+                "reference": reference, "wall_seconds": wall}
 
     def _write_summary(self):
         document = self.summary()
@@ -258,20 +348,29 @@ class SceneRun:
         """Last VTU, snapshots and history of the last converged state; final summary."""
         state = self.simulation.state
         output = self.scene.data["output"]
-        if output["vtu"] and self._last_vtu_step != state.step:
-            self._write_vtu(state)
+        if self._last_saved_step != state.step:  # the last converged state's .vtu and profile
+            self._write_vtu(state, last=True)
         if output["snapshots"]:
             mesh, dd, pressure, codes = self.simulation.view()
             fields = cell_fields(mesh, dd, pressure, self._stress, codes)
             try:
+                front = None if state.front_class is None else (state.front_distance, state.front_velocity,
+                                                                    state.front_class)
                 self.written["snapshots"] = write_snapshots(self.out, mesh, fields, state.step, state.time,
-                                                            self.scene.name, layer_interfaces(self.scene.data))
+                                                            self.scene.name, layer_interfaces(self.scene.data),
+                                                            self.scene.data, front)
+                from .fronts import write_tip_regime
+
+                regime = write_tip_regime(self.out / SNAPSHOT_DIR, mesh, fields, front, self.scene.data, state.step,
+                                          state.time, snapshot_title(self.scene.name, state.time, mesh))
+                if regime is not None:
+                    self.written["snapshots"].append(regime)
             except OutputError:
                 raise
             except HmatddmError as error:  # e.g. no offscreen OpenGL on this machine
                 self.note(f"hmatddm: warning: no snapshots written: {error}")
         if output["history_plot"]:
-            self.written["history"] = write_history(self.out, self.records, self.scene.data)
+            self.written["history"] = write_history(self.out, self.steps, self.scene.data)
         if self._monitor is not None:
             self.written["monitor"] = self._monitor.plot(self.scene.name)
         if "microseismic" in self.scene.data:  # events.csv and the event map (ref. Ch. 7)

@@ -3,6 +3,8 @@ the checks of the fields drawn, the opening colour range, the legend, the size o
 arrows, the frame and length scale of a plan view, and the plan-view traces of a mesh of
 (mostly) vertical fractures. :mod:`hmatddm.render.snapshots` draws with these.
 """
+from dataclasses import dataclass
+
 import numpy as np
 
 from .._validation import finite_array
@@ -172,6 +174,58 @@ def length_text(length):
     return f"{length * 1e3:g} mm" if length < 1e-2 else (f"{length:g} m" if length < 1e3 else f"{length / 1e3:g} km")
 
 
+@dataclass(frozen=True)
+class Curve:
+    """A line drawn over the fractures of a snapshot: ``points`` (n, 2 or 3), m, joined in
+    order, or with ``pairs=True`` taken two by two as separate segments."""
+
+    points: np.ndarray
+    colour: str = "black"
+    dashed: bool = False
+    label: str = ""
+    width: float = 3.0
+    pairs: bool = False
+
+
+def check_curves(curves, dim):
+    """``curves`` as a list of :class:`Curve` with finite (n >= 2, 2 or 3) points (2D: 2 or 3)."""
+    checked = []
+    for index, curve in enumerate(curves or ()):
+        if not isinstance(curve, Curve):
+            raise InputError(f"curves[{index}] must be an hmatddm.render.Curve, got {type(curve).__name__}")
+        points = finite_array(f"curves[{index}].points", curve.points)
+        if points.ndim != 2 or points.shape[1] not in (2, 3) or (dim == 3 and points.shape[1] != 3):
+            raise InputError(f"curves[{index}].points must have shape (n, {dim}), got {points.shape}")
+        if curve.pairs and len(points) % 2:
+            raise InputError(f"curves[{index}].points must hold pairs of points (pairs=True), got {len(points)}")
+        checked.append(Curve(points, curve.colour, curve.dashed, curve.label, curve.width, curve.pairs))
+    return checked
+
+
+def dashes(points, length):
+    """The polyline ``points`` (n, 3) cut into dashes: pieces of ``length`` (m) separated by
+    gaps of the same length, measured along the line."""
+    points = np.asarray(points, dtype=float)
+    arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
+    if arc[-1] <= 0.0:
+        return []
+    pieces = []
+    for start in np.arange(0.0, arc[-1], 2.0 * length):
+        stops = np.concatenate([[start], arc[(arc > start) & (arc < start + length)], [min(start + length, arc[-1])]])
+        pieces.append(np.column_stack([np.interp(stops, arc, points[:, k]) for k in range(points.shape[1])]))
+    return pieces
+
+
+def plan_ticks(low, high):
+    """Round tick values (m) between ``low`` and ``high``: steps of 1, 2 or 5 x 10^k, 3 to 8 ticks."""
+    span = float(high - low)
+    if not span > 0.0:
+        return np.array([low])
+    power = 10.0 ** np.floor(np.log10(span / 8.0))
+    step = next(m * power for m in (1.0, 2.0, 5.0, 10.0) if span / (m * power) <= 8.0)
+    return np.arange(np.ceil(low / step) * step, high + 1e-9 * span, step)
+
+
 def vertical_elements(mesh):
     """Boolean mask of the elements of a Mesh3D that stand vertical (``|n_z| <=
     VERTICAL_NORMAL_Z``, within ~2.9 degrees), which a plan view sees edge on."""
@@ -246,6 +300,7 @@ def plan_traces(mesh, opening=None, state=None, slip=None):
     return traces, line_opening, line_state, line_slip, column
 
 
-__all__ = ["HYDRAULIC", "INTACT_NATURAL", "FAILED_NATURAL", "VIEWS", "PLAN_STYLES", "opening_colour_range",
+__all__ = ["Curve", "check_curves", "dashes", "plan_ticks",
+           "HYDRAULIC", "INTACT_NATURAL", "FAILED_NATURAL", "VIEWS", "PLAN_STYLES", "opening_colour_range",
            "legend_labels", "slip_arrow_length", "plan_frame", "plan_scale_bar", "scale_bar_length",
            "vertical_elements", "is_mostly_vertical", "plan_traces"]

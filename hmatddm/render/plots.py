@@ -3,7 +3,10 @@
 :func:`plot_history` draws three panels against time: the fracture size (radius,
 half-length, or the equivalent radius ``sqrt(area / pi)``), the maximum opening (mm)
 and the wellbore pressure of each cluster (MPa), with closed-form solutions overlaid
-as dashed lines.
+as dashed lines; and, when the records carry a fluid ``budget``
+(:func:`hmatddm.simulation.records.fluid_budget`), a fourth panel: where the fluid is
+(fractures, leaked off, stored in the wellbores since t = 0, stacked) against the fluid
+injected plus the fluid of the initial fractures.
 """
 from pathlib import Path
 
@@ -14,7 +17,7 @@ from ..errors import InputError
 from ..io import atomic_output
 
 REQUIRED_KEYS = ("time", "fracture_area", "max_opening", "wellbore_pressure")
-REFERENCE_KEYS = ("time", "radius", "half_length", "max_opening", "net_pressure")
+REFERENCE_KEYS = ("time", "radius", "half_length", "max_opening", "net_pressure", "top", "bottom")
 CLOSED_FORM_STYLE = dict(color="black", linestyle="--", linewidth=1.2, label="closed form")
 
 
@@ -86,7 +89,8 @@ def _check_reference(reference):
 
 def _size_series(records):
     """(values, axis label) of the fracture size: radius, half-length or equivalent radius."""
-    for key, label in (("radius", "radius (m)"), ("half_length", "half-length (m)")):
+    for key, label in (("height", "height, bottom to top (m)"), ("radius", "radius (m)"),
+                       ("half_length", "half-length (m)")):
         if all(key in record for record in records):
             return _column(records, key), label
     area = _column(records, "fracture_area")
@@ -132,7 +136,49 @@ def _draw_pressure(axis, time, records, curves, confining_stress):
     axis.set_xlabel("time (s)")
 
 
-def plot_history(records, path, reference=None, confining_stress=0.0):
+def _budgets(records):
+    """``(time, budgets)`` of the records with a budget, when there are at least two."""
+    rows = [(record["time"], record["budget"]) for record in records if record.get("budget")]
+    return rows if len(rows) >= 2 else None
+
+
+def _draw_budget(axis, rows):
+    """Stacked: fluid in the fractures, leaked off, and the change of the wellbores'
+    fluid since the first record (negative when the wellbores gave fluid back); dashed:
+    injected plus the fluid in the fractures at the first record. The stack reaches the
+    dashed line when the budget closes (the worst residual is in the legend)."""
+    time = np.array([row[0] for row in rows], dtype=float)
+
+    def column(key):
+        return np.array([_finite_number(row[1].get(key, 0.0), f"budget[{key!r}]") for row in rows])
+
+    fractures, leaked, wellbore = column("fractures"), column("leaked"), column("wellbore")
+    sources = column("injected") + column("initial") + column("natural") - wellbore[0]
+    stored = wellbore - wellbore[0]
+    residual = column("residual")
+    moved = np.maximum(column("injected"), fractures)
+    worst = float(np.max(np.abs(residual) / np.where(moved > 0.0, moved, np.inf)))
+    axis.stackplot(time, fractures, leaked, stored, labels=("in the fractures", "leaked off",
+                                                            "stored in the wellbores since t0"),
+                   colors=("tab:blue", "tab:orange", "tab:green"), alpha=0.6)
+    axis.plot(time, sources, color="black", linestyle="--", linewidth=1.2,
+              label=f"injected + initial fractures (worst residual {worst:.1e} of the fluid moved)")
+    _finish(axis, "fluid volume (m³, reference density)")
+
+
+def _draw_tips(axis, time, records, curves, interfaces):
+    """Height growth in layers: the top and bottom of the fractures against time, the layer
+    interfaces as grey lines, the closed form's tips (``top``, ``bottom``) dashed."""
+    axis.plot(time, _column(records, "top"), marker=".", color="tab:red", label="top")
+    axis.plot(time, _column(records, "bottom"), marker=".", color="tab:purple", label="bottom")
+    for key in ("top", "bottom"):
+        _overlay(axis, curves, key)
+    for index, height in enumerate(interfaces):
+        axis.axhline(height, color="grey", linewidth=1.0, label="layer interfaces" if index == 0 else None)
+    _finish(axis, "fracture tips, vertical (m)")
+
+
+def plot_history(records, path, reference=None, confining_stress=0.0, interfaces=()):
     """Plot a simulation history as a three-panel PNG.
 
     Parameters
@@ -141,7 +187,9 @@ def plot_history(records, path, reference=None, confining_stress=0.0):
         One dict per time step with at least ``time`` (s), ``fracture_area`` (m²),
         ``max_opening`` (m) and ``wellbore_pressure`` (Pa; a list, one value per
         cluster, or a scalar); optionally ``radius`` or ``half_length`` (m), plotted
-        instead of the equivalent radius ``sqrt(area / pi)`` when every record has it.
+        instead of the equivalent radius ``sqrt(area / pi)`` when every record has it,
+        and a fluid ``budget`` (a panel, when at least two records have one); ``top`` and
+        ``bottom`` (m, in a layered medium: a panel of the tips against ``interfaces``).
     path : str or Path
         Output PNG (folder created if missing; written atomically).
     reference : dict of arrays, optional
@@ -154,6 +202,8 @@ def plot_history(records, path, reference=None, confining_stress=0.0):
         closed-form curve on the pressure panel is
         ``confining_stress + net_pressure``, so it compares with the absolute
         wellbore pressure; leave 0 when the records hold net pressures.
+    interfaces : sequence of float
+        Heights of the layer interfaces (m), drawn in the panel of the tips.
 
     Returns
     -------
@@ -166,12 +216,24 @@ def plot_history(records, path, reference=None, confining_stress=0.0):
     curves = _check_reference(reference)
     confining_stress = _finite_number(confining_stress, "confining_stress")
     time = _column(records, "time")
-    figure = Figure(figsize=(7.0, 9.0), dpi=110, layout="constrained")
+    budgets = _budgets(records)
+    tips = all("top" in record and "bottom" in record for record in records)
+    panels = 3 + (budgets is not None) + tips
+    figure = Figure(figsize=(7.0, 3.0 * panels), dpi=110, layout="constrained")
     FigureCanvasAgg(figure)
-    size_axis, opening_axis, pressure_axis = figure.subplots(3, 1, sharex=True)
-    _draw_size(size_axis, time, records, curves)
-    _draw_opening(opening_axis, time, records, curves)
-    _draw_pressure(pressure_axis, time, records, curves, confining_stress)
+    axes = figure.subplots(panels, 1, sharex=True)
+    _draw_size(axes[0], time, records, curves)
+    _draw_opening(axes[1], time, records, curves)
+    _draw_pressure(axes[2], time, records, curves, confining_stress)
+    extra = 3
+    if tips:
+        _draw_tips(axes[extra], time, records, curves, [float(h) for h in interfaces])
+        extra += 1
+    if budgets is not None:
+        _draw_budget(axes[extra], budgets)
+    for axis in axes[:-1]:
+        axis.set_xlabel("")
+    axes[-1].set_xlabel("time (s)")
     path = Path(path)
     with atomic_output(path) as temporary:
         figure.savefig(temporary, format="png")

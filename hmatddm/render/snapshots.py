@@ -41,7 +41,7 @@ from .layout import (BAR_LEFT, FAILED_COLOR, FAILED_NATURAL, INTACT_COLOR, INTAC
                      SLIP_VISIBLE_FRACTION, VERTICAL_NORMAL_Z, VIEWS, check_fields, check_mesh_type, check_window_size,
                      mesh_diagonal, length_text, plan_extent, slip_shown, is_mostly_vertical, legend_labels,
                      opening_colour_range, plan_frame, plan_scale_bar, plan_traces, slip_arrow_length,
-                     vertical_elements)
+                     vertical_elements, Curve, check_curves, dashes, plan_ticks)
 from .offscreen import new_plotter, offscreen_pyvista, save_png, screenshot
 
 
@@ -168,10 +168,30 @@ def _add_slip_arrows(plotter, mesh, slip, lift=0.0):
     plotter.add_mesh(arrows, color=SLIP_ARROW_COLOR)
 
 
-def _add_legend(plotter, state, slip_shown=False):
+def _add_curves(plotter, mesh, curves):
+    """Lines over the fractures (fronts): each :class:`Curve`'s points joined, dashed ones
+    as dashes of about 1.5% of the mesh diagonal, lifted above every element (a plan view
+    looks down ``-z``)."""
+    pyvista = offscreen_pyvista()
+    lift = (float(np.max(mesh.corners()[..., 2])) if isinstance(mesh, Mesh3D) else 0.0) + 0.3 * mesh_diagonal(mesh)
+    for curve in curves:
+        points = np.asarray(curve.points, dtype=float)
+        if points.shape[1] == 2:
+            points = np.column_stack([points, np.zeros(len(points))])
+        points = points + np.array([0.0, 0.0, lift])
+        if curve.pairs:
+            plotter.add_mesh(pyvista.line_segments_from_points(points), color=curve.colour, line_width=curve.width)
+            continue
+        pieces = [points] if not curve.dashed else dashes(points, 0.015 * mesh_diagonal(mesh))
+        for piece in pieces:
+            if len(piece) >= 2:
+                plotter.add_mesh(pyvista.lines_from_points(piece), color=curve.colour, line_width=curve.width)
+
+
+def _add_legend(plotter, state, slip_shown=False, curves=()):
     """The legend at the bottom, between the length scale and the colour bar, below the
     fractures in a plan view (:func:`plan_frame`)."""
-    labels = legend_labels(state, slip_shown)
+    labels = legend_labels(state, slip_shown) + [[curve.label, curve.colour] for curve in curves if curve.label]
     if labels:
         plotter.add_legend(labels=labels, bcolor="white", face="rectangle", loc="lower center",
                            size=(0.4, 0.028 * len(labels) + 0.008))
@@ -214,6 +234,7 @@ def _frame_plan(plotter, mesh, window_size, colour_bar, title, interfaces=()):
     plotter.add_text(length_text(length), position=(int((right_end + 0.01) * window_size[0]),
                                                      int((SCALE_Y - 0.02) * window_size[1])),
                      font_size=10, color="black")
+    _plan_axes(plotter, (x_left, x_right, y_low, y_high), box, window_size, lift, diagonal)
     plotter.view_xy()  # the camera pyvista frames (its distance keeps the lighting), moved over the box
     plotter.enable_parallel_projection()
     plotter.reset_camera()
@@ -225,7 +246,54 @@ def _frame_plan(plotter, mesh, window_size, colour_bar, title, interfaces=()):
     plotter.reset_camera_clipping_range()
 
 
-def _draw(plotter, mesh, opening, state, slip):
+def _plan_axes(plotter, limits, box, window_size, lift, diagonal):
+    """Axes in metres round the plot box of a plan view: ticks at round coordinates along
+    its lower and left edges (x to the right, y up), labelled below and inside."""
+    pyvista = offscreen_pyvista()
+    x_left, x_right, y_low, y_high = limits
+    width, height = window_size
+    tick = 0.012 * max(x_right - x_left, y_high - y_low)
+    segments = []
+    for x in plan_ticks(x_left, x_right):
+        segments += [(x, y_low, lift), (x, y_low + tick, lift)]
+        fraction = box[0] + (x - x_left) / (x_right - x_left) * (box[1] - box[0])
+        plotter.add_text(f"{x:g}", position=(int(fraction * width) - 8, int((box[2] - 0.035) * height)),
+                         font_size=9, color="dimgrey")
+    for y in plan_ticks(y_low, y_high):
+        segments += [(x_left, y, lift), (x_left + tick, y, lift)]
+        fraction = box[2] + (y - y_low) / (y_high - y_low) * (box[3] - box[2])
+        plotter.add_text(f"{y:g}", position=(int(box[0] * width) + 12, int(fraction * height) - 7),
+                         font_size=9, color="dimgrey")
+    segments += [(x_left, y_low, lift), (x_right, y_low, lift), (x_left, y_low, lift), (x_left, y_high, lift)]
+    plotter.add_mesh(pyvista.line_segments_from_points(np.array(segments, dtype=float)), color="dimgrey",
+                     line_width=1)
+    plotter.add_text("x (m)", position=(int(box[1] * width) - 40, int((box[2] - 0.035) * height)), font_size=9,
+                     color="dimgrey")
+    plotter.add_text("y (m)", position=(int(box[0] * width) + 12, int(box[3] * height) + 4), font_size=9,
+                     color="dimgrey")
+
+
+def _add_interface_planes(plotter, mesh, interfaces):
+    """The layer interfaces ``z = d`` of a 3D side (oblique) view: translucent grey planes over
+    the fractures' horizontal extent (padded by a fifth), those within a mesh diagonal of
+    the fractures, named in a line of text."""
+    pyvista = offscreen_pyvista()
+    corners = mesh.corners().reshape(-1, 3)
+    low, high = corners.min(axis=0), corners.max(axis=0)
+    diagonal = mesh_diagonal(mesh)
+    span = np.maximum(high[:2] - low[:2], 0.2 * diagonal) * 1.4
+    centre = 0.5 * (low[:2] + high[:2])
+    shown = [d for d in interfaces if low[2] - diagonal <= d <= high[2] + diagonal]
+    for height in shown:
+        plane = pyvista.Plane(center=(centre[0], centre[1], height), direction=(0.0, 0.0, 1.0), i_size=span[0],
+                              j_size=span[1], i_resolution=1, j_resolution=1)
+        plotter.add_mesh(plane, color="grey", opacity=0.25, show_edges=True, edge_color="dimgrey")
+    if shown:
+        plotter.add_text("grey planes: layer interfaces (" + ", ".join(f"z = {d:g} m" for d in shown) + ")",
+                         position="lower_left", font_size=10, color="dimgrey")
+
+
+def _draw(plotter, mesh, opening, state, slip, curves=()):
     every = np.arange(mesh.n_elements)
     if state is None:
         _add_coloured(plotter, mesh, every, opening)
@@ -233,9 +301,10 @@ def _draw(plotter, mesh, opening, state, slip):
         _add_coloured(plotter, mesh, every[state != INTACT_NATURAL], opening)
         _add_intact(plotter, mesh, every[state == INTACT_NATURAL])
         _add_failed_outline(plotter, mesh, every[state == FAILED_NATURAL])
-    _add_legend(plotter, state, slip_shown(slip))
+    _add_legend(plotter, state, slip_shown(slip), curves)
     if slip is not None:
         _add_slip_arrows(plotter, mesh, slip)
+    _add_curves(plotter, mesh, curves)
 
 
 # ---------------------------------------------------------------------------------
@@ -243,7 +312,7 @@ def _draw(plotter, mesh, opening, state, slip):
 # ---------------------------------------------------------------------------------
 
 
-def _draw_plan_traces(plotter, mesh, opening, state, slip):
+def _draw_plan_traces(plotter, mesh, opening, state, slip, curves=()):
     """Plan view of a mostly vertical Mesh3D: traces of the vertical elements on top,
     the non-vertical elements as surfaces (as :func:`_draw`) underneath."""
     vertical = vertical_elements(mesh)
@@ -274,9 +343,10 @@ def _draw_plan_traces(plotter, mesh, opening, state, slip):
         _add_coloured(plotter, traces, lines[line_state != INTACT_NATURAL], line_opening, lift=lift, clim=clim)
         _add_intact(plotter, traces, lines[line_state == INTACT_NATURAL], lift=lift)
         _add_failed_outline(plotter, traces, lines[line_state == FAILED_NATURAL], lift=lift)
-    _add_legend(plotter, state, slip_shown(line_slip) or (slip is not None and slip_shown(slip[others])))
+    _add_legend(plotter, state, slip_shown(line_slip) or (slip is not None and slip_shown(slip[others])), curves)
     if line_slip is not None and np.any(line_slip):
         _add_slip_arrows(plotter, traces, line_slip, lift=lift)
+    _add_curves(plotter, mesh, curves)
 
 
 # ---------------------------------------------------------------------------------
@@ -284,7 +354,7 @@ def _draw_plan_traces(plotter, mesh, opening, state, slip):
 # ---------------------------------------------------------------------------------
 
 def snapshot(mesh, path, opening=None, state=None, slip=None, view="oblique", title=None,
-             window_size=(1200, 900), plan_style="auto", interfaces=()):
+             window_size=(1200, 900), plan_style="auto", interfaces=(), curves=()):
     """Render one offscreen PNG of the fractures.
 
     Parameters
@@ -317,9 +387,13 @@ def snapshot(mesh, path, opening=None, state=None, slip=None, view="oblique", ti
     window_size : (width, height)
         Image size in pixels.
     interfaces : sequence of float, optional
-        Heights (m, the vertical second coordinate) of layer interfaces, drawn in a 2D
-        vertical section as grey lines across the picture (docs/conventions.md §3).
-        Ignored for a Mesh3D.
+        Heights (m, the vertical coordinate, docs/conventions.md §3) of layer interfaces,
+        drawn in a 2D vertical section as grey lines across the picture and in the
+        oblique view of a Mesh3D as translucent horizontal planes (not in its plan view,
+        which looks down on them).
+    curves : sequence of Curve, optional
+        Lines drawn over the fractures and named in the legend (the tracked front, the
+        closed-form front dashed), points in metres (2D: x, y).
 
     Returns
     -------
@@ -352,14 +426,16 @@ def snapshot(mesh, path, opening=None, state=None, slip=None, view="oblique", ti
     pyvista = offscreen_pyvista()
     plotter = new_plotter(pyvista, window_size)
     try:
+        curves = check_curves(curves, mesh.dim)
         if traces:
-            _draw_plan_traces(plotter, mesh, opening, state, slip)
+            _draw_plan_traces(plotter, mesh, opening, state, slip, curves)
         else:
-            _draw(plotter, mesh, opening, state, slip)
+            _draw(plotter, mesh, opening, state, slip, curves)
         if title is not None:
             plotter.add_text(str(title), position="upper_edge", font_size=12)
         if view == "oblique" and isinstance(mesh, Mesh3D):
             plotter.add_axes()  # a plan view has x to the right and y up, and a length scale instead
+            _add_interface_planes(plotter, mesh, interfaces)
         if view == "plan" or isinstance(mesh, Mesh2D):
             _frame_plan(plotter, mesh, window_size, colour_bar=opening is not None, title=title is not None,
                         interfaces=interfaces if isinstance(mesh, Mesh2D) else ())
@@ -385,4 +461,4 @@ def snapshots(mesh, folder, stem, **fields):
     return [snapshot(mesh, folder / f"{stem}_{view}.png", view=view, **fields) for view in views]
 
 
-__all__ = ["snapshot", "snapshots", "element_geometry"]
+__all__ = ["snapshot", "snapshots", "element_geometry", "Curve"]

@@ -254,7 +254,7 @@ class AsymptoticFront:
                             front_distance=front_distance, front_velocity=front_velocity, front_class=state)
         tally.operator_builds = sim.operator_builds - builds
         width = np.sum(trial.dd * mesh.normals, axis=1)
-        record = step_record(sim, flow, width, tally, relaxation, time.perf_counter() - clock)
+        record = step_record(sim, flow, width, tally, relaxation, time.perf_counter() - clock, start)
         record.update(self.measures(sim.state, sim))
         record["front_iterations"] = int(iterations)
         sim.records.append(record)

@@ -26,12 +26,16 @@ class Progress:
 
     On a terminal the line is redrawn in place after every step: step, simulated time
     against the end time with a bar, elements, nonlinear (and linear) iterations,
-    seconds of the last step and an estimate of the time left. When the stream is not
+    seconds of the last step and an estimate of the time left: the simulated time still
+    to go at the pace of the last :data:`RECENT` steps, the first step of a session left
+    out (it includes compiling and building the operator; ``left ~?`` until a second
+    step gives a pace). When the stream is not
     a terminal (a log file, CI), a plain line is printed every ``ceil(steps / 10)``
     steps and at the end. ``enabled=False`` prints nothing.
     """
 
     BAR = 20
+    RECENT = 5
 
     def __init__(self, end_time, time_step, stream=None, enabled=True, start_time=0.0):
         self.stream = sys.stderr if stream is None else stream
@@ -44,18 +48,28 @@ class Progress:
         self.start_time = float(start_time)
         self._drawn = False
         self._width = 0
+        self._seen = []  # (wall clock, simulated time) after each step of this session
+
+    def _left(self, record):
+        """Seconds left at the pace of the recent steps (None before a pace is known)."""
+        self._seen.append((time.perf_counter(), float(record["time"])))
+        self._seen = self._seen[-(self.RECENT + 1):]
+        if len(self._seen) < 2:
+            return None
+        (clock0, time0), (clock1, time1) = self._seen[0], self._seen[-1]
+        if time1 <= time0:
+            return None
+        return (clock1 - clock0) / (time1 - time0) * max(self.end_time - time1, 0.0)
 
     def _line(self, record):
         fraction = min(1.0, max(0.0, record["time"] / self.end_time))
         filled = int(round(fraction * self.BAR))
         bar = "#" * filled + "-" * (self.BAR - filled)
-        elapsed = time.perf_counter() - self.started
-        done = (record["time"] - self.start_time) / max(self.end_time - self.start_time, 1e-300)
-        left = elapsed * (1.0 - done) / done if 0.0 < done < 1.0 else 0.0
+        left = self._left(record)
         return (f"step {record['step']:>4}  t {record['time']:g}/{self.end_time:g} s [{bar}] {100 * fraction:3.0f}%"
                 f"  elements {record['n_elements']}  iterations {record['nonlinear_iterations']}"
                 f" ({record['linear_iterations']} linear)  {record['solve_seconds']:.1f} s/step"
-                f"  left ~{_format_seconds(left)}")
+                f"  left ~{'?' if left is None else _format_seconds(left)}")
 
     def update(self, record):
         if not self.enabled:

@@ -1,5 +1,7 @@
-"""The record of one time step (:attr:`hmatddm.Simulation.records`), and the view of a
-run's elements that output reads (:meth:`hmatddm.Simulation.view`)."""
+"""The record of one time step (:attr:`hmatddm.Simulation.records`), the record of the
+initial state (:func:`initial_record`), the fluid budget of every record
+(:func:`fluid_budget`), and the view of a run's elements that output reads
+(:meth:`hmatddm.Simulation.view`)."""
 from dataclasses import asdict, dataclass, field
 from enum import IntEnum
 
@@ -44,14 +46,28 @@ class StepTally:
         self.events.contact_frozen = max(self.events.contact_frozen, info.get("contact_frozen", 0))
 
 
-def step_record(simulation, flow, width, tally, relaxation, seconds):
+def step_record(simulation, flow, width, tally, relaxation, seconds, start=None):
     """The record of the step that led to ``simulation.state`` (its last solve's ``flow``
-    model, ``width`` and relaxation ``relaxation``; ``seconds`` of wall time)."""
-    sim, s = simulation, simulation.state
+    model, ``width`` and relaxation ``relaxation``; ``seconds`` of wall time). With the
+    step's ``start`` (a :class:`~hmatddm.simulation.state.StepStart`), the record has its
+    fluid ``budget`` (:func:`fluid_budget`)."""
+    sim = simulation
+    previous = sim.records[-1] if sim.records else None
+    record = _state_record(sim, sim.state, flow, width, tally, relaxation, seconds,
+                           previous["time"] if previous else 0.0)
+    if start is not None:
+        before = previous.get("budget") if previous is not None else initial_budget(sim)
+        if before is not None:  # (a record of a run checkpointed before budgets were recorded has none)
+            record["budget"] = fluid_budget(sim, before, start, flow, record["time"] - record["time_step"])
+    return record
+
+
+def _state_record(sim, s, flow, width, tally, relaxation, seconds, previous_time):
+    """The record's numbers of state ``s`` (see :func:`step_record`)."""
     mesh = s.mesh
     area = float(np.sum(flow.areas))
     record = dict(
-        step=s.step, time=s.time, time_step=float(s.time - (sim.records[-1]["time"] if sim.records else 0.0)),
+        step=s.step, time=s.time, time_step=float(s.time - previous_time),
         n_elements=int(mesh.n_elements), injected_volume=s.injected_volume,
         fracture_volume=float(np.sum(flow.areas * width)), fracture_area=area, max_opening=float(np.max(width)),
         wellbore_pressure=[float(s.pressure[i]) for i in sim.injection_elements],
@@ -77,7 +93,152 @@ def step_record(simulation, flow, width, tally, relaxation, seconds):
         record["radius"] = float(np.sqrt(area / np.pi))
     else:
         record["half_length"] = float(np.sum(mesh.areas) / 2.0)
+    if sim.medium is not None:
+        record.update(height_growth(mesh, s.origin, sim.medium))
     return record
+
+
+def height_growth(mesh, origin, medium):
+    """How far the hydraulic fractures reach up and down in a layered medium (ref. Ch. 3),
+    along the vertical axis (z in 3D, the second coordinate in 2D, docs/conventions.md §3):
+    ``top`` and ``bottom`` (m, the highest and lowest point of a hydraulic element),
+    ``height = top - bottom``, the layer of the element at each (``top_layer``,
+    ``bottom_layer``: 0 the top layer; :meth:`~hmatddm.layered.LayeredMedium.layer_of` of its
+    centre) and ``interfaces_crossed`` (interfaces strictly between bottom and top)."""
+    hydraulic = np.flatnonzero(origin == Origin.HYDRAULIC)
+    if hydraulic.size == 0:
+        return {}
+    axis = mesh.dim - 1
+    if mesh.dim == 3:
+        points = mesh.subset(hydraulic).corners()[..., axis]          # (n, 4)
+    else:
+        ends = mesh.subset(hydraulic).endpoints
+        points = np.stack([ends[0][:, axis], ends[1][:, axis]], axis=1)  # (n, 2)
+    highest, lowest = np.max(points, axis=1), np.min(points, axis=1)
+    top_element, bottom_element = hydraulic[np.argmax(highest)], hydraulic[np.argmin(lowest)]
+    top, bottom = float(np.max(highest)), float(np.min(lowest))
+    layers = medium.layer_of(mesh.centers[[top_element, bottom_element], axis])
+    interfaces = np.asarray(medium.interfaces, dtype=float)
+    return dict(height=top - bottom, top=top, bottom=bottom, top_layer=int(layers[0]), bottom_layer=int(layers[1]),
+                interfaces_crossed=int(np.count_nonzero((interfaces < top) & (interfaces > bottom))))
+
+
+# ---------------------------------------------------------------------------------
+# The initial state and the fluid budget
+# ---------------------------------------------------------------------------------
+
+BUDGET_KEYS = ("injected", "initial", "fractures", "wellbore", "leaked", "residual")
+
+
+def initial_record(simulation):
+    """The record of the initial state (step 0, time 0): the initial fractures at
+    ``initial_opening``, the pressure ``initial_pressure`` everywhere (the wellbores
+    too), no iteration, and the initial fluid ``budget``. It has every key of a step's
+    record, so that a table of the records starts at t = 0."""
+    from .step_solve import mesh_topology
+
+    sim = simulation
+    state = sim._initial_state()
+    _, faces = mesh_topology(state.mesh, sim.height)
+    flow = sim.flow_model(state.mesh, faces)
+    width = np.sum(state.dd * state.mesh.normals, axis=1)
+    record = _state_record(sim, state, flow, width, StepTally(), state.relaxation, 0.0, 0.0)
+    if sim.front is not None:  # the asymptotic front's measures of the initial elements
+        record.update(sim.front.measures(state, sim))
+        record["front_iterations"] = 0
+    record["budget"] = initial_budget(sim)
+    return record
+
+
+def initial_budget(simulation):
+    """The fluid budget at t = 0 (:func:`fluid_budget`): the initial fractures (their
+    area times ``initial_opening``) and the wellbores, at the initial pressure."""
+    sim = simulation
+    mesh = sim.mesh0
+    areas = mesh.areas * (sim.height if mesh.dim == 2 else 1.0)
+    fractures = float(np.sum(areas) * sim.initial_opening)
+    wellbore = float(sum(c.wellbore_volume for c in sim.clusters))
+    budget = dict(injected=0.0, initial=fractures + wellbore, fractures=fractures, wellbore=wellbore, leaked=0.0,
+                  residual=0.0, compression=0.0)
+    if sim.network is not None:
+        budget["natural"] = 0.0
+    return budget
+
+
+def fluid_budget(simulation, before, start, flow, time_old):
+    """The fluid budget at the end of the step from ``time_old`` to ``simulation.state``:
+    where the fluid pumped (``injected``) and present at t = 0 (``initial``) is, as
+    volume at the reference density (the density at ``initial_pressure``, ref. Eq. 4.22):
+
+    * ``fractures``: the volume of the openings plus the fluid stored in them by
+      compression (``compression``, accumulated step by step as the storage term of
+      ref. Eq. 4.36, ``c_f S_i w_i (p_i - p_i^n)``);
+    * ``wellbore``: ``V_w (1 + c_f (p_w - p_0))`` of each cluster;
+    * ``leaked``: Carter leak-off into the rock, ``S_i Lambda_i (p_i - p_r) dt`` per step
+      (ref. Eqs 4.25-4.26);
+    * ``natural`` (runs with natural fractures): the pore fluid that remotely failed
+      natural elements held when a fluid path first joined them to a wellbore
+      (drained failed elements are held at their failure pressure without a flow
+      equation, ref. Sec. 5.3, so their fluid is the rock's, not the pump's);
+    * ``residual = injected + initial (+ natural) - fractures - wellbore - leaked``.
+
+    Summed over the elements, the fluxes of ref. Eq. 4.36 cancel, so ``residual``
+    measures how well the step's solve satisfied the flow equations (the linear and
+    nonlinear tolerances of the coupled solve) plus the difference between the width of
+    the last iterate, which the storage term lags, and the final one.
+    ``before`` is the budget at ``time_old``; ``start`` the step's
+    :class:`~hmatddm.simulation.state.StepStart` (``w^n``, ``p^n``; new elements 0 and
+    their parent's pressure); ``flow`` its last solve's :class:`~hmatddm.flow.LubricationModel`.
+    """
+    from .step_solve import drained
+
+    sim, s = simulation, simulation.state
+    mesh = s.mesh
+    fed = np.ones(mesh.n_elements, bool)
+    if sim.network is not None:  # drained failed elements: no flow equation (the pore fluid's)
+        fed = ~drained(sim, mesh, flow.faces, s.origin)
+    areas, c_f = flow.areas[fed], sim.fluid.compressibility
+    width = np.sum(s.dd * mesh.normals, axis=1)[fed]
+    pressure = s.pressure[fed]
+    compression = before["compression"] + c_f * float(np.sum(areas * flow.effective_width(width)
+                                                             * (pressure - start.pressure[fed])))
+    volume = float(np.sum(areas * width))
+    rate = flow.leak_off_rate(s.creation_time, time_old, s.time)[fed]
+    leaked = before["leaked"] + (s.time - time_old) * float(
+        np.sum(areas * rate * (pressure - sim.leak_off.pore_pressure)))
+    wellbore = float(sum(c.wellbore_volume * (1.0 + c_f * (s.pressure[i] - sim.initial_pressure))
+                         for c, i in zip(sim.clusters, sim.injection_elements)))
+    budget = dict(injected=float(s.injected_volume), initial=before["initial"], fractures=volume + compression,
+                  wellbore=wellbore, leaked=leaked, residual=0.0, compression=compression)
+    sources = budget["injected"] + budget["initial"]
+    if sim.network is not None:  # fluid the joined elements held before the step, not counted before
+        budget["natural"] = before["natural"] + float(np.sum(areas * start.width[fed])) - (
+            before["fractures"] - before["compression"])
+        sources += budget["natural"]
+    budget["residual"] = sources - budget["fractures"] - wellbore - leaked
+    return budget
+
+
+def worst_budget_residual(records):
+    """``(residual, fluid moved, step)`` of the record whose budget closes worst relative to
+    the fluid moved (:func:`fluid_moved`); None when no record has a budget."""
+    worst = None
+    for record in records:
+        budget = record.get("budget")
+        if not budget:
+            continue
+        moved = fluid_moved(budget)
+        ratio = abs(budget["residual"]) / moved if moved > 0.0 else 0.0
+        if worst is None or ratio > worst[0]:
+            worst = (ratio, budget["residual"], moved, record["step"])
+    return None if worst is None else worst[1:]
+
+
+def fluid_moved(budget):
+    """The fluid a budget moved, what its residual is measured against: the larger of the
+    volume injected and the fluid in the fractures (a run without injection moves only
+    the fluid it started with)."""
+    return max(budget["injected"], budget["fractures"])
 
 
 def output_view(simulation):

@@ -341,7 +341,7 @@ class Simulation:
         self.state = self._finished(begin, trial, solved.flow, t_old, t_new, relaxation, tally)
         tally.operator_builds = self.operator_builds - builds
         width = np.sum(trial.dd * trial.mesh.normals, axis=1)
-        record = step_record(self, solved.flow, width, tally, relaxation, time.perf_counter() - clock)
+        record = step_record(self, solved.flow, width, tally, relaxation, time.perf_counter() - clock, start)
         self.records.append(record)
         return record
 

@@ -54,7 +54,7 @@ def test_run_writes_the_outputs_and_exits_0(tiny, tmp_path, capsys):
     assert "running 'tiny'" in captured.err and "step    2  t 2/2 s" in captured.err
     summary = json.loads((out / "summary.json").read_text())
     assert tuple(summary) == ("scene", "versions", "steps", "reference", "wall_seconds")
-    assert len(summary["steps"]) == 2 and len(summary["reference"]) == 2
+    assert len(summary["steps"]) == 3 and len(summary["reference"]) == 3  # step 0: the initial state
     assert len(list((out / "vtu").glob("*.vtu"))) == 3 and (out / "fractures.pvd").is_file()
     assert (out / "snapshots/step-000002_plan.png").is_file() and (out / "history.png").is_file()
 
@@ -62,7 +62,7 @@ def test_run_writes_the_outputs_and_exits_0(tiny, tmp_path, capsys):
     assert cli.main(["run", "--out", str(out), "--resume", "--set", "numerics.end_time=3", "--quiet"]) == 0
     assert capsys.readouterr().out == ""
     summary = json.loads((out / "summary.json").read_text())
-    assert [s["step"] for s in summary["steps"]] == [1, 2, 3]
+    assert [s["step"] for s in summary["steps"]] == [0, 1, 2, 3]
     # the run was a different scene: its checkpoints are refused
     assert cli.main(["run", str(tiny), "--out", str(out), "--resume", "--set", "fluid.viscosity=1e-3"]) == 2
     assert "belong to a different run" in capsys.readouterr().err
@@ -108,7 +108,7 @@ def test_a_run_that_does_not_converge_exits_3(tiny, tmp_path, capsys):
     err = capsys.readouterr().err
     assert "did not converge in the first step" in err
     summary = json.loads((out / "summary.json").read_text())  # readable, with the steps that converged
-    assert summary["steps"] == []
+    assert [s["step"] for s in summary["steps"]] == [0]  # the initial state only
 
 
 def test_interrupt_exits_130_and_says_how_to_resume(tiny, tmp_path, capsys, monkeypatch):
@@ -123,7 +123,7 @@ def test_interrupt_exits_130_and_says_how_to_resume(tiny, tmp_path, capsys, monk
     assert f"hmatddm run --out {out} --resume" in err
     monkeypatch.undo()
     assert cli.main(["run", "--out", str(out), "--resume", "--quiet"]) == cli.EXIT_OK
-    assert len(json.loads((out / "summary.json").read_text())["steps"]) == 2
+    assert len(json.loads((out / "summary.json").read_text())["steps"]) == 3
     assert cli.main(["run", str(tiny), "--out", str(out)]) == cli.EXIT_BAD_INPUT  # no silent overwrite
     assert "already holds a run" in capsys.readouterr().err
     assert cli.main(["run", str(tiny), "--out", str(out), "--overwrite", "--quiet"]) == cli.EXIT_OK
@@ -259,17 +259,17 @@ def test_the_last_step_lands_on_end_time(tiny, tmp_path, capsys):
     captured = capsys.readouterr()
     assert "t 0.5/0.5 s" in captured.err and "t = 0.5 s, " in captured.out
     steps = json.loads((out / "summary.json").read_text())["steps"]
-    assert [s["time"] for s in steps] == [0.5]
-    assert steps[0]["injected_volume"] == pytest.approx(0.5 * 5e-4, rel=1e-12)
+    assert [s["time"] for s in steps] == [0.0, 0.5]
+    assert steps[1]["injected_volume"] == pytest.approx(0.5 * 5e-4, rel=1e-12)
     out = tmp_path / "uneven"
     assert cli.main(["run", str(tiny), "--out", str(out), "--quiet", "--set", "numerics.end_time=2.5"]) == 0
     steps = json.loads((out / "summary.json").read_text())["steps"]
-    assert [s["time"] for s in steps] == [1.0, 2.0, 2.5]
+    assert [s["time"] for s in steps] == [0.0, 1.0, 2.0, 2.5]
     assert steps[-1]["injected_volume"] == pytest.approx(2.5 * 5e-4, rel=1e-12)
     # a resume to an end time the run has already passed is refused, not reported
     assert cli.main(["run", "--out", str(out), "--resume", "--set", "numerics.end_time=2"]) == cli.EXIT_BAD_INPUT
     assert "already at t = 2.5 s, past numerics.end_time = 2 s" in capsys.readouterr().err
-    assert [s["time"] for s in json.loads((out / "summary.json").read_text())["steps"]] == [1.0, 2.0, 2.5]
+    assert [s["time"] for s in json.loads((out / "summary.json").read_text())["steps"]] == [0.0, 1.0, 2.0, 2.5]
 
 
 def test_a_folder_without_a_finished_step_is_not_claimed(tiny, tmp_path, capsys):
@@ -283,10 +283,10 @@ def test_a_folder_without_a_finished_step_is_not_claimed(tiny, tmp_path, capsys)
     failing = ["--set", "numerics.max_iterations=1", "--set", "numerics.min_relaxation=1.0",
                "--set", "numerics.tolerance_pressure=1e-15"]
     assert cli.main(["run", str(tiny), "--out", str(out), "--quiet", *failing]) == cli.EXIT_NOT_CONVERGED
-    assert json.loads((out / "summary.json").read_text())["steps"] == []
+    assert [s["step"] for s in json.loads((out / "summary.json").read_text())["steps"]] == [0]
     capsys.readouterr()
     assert cli.main(["run", str(tiny), "--out", str(out), "--quiet"]) == cli.EXIT_OK  # no --overwrite needed
-    assert len(json.loads((out / "summary.json").read_text())["steps"]) == 2
+    assert len(json.loads((out / "summary.json").read_text())["steps"]) == 3
     assert cli.main(["run", str(tiny), "--out", str(out), "--quiet"]) == cli.EXIT_BAD_INPUT  # now it holds a run
     assert "already holds a run" in capsys.readouterr().err
     assert cli.main(["run", str(tiny), "--out", str(out), "--quiet", "--overwrite"]) == cli.EXIT_OK
@@ -325,13 +325,13 @@ def test_growth_past_max_elements_stops_resumably(tiny, tmp_path, capsys):
     assert "every step up to step 1 is checkpointed" in err
     assert f"hmatddm run --out {out} --resume --set numerics.max_elements=16" in err
     summary = json.loads((out / "summary.json").read_text())
-    assert [s["n_elements"] for s in summary["steps"]] == [7]
+    assert [s["n_elements"] for s in summary["steps"]] == [3, 7]
     assert (out / "snapshots" / "step-000001_plan.png").is_file()
     assert cli.main(["run", "--out", str(out), "--resume", "--quiet", "--set", "numerics.max_elements=12"]) == 2
     capsys.readouterr()
     assert cli.main(["run", "--out", str(out), "--resume", "--quiet", "--set", "numerics.max_elements=100"]) == 0
     steps = json.loads((out / "summary.json").read_text())["steps"]
-    assert [s["step"] for s in steps] == [1, 2, 3, 4] and steps[-1]["n_elements"] > 10
+    assert [s["step"] for s in steps] == [0, 1, 2, 3, 4] and steps[-1]["n_elements"] > 10
 
 
 def test_validate_prints_progress_per_check(capsys, monkeypatch):
@@ -387,4 +387,4 @@ def test_run_with_auto_steps_says_so_and_records_the_steps(tmp_path, capsys):
                      "--set", "numerics.time_step=auto", "--set", "numerics.first_time_step=0.5"]) == cli.EXIT_OK
     assert "dt = auto from 0.5 s" in capsys.readouterr().err
     steps = json.loads((out / "summary.json").read_text())["steps"]
-    assert steps[0]["time_step"] == 0.5 and steps[-1]["time"] == 2.0
+    assert steps[1]["time_step"] == 0.5 and steps[-1]["time"] == 2.0

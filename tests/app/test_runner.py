@@ -57,10 +57,10 @@ def test_a_run_writes_every_output(finished_3d):
     assert tuple(document) == runner.SUMMARY_KEYS
     assert document["scene"]["name"] == "tiny" and document["scene"]["numerics"]["backend"] == "dense"
     assert set(document["versions"]) == {"hmatddm", "numpy", "scipy", "numba", "python"}
-    assert [s["step"] for s in document["steps"]] == [1, 2]
-    assert set(hd.simulation.RECORD_KEYS) <= set(document["steps"][-1])
-    assert len(document["reference"]) == 2
-    assert {"radius", "max_opening", "net_pressure", "relative_error"} <= set(document["reference"][0])
+    assert [s["step"] for s in document["steps"]] == [0, 1, 2]  # step 0: the initial state
+    assert all(set(hd.simulation.RECORD_KEYS) <= set(step) for step in document["steps"])
+    assert len(document["reference"]) == 3 and document["reference"][0]["radius"] is None
+    assert {"radius", "max_opening", "net_pressure", "relative_error"} <= set(document["reference"][1])
     assert document["wall_seconds"] > 0
     assert document["steps"][-1]["n_elements"] > 9  # it grew
     # ParaView time series: one .vtu per step (every = 1), listed in the .pvd with their times
@@ -90,7 +90,7 @@ def test_a_vertical_3d_run_writes_the_plan_view_of_its_traces(tmp_path):
     assert runner.snapshot_views(hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 0, 1], 3, 3, 3, 3)) == (
         "plan", "oblique")
     summary = runner.run_scene(hs.parse_scene(text), tmp_path, quiet=True)
-    assert [s["step"] for s in summary["steps"]] == [1]
+    assert [s["step"] for s in summary["steps"]] == [0, 1]
     plan = tmp_path / "snapshots" / "step-000001_plan.png"
     assert png_is_not_blank(plan) and png_is_not_blank(tmp_path / "snapshots" / "step-000001_oblique.png")
     image = np.asarray(Image.open(plan).convert("RGB"), dtype=float) / 255.0
@@ -114,17 +114,19 @@ def test_interrupted_run_is_readable_and_resumes_to_the_same_result(tmp_path, mo
     with pytest.raises(KeyboardInterrupt):
         run.execute()
     partial = json.loads((tmp_path / "part/summary.json").read_text())
-    assert [s["step"] for s in partial["steps"]] == [1, 2, 3] and len(partial["reference"]) == 3
+    assert [s["step"] for s in partial["steps"]] == [0, 1, 2, 3] and len(partial["reference"]) == 4
     assert run.last_record["step"] == 3
     monkeypatch.undo()
 
     # render reads a partial run (newest checkpoint)
     written = runner.render_folder(tmp_path / "part")
-    assert [p.name for p in written] == ["step-000003_plan.png", "history.png"]
+    # the plan view of the newest state (a checkpoint), the profiles of the saved steps (every 2) and of it
+    assert [p.name for p in written] == ["step-000003_plan.png", "step-000000_profile.png", "step-000002_profile.png",
+                                         "step-000003_profile.png", "history.png"]
     assert all(png_is_not_blank(p) for p in written)
 
     resumed = runner.run_scene(scene, tmp_path / "part", resume=True, quiet=True)
-    assert [s["step"] for s in resumed["steps"]] == list(range(1, 7))
+    assert [s["step"] for s in resumed["steps"]] == list(range(0, 7))
     for a, b in zip(resumed["steps"], full["steps"]):
         assert a["n_elements"] == b["n_elements"]
         assert a["max_opening"] == pytest.approx(b["max_opening"], rel=1e-9)
@@ -143,7 +145,7 @@ def test_resume_without_checkpoints_starts_from_zero(tmp_path):
     stream = io.StringIO()
     summary = runner.run_scene(hs.parse_scene(TINY_2D, overrides=["numerics.end_time=1"]), tmp_path, resume=True,
                                stream=stream)
-    assert [s["step"] for s in summary["steps"]] == [1]
+    assert [s["step"] for s in summary["steps"]] == [0, 1]
 
 
 def test_render_from_vtu_files_only(tmp_path):

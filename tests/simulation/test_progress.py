@@ -66,3 +66,21 @@ def test_tasks_print_one_line_each_and_a_closing_line_with_cpu_time():
     assert re.fullmatch(r"\[1/2\] griffith \.\.\. error 1e-3 \(\d+\.\d s\)", lines[0])
     assert lines[1].startswith("[2/2] sneddon ... error 1e-3")
     assert re.fullmatch(r"2 task\(s\) in \d+\.\d s wall, \d+\.\d s CPU", lines[2])
+
+
+def test_the_time_left_follows_the_recent_steps_not_the_first(monkeypatch):
+    """Issue 38: the first step includes compiling and building the operator; the estimate
+    of the time left uses the pace of the last steps, and says '?' until it has one."""
+    import hmatddm.simulation.progress as progress_module
+
+    clock = [0.0]
+    monkeypatch.setattr(progress_module.time, "perf_counter", lambda: clock[0])
+    stream = _Terminal()
+    progress = Progress(end_time=100.0, time_step=1.0, stream=stream)
+    clock[0] = 60.0  # the first step: a minute
+    progress.update(_record(1, 1.0))
+    assert stream.getvalue().rstrip().endswith("left ~?")
+    for step in range(2, 11):  # then 2 s per step of 1 s: 90 s of simulated time left = 180 s
+        clock[0] += 2.0
+        progress.update(_record(step, float(step)))
+    assert stream.getvalue().rstrip().endswith("left ~3m00s")
