@@ -288,16 +288,31 @@ class ExtendedElasticityOperator(ProductCounter, LinearOperator):
         out = np.empty(self.shape[0])
         top, bottom = out[:k], out[k:]
         top[:] = self._base_product(x_old)
+        compressed = [chunk for chunk in self.chunks if chunk.compressed]
         for chunk in self.chunks:
-            chunk.add_column_product(x_new[chunk.start:chunk.stop], top)
+            if not chunk.compressed:
+                chunk.add_column_product(x_new[chunk.start:chunk.stop], top)
+        if compressed:  # the old unknowns in the base tree's order, summed there, scattered once
+            order = compressed[0].on_t.row_order
+            top_in_order = np.zeros(k)
+            for chunk in compressed:
+                top_in_order += chunk.on_t.matvec_in_tree_order(x_new[chunk.start:chunk.stop][chunk.on_t.col_order])
+            top[order] += top_in_order
         self._border_rows(x_old, bottom)
         bottom += self.nn @ x_new
         return out
 
     def _border_rows(self, x_old, out):
-        """``out = A_no x_old``, chunk by chunk."""
+        """``out = A_no x_old``, chunk by chunk (the compressed ones from one permuted
+        copy of ``x_old``)."""
+        x_in_order = None
         for chunk in self.chunks:
-            chunk.row_product(x_old, out[chunk.start:chunk.stop])
+            if chunk.compressed:
+                if x_in_order is None:
+                    x_in_order = x_old[chunk.no.col_order]
+                out[chunk.start:chunk.stop][chunk.no.row_order] = chunk.no.matvec_in_tree_order(x_in_order)
+            else:
+                chunk.row_product(x_old, out[chunk.start:chunk.stop])
         return out
 
     #: The block-triangular inverse ignores ``A_on``: never exact, a solve iterates.

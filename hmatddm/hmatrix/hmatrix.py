@@ -204,6 +204,24 @@ class HMatrix(LinearOperator):
         out[self._unknown_permutation] = result[0]
         return out
 
+    # ------------------------------------------------------------------ products in tree order
+    @property
+    def row_order(self):
+        """The row unknowns in the row tree's order: tree-order row ``k`` is row
+        ``row_order[k]`` of the matrix."""
+        return self._unknown_permutation
+
+    @property
+    def col_order(self):
+        """The column unknowns in the column tree's order (see :attr:`row_order`)."""
+        return self._col_permutation
+
+    def matvec_in_tree_order(self, x):
+        """``A x`` with ``x`` and the result in the trees' orders (``x[k]`` is unknown
+        ``col_order[k]``; ``result[k]`` is row ``row_order[k]``): several matrices over
+        one tree (the border blocks of a grown mesh) permute a vector once, not each."""
+        return self.storage.matmat_permuted(np.asarray(x, dtype=np.float64).reshape(1, -1))[0]
+
     def _adjoint(self):
         raise NotImplementedError("HMatrix does not implement the transpose product")
 

@@ -50,7 +50,8 @@ class GrowingOperator:
         elif (extends and self.operator_settings.backend == "hmatrix"
               and self.rebuild_settings.border_fits(base.mesh.n_elements, n - base.mesh.n_elements, base.dof,
                                                     getattr(base, "border_entries_per_pair", None),
-                                                    self._border_bytes_per_element(base))):
+                                                    self._border_bytes_per_element(base),
+                                                    base.stats["memory_bytes"] if compresses_borders(base) else None)):
             # the border blocks of the elements the last operator had are copied, not re-evaluated
             grown = (PlanarExtendedOperator if isinstance(base, PlanarElasticityOperator) and is_planar(mesh)
                      else ExtendedElasticityOperator)

@@ -48,18 +48,25 @@ class RebuildSettings:
         object.__setattr__(self, "rebuild_fraction", fraction)
         object.__setattr__(self, "max_border_bytes", finite_scalar("max_border_bytes", self.max_border_bytes))
 
-    def border_fits(self, compressed, added, dof, entries_per_pair=None, bytes_per_added=None):
+    def border_fits(self, compressed, added, dof, entries_per_pair=None, bytes_per_added=None, base_bytes=None):
         """Whether ``added`` elements may join ``compressed`` ones (``dof`` unknowns per
         element) as border blocks; ``entries_per_pair``: the border entries an element
         pair stores (default ``dof**2``; a planar crack's split operator stores 1 for its
         opening part, 4 more once its shear part is built). ``bytes_per_added``: what
         ``A_on`` and ``A_no`` hold per added element when they are compressed
         (:mod:`hmatddm.elasticity.extended`); None: dense, ``2 x compressed`` pairs. The
-        added elements' own block ``A_nn`` is dense (``added**2`` pairs) either way."""
+        added elements' own block ``A_nn`` is dense (``added**2`` pairs) either way, and its
+        block LU holds about twice as much again; ``base_bytes`` (the base H-matrix's
+        memory, given with compressed borders): ``A_nn`` and its factors may not outgrow
+        it, so that they never cost a product more than the base does (on the h = 0.25 m
+        radial run, letting ``A_nn`` grow to a quarter of the base made the run 7% slower
+        although its borders were compressed)."""
         entries = dof * dof if entries_per_pair is None else entries_per_pair
         border = 8.0 * entries * 2 * compressed * added if bytes_per_added is None else bytes_per_added * added
-        border_bytes = border + 8.0 * entries * added * added
-        return added <= self.rebuild_fraction * compressed and border_bytes <= self.max_border_bytes
+        own = 8.0 * entries * added * added
+        border_bytes = border + own
+        return (added <= self.rebuild_fraction * compressed and border_bytes <= self.max_border_bytes
+                and (base_bytes is None or 3.0 * own <= base_bytes))
 
 
 @dataclass(frozen=True)

@@ -148,3 +148,35 @@ def test_build_free_product_refuses_bad_input():
         build_free_product(generator, np.ones(generator.shape[1]), 2.0, **options)
     with pytest.raises(InputError, match="BlockGenerator"):
         build_free_product(object(), np.ones(3), 1e-4)
+
+
+def test_offsets_take_slices_of_a_larger_kernel_and_trees_can_be_given():
+    """A generator over consecutive slices of a square kernel's elements (row_offset,
+    col_offset) compresses exactly that block of the full matrix; an H-matrix built on a
+    given row tree uses it; products in tree order are the permuted products; bad offsets
+    and trees are refused naming the argument."""
+    from hmatddm.hmatrix.example_kernels import inverse_distance_generator, inverse_distance_kernel
+
+    rng = np.random.default_rng(7)
+    points = rng.uniform(-5.0, 5.0, (900, 2))
+    full = inverse_distance_generator(points, diagonal=3.0).to_dense()
+    data = (points, np.array([3.0]))
+    rows, cols = slice(0, 700), slice(700, 900)
+    tree = cluster_tree(points[rows], 0.0, 32)
+    generator = BlockGenerator(inverse_distance_kernel, data, points[rows], 0.0, 1, col_points=points[cols],
+                               col_radii=0.0, col_dof=1, row_offset=0, col_offset=700)
+    block = HMatrix.build(generator, eps=1e-8, leaf_size=32, row_tree=tree)
+    assert block.tree is tree
+    np.testing.assert_allclose(block.to_dense(), full[rows, cols], rtol=0, atol=1e-7 * np.abs(full[rows, cols]).max())
+    x = rng.normal(size=200)
+    y = block.matvec(x)
+    np.testing.assert_array_equal(block.matvec_in_tree_order(x[block.col_order]), y[block.row_order])
+    transposed = BlockGenerator(inverse_distance_kernel, data, points[cols], 0.0, 1, col_points=points[rows],
+                                col_radii=0.0, col_dof=1, row_offset=700, col_offset=0)
+    np.testing.assert_array_equal(transposed.fill(np.arange(3), np.arange(4)), full[700:703, 0:4])
+    with pytest.raises(InputError, match="row_offset"):
+        BlockGenerator(inverse_distance_kernel, data, points, 0.0, 1, row_offset=-1)
+    with pytest.raises(InputError, match="col_offset"):
+        BlockGenerator(inverse_distance_kernel, data, points, 0.0, 1, col_offset=3)  # square: no column slice
+    with pytest.raises(InputError, match="row_tree"):
+        HMatrix.build(generator, row_tree=cluster_tree(points, 0.0, 32))
