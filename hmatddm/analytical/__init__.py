@@ -3,6 +3,8 @@ the validation table and the scenes' ``[reference]`` blocks compare with.
 
 * :mod:`.solutions`: Griffith and Sneddon cracks, the radial and KGD vertex solutions
   (K and M), their regime numbers and the radial K-M transition (Dontsov 2016).
+* :mod:`.regimes`: the regime numbers (dimensionless toughness and leak-off, radial and
+  KGD), where each vertex applies, and the closed forms a scene's ``[reference]`` names.
 * :mod:`.tip_asymptote`: the universal tip asymptote (Dontsov and Peirce 2015), inverted
   by the asymptotic front.
 
@@ -17,7 +19,12 @@ _SOLUTIONS = (
     "radial_m_vertex_pressure", "kgd_m_vertex_profile", "kgd_m_vertex", "radial_regime", "kgd_regime",
     "radial_transition_profile", "radial_transition",
 )
+_REGIMES = (
+    "radial_toughness_number", "kgd_toughness_number", "radial_leak_off_number", "kgd_leak_off_number",
+    "applicable_solution",
+)
 _EXPORTS = {name: ".solutions" for name in _SOLUTIONS}
+_EXPORTS.update({name: ".regimes" for name in _REGIMES})
 __getattr__, __dir__ = attach(__name__, _EXPORTS)
 
-__all__ = list(_SOLUTIONS)
+__all__ = list(_SOLUTIONS) + list(_REGIMES)

@@ -189,7 +189,7 @@ from .schema import far_field_stress, has_natural_fractures, to_toml, validate
 # on first use, so that validating and refusing a scene stays quick
 __getattr__, __dir__ = attach(__name__, {name: ".build" for name in (
     "build_simulation", "natural_mesh", "natural_network", "natural_properties", "confining_stress", "initial_mesh",
-    "reference_curves", "reference_values")})
+    "reference_curves", "reference_values", "reference_regime", "reference_warning")})
 
 
 @dataclass(frozen=True)
@@ -348,5 +348,6 @@ def apply_override(raw, assignment):
 
 __all__ = ["Scene", "load_scene", "parse_scene", "scene_from_dict", "embedded_names", "embedded_text",
            "embedded_scenes", "apply_override", "validate", "build_simulation", "initial_mesh",
-           "reference_values", "reference_curves", "confining_stress", "far_field_stress",
+           "reference_values", "reference_curves", "reference_regime", "reference_warning",
+           "confining_stress", "far_field_stress",
            "has_natural_fractures", "to_toml", "natural_mesh", "natural_network", "natural_properties"]
