@@ -259,10 +259,12 @@ def reference_values(scene, records):
     also the K-vertex beside it (``k_vertex``: its values and the simulation's relative
     differences, net pressure included). None when the scene has no ``[reference]``.
 
-    The simulated net pressure is the injection element's pressure minus the confining
-    stress: the closed forms' net pressure at the injection point (uniform at the K-vertex;
-    ``p(0)`` of the KGD M-vertex). The radial M-vertex and the transition solution have no
-    finite net pressure at the injection point (log-singular, resp. not approximated)."""
+    The net pressure is compared where the closed form defines it (:func:`_simulated`): a
+    K-vertex's is uniform, compared with the fracture's opening-weighted mean pressure minus
+    the confining stress (``net_pressure``) and with the injection element's
+    (``injection_net_pressure``, which adds the viscous drop near the well); the KGD
+    M-vertex's ``p(0)`` with the injection element's. The radial M-vertex and the transition
+    solution give none (log-singular at the well, resp. not approximated)."""
     if "reference" not in scene:
         return None
     if not records:
@@ -280,8 +282,7 @@ def reference_values(scene, records):
     rows = []
     for index, record in enumerate(records):
         row = {key: float(values[index]) for key, values in curves.items()}
-        simulated = {size_key: record.get(size_key), "max_opening": record.get("max_opening"),
-                     "net_pressure": record["wellbore_pressure"][0] - confining}
+        simulated = _simulated(record, size_key, confining, uniform_pressure=kind.endswith("-k"))
         row["relative_error"] = _relative(simulated, row)
         row["regime"] = {"number": regime["number"], "value": row["dimensionless_toughness"],
                          "vertex": regime["vertex"][index + 1], "applies_over_run": regime["applies"],
@@ -289,15 +290,35 @@ def reference_values(scene, records):
         row["solution"] = solution
         if beside is not None:
             vertex = {key: float(beside[key][index]) for key in (size_key, "max_opening", "net_pressure")}
-            vertex["relative_error"] = _relative(simulated, vertex)
+            vertex["relative_error"] = _relative(_simulated(record, size_key, confining, uniform_pressure=True),
+                                                 vertex)
             vertex["solution"] = SOLUTIONS["radial-k"].as_dict()
             row["k_vertex"] = vertex
         rows.append(row)
     return rows
 
 
+def _simulated(record, size_key, confining, uniform_pressure):
+    """The simulated values a closed form is compared with. ``net_pressure``: where the closed
+    form's net pressure is uniform (K-vertex), the opening-weighted mean pressure of the
+    fracture (``mean_pressure`` of the record, :func:`hmatddm.simulation.records.step_record`)
+    minus the confining stress, and the injection element's beside it
+    (``injection_net_pressure``); otherwise (the KGD M-vertex's ``p(0)``) the injection
+    element's."""
+    injection = record["wellbore_pressure"][0] - confining
+    simulated = {size_key: record.get(size_key), "max_opening": record.get("max_opening"), "net_pressure": injection}
+    if uniform_pressure and record.get("mean_pressure") is not None:
+        simulated["net_pressure"] = record["mean_pressure"] - confining
+        simulated["injection_net_pressure"] = injection
+    return simulated
+
+
 def _relative(simulated, closed_form):
     """``simulated / closed form - 1`` for the keys the closed form has (None where the
-    simulation has no value or the closed form is 0)."""
+    simulation has no value or the closed form is 0); ``injection_net_pressure`` against the
+    closed form's (uniform) ``net_pressure``."""
+    closed_form = dict(closed_form)
+    if "net_pressure" in closed_form:
+        closed_form.setdefault("injection_net_pressure", closed_form["net_pressure"])
     return {key: (None if value is None or closed_form[key] == 0.0 else float(value / closed_form[key] - 1.0))
             for key, value in simulated.items() if key in closed_form}

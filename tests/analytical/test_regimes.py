@@ -158,3 +158,26 @@ def test_a_transitional_kgd_warns_and_names_the_plane_strain_transition():
     raw["propagation"]["toughness"] = 2e6  # K_m ~ 2
     line = hs.reference_warning(hs.scene_from_dict(raw).data)
     assert "'kgd-k'" in line and "Dontsov 2017" in line and "K_m = 1.95 " in line
+
+
+def test_a_uniform_pressure_vertex_is_compared_with_the_mean_pressure_and_the_injection_beside():
+    data = hs.load_scene("radial-k").data
+    mat, rate, _, toughness = _scene_inputs(data)
+    e_prime = 2.0 * mat.shear_modulus / (1.0 - mat.poisson_ratio)
+    t = 20.0
+    # K-vertex, written out: R from Q t = 16 p R^3 / (3 E') with p = pi^(1/2) K_Ic / (2 R^(1/2))
+    radius = (3.0 * e_prime * rate * t / (8.0 * np.sqrt(np.pi) * toughness)) ** 0.4
+    pressure = np.sqrt(np.pi) * toughness / (2.0 * np.sqrt(radius))
+    confining = 8e6
+    record = dict(time=t, radius=radius, max_opening=1e-3, mean_pressure=confining + 1.02 * pressure,
+                  wellbore_pressure=[confining + 1.05 * pressure])
+    (row,) = hs.reference_values(data, [record])
+    assert row["relative_error"]["net_pressure"] == pytest.approx(0.02)
+    assert row["relative_error"]["injection_net_pressure"] == pytest.approx(0.05)
+    km = hs.load_scene("radial-km").data  # the K-vertex beside the transition: the same two pressures
+    (row,) = hs.reference_values(km, [record])
+    assert "net_pressure" not in row["relative_error"]
+    vertex_pressure = np.sqrt(np.pi) * 5e6 / (2.0 * np.sqrt(row["k_vertex"]["radius"]))
+    assert row["k_vertex"]["relative_error"]["net_pressure"] == pytest.approx(1.02 * pressure / vertex_pressure - 1)
+    assert row["k_vertex"]["relative_error"]["injection_net_pressure"] == pytest.approx(
+        1.05 * pressure / vertex_pressure - 1)
