@@ -127,10 +127,20 @@ def main():
                         help="skip a run whose closed-form size needs more elements than this")
     parser.add_argument("--plot", default=os.path.join(HERE, "convergence.png"))
     parser.add_argument("--json", default=None, help="also write the rows to this file")
+    parser.add_argument("--report", default=None,
+                        help="no runs: print the tables and plot of earlier --json files (comma separated)")
     args = parser.parse_args()
     sys.path.insert(0, HERE)
-    from _common import machine, print_table
+    from _common import machine
 
+    if args.report:
+        rows, skipped = [], []
+        for path in args.report.split(","):
+            earlier = json.load(open(path))
+            print(f"{path}: {earlier['machine']}")
+            rows += earlier["rows"]
+            skipped += earlier["skipped"]
+        return report(rows, skipped, args.plot)
     print(f"Machine: {machine()}", flush=True)
     rows, skipped = [], []
     with tempfile.TemporaryDirectory() as folder:
@@ -145,6 +155,13 @@ def main():
                 print(json.dumps(rows[-1]), flush=True)
     if args.json:
         json.dump(dict(rows=rows, skipped=skipped, machine=machine()), open(args.json, "w"), indent=1)
+    report(rows, skipped, args.plot)
+
+
+def report(rows, skipped, plot_path):
+    """The table of the runs, the observed orders, what was skipped, and the plot."""
+    from _common import print_table
+
     header = ["case", "h (m)", "K_m (first, last)", "elements", "steps", "CPU (s)", "wall (s)", "R or l (m)",
               "w0 (mm)", "p net (MPa)", "R/l err", "w0 err", "p err", "p well err", "RMS R/l", "RMS w0", "RMS p",
               "RMS p well", "roundness"]
@@ -171,7 +188,7 @@ def main():
                  "order R/l (RMS)", "order w0 (RMS)", "order p (RMS)", "order p well (RMS)"], orders)
     for line in skipped:
         print(f"skipped: {line}")
-    plot(rows, args.plot)
+    plot(rows, plot_path)
 
 
 def _fmt(value):

@@ -128,6 +128,9 @@ The format, annotated (``=`` values are the defaults unless marked REQUIRED)::
     kind = "radial-k"              # "radial-k", "radial-m", "radial-km" (3D; K-M transition,
                                    # Dontsov 2016), "kgd-k", "kgd-m" (2D);
                                    # needs one cluster, [propagation] and no leak-off
+                                   # summary.json's reference rows record the regime number
+                                   # K_m and the solution (formula, source); `hmatddm run`
+                                   # warns when the vertex does not apply over the run
 
     # Natural fractures: the schema is defined and validated, but the engine has no
     # natural-fracture physics yet, so `hmatddm run` refuses such scenes (exit code 2).
