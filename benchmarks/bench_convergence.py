@@ -224,6 +224,7 @@ def plot(rows, path):
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    import matplotlib.ticker  # noqa: F401  (matplotlib.ticker.NullLocator below)
 
     cases = list(dict.fromkeys(r["case"] for r in rows))
     figure, axes = plt.subplots(1, len(cases), figsize=(4.2 * len(cases), 3.8), squeeze=False)
@@ -240,6 +241,8 @@ def plot(rows, path):
                                 label=f"{labels[quantity]} ({suffix})")
         if len(h) > 1:  # first-order guide
             axis.loglog(h, [0.01 * x / h[0] for x in h], ":", color="grey", label="O(h)")
+        axis.set_xticks(h, [f"{x:g}" for x in h])
+        axis.xaxis.set_minor_locator(matplotlib.ticker.NullLocator())
         axis.set_title(case)
         axis.set_xlabel("element size h (m)")
         axis.invert_xaxis()
