@@ -253,8 +253,8 @@ def reference_values(scene, records):
     """One dict per record with the closed-form values at its time, the relative
     differences of the simulation (``relative_error``: simulation / closed form - 1),
     the regime there (``dimensionless_toughness``; ``regime``: its number, value, the
-    vertex it is at and whether the closed form applies over the whole run) and the
-    ``solution`` compared with (kind, name, formula, source,
+    vertex it is at, whether the closed form applies from the first step to the last
+    record) and the ``solution`` compared with (kind, name, formula, source,
     :data:`hmatddm.analytical.regimes.SOLUTIONS`); with ``reference.kind = "radial-km"``
     also the K-vertex beside it (``k_vertex``: its values and the simulation's relative
     differences, net pressure included). None when the scene has no ``[reference]``.
