@@ -3,6 +3,8 @@ the validation table and the scenes' ``[reference]`` blocks compare with.
 
 * :mod:`.solutions`: Griffith and Sneddon cracks, the radial and KGD vertex solutions
   (K and M), their regime numbers and the radial K-M transition (Dontsov 2016).
+* :mod:`.regimes`: the regime numbers (dimensionless toughness and leak-off, radial and
+  KGD), where each vertex applies, and the closed forms a scene's ``[reference]`` names.
 * :mod:`.tip_asymptote`: the universal tip asymptote (Dontsov and Peirce 2015), inverted
   by the asymptotic front.
 * :mod:`.leak_off`: leak-off-dominated sizes (the K~ and M~ vertices) and the plane-strain
@@ -21,7 +23,12 @@ _SOLUTIONS = (
 )
 _LEAK_OFF = ("kgd_leak_off_half_length", "radial_leak_off_radius", "kgd_toughness_leak_off_edge",
              "radial_toughness_leak_off_edge")
-_EXPORTS = {**{name: ".solutions" for name in _SOLUTIONS}, **{name: ".leak_off" for name in _LEAK_OFF}}
+_REGIMES = (
+    "radial_toughness_number", "kgd_toughness_number", "radial_leak_off_number", "kgd_leak_off_number",
+    "applicable_solution",
+)
+_EXPORTS = {**{name: ".solutions" for name in _SOLUTIONS}, **{name: ".leak_off" for name in _LEAK_OFF},
+            **{name: ".regimes" for name in _REGIMES}}
 __getattr__, __dir__ = attach(__name__, _EXPORTS)
 
-__all__ = list(_SOLUTIONS) + list(_LEAK_OFF)
+__all__ = list(_SOLUTIONS) + list(_LEAK_OFF) + list(_REGIMES)

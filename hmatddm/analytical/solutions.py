@@ -344,29 +344,26 @@ def radial_regime(t, injection_rate, viscosity, fracture_toughness, material):
     """Dimensionless toughness ``K_m = K' (t^2 / (mu'^5 Q^3 E'^13))^(1/18)`` of a radial
     fracture (Savitski and Detournay 2002), zero leak-off; ``K' = 4 (2/pi)^(1/2) K_Ic``,
     ``mu' = 12 mu``. It grows as ``t^(1/9)``: a radial fracture starts viscosity dominated
-    and ends toughness dominated. ``K_m <~ 1``: M-vertex (:func:`radial_m_vertex`,
-    :func:`radial_m_vertex_profile`); ``K_m >~ 3.5``: K-vertex (:func:`radial_k_vertex`);
+    and ends toughness dominated. ``K_m <= 1``: M-vertex (:func:`radial_m_vertex`,
+    :func:`radial_m_vertex_profile`); ``K_m >= 3.5``: K-vertex (:func:`radial_k_vertex`);
     in between the fracture is in transition and neither vertex is exact
     (:func:`radial_transition`, Dontsov 2016). ``K_m = (t / t_mk)^(1/9)`` with Dontsov's transition time
-    ``t_mk = (mu'^5 E'^13 Q^3 / K'^18)^(1/2)``. Returns an array like ``t``."""
-    t = _positive_times(t)
-    q = positive_scalar("injection_rate", injection_rate)
-    mu_prime = 12.0 * positive_scalar("viscosity", viscosity)
-    k_prime = toughness_scale(positive_scalar("fracture_toughness", fracture_toughness))
-    e_prime = material.plane_strain_modulus
-    return k_prime * (t**2 / (mu_prime**5 * q**3 * e_prime**13)) ** (1.0 / 18.0)
+    ``t_mk = (mu'^5 E'^13 Q^3 / K'^18)^(1/2)``. Returns an array like ``t``; the same as
+    :func:`hmatddm.analytical.regimes.radial_toughness_number`, where the limits live."""
+    from .regimes import radial_toughness_number
+
+    return radial_toughness_number(t, injection_rate, viscosity, fracture_toughness, material)
 
 
 def kgd_regime(injection_rate, viscosity, fracture_toughness, material):
     """Dimensionless toughness ``K_m = K' / (E'^3 mu' Q)^(1/4)`` of a plane-strain (KGD)
     fracture, zero leak-off (Detournay 2004; Adachi and Detournay 2002), ``Q`` per unit
-    height into both wings. It does not depend on time: ``K_m <~ 1`` M-vertex
-    (:func:`kgd_m_vertex`), ``K_m >~ 4`` K-vertex (:func:`kgd_k_vertex`)."""
-    q = positive_scalar("injection_rate", injection_rate)
-    mu_prime = 12.0 * positive_scalar("viscosity", viscosity)
-    k_prime = toughness_scale(positive_scalar("fracture_toughness", fracture_toughness))
-    e_prime = material.plane_strain_modulus
-    return k_prime / (e_prime**3 * mu_prime * q) ** 0.25
+    height into both wings. It does not depend on time: ``K_m <= 1`` M-vertex
+    (:func:`kgd_m_vertex`), ``K_m >= 4`` K-vertex (:func:`kgd_k_vertex`). The same as
+    :func:`hmatddm.analytical.regimes.kgd_toughness_number`."""
+    from .regimes import kgd_toughness_number
+
+    return kgd_toughness_number(injection_rate, viscosity, fracture_toughness, material)
 
 
 # --- the K-M transition of a radial fracture (Dontsov 2016) ----------------------------------

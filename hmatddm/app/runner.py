@@ -165,6 +165,7 @@ class SceneRun:
         start_time = simulation.state.time
         self.progress = Progress(numerics["end_time"], simulation.time_step, stream=self.stream,
                                  enabled=not self.quiet, start_time=start_time)
+        self._warn_reference()
         step = simulation.state.step
         if step == 0 or (step % scene["output"]["every"] == 0 and self._last_vtu_step != step):
             self._write_vtu(simulation.state)  # t = 0, or a step whose .vtu an interruption cut off
@@ -184,6 +185,15 @@ class SceneRun:
             raise
         self.progress.close()
         return self._finish()
+
+    def _warn_reference(self):
+        """One line when the scene's [reference] closed form does not apply over the run
+        (hmatddm.scene.reference_warning: its regime number), naming the one that does."""
+        from ..scene import reference_warning
+
+        warning = reference_warning(self.scene.data)
+        if warning:
+            self.note(f"hmatddm: warning: {warning}")
 
     # -- folder -------------------------------------------------------------------------
     def _holds_a_run(self):

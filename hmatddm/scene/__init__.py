@@ -138,6 +138,9 @@ The format, annotated (``=`` values are the defaults unless marked REQUIRED)::
     kind = "radial-k"              # "radial-k", "radial-m", "radial-km" (3D; K-M transition,
                                    # Dontsov 2016), "kgd-k", "kgd-m" (2D);
                                    # needs one cluster, [propagation] and no leak-off
+                                   # summary.json's reference rows record the regime number
+                                   # K_m and the solution (formula, source); `hmatddm run`
+                                   # warns when the vertex does not apply over the run
 
     # Natural fractures: the schema is defined and validated, but the engine has no
     # natural-fracture physics yet, so `hmatddm run` refuses such scenes (exit code 2).
@@ -211,7 +214,7 @@ from .schema import far_field_stress, has_natural_fractures, to_toml, validate
 # on first use, so that validating and refusing a scene stays quick
 __getattr__, __dir__ = attach(__name__, {name: ".build" for name in (
     "build_simulation", "natural_mesh", "natural_network", "natural_properties", "confining_stress", "initial_mesh",
-    "reference_curves", "reference_values")})
+    "reference_curves", "reference_values", "reference_regime", "reference_warning")})
 
 
 @dataclass(frozen=True)
@@ -370,5 +373,6 @@ def apply_override(raw, assignment):
 
 __all__ = ["Scene", "load_scene", "parse_scene", "scene_from_dict", "embedded_names", "embedded_text",
            "embedded_scenes", "apply_override", "validate", "build_simulation", "initial_mesh",
-           "reference_values", "reference_curves", "confining_stress", "far_field_stress",
+           "reference_values", "reference_curves", "reference_regime", "reference_warning",
+           "confining_stress", "far_field_stress",
            "has_natural_fractures", "to_toml", "natural_mesh", "natural_network", "natural_properties"]

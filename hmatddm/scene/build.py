@@ -183,13 +183,13 @@ def confining_stress(scene, normal=None):
 # Closed-form reference (ref. Sec. 4.5)
 # ---------------------------------------------------------------------------------
 
-def _closed_form(scene, times):
+def _closed_form(scene, times, kind=None):
     """Closed-form curves at ``times`` (> 0): dict of arrays with ``time``, ``radius`` or
     ``half_length``, ``max_opening``, optionally ``net_pressure``, and
-    ``dimensionless_toughness``."""
+    ``dimensionless_toughness``; of the scene's ``[reference] kind`` or of ``kind``."""
     from .. import analytical  # scipy.special: loaded only for a [reference]
 
-    kind = scene["reference"]["kind"]
+    kind = scene["reference"]["kind"] if kind is None else kind
     mat = material(scene)
     rate = scene["cluster"][0]["rate"]
     toughness = scene["propagation"]["toughness"]
@@ -238,6 +238,49 @@ def _closed_form(scene, times):
     return curves
 
 
+def reference_regime(scene, times):
+    """The regime of a scene with a ``[reference]`` at ``times`` (s, > 0): a dict with
+    ``number`` (``"K_m"``), ``values`` (array like ``times``), ``vertex`` (``"M"``, ``"K"``
+    or ``"transition"`` at each time, :func:`hmatddm.analytical.regimes.vertex`), ``applies``
+    (whether the reference's closed form applies at every time) and ``instead`` (the
+    solution that applies where it does not, else None)."""
+    from ..analytical import regimes
+
+    kind = scene["reference"]["kind"]
+    values = _closed_form(scene, times)["dimensionless_toughness"]
+    geometry = "radial" if kind.startswith("radial") else "kgd"
+    applies, instead = regimes.applicable_solution(kind, values)
+    return {"number": "K_m", "values": values, "vertex": [regimes.vertex(float(k), geometry) for k in values],
+            "applies": applies, "instead": instead}
+
+
+def run_times(scene):
+    """First and last time of a run of ``scene`` (s): the first step and ``numerics.end_time``."""
+    numerics = scene["numerics"]
+    return np.array([min(first_time_step(numerics), numerics["end_time"]), numerics["end_time"]])
+
+
+def reference_warning(scene):
+    """One line when the scene's ``[reference]`` closed form does not apply over the run
+    (its dimensionless toughness at the first step and at the end, :func:`reference_regime`),
+    naming the solution that does; None when it applies or there is no ``[reference]``."""
+    if "reference" not in scene:
+        return None
+    times = run_times(scene)
+    regime = reference_regime(scene, times)
+    if regime["applies"]:
+        return None
+    from ..analytical.regimes import KGD_LIMITS, RADIAL_LIMITS, SOLUTIONS
+
+    kind = scene["reference"]["kind"]
+    low, high = RADIAL_LIMITS if kind.startswith("radial") else KGD_LIMITS
+    k_first, k_last = regime["values"]
+    over = (f"K_m = {k_first:.2f}" if abs(k_last - k_first) < 5e-3 else f"K_m = {k_first:.2f} to {k_last:.2f}")
+    return (f"reference.kind = {kind!r} ({SOLUTIONS[kind].name}) does not apply over this run: {over} between "
+            f"t = {times[0]:g} and {times[1]:g} s (M-vertex at K_m <= {low:g}, K-vertex at K_m >= {high:g}); "
+            f"the solution that applies is {regime['instead']}")
+
+
 def reference_curves(scene, end_time=None, samples=200):
     """Closed-form curves for a history plot (``time`` from a small fraction of the
     first step to ``end_time``), in the format of :func:`hmatddm.render.plot_history`;
@@ -252,23 +295,75 @@ def reference_curves(scene, end_time=None, samples=200):
 
 
 def reference_values(scene, records):
-    """One dict per record with the closed-form values at its time and the relative
-    differences of the simulation (``relative_error``: simulation / closed form - 1);
-    None when the scene has no ``[reference]``."""
+    """One dict per record with the closed-form values at its time, the relative
+    differences of the simulation (``relative_error``: simulation / closed form - 1),
+    the regime there (``dimensionless_toughness``; ``regime``: its number, value, the
+    vertex it is at, whether the closed form applies from the first step to the last
+    record) and the ``solution`` compared with (kind, name, formula, source,
+    :data:`hmatddm.analytical.regimes.SOLUTIONS`); with ``reference.kind = "radial-km"``
+    also the K-vertex beside it (``k_vertex``: its values and the simulation's relative
+    differences, net pressure included). None when the scene has no ``[reference]``.
+
+    The net pressure is compared where the closed form defines it (:func:`_simulated`): a
+    K-vertex's is uniform, compared with the fracture's opening-weighted mean pressure minus
+    the confining stress (``net_pressure``) and with the injection element's
+    (``injection_net_pressure``, which adds the viscous drop near the well); the KGD
+    M-vertex's ``p(0)`` with the injection element's. The radial M-vertex and the transition
+    solution give none (log-singular at the well, resp. not approximated)."""
     if "reference" not in scene:
         return None
     if not records:
         return []
-    curves = _closed_form(scene, [record["time"] for record in records])
+    from ..analytical.regimes import SOLUTIONS
+
+    times = [record["time"] for record in records]
+    kind = scene["reference"]["kind"]
+    curves = _closed_form(scene, times)
+    beside = _closed_form(scene, times, kind="radial-k") if kind == "radial-km" else None
+    regime = reference_regime(scene, np.concatenate([run_times(scene)[:1], times]))
+    solution = SOLUTIONS[kind].as_dict()
     confining = confining_stress(scene)
     size_key = "radius" if "radius" in curves else "half_length"
     rows = []
     for index, record in enumerate(records):
         row = {key: float(values[index]) for key, values in curves.items()}
-        simulated = {size_key: record.get(size_key), "max_opening": record.get("max_opening")}
-        if "net_pressure" in curves:
-            simulated["net_pressure"] = record["wellbore_pressure"][0] - confining
-        row["relative_error"] = {key: (None if value is None or row[key] == 0.0 else float(value / row[key] - 1.0))
-                                 for key, value in simulated.items()}
+        simulated = _simulated(record, size_key, confining, uniform_pressure=kind.endswith("-k"))
+        row["relative_error"] = _relative(simulated, row)
+        row["regime"] = {"number": regime["number"], "value": row["dimensionless_toughness"],
+                         "vertex": regime["vertex"][index + 1], "applies_over_run": regime["applies"],
+                         "solution_that_applies": regime["instead"]}
+        row["solution"] = solution
+        if beside is not None:
+            vertex = {key: float(beside[key][index]) for key in (size_key, "max_opening", "net_pressure")}
+            vertex["relative_error"] = _relative(_simulated(record, size_key, confining, uniform_pressure=True),
+                                                 vertex)
+            vertex["solution"] = SOLUTIONS["radial-k"].as_dict()
+            row["k_vertex"] = vertex
         rows.append(row)
     return rows
+
+
+def _simulated(record, size_key, confining, uniform_pressure):
+    """The simulated values a closed form is compared with. ``net_pressure``: where the closed
+    form's net pressure is uniform (K-vertex), the opening-weighted mean pressure of the
+    fracture (``mean_pressure`` of the record, :func:`hmatddm.simulation.records.step_record`)
+    minus the confining stress, and the injection element's beside it
+    (``injection_net_pressure``); otherwise (the KGD M-vertex's ``p(0)``) the injection
+    element's."""
+    injection = record["wellbore_pressure"][0] - confining
+    simulated = {size_key: record.get(size_key), "max_opening": record.get("max_opening"), "net_pressure": injection}
+    if uniform_pressure and record.get("mean_pressure") is not None:
+        simulated["net_pressure"] = record["mean_pressure"] - confining
+        simulated["injection_net_pressure"] = injection
+    return simulated
+
+
+def _relative(simulated, closed_form):
+    """``simulated / closed form - 1`` for the keys the closed form has (None where the
+    simulation has no value or the closed form is 0); ``injection_net_pressure`` against the
+    closed form's (uniform) ``net_pressure``."""
+    closed_form = dict(closed_form)
+    if "net_pressure" in closed_form:
+        closed_form.setdefault("injection_net_pressure", closed_form["net_pressure"])
+    return {key: (None if value is None or closed_form[key] == 0.0 else float(value / closed_form[key] - 1.0))
+            for key, value in simulated.items() if key in closed_form}

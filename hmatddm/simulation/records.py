@@ -75,6 +75,13 @@ def _state_record(sim, s, flow, width, tally, relaxation, seconds, previous_time
         matvecs=int(tally.elastic_products), solve_seconds=float(seconds), leaked_volume=s.leaked_volume, relaxation=float(relaxation),
         restarts=int(tally.restarts), elements_added=int(tally.elements_added),
         growth_passes=int(tally.growth_passes), operator_builds=int(tally.operator_builds))
+    # fluid pressure weighted by the opening (issue 39): by Betti's reciprocity a crack's volume
+    # is its pressure weighted by the opening under a unit uniform pressure, the opening's
+    # shape near a K-vertex; so this is the pressure a uniform-pressure closed form (radial,
+    # KGD K-vertex) predicts. The injection element's pressure adds the viscous drop of a
+    # point source (log-singular in 3D: it grows as the element shrinks).
+    held = flow.areas * np.maximum(width, 0.0)
+    record["mean_pressure"] = float(np.sum(held * s.pressure) / np.sum(held)) if np.sum(held) > 0.0 else None
     record["junctions"] = int(tally.events.junctions)
     if sim.network is not None:
         record["natural_active"] = int(np.count_nonzero(s.origin == Origin.ACTIVATED))

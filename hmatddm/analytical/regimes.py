@@ -1,0 +1,193 @@
+"""Regime numbers of a growing hydraulic fracture and which closed form applies to it.
+
+A fracture driven by a Newtonian fluid at a constant rate ``Q`` spends the injected power
+on fracturing the rock (toughness ``K_Ic``), on the viscous flow (viscosity ``mu``) and,
+with leak-off, loses fluid to the rock. Scaled by the viscosity (M) scaling, the
+solution depends on dimensionless numbers only; which vertex solution applies is read off
+them (Savitski and Detournay 2002; Detournay 2004; Detournay 2016). Notation:
+``E' = 2 G / (1 - nu)``, ``K' = 4 (2/pi)^(1/2) K_Ic`` (ref. Eq. 4.68), ``mu' = 12 mu``,
+``C' = 2 C_L`` (Carter's coefficient of both faces together: a total leak-off rate
+``C' / (t - tau)^(1/2)`` per unit fracture area).
+
+Toughness numbers (zero leak-off):
+
+* radial: ``K_m = K' (t^2 / (mu'^5 Q^3 E'^13))^(1/18)`` (Savitski and Detournay 2002),
+  growing as ``t^(1/9)``: a radial fracture starts viscosity dominated and ends toughness
+  dominated; ``K_m <= 1`` M-vertex, ``K_m >= 3.5`` K-vertex, in between the K-M transition
+  (Dontsov 2016, :func:`hmatddm.analytical.radial_transition`);
+* plane strain (KGD): ``K_m = K' / (E'^3 mu' Q)^(1/4)``, ``Q`` per unit height into both
+  wings (Detournay 2004), constant in time; ``K_m <= 1`` M-vertex, ``K_m >= 4`` K-vertex,
+  in between the transition (Garagash 2006, large-toughness expansion; Dontsov 2017,
+  approximate solution; neither is in this package).
+
+Leak-off numbers (the ratio ``C' t^(1/2) / W_m`` of the leak-off length to the
+viscosity width scale ``W_m = eps_m L_m``; zero at a storage vertex):
+
+* radial: ``C_m = (C'^18 E'^4 t^7 / (mu'^4 Q^6))^(1/18)`` (Madyarova 2003; Detournay 2016),
+  growing as ``t^(7/18)``;
+* plane strain: ``C_m = (C'^6 E' t / (mu' Q^3))^(1/6)`` (Adachi and Detournay 2008),
+  growing as ``t^(1/6)``.
+
+Every closed form of :mod:`.solutions` for a growing fracture is a zero-leak-off
+solution, so a scene's ``[reference]`` refuses leak-off (:mod:`hmatddm.scene.schema`);
+the leak-off numbers say how far a scene with leak-off is from them.
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._validation import finite_array, positive_scalar
+from ..errors import InputError
+
+# Where the vertices apply (dimensionless toughness K_m): M-vertex at or below the first,
+# K-vertex at or above the second (Savitski and Detournay 2002 for radial; Detournay 2004
+# for plane strain).
+RADIAL_LIMITS = (1.0, 3.5)
+KGD_LIMITS = (1.0, 4.0)
+
+
+def _times(t):
+    t = finite_array("t", t)
+    if np.any(t <= 0.0):
+        raise InputError(f"t must be > 0 (time since the start of injection), got min {t.min()}")
+    return t
+
+
+def toughness_prime(fracture_toughness):
+    """``K' = 4 (2/pi)^(1/2) K_Ic`` (ref. Eq. 4.68)."""
+    return 4.0 * np.sqrt(2.0 / np.pi) * positive_scalar("fracture_toughness", fracture_toughness)
+
+
+def radial_toughness_number(t, injection_rate, viscosity, fracture_toughness, material):
+    """``K_m = K' (t^2 / (mu'^5 Q^3 E'^13))^(1/18)`` of a radial fracture, zero leak-off
+    (Savitski and Detournay 2002). Returns an array like ``t`` (s, > 0)."""
+    t = _times(t)
+    q = positive_scalar("injection_rate", injection_rate)
+    mu_prime = 12.0 * positive_scalar("viscosity", viscosity)
+    e_prime = material.plane_strain_modulus
+    return toughness_prime(fracture_toughness) * (t**2 / (mu_prime**5 * q**3 * e_prime**13)) ** (1.0 / 18.0)
+
+
+def kgd_toughness_number(injection_rate, viscosity, fracture_toughness, material):
+    """``K_m = K' / (E'^3 mu' Q)^(1/4)`` of a plane-strain (KGD) fracture, zero leak-off
+    (Detournay 2004); ``Q`` per unit height into both wings. Independent of time."""
+    q = positive_scalar("injection_rate", injection_rate)
+    mu_prime = 12.0 * positive_scalar("viscosity", viscosity)
+    e_prime = material.plane_strain_modulus
+    return toughness_prime(fracture_toughness) / (e_prime**3 * mu_prime * q) ** 0.25
+
+
+def radial_leak_off_number(t, injection_rate, viscosity, leak_off, material):
+    """``C_m = (C'^18 E'^4 t^7 / (mu'^4 Q^6))^(1/18)`` of a radial fracture (Madyarova 2003;
+    Detournay 2016), ``leak_off`` = ``C'`` in m/s^(1/2) (both faces; >= 0). An array like ``t``."""
+    t = _times(t)
+    c_prime = _leak_off(leak_off)
+    q = positive_scalar("injection_rate", injection_rate)
+    mu_prime = 12.0 * positive_scalar("viscosity", viscosity)
+    e_prime = material.plane_strain_modulus
+    return c_prime * (e_prime**4 * t**7 / (mu_prime**4 * q**6)) ** (1.0 / 18.0)
+
+
+def kgd_leak_off_number(t, injection_rate, viscosity, leak_off, material):
+    """``C_m = (C'^6 E' t / (mu' Q^3))^(1/6)`` of a plane-strain fracture (Adachi and
+    Detournay 2008), ``Q`` per unit height, ``leak_off`` = ``C'`` in m/s^(1/2). Like ``t``."""
+    t = _times(t)
+    c_prime = _leak_off(leak_off)
+    q = positive_scalar("injection_rate", injection_rate)
+    mu_prime = 12.0 * positive_scalar("viscosity", viscosity)
+    e_prime = material.plane_strain_modulus
+    return c_prime * (e_prime * t / (mu_prime * q**3)) ** (1.0 / 6.0)
+
+
+def _leak_off(value):
+    value = float(value)
+    if not np.isfinite(value) or value < 0.0:
+        raise InputError(f"leak_off (C' = 2 C_L, m/s^0.5) must be finite and >= 0, got {value}")
+    return value
+
+
+def vertex(toughness_number, geometry):
+    """``"M"``, ``"K"`` or ``"transition"`` for a dimensionless toughness (scalar), by
+    :data:`RADIAL_LIMITS` (``geometry = "radial"``) or :data:`KGD_LIMITS` (``"kgd"``)."""
+    low, high = _limits(geometry)
+    if toughness_number <= low:
+        return "M"
+    if toughness_number >= high:
+        return "K"
+    return "transition"
+
+
+def _limits(geometry):
+    if geometry not in ("radial", "kgd"):
+        raise InputError(f"geometry must be 'radial' or 'kgd', got {geometry!r}")
+    return RADIAL_LIMITS if geometry == "radial" else KGD_LIMITS
+
+
+@dataclass(frozen=True)
+class Solution:
+    """A closed form a scene is compared with: its ``[reference] kind``, a name, the
+    formula of its radius (or half-length) and the published source."""
+
+    kind: str
+    name: str
+    formula: str
+    source: str
+
+    def as_dict(self):
+        return {"kind": self.kind, "name": self.name, "formula": self.formula, "source": self.source}
+
+
+SOLUTIONS = {
+    "radial-k": Solution(
+        "radial-k", "radial K-vertex (zero viscosity, zero leak-off; exact)",
+        "R = (3 E' Q t / (8 pi^(1/2) K_Ic))^(2/5), p = pi^(1/2) K_Ic / (2 R^(1/2)), w0 = 8 p R / (pi E')",
+        "ref. Eqs 4.65-4.67; Savitski and Detournay 2002"),
+    "radial-m": Solution(
+        "radial-m", "radial M-vertex (zero toughness, zero leak-off)",
+        "R = 0.6944 (Q^3 E' t^4 / mu')^(1/9), w0 = 1.1901 (mu'^2 Q^3 t / E'^2)^(1/9)",
+        "ref. Eqs 4.62-4.63; Savitski and Detournay 2002; Dontsov 2016"),
+    "radial-km": Solution(
+        "radial-km", "radial K-M transition (any K_m, zero leak-off; approximate, ~1%)",
+        "w = w_a (1 - rho)^delta ((1 + rho)/2)^lambda, w_a the universal tip asymptote at s = R, "
+        "R such that the volume is Q t",
+        "Dontsov 2016, R. Soc. open sci. 3:160737; tip asymptote of Dontsov and Peirce 2015"),
+    "kgd-k": Solution(
+        "kgd-k", "plane-strain (KGD) K-vertex (zero viscosity, zero leak-off; exact)",
+        "l = (E' Q t / (2 pi^(1/2) K_Ic))^(2/3), p = K_Ic / (pi l)^(1/2), w0 = 4 p l / E'",
+        "Garagash 2006; Detournay 2004"),
+    "kgd-m": Solution(
+        "kgd-m", "plane-strain (KGD) M-vertex (zero toughness, zero leak-off)",
+        "l = 0.61524 (E' Q^3 t^4 / mu')^(1/6), w0 = 1.1233 (mu' Q^3 t^2 / E')^(1/6), "
+        "p(0) = 0.5443 (mu' E'^2 / t)^(1/3)",
+        "Spence and Sharp 1985; Adachi and Detournay 2002"),
+}
+
+# what applies where a vertex does not: the transition solutions
+_TRANSITION = {
+    "radial": "radial-km (Dontsov 2016, in this package)",
+    "kgd": "the plane-strain K-M transition (Dontsov 2017, or Garagash 2006's large-toughness expansion; "
+           "not in this package)",
+}
+
+
+def applicable_solution(kind, toughness_numbers):
+    """Whether the closed form ``kind`` applies at every toughness number of
+    ``toughness_numbers`` (the run's times), and, where it does not, the solution that does.
+
+    Returns ``(applies, name_of_the_solution_that_applies)`` (the name is None when it
+    applies). A vertex applies when every number is on its side of the limits
+    (:data:`RADIAL_LIMITS`, :data:`KGD_LIMITS`); the radial transition applies at any ``K_m``.
+    """
+    if kind not in SOLUTIONS:
+        raise InputError(f"reference kind must be one of {sorted(SOLUTIONS)}, got {kind!r}")
+    geometry = "radial" if kind.startswith("radial") else "kgd"
+    if kind == "radial-km":
+        return True, None
+    vertices = {vertex(float(k), geometry) for k in np.ravel(toughness_numbers)}
+    wanted = kind.rsplit("-", 1)[1].upper()
+    if vertices == {wanted}:
+        return True, None
+    if vertices == {"M" if wanted == "K" else "K"}:  # the other vertex all along
+        other = SOLUTIONS[f"{kind.split('-')[0]}-{'m' if wanted == 'K' else 'k'}"]
+        return False, f"{other.kind} ({other.name}; {other.source})"
+    return False, _TRANSITION[geometry]
