@@ -72,7 +72,8 @@ def _state_record(sim, s, flow, width, tally, relaxation, seconds, previous_time
         fracture_volume=float(np.sum(flow.areas * width)), fracture_area=area, max_opening=float(np.max(width)),
         wellbore_pressure=[float(s.pressure[i]) for i in sim.injection_elements],
         nonlinear_iterations=int(tally.nonlinear_iterations), linear_iterations=int(tally.linear_iterations),
-        matvecs=int(tally.elastic_products), solve_seconds=float(seconds), leaked_volume=s.leaked_volume, relaxation=float(relaxation),
+        matvecs=int(tally.elastic_products), solve_seconds=float(seconds), leaked_volume=s.leaked_volume,
+        relaxation=float(relaxation),
         restarts=int(tally.restarts), elements_added=int(tally.elements_added),
         growth_passes=int(tally.growth_passes), operator_builds=int(tally.operator_builds))
     # fluid pressure weighted by the opening (issue 39): by Betti's reciprocity a crack's volume
