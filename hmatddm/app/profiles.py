@@ -46,9 +46,25 @@ def closed_form_profile(scene, time_value):
     kind = reference["kind"]
     rock = material(scene)
     rate = scene["cluster"][0]["rate"]
-    viscosity = scene["fluid"]["viscosity"]
+    fluid = scene["fluid"]
+    viscosity = fluid.get("viscosity")
     toughness = scene.get("propagation", {}).get("toughness")
     t = float(time_value)
+    if fluid.get("rheology") == "power-law" and kind in ("kgd-m", "radial-m"):  # hmatddm.analytical.power_law
+        from ..analytical import power_law
+
+        fluid_args = (fluid["consistency"], fluid["flow_index"])
+        if kind == "kgd-m":
+            size = power_law.kgd_power_law_vertex(t, rate / scene["height"], *fluid_args, rock)[0]
+            rho = np.linspace(0.0, _M_RHO[1], SAMPLES)
+            width, pressure = power_law.kgd_power_law_profile(rho, t, rate / scene["height"], *fluid_args, rock)
+        else:
+            size = power_law.radial_power_law_vertex(t, rate, *fluid_args, rock)[0]
+            rho = np.linspace(*_M_RHO, SAMPLES)
+            width, pressure = power_law.radial_power_law_profile(rho, t, rate, *fluid_args, rock)
+        profile = _symmetric(rho, np.ravel(width), np.ravel(pressure), float(np.ravel(size)[0]))
+        profile["label"] = f"power-law {kind[-1].upper()}-vertex (n = {fluid['flow_index']:g})"
+        return profile
     if kind in ("kgd-k", "radial-k"):
         if kind == "kgd-k":
             size, width, pressure = analytical.kgd_k_vertex(t, rate / scene["height"], toughness, rock)

@@ -59,8 +59,9 @@ class RebuildSettings:
         block LU holds about twice as much again; ``base_bytes`` (the base H-matrix's
         memory, given with compressed borders): ``A_nn`` and its factors may not outgrow
         it, so that they never cost a product more than the base does (on the h = 0.25 m
-        radial run, letting ``A_nn`` grow to a quarter of the base made the run 7% slower
-        although its borders were compressed)."""
+        radial K run, compressed borders with ``A_nn`` allowed a quarter of the base took
+        309.7 s of CPU against 288.0 s for the dense borders of the version before, in one
+        session on a shared machine; benchmarks/RESULTS.md, issue 33)."""
         entries = dof * dof if entries_per_pair is None else entries_per_pair
         border = 8.0 * entries * 2 * compressed * added if bytes_per_added is None else bytes_per_added * added
         own = 8.0 * entries * added * added

@@ -105,9 +105,38 @@ def _scene_inputs(data):
     return mat, rate, data["fluid"]["viscosity"], data["propagation"]["toughness"]
 
 
+# embedded scenes of a power-law fluid with a [reference] (issue 34): the regime they claim
+POWER_LAW_SCENES = {"kgd-power-law": "M"}
+
+
 def test_every_embedded_reference_scene_is_named():
     with_reference = {name for name in hs.embedded_names() if "reference" in hs.load_scene(name).data}
-    assert with_reference == set(SCENE_REGIMES)
+    assert with_reference == set(SCENE_REGIMES) | set(POWER_LAW_SCENES)
+
+
+def independent_power_law_kgd_km(t, rate, consistency, n, toughness, mat):
+    """K_m = K' / (E' eps L^(1/2)) of a power-law KGD fracture in Adachi and Detournay's
+    (2002) M-scaling: M' = 2^(n+1) (2n+1)^n n^-n K, eps = (M' / (E' t^n))^(1/(n+2)),
+    L = (E' Q^(n+2) t^(2n+2) / M')^(1/(2n+4)); 12 mu, Savitski's K_m at n = 1."""
+    e_prime = mat.youngs_modulus / (1.0 - mat.poisson_ratio ** 2)
+    m_prime = 2.0 ** (n + 1) * (2 * n + 1) ** n / n ** n * consistency
+    eps = (m_prime / (e_prime * t ** n)) ** (1.0 / (n + 2))
+    length = (e_prime * rate ** (n + 2) * t ** (2 * n + 2) / m_prime) ** (1.0 / (2 * n + 4))
+    k_prime = np.sqrt(32.0 / np.pi) * toughness
+    return k_prime / (e_prime * eps * np.sqrt(length))
+
+
+@pytest.mark.parametrize("name", sorted(POWER_LAW_SCENES))
+def test_regime_of_each_power_law_scene(name):
+    data = hs.load_scene(name).data
+    mat = Elastic(shear_modulus=data["material"]["shear_modulus"], poisson_ratio=data["material"]["poisson_ratio"])
+    fluid, numerics = data["fluid"], data["numerics"]
+    times = np.array([numerics["time_step"], numerics["end_time"]])
+    expected = independent_power_law_kgd_km(times, data["cluster"][0]["rate"] / data["height"], fluid["consistency"],
+                                            fluid["flow_index"], data["propagation"]["toughness"], mat)
+    regime = hs.reference_regime(data, times)
+    assert np.allclose(regime["values"], expected, rtol=1e-12)
+    assert POWER_LAW_SCENES[name] == "M" and expected.max() <= 1.0 and regime["applies"]
 
 
 @pytest.mark.parametrize("name", sorted(SCENE_REGIMES))

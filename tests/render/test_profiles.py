@@ -117,3 +117,18 @@ def test_a_3d_side_view_draws_the_layer_interfaces(tmp_path):
                                 interfaces=[2.0, -2.0]))
     changed = np.mean(np.any(np.abs(layered - plain) > 0.05, axis=2))
     assert changed > 0.02  # two translucent planes and their caption
+
+
+def test_every_embedded_reference_scene_has_a_closed_form_profile():
+    """Each embedded scene with a [reference] (power-law fluids included) gets a finite
+    closed-form profile to overlay."""
+    import hmatddm.scene as scenes
+    from hmatddm.app.profiles import closed_form_profile
+
+    for name in scenes.embedded_names():
+        data = scenes.load_scene(name).data
+        if "reference" not in data:
+            continue
+        profile = closed_form_profile(data, data["numerics"]["end_time"])
+        assert profile is not None and profile["label"], name
+        assert np.all(np.isfinite(profile["opening"])) and np.all(profile["opening"] >= 0.0), name
