@@ -2,21 +2,24 @@
 
 When a fracture grows, the mesh gains a ring of elements at its front. Rebuilding the
 H-matrix for every growth pass would dominate the run time, so the new elements are
-added as exact border blocks around the existing operator::
+added as border blocks around the existing operator::
 
     A = [ A_oo   A_on ]    A_oo: the H-matrix (or dense matrix) already built
-        [ A_no   A_nn ]    A_on, A_no, A_nn: exact kernel blocks (dense)
+        [ A_no   A_nn ]    A_on, A_no: exact kernel blocks, or compressed (below)
+                           A_nn: exact kernel block (dense)
 
-Matvec cost grows by ``2 N m d^2`` for ``m`` new elements, so the simulation rebuilds
-the base operator once the border is large (see ``Simulation``). The preconditioner
+Dense borders cost ``2 N m d^2`` per product for ``m`` new elements, so the simulation
+rebuilds the base operator once the border is large (see ``Simulation``). The preconditioner
 is block lower-triangular: the base near-field preconditioner for the old unknowns,
 then an exact LU of ``A_nn`` for the new ones.
 
 Large borders are compressed: once the base is an H-matrix of a few thousand elements,
 a chunk of added elements gets ``A_on`` and ``A_no`` as rectangular H-matrices (the base's
 cluster tree against a tree of the chunk, same ``eps`` and ``eta`` as the base), so a
-border costs ``O((N + m) k)`` entries instead of ``N m`` and a mesh can grow by a large
-fraction of itself before the base is rebuilt (see :data:`COMPRESS_MIN_BASE`).
+border costs ``O((N + m) k)`` entries instead of ``N m`` and its size no longer forces a
+rebuild of the base at every ring of a large mesh (see :data:`COMPRESS_MIN_BASE`; 62k
+elements + a ring of 1000: 27 MB and 3.5 s instead of 1 GB and 26 s, benchmarks/RESULTS.md,
+issue 33).
 
 Growth passes share work (a pass adds a few elements to the last pass's mesh): the border
 is kept as one chunk of ``A_on`` columns and ``A_no`` rows per batch of added elements,
@@ -62,7 +65,8 @@ NEAR_SEARCH_RADII = 6.0
 
 class ExtendedElasticityOperator(ProductCounter, LinearOperator):
     """``base`` (an ElasticityOperator of the first ``n0`` elements of ``mesh``) plus
-    exact border blocks for elements ``n0..N-1``.
+    border blocks for elements ``n0..N-1``: exact, or compressed to the base's ``eps``
+    (module docstring).
 
     ``base`` may also be one part of a planar crack's operator
     (:meth:`hmatddm.elasticity.planar.PlanarElasticityOperator.part`): its ``dof`` unknowns
@@ -194,7 +198,7 @@ class ExtendedElasticityOperator(ProductCounter, LinearOperator):
         mesh, d, n0 = self.mesh, self.dof, self.n_base
         first = int(added[0])
         if not np.array_equal(added, np.arange(first, first + added.size)):
-            raise AssertionError("added elements are consecutive")  # appended by construction
+            raise AssertionError("the added elements must be consecutive")  # appended by construction
         old_points, old_radii = mesh.centers[:n0], mesh.radii[:n0]
         new_points, new_radii = mesh.centers[added], mesh.radii[added]
         new_tree = cluster_tree(new_points, new_radii, base.leaf_size)
