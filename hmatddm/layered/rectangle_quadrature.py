@@ -64,27 +64,6 @@ def nearest_singularity(y, receiver_layer, center, frame, a, b, source_layer, in
 
 
 @njit(cache=True)
-def image_singularity(y, receiver_layer, center, frame, a, b, source_layer, interfaces):
-    """:func:`nearest_singularity` without the mirror images that no triple in the
-    receiver's layer has: across the interfaces between a source and a receiver in
-    different layers (a triple living in a layer emanates from outside it, so a triple
-    in the receiver's layer never sits at the source's mirror in an interface facing the
-    receiver, nor at its mirror in the receiver's interface facing the source)."""
-    if receiver_layer == source_layer:
-        return nearest_singularity(y, receiver_layer, center, frame, a, b, source_layer, interfaces)
-    dmin = rectangle_distance(y, center, frame, a, b)
-    n_if = interfaces.shape[0]
-    if receiver_layer < source_layer:  # the receiver above: keep the source's bottom and the receiver's top
-        far_source, far_receiver = source_layer, receiver_layer - 1
-    else:
-        far_source, far_receiver = source_layer - 1, receiver_layer
-    for k in (far_source, far_receiver):
-        if 0 <= k < n_if:
-            dmin = min(dmin, _distance(y[0], y[1], 2.0 * interfaces[k] - y[2], center, frame, a, b))
-    return dmin
-
-
-@njit(cache=True)
 def subdivisions(y, receiver_layer, center, frame, a, b, source_layer, interfaces, max_sub):
     """Sub-squares per side so that each is at most half as large as the distance from
     the receiver to the nearest singular point of the integrand (:func:`nearest_singularity`)."""
@@ -238,8 +217,7 @@ def _image_order(y, receiver_layer, center, frame, a, b, source_layer, interface
     dmin = nearest_singularity(y, receiver_layer, center, frame, a, b, source_layer, interfaces)
     n_sub = 2 ** subdivision_level(_sub_count(dmin, a, b, max_sub))
     if entry_tol > 0.0:
-        d_image = image_singularity(y, receiver_layer, center, frame, a, b, source_layer, interfaces)
-        while n_sub < max_sub and NEAR_FACTOR * entry_error(d_image, a, b, n_sub, gauss_points) > entry_tol:
+        while n_sub < max_sub and NEAR_FACTOR * entry_error(dmin, a, b, n_sub, gauss_points) > entry_tol:
             n_sub *= 2
     if n_sub == 1:
         n = far_order(dmin / max(a, b), gauss_points, far_tol)
