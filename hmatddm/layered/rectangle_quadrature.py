@@ -110,12 +110,6 @@ ENTRY_TOL = 1e-9
 #: middle layer), 0.9 (a 5:1 bi-material) on randomly oriented squares at 2 to 100 half
 #: sides; five times the largest.
 IMAGE_BOUND = 10.0
-#: Measured error over :func:`entry_error` of 4 points per side on 1, 2 and 4 sub-squares
-#: per side next to an interface (squares 0.36-0.9 m from a free surface or from the
-#: interfaces of three layers, receivers within ~1 m, 120 random pairs): at most 6e-4.
-#: The sub-squares are refined until this factor times the bound meets the tolerance,
-#: 17 times the largest measured.
-NEAR_FACTOR = 1e-2
 
 
 @njit(cache=True)
@@ -137,15 +131,6 @@ def entry_order(dmin, a, b, n_max, tol):
         if 40.0 * n * ratio ** (-2.0 * n) * size <= tol:
             return n
     return n_max
-
-
-@njit(cache=True)
-def entry_error(dmin, a, b, n_sub, n_gauss):
-    """Bound of the error of ``n_gauss`` points per side on each of ``n_sub^2``
-    sub-squares (:func:`entry_order`'s model with the sub-square's distance ratio), per
-    unit ``G_max``."""
-    ratio = dmin * n_sub / max(a, b)
-    return 40.0 * n_gauss * ratio ** (-2.0 * n_gauss) * IMAGE_BOUND * 4.0 * a * b / (dmin * dmin * dmin)
 
 
 @njit(cache=True)
@@ -209,16 +194,10 @@ def _image_order(y, receiver_layer, center, frame, a, b, source_layer, interface
                  entry_tol):
     """``(n_gauss, n_sub)`` of the image quadrature of a rectangle at ``y``: sub-squares
     by :func:`subdivisions` rounded up to a power of two, and, on one square,
-    :func:`far_order` points per side. With ``entry_tol > 0`` (the error allowed
-    relative to the largest entry, over ``G_max``): sub-squares doubled until
-    :func:`entry_error` is below it (what ``gauss_points = 4`` leaves next to an
-    interface otherwise: up to 9e-8 of the largest entry), and on one square fewer
-    points by :func:`entry_order`."""
+    :func:`far_order` points per side, or fewer by :func:`entry_order` when
+    ``entry_tol > 0`` (the error allowed relative to the largest entry, over ``G_max``)."""
     dmin = nearest_singularity(y, receiver_layer, center, frame, a, b, source_layer, interfaces)
     n_sub = 2 ** subdivision_level(_sub_count(dmin, a, b, max_sub))
-    if entry_tol > 0.0:
-        while n_sub < max_sub and NEAR_FACTOR * entry_error(dmin, a, b, n_sub, gauss_points) > entry_tol:
-            n_sub *= 2
     if n_sub == 1:
         n = far_order(dmin / max(a, b), gauss_points, far_tol)
         if entry_tol > 0.0:
