@@ -5,7 +5,16 @@ half-space, a bi-material and three layers, next to the homogeneous kernel. The 
 each block is measured against the same block with 8 Gauss points per side on every
 (sub-)square (``far_tol = 0``; ``--quick``: the half-space only).
 
-Run: ``NUMBA_NUM_THREADS=1 python benchmarks/bench_layered3d_kernel.py``."""
+``--issue32``: the mesh of issue 32 (576 randomly oriented 0.5 m squares on an 8 x 8 x 9
+lattice of 3 m, centres at 3-27 m depth), uniform rock, a half-space (``images=1``) and a
+free surface with interfaces at z = -10, -20 m (G, 2G, G, ``images=4``) side by side:
+per-pair CPU of the default path (merged image triples, Gauss order from the error
+allowed relative to the largest entry) and of the relative-error rule of issue 14
+(``entry_tol = 0``), each with its error against 8 points per side everywhere (on
+``--error-rows`` receivers), for ``gauss_points`` 4 (the default) and 6; the three-layer
+timings on ``--rows3`` receivers (all 576 sources).
+
+Run: ``NUMBA_NUM_THREADS=1 python benchmarks/bench_layered3d_kernel.py [--issue32]``."""
 import argparse
 import time
 
@@ -45,10 +54,75 @@ def block(data, rows, cols, repeats=2):
     return out, best[0], best[1]
 
 
+def issue32_mesh(n_side=8, levels=9, seed=0):
+    """576 randomly oriented 0.5 m squares on a lattice of 3 m, centres at 3-27 m depth."""
+    rng = np.random.default_rng(seed)
+    xs = np.arange(n_side) * 3.0
+    centers = np.array([[x, y, -3.0 - 3.0 * k] for k in range(levels) for x in xs for y in xs])
+    frames = np.linalg.qr(rng.normal(size=(len(centers), 3, 3)))[0]
+    half = np.full(len(centers), 0.25)
+    return hd.Mesh3D.from_rectangles(centers, frames[:, :, 0], frames[:, :, 1], half, half)
+
+
+def _timed(data, rows, cols):
+    out = np.empty((3 * len(rows), 3 * len(cols)))
+    drivers.traction_block(data, rows[:2], cols[:2], np.empty((6, 6)))
+    t0, c0 = time.perf_counter(), time.process_time()
+    drivers.traction_block(data, rows, cols, out)
+    return out, time.process_time() - c0, time.perf_counter() - t0
+
+
+def issue32(args):
+    grid = issue32_mesh()
+    every = np.arange(grid.n_elements, dtype=np.int64)
+    g = 1.0
+    media = {"uniform": hd.Elastic(g, 0.25),
+             "half-space, images=1": lambda n: LayeredMedium([0.0], [0.0, g], [0.25, 0.25], images=1,
+                                                             gauss_points=n),
+             "surface + 2 interfaces, images=4": lambda n: LayeredMedium(
+                 [0.0, -10.0, -20.0], [0.0, g, 2 * g, g], [0.25] * 4, images=4, gauss_points=n)}
+    print(f"issue 32 mesh: {grid.n_elements} squares; 1 thread")
+    print(machine())
+    table = []
+    base = None
+    for name, medium in media.items():
+        layered = callable(medium)
+        for n_gauss in ((4, 6) if layered else (None,)):
+            data = operators.influence_data(grid, medium(n_gauss) if layered else medium)
+            rows = every if not name.startswith("surface") else every[::len(every) // args.rows3][:args.rows3]
+            err_rows = every[::len(every) // args.error_rows][:args.error_rows]
+            paths = [("default", data)]
+            if layered:
+                paths.append(("relative rule (issue 14)", data._replace(entry_tol=0.0)))
+            reference = None
+            if layered:
+                reference, *_ = _timed(data._replace(gauss_points=8, far_tol=0.0, entry_tol=0.0), err_rows, every)
+            for label, d in paths:
+                _, cpu, wall = _timed(d, rows, every)
+                per = cpu / (len(rows) * len(every)) * 1e6
+                base = base or per
+                error = "-"
+                if reference is not None:
+                    got, *_ = _timed(d, err_rows, every)
+                    error = f"{np.abs(got - reference).max() / np.abs(reference).max():.1e}"
+                table.append([name, n_gauss or "-", label, f"{len(rows)} x {len(every)}", f"{cpu:.3f}", f"{wall:.3f}",
+                              f"{per:.2f}", f"{per / base:.0f}", error])
+                print(table[-1], flush=True)
+    print(markdown_table(["medium", "gauss_points", "path", "pairs", "CPU s", "wall s", "CPU us / pair",
+                          "x uniform", "max error / max entry (vs 8 points)"], table))
+    print(machine())
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--quick", action="store_true")
+    parser.add_argument("--issue32", action="store_true")
+    parser.add_argument("--rows3", type=int, default=48)
+    parser.add_argument("--error-rows", type=int, default=12)
     args = parser.parse_args()
+    if args.issue32:
+        issue32(args)
+        return
     grid = mesh()
     rows = np.arange(0, grid.n_elements, 2, dtype=np.int64)
     cols = np.arange(1, grid.n_elements, 2, dtype=np.int64)

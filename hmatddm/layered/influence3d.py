@@ -11,6 +11,7 @@ from ..kernels.drivers import finite_stress_sum, with_self_max
 from . import images3d
 from .influence2d import choose_images as _choose_images
 from .influence2d import layers_of_extents, with_images
+from .rectangle_quadrature import ENTRY_TOL, entry_scale
 
 #: Largest number of sub-squares per side of a rectangle for the image quadrature.
 MAX_SUBDIVISIONS = 16
@@ -37,11 +38,12 @@ def influence_data(mesh, medium, singular_shift, alpha, near_fraction, n_images)
     with ``n_images`` images; ``alpha > 0`` fills ``self_max`` for ref. Eq. 6.11."""
     layers = element_layers(mesh, medium)
     interfaces, g, nu = medium.arrays()
+    scale = entry_scale(mesh.half_a, mesh.half_b, layers, g, nu) / g.max() if interfaces.shape[0] > 0 else 0.0
     return with_self_max(images3d.LayeredRectangles(
         mesh.centers, mesh.frames, mesh.half_a, mesh.half_b, layers, interfaces, g, nu, n_images=int(n_images),
         gauss_points=int(medium.gauss_points), max_subdivisions=int(MAX_SUBDIVISIONS),
         singular_shift=float(singular_shift), near_fraction=float(near_fraction), alpha=float(alpha),
-        self_max=np.zeros(mesh.n_elements)))
+        self_max=np.zeros(mesh.n_elements), entry_tol=float(ENTRY_TOL), entry_scale=float(scale)))
 
 
 def choose_images(mesh, medium, data, max_samples=12, max_sources=120):
