@@ -191,15 +191,19 @@ def solve(flow_index):
     return PowerLawKGD(n, coefficients, float(np.sqrt(0.5 / volume)), float(np.max(np.abs(fit.fun))))
 
 
-def scales(t, injection_rate, consistency, flow_index, material):
-    """``(E', eps, L)`` of the module docstring (arrays like ``t``)."""
+def _scaling_inputs(t, injection_rate, consistency, flow_index, material):
+    """The checked ``(t, Q, n, M', E')`` both scalings start from."""
     t = finite_array("t", t)
     if np.any(t <= 0.0):
         raise InputError(f"t must be > 0 (time since the start of injection), got min {t.min()}")
-    q = positive_scalar("injection_rate", injection_rate)
     n = _flow_index(flow_index)
-    m_prime = consistency_prime(consistency, n)
-    e_prime = material.plane_strain_modulus
+    return (t, positive_scalar("injection_rate", injection_rate), n, consistency_prime(consistency, n),
+            material.plane_strain_modulus)
+
+
+def scales(t, injection_rate, consistency, flow_index, material):
+    """``(E', eps, L)`` of the module docstring (arrays like ``t``)."""
+    t, q, n, m_prime, e_prime = _scaling_inputs(t, injection_rate, consistency, flow_index, material)
     length = (e_prime * q ** (n + 2.0) * t ** (2.0 * n + 2.0) / m_prime) ** (1.0 / (2.0 * n + 4.0))
     return e_prime, (m_prime / (e_prime * t**n)) ** (1.0 / (n + 2.0)), length
 
@@ -398,13 +402,7 @@ def _gauss_legendre_moment(n, alpha):
 
 def radial_scales(t, injection_rate, consistency, flow_index, material):
     """``(E', eps, L)`` of the radial problem (block comment above), arrays like ``t``."""
-    t = finite_array("t", t)
-    if np.any(t <= 0.0):
-        raise InputError(f"t must be > 0 (time since the start of injection), got min {t.min()}")
-    q = positive_scalar("injection_rate", injection_rate)
-    n = _flow_index(flow_index)
-    m_prime = consistency_prime(consistency, n)
-    e_prime = material.plane_strain_modulus
+    t, q, n, m_prime, e_prime = _scaling_inputs(t, injection_rate, consistency, flow_index, material)
     length = (e_prime * q ** (n + 2.0) * t ** (2.0 * n + 2.0) / m_prime) ** (1.0 / (3.0 * n + 6.0))
     return e_prime, q * t / length**3, length
 
