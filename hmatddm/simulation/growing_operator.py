@@ -92,6 +92,12 @@ class GrowingOperator:
         self.builds += 1
         return self.base
 
+    def reset(self, base):
+        """Go back to ``base`` (an earlier :attr:`base`, or None), forgetting the operators
+        made since: a step tried again starts from the operator it started from, as a run
+        resumed from that step's checkpoint would."""
+        self.base, self._mesh, self._operator = base, None, None
+
     def restore(self, mesh, compressed_elements):
         """Rebuild the base an interrupted run had (its first ``compressed_elements``
         elements of ``mesh``), so that a resumed run applies the same operator, bit for bit."""

@@ -28,7 +28,7 @@ import numpy as np
 
 from .._validation import finite_array, positive_scalar
 from ..coupled import SchemeSettings
-from ..errors import InputError, NoInjectionWarning, SizeLimitError
+from ..errors import ConvergenceError, InputError, NoInjectionWarning, SizeLimitError
 from ..flow import Cluster, Fluid, LeakOff, LubricationModel
 from ..fracture import Propagation
 from ..layered.medium import LayeredMedium
@@ -302,10 +302,34 @@ class Simulation:
         With ``end_time``, a step that would reach or pass it (within 1e-9 of a step) ends
         exactly at ``end_time``: the last step of a run is shortened, never longer.
         Raises :class:`~hmatddm.errors.SizeLimitError` (the state stays the last finished
-        step) when growth would take the mesh past ``max_elements``.
+        step) when growth would take the mesh past ``max_elements``. With front-following
+        steps (``step_control``), a step whose solve does not converge is tried again at
+        half its length, down to ``min_time_step`` (the record's ``step_retries`` counts the
+        tries); with fixed steps the :class:`~hmatddm.errors.ConvergenceError` is raised.
         """
         if self.front is not None:  # propagation.front = "asymptotic" (hmatddm.simulation.asymptotic)
             return self.front.step(self, end_time)
+        if self.step_control is None:
+            return self._step(end_time)
+        # front-following steps: a step that does not converge is tried again at half its
+        # length (down to min_time_step), from the same state and the same base operator
+        base, clock, retries = self.operators.base, time.perf_counter(), 0
+        while True:
+            try:
+                record = self._step(end_time)
+            except ConvergenceError:
+                shorter = max(0.5 * self.state.time_step, self.step_control.minimum)
+                if shorter >= self.state.time_step:
+                    raise
+                self.state = replace(self.state, time_step=shorter)
+                self.operators.reset(base)
+                retries += 1
+                continue
+            record.update(solve_seconds=float(time.perf_counter() - clock), step_retries=retries)
+            return record
+
+    def _step(self, end_time):
+        """One step of the element front (see :meth:`step`)."""
         clock = time.perf_counter()
         t_old, t_new = self.step_times(end_time)
         begin = self.state

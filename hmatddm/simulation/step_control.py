@@ -13,7 +13,10 @@ element; this module does the same for any mesh, element front or asymptotic fro
   last step, assumed to hold for the next), at most ``GROWTH`` times longer and at least
   ``1 / GROWTH`` times shorter; a step without growth doubles the next one;
 * every step lies in ``[min_time_step, max_time_step]``; the first is
-  ``first_time_step``; a run's last step still ends exactly at its end time.
+  ``first_time_step``; a run's last step still ends exactly at its end time;
+* a step whose solve does not converge is tried again at half its length, from the same
+  state and base operator, down to ``min_time_step`` (:meth:`hmatddm.Simulation.step`;
+  ``step_retries`` in the record).
 
 The chosen step sizes are in every record (``time_step``) and in the checkpoints, so a
 resumed run takes the same steps.

@@ -141,3 +141,34 @@ def test_every_step_records_its_elasticity_products(monkeypatch):
     records = [simulation.step() for _ in range(4)]
     assert all(r["matvecs"] >= r["linear_iterations"] > 0 for r in records)
     assert sum(r["matvecs"] for r in records) == len(calls)
+
+
+def test_a_step_that_does_not_converge_is_tried_again_at_half_its_length(monkeypatch):
+    """With front-following steps a step whose solve raises ConvergenceError starts again
+    from the same state at half its length (recorded in ``step_retries``) and the run goes
+    on; at min_time_step, and with fixed steps, the error reaches the caller."""
+    from hmatddm.errors import ConvergenceError
+    from hmatddm.simulation import step_solve
+
+    original = step_solve.solve
+
+    def refuses_long_steps(simulation, trial, start, t_old, t_new, *args):
+        if t_new - t_old > 0.3:
+            raise ConvergenceError("too long a step for this test", iterations=1)
+        return original(simulation, trial, start, t_old, t_new, *args)
+
+    monkeypatch.setattr(step_solve, "solve", refuses_long_steps)
+    simulation = kgd(first=1.0, minimum=0.1)
+    record = simulation.step()
+    assert record["time_step"] == pytest.approx(0.25) and record["step_retries"] == 2
+    assert record["time"] == pytest.approx(0.25) and simulation.state.step == 1
+    reference = kgd(first=0.25, minimum=0.1)
+    monkeypatch.setattr(step_solve, "solve", original)
+    first = reference.step()
+    np.testing.assert_array_equal(simulation.state.dd, reference.state.dd)  # the same step as a fresh 0.25 s one
+    assert first["step_retries"] == 0
+    monkeypatch.setattr(step_solve, "solve", refuses_long_steps)
+    with pytest.raises(ConvergenceError):
+        kgd(first=1.0, minimum=0.6).step()
+    with pytest.raises(ConvergenceError):
+        kgd(time_step=1.0).step()
