@@ -37,7 +37,7 @@ sys.exit(main(sys.argv[1:]))
 def run(scene, h, steps, folder, source=ROOT, label="this", extra=()):
     """One run in a child process (the package of the source tree ``source``): its
     summary totals, wall and CPU time, peak memory."""
-    out = os.path.join(folder, f"{label}-{os.path.basename(scene)}-{h}-{steps}-{len(extra)}")
+    out = os.path.join(folder, f"{label}-{os.path.basename(scene)}-{h}-{steps}-{len(os.listdir(folder))}")
     arguments = ["run", scene, "--out", out, "--quiet"]
     if h is not None:
         arguments += ["--set", f"initial_fracture[0].element_size={h}"]
