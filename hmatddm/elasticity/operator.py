@@ -44,6 +44,13 @@ class ProductCounter:
         self.products += int(np.shape(X)[1]) if np.ndim(X) == 2 else 1
         return super().matmat(X)
 
+    def _matmat(self, X):
+        # column by column through the uncounted _matvec (scipy's default goes through the
+        # counted matvec and would count each column twice); a class with its own _matmat
+        # overrides this one
+        X = np.asarray(X, dtype=np.float64)
+        return np.column_stack([self._matvec(X[:, k]) for k in range(X.shape[1])])
+
 
 class ElasticityOperator(ProductCounter, LinearOperator):
     """DDM influence operator of a mesh in a homogeneous elastic medium.

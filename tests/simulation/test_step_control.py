@@ -172,3 +172,19 @@ def test_a_step_that_does_not_converge_is_tried_again_at_half_its_length(monkeyp
         kgd(first=1.0, minimum=0.6).step()
     with pytest.raises(ConvergenceError):
         kgd(time_step=1.0).step()
+
+
+def test_operators_count_each_product_once():
+    """``products`` of an elasticity operator: one per matvec, one per column of a matmat,
+    for the dense, H-matrix and grown operators alike."""
+    from hmatddm.elasticity.extended import ExtendedElasticityOperator
+
+    material = hd.Elastic(shear_modulus=10e9, poisson_ratio=0.25)
+    mesh = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 8.0, 8.0, 8, 8)
+    base = hd.ElasticityOperator(mesh.subset(np.arange(40)), material, backend="hmatrix", leaf_size=16)
+    for operator in (hd.ElasticityOperator(mesh, material), base, ExtendedElasticityOperator(base, mesh)):
+        X = np.random.default_rng(1).normal(size=(operator.shape[0], 3))
+        operator @ X
+        operator.matvec(X[:, 0])
+        operator @ X[:, 1]
+        assert operator.products == 5
