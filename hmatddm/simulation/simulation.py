@@ -13,7 +13,7 @@ with ``resume=True`` continues from the newest good checkpoint and gives the sam
 numbers as an uninterrupted run (everything the loop carries from one step to the
 next, the :class:`~hmatddm.simulation.state.State`, is in the checkpoint).
 
-Length (over ~400 lines): about 80 lines are the parameter documentation of the public
+Over 500 lines: about 80 lines are the parameter documentation of the public
 :class:`Simulation`; the logic is split into ``state``, ``growth_pass``, ``step_solve``,
 ``records``, ``growing_operator``, ``junctions``, ``linking`` and ``encounters``.
 """
