@@ -7,6 +7,8 @@ the validation table and the scenes' ``[reference]`` blocks compare with.
   KGD), where each vertex applies, and the closed forms a scene's ``[reference]`` names.
 * :mod:`.tip_asymptote`: the universal tip asymptote (Dontsov and Peirce 2015), inverted
   by the asymptotic front.
+* :mod:`.transition_table`: the radial K-M transition tabulated in time, for a run that
+  compares with it at every step.
 * :mod:`.leak_off`: leak-off-dominated sizes (the K~ and M~ vertices) and the plane-strain
   K-K~ edge.
 
@@ -27,8 +29,9 @@ _REGIMES = (
     "radial_toughness_number", "kgd_toughness_number", "radial_leak_off_number", "kgd_leak_off_number",
     "applicable_solution",
 )
+_TABLES = ("RadialTransitionTable", "radial_transition_table")
 _EXPORTS = {**{name: ".solutions" for name in _SOLUTIONS}, **{name: ".leak_off" for name in _LEAK_OFF},
-            **{name: ".regimes" for name in _REGIMES}}
+            **{name: ".regimes" for name in _REGIMES}, **{name: ".transition_table" for name in _TABLES}}
 __getattr__, __dir__ = attach(__name__, _EXPORTS)
 
-__all__ = list(_SOLUTIONS) + list(_LEAK_OFF) + list(_REGIMES)
+__all__ = list(_SOLUTIONS) + list(_LEAK_OFF) + list(_REGIMES) + list(_TABLES)

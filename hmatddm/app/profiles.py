@@ -7,7 +7,9 @@ Sneddon's elliptical opening ``w_max (1 - rho^2)^(1/2)`` under a uniform net pre
 M-vertices the profiles of Savitski and Detournay (2002, radial) and Adachi and Detournay
 (2002, KGD), :func:`hmatddm.analytical.radial_m_vertex_profile` and
 :func:`~hmatddm.analytical.kgd_m_vertex_profile`; the K-M transition the opening of
-Dontsov (2016), :func:`~hmatddm.analytical.radial_transition_profile` (no pressure).
+Dontsov (2016), :func:`~hmatddm.analytical.radial_transition_profile` (no pressure),
+tabulated in time (:mod:`hmatddm.analytical.transition_table`) since a run draws one
+picture per saved step.
 """
 from pathlib import Path
 
@@ -88,7 +90,8 @@ def closed_form_profile(scene, time_value):
         profile = _symmetric(rho, width, pressure, radius)
     elif kind == "radial-km":
         rho = np.linspace(0.0, 1.0, SAMPLES)
-        radius, width = analytical.radial_transition_profile(rho, t, rate, viscosity, toughness, rock)
+        table = analytical.radial_transition_table(rate, viscosity, toughness, rock)  # tabulated in time
+        radius, width = table.profile(rho, t)
         profile = _symmetric(rho, width, None, float(radius))
     else:
         return None
