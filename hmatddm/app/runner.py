@@ -52,8 +52,6 @@ from .run_folder import (CHECKPOINT_DIR, HISTORY, MOVIE, PVD,  # noqa: F401  (re
                          vtu_steps, write_history, write_json, write_snapshots)
 from ..simulation import checkpoint as checkpoints
 
-PROFILE_SHARE = 0.02  # the largest share of a run's CPU time its profile pictures may take
-
 
 # ---------------------------------------------------------------------------------
 # A run
@@ -100,9 +98,7 @@ class SceneRun:
         self._initial = None  # the record of step 0 (hmatddm.simulation.records.initial_record)
         self.resumed = False  # whether this session continued a run from a checkpoint
         self._plotter = None  # the ProfilePlotter of the profile pictures, made at the first
-        self._started_cpu = time.process_time()
-        self._profile_cpu = 0.0  # CPU seconds spent on profile pictures (_draws_profile)
-        self._last_profile_cpu = 0.0
+        self.profile_seconds = 0.0  # CPU seconds spent on the profile pictures of this session
 
     # -- public -----------------------------------------------------------------------
     @property
@@ -146,7 +142,6 @@ class SceneRun:
             raise InputError("--resume continues the run in the folder and --overwrite starts it over: give one "
                              "of them, not both")
         self._started = time.perf_counter()
-        self._started_cpu = time.process_time()
         scene = self.scene.data
         numerics = scene["numerics"]
         simulation = build_simulation(scene, checkpoint_dir=self.out / CHECKPOINT_DIR)
@@ -262,11 +257,16 @@ class SceneRun:
             temporary.write_text(to_toml(self.scene.data, header), encoding="utf-8")
 
     # -- per step ------------------------------------------------------------------------
-    def _write_vtu(self, state, last=False):
-        """The .vtu file (``output.vtu``) and the profile picture (``output.snapshots``,
-        :meth:`_draws_profile`) of a saved step; ``last``: the run's last state."""
+    def _write_vtu(self, state):
+        """The .vtu file (``output.vtu``) and the profile picture (``output.snapshots``) of
+        a saved step (every ``output.every``-th step and the last).
+
+        Every saved step gets its picture: about 0.1 s of CPU each (matplotlib on one reused
+        figure; the closed form of a [reference] is tabulated in time,
+        :mod:`hmatddm.analytical.transition_table`), 4 % of the default run of 50 saved
+        steps on an Intel Xeon at dgemm 70 GFLOP/s (benchmarks/RESULTS.md, issue 38)."""
         output = self.scene.data["output"]
-        profile = output["snapshots"] and self._draws_profile(last)
+        profile = output["snapshots"]
         if not (output["vtu"] or profile):
             return
         mesh, dd, pressure, codes = self.simulation.view()
@@ -282,16 +282,6 @@ class SceneRun:
         write_pvd(self.out / PVD, self._pvd_entries)
         self._last_vtu_step = state.step
         self.written["vtu"] += 1
-
-    def _draws_profile(self, last):
-        """Whether a saved step gets its profile picture: the last state always, the others
-        while the pictures have cost at most :data:`PROFILE_SHARE` of the run's CPU time so
-        far (the next one counted at the cost of the last), so that pictures never slow a
-        run down by more than that; ``hmatddm render DIR`` draws every saved step."""
-        if last or self._profile_cpu == 0.0:
-            return True
-        spent = time.process_time() - self._started_cpu
-        return self._profile_cpu + self._last_profile_cpu <= PROFILE_SHARE * spent
 
     def _write_profile(self, mesh, fields, state):
         from ..render.profiles import ProfilePlotter
@@ -310,8 +300,7 @@ class SceneRun:
             self.note(f"hmatddm: warning: no profile picture of step {state.step}: {error}")
             return
         finally:
-            self._last_profile_cpu = time.process_time() - clock
-            self._profile_cpu += self._last_profile_cpu
+            self.profile_seconds += time.process_time() - clock
         if path is not None:
             self.written.setdefault("profiles", []).append(path)
 
@@ -322,7 +311,7 @@ class SceneRun:
     def _after_step(self, simulation, record):
         every = self.scene.data["output"]["every"]
         if record["step"] % every == 0 or self._is_last(record):
-            self._write_vtu(simulation.state, last=self._is_last(record))
+            self._write_vtu(simulation.state)
         if self._monitor is not None:
             self._monitor.record(simulation, record)
         self._write_summary()
@@ -333,11 +322,6 @@ class SceneRun:
 
         wall = self._wall_before + self.session_seconds
         reference = reference_values(self.scene.data, self.records)
-        if reference is None:  # a symmetric three-layer stack: its equilibrium height (hmatddm.app.height)
-            from .height import height_reference
-
-            return {"scene": self.scene.to_dict(), "versions": versions(), "steps": self.steps,
-                    "reference": height_reference(self.scene.data, self.steps), "wall_seconds": wall}
         if reference is not None and self._initial is not None:  # the closed forms are singular at t = 0
             keys = reference[0] if reference else {"time": None}
             initial = {key: None for key in keys}
@@ -359,7 +343,7 @@ class SceneRun:
         state = self.simulation.state
         output = self.scene.data["output"]
         if self._last_saved_step != state.step:  # the last converged state's .vtu and profile
-            self._write_vtu(state, last=True)
+            self._write_vtu(state)
         if output["snapshots"]:
             mesh, dd, pressure, codes = self.simulation.view()
             fields = cell_fields(mesh, dd, pressure, self._stress, codes)

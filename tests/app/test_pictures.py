@@ -10,7 +10,7 @@ import hmatddm as hd
 import hmatddm.scene as hs
 from hmatddm.app import cli, runner
 from hmatddm.app.fronts import asymptotic_front, element_front, reference_front, tip_regime
-from hmatddm.app.height import height_reference, three_layer_stack
+from hmatddm.scene.height_reference import height_reference, stack_problem, three_layer_stack
 from hmatddm.app.profiles import closed_form_profile
 from hmatddm.render.profiles import plot_tip_regime
 from scene_texts import KGD_2D_HEAD
@@ -32,8 +32,8 @@ def test_a_run_draws_profiles_and_render_draws_every_saved_step_and_a_movie(tmp_
     out = tmp_path / "out"
     runner.run_scene(hs.parse_scene(TINY_2D, overrides=["numerics.end_time=2"]), out, quiet=True)
     snapshots = out / "snapshots"
-    # the first and the last saved steps always; the others as the picture budget allows
-    assert not_blank(snapshots / "step-000000_profile.png") and not_blank(snapshots / "step-000002_profile.png")
+    for step in (0, 1, 2):  # the run itself draws a profile beside every saved step
+        assert not_blank(snapshots / f"step-{step:06d}_profile.png")
     assert cli.main(["render", str(out), "--movie"]) == cli.EXIT_OK
     written = capsys.readouterr().out
     for step in (0, 1, 2):  # output.every = 1: every step is saved
@@ -114,7 +114,8 @@ def test_layered_height_reports_its_height_tips_and_the_closed_form(tmp_path):
     assert len(rows) == len(steps) and rows[0]["height"] is None
     for row, step in zip(rows[1:], steps[1:]):
         assert row["net_pressure"] == pytest.approx(step["wellbore_pressure"][0] - 0.5e6)
-        assert "Simonson" in row["source"] and row["formula"].startswith("K_Ic = sqrt(pi a)")
+        assert "Simonson" in row["solution"]["source"] and row["solution"]["formula"].startswith("K_Ic = sqrt(pi a)")
+        assert row["solution"]["kind"] == "three-layer-height"
         if row["net_pressure"] >= 0.5e6:  # above the contrast: no equilibrium
             assert row["height"] is None and row["contained"] is False
     assert not_blank(tmp_path / "history.png")
@@ -129,6 +130,24 @@ def test_height_reference_of_a_contained_stack():
     assert row["height"] == pytest.approx(equilibrium_height(0.45e6, 0.5e6, 6.0, 0.5e6)) and row["height"] > 6.0
     assert row["contained"] is True and row["relative_error"]["height"] == pytest.approx(10.0 / row["height"] - 1)
     assert height_reference(hs.load_scene("kgd").data, steps) is None
+
+
+@pytest.mark.parametrize("overrides, message", [
+    (["cluster[0].position=[0.0, 1.0]"], "the injection point (y = 1 m) must be in the middle of the pay zone"),
+    (["layer[2].s_hmin=2e6"], "the two bounding layers need the same layer s_hmin"),
+    (["layer[0].s_hmin=0.2e6", "layer[2].s_hmin=0.2e6"], "must exceed the pay zone's closing stress"),
+])
+def test_the_three_layer_height_reference_is_refused_where_it_does_not_apply(overrides, message):
+    import re
+
+    with pytest.raises(hd.InputError) as refused:
+        hs.load_scene("layered-height", overrides=overrides)
+    assert str(refused.value).startswith("reference.kind = 'three-layer-height' is the equilibrium height of a "
+                                         "symmetric three-layer stack: ")
+    assert message in str(refused.value)
+    with pytest.raises(hd.InputError, match=re.escape("is a 2D closed form; the scene has dimension = 3")):
+        hs.load_scene("radial-k", overrides=['reference.kind="three-layer-height"'])
+    assert stack_problem(hs.load_scene("layered-height").data) is None
 
 
 def test_a_folder_given_as_the_scene(tmp_path, capsys):
