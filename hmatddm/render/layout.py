@@ -106,6 +106,37 @@ def slip_arrow_length(mesh, slipping, n_arrows):
     return float(np.clip(1.5 * spacing, 0.03 * diagonal, 0.12 * diagonal))
 
 
+RIBBON_SHARE = 0.04  # the widest opening of a 2D picture drawn as this share of the mesh diagonal
+
+
+def opening_ribbon(mesh, opening, diagonal, share=RIBBON_SHARE):
+    """The opening of 2D elements as a band across each segment: ``(points (4N, 2), quads
+    (N, 4), exaggeration)``, element ``i`` the quad of its end points moved by ``+-
+    exaggeration * max(w_i, 0) / 2`` along its normal (the DD is constant along an element,
+    so the band steps at element ends), ``exaggeration = share * diagonal / max(w)``;
+    ``(None, None, None)`` when no element is open. ``diagonal``: of the whole picture
+    (:func:`mesh_diagonal`), so that parts drawn apart share one scale when their widest
+    openings do."""
+    if not isinstance(mesh, Mesh2D):
+        raise InputError("opening_ribbon needs a Mesh2D")
+    opening = np.clip(np.asarray(opening, dtype=float), 0.0, None)
+    widest = float(np.max(opening)) if opening.size else 0.0
+    if not widest > 0.0:
+        return None, None, None
+    exaggeration = share * float(diagonal) / widest
+    start, end = mesh.endpoints
+    offset = 0.5 * exaggeration * opening[:, None] * mesh.frames[:, 1, :]
+    points = np.stack([start - offset, end - offset, end + offset, start + offset], axis=1).reshape(-1, 2)
+    quads = np.arange(4 * mesh.n_elements).reshape(-1, 4)
+    return points, quads, exaggeration
+
+
+def ribbon_text(exaggeration):
+    """The note of a 2D picture's opening band, e.g. ``band width: opening x 1.2e+03
+    (colour: true opening)``."""
+    return f"band width: opening x {exaggeration:.3g} (colour: true opening)"
+
+
 def legend_labels(state, slip_shown=False):
     """``[[text, colour], ...]`` of the legend: the natural-fracture states present and
     the slip arrows when drawn."""
@@ -303,4 +334,4 @@ def plan_traces(mesh, opening=None, state=None, slip=None):
 __all__ = ["Curve", "check_curves", "dashes", "plan_ticks",
            "HYDRAULIC", "INTACT_NATURAL", "FAILED_NATURAL", "VIEWS", "PLAN_STYLES", "opening_colour_range",
            "legend_labels", "slip_arrow_length", "plan_frame", "plan_scale_bar", "scale_bar_length",
-           "vertical_elements", "is_mostly_vertical", "plan_traces"]
+           "vertical_elements", "is_mostly_vertical", "plan_traces", "opening_ribbon", "ribbon_text", "RIBBON_SHARE"]

@@ -17,7 +17,9 @@
   the legend (:func:`plan_frame`), with a round length scale in the lower left corner;
 * ``view="plan"`` looks down ``-z`` (map view, parallel projection),
   ``view="oblique"`` is an isometric perspective. A :class:`~hmatddm.mesh.Mesh2D` is
-  always drawn as lines in the ``xy``-plane seen from ``+z``.
+  always drawn in the ``xy``-plane seen from ``+z``: each element as a band across its
+  segment as wide as its opening, exaggerated so that the widest is 4 % of the mesh
+  diagonal (the factor is written under the title), over a thin centre line.
 * the plan view of a 3D mesh of (mostly) vertical fractures, which looking down ``-z``
   would see edge on, draws each vertical element as its horizontal trace (a line, as
   in the DFN maps of ref. Figs 6.10-6.14): the elements of one column (same fracture,
@@ -41,7 +43,7 @@ from .layout import (BAR_LEFT, FAILED_COLOR, FAILED_NATURAL, INTACT_COLOR, INTAC
                      SLIP_VISIBLE_FRACTION, VERTICAL_NORMAL_Z, VIEWS, check_fields, check_mesh_type, check_window_size,
                      mesh_diagonal, length_text, plan_extent, slip_shown, is_mostly_vertical, legend_labels,
                      opening_colour_range, plan_frame, plan_scale_bar, plan_traces, slip_arrow_length,
-                     vertical_elements, Curve, check_curves, dashes, plan_ticks)
+                     vertical_elements, Curve, check_curves, dashes, plan_ticks, opening_ribbon, ribbon_text)
 from .offscreen import new_plotter, offscreen_pyvista, save_png, screenshot
 
 
@@ -80,27 +82,52 @@ def _line_width(coloured=True):
     return 6 if coloured else 2
 
 
+def _ribbon(mesh, indices, opening, lift=0.0):
+    """The 2D elements ``indices`` as the band of :func:`opening_ribbon` (quads at ``z =
+    lift``) and its exaggeration, or ``(None, None)`` when none of them is open."""
+    pyvista = offscreen_pyvista()
+    points, quads, exaggeration = opening_ribbon(mesh.subset(indices), opening[indices], mesh_diagonal(mesh))
+    if points is None:
+        return None, None
+    points = np.column_stack([points, np.full(len(points), float(lift))])
+    faces = np.column_stack([np.full(len(quads), 4), quads]).reshape(-1)
+    return pyvista.PolyData(points, faces=faces), exaggeration
+
+
 def _add_coloured(plotter, mesh, indices, opening, lift=0.0, clim=None):
     """Hydraulic and failed elements: coloured by opening (mm; colour range ``clim``,
-    default that of these elements, :func:`opening_colour_range`) or a plain colour."""
+    default that of these elements, :func:`opening_colour_range`) or a plain colour.
+
+    2D (and the traces of a 3D plan view): each element is drawn as a band across its
+    segment as wide as its opening times an exaggeration (:func:`opening_ribbon`), over a
+    thin coloured centre line that keeps closed elements in sight. Returns the
+    exaggeration (None without a band)."""
     if indices.size == 0:
-        return
+        return None
     part = _part(mesh, indices, lift)
     is_2d = isinstance(mesh, Mesh2D)
     style = dict(line_width=_line_width(), render_lines_as_tubes=True) if is_2d else dict(
         show_edges=mesh.n_elements <= MAX_ELEMENTS_WITH_EDGES, edge_color="dimgrey")
     if opening is None:
         plotter.add_mesh(part, color=PLAIN_SURFACE_COLOR, **style)
-        return
+        return None
     opening_mm = 1e3 * opening
     part.cell_data["opening (mm)"] = opening_mm[indices]
     if clim is None:
         clim = opening_colour_range(opening_mm[indices])
     limits, title = clim
-    plotter.add_mesh(part, scalars="opening (mm)", cmap=OPENING_COLORMAP, clim=limits,
-                     scalar_bar_args=dict(title=title, vertical=True, fmt="%.3g", position_x=BAR_LEFT,
-                                          position_y=0.15, height=0.7, width=0.08),
-                     **style)
+    colours = dict(scalars="opening (mm)", cmap=OPENING_COLORMAP, clim=limits)
+    exaggeration = None
+    if is_2d:
+        band, exaggeration = _ribbon(mesh, indices, opening, lift)
+        style.update(line_width=_line_width(coloured=False), render_lines_as_tubes=False)
+        if band is not None:
+            band.cell_data["opening (mm)"] = opening_mm[indices]
+            plotter.add_mesh(band, show_scalar_bar=False, lighting=False, **colours)
+    plotter.add_mesh(part, scalar_bar_args=dict(title=title, vertical=True, fmt="%.3g", position_x=BAR_LEFT,
+                                                position_y=0.15, height=0.7, width=0.08),
+                     **colours, **style)
+    return exaggeration
 
 
 def _add_intact(plotter, mesh, indices, lift=0.0):
@@ -294,17 +321,19 @@ def _add_interface_planes(plotter, mesh, interfaces):
 
 
 def _draw(plotter, mesh, opening, state, slip, curves=()):
+    """Every element as itself; returns the exaggeration of a 2D opening band, or None."""
     every = np.arange(mesh.n_elements)
     if state is None:
-        _add_coloured(plotter, mesh, every, opening)
+        exaggeration = _add_coloured(plotter, mesh, every, opening)
     else:
-        _add_coloured(plotter, mesh, every[state != INTACT_NATURAL], opening)
+        exaggeration = _add_coloured(plotter, mesh, every[state != INTACT_NATURAL], opening)
         _add_intact(plotter, mesh, every[state == INTACT_NATURAL])
         _add_failed_outline(plotter, mesh, every[state == FAILED_NATURAL])
     _add_legend(plotter, state, slip_shown(slip), curves)
     if slip is not None:
         _add_slip_arrows(plotter, mesh, slip)
     _add_curves(plotter, mesh, curves)
+    return exaggeration
 
 
 # ---------------------------------------------------------------------------------
@@ -314,7 +343,8 @@ def _draw(plotter, mesh, opening, state, slip, curves=()):
 
 def _draw_plan_traces(plotter, mesh, opening, state, slip, curves=()):
     """Plan view of a mostly vertical Mesh3D: traces of the vertical elements on top,
-    the non-vertical elements as surfaces (as :func:`_draw`) underneath."""
+    the non-vertical elements as surfaces (as :func:`_draw`) underneath. Returns the
+    exaggeration of the traces' opening band, or None."""
     vertical = vertical_elements(mesh)
     traces, line_opening, line_state, line_slip, _ = plan_traces(mesh, opening, state, slip)
     others = np.flatnonzero(~vertical)
@@ -338,15 +368,17 @@ def _draw_plan_traces(plotter, mesh, opening, state, slip, curves=()):
     lift = float(np.max(mesh.corners()[..., 2])) + 0.2 * mesh_diagonal(mesh)
     lines = np.arange(traces.n_elements)
     if line_state is None:
-        _add_coloured(plotter, traces, lines, line_opening, lift=lift, clim=clim)
+        exaggeration = _add_coloured(plotter, traces, lines, line_opening, lift=lift, clim=clim)
     else:
-        _add_coloured(plotter, traces, lines[line_state != INTACT_NATURAL], line_opening, lift=lift, clim=clim)
+        exaggeration = _add_coloured(plotter, traces, lines[line_state != INTACT_NATURAL], line_opening, lift=lift,
+                                     clim=clim)
         _add_intact(plotter, traces, lines[line_state == INTACT_NATURAL], lift=lift)
         _add_failed_outline(plotter, traces, lines[line_state == FAILED_NATURAL], lift=lift)
     _add_legend(plotter, state, slip_shown(line_slip) or (slip is not None and slip_shown(slip[others])), curves)
     if line_slip is not None and np.any(line_slip):
         _add_slip_arrows(plotter, traces, line_slip, lift=lift)
     _add_curves(plotter, mesh, curves)
+    return exaggeration
 
 
 # ---------------------------------------------------------------------------------
@@ -428,11 +460,15 @@ def snapshot(mesh, path, opening=None, state=None, slip=None, view="oblique", ti
     try:
         curves = check_curves(curves, mesh.dim)
         if traces:
-            _draw_plan_traces(plotter, mesh, opening, state, slip, curves)
+            exaggeration = _draw_plan_traces(plotter, mesh, opening, state, slip, curves)
         else:
-            _draw(plotter, mesh, opening, state, slip, curves)
+            exaggeration = _draw(plotter, mesh, opening, state, slip, curves)
         if title is not None:
             plotter.add_text(str(title), position="upper_edge", font_size=12)
+        if exaggeration is not None:  # in the lower left corner, under the length scale
+            plotter.add_text(ribbon_text(exaggeration), position=(int(0.02 * window_size[0]),
+                                                                  int(0.012 * window_size[1])),
+                             font_size=9, color="dimgrey")
         if view == "oblique" and isinstance(mesh, Mesh3D):
             plotter.add_axes()  # a plan view has x to the right and y up, and a length scale instead
             _add_interface_planes(plotter, mesh, interfaces)

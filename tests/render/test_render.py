@@ -235,6 +235,22 @@ def test_a_long_2d_crack_ends_left_of_the_colour_bar(tmp_path):
     assert not gap.any(), "something coloured between the crack and the colour bar"
 
 
+def test_a_2d_crack_is_drawn_as_a_band_as_wide_as_its_opening(tmp_path):
+    """A KGD-like crack from x = -10 to 10 m: the coloured band is thickest at the middle
+    (the widest opening drawn as 4 % of the diagonal, about 0.8 m), and a line where the
+    opening is zero."""
+    mesh = hd.mesh.line([-10.0, 0.0], [10.0, 0.0], 40)
+    opening = 1e-3 * np.sqrt(np.clip(1 - (mesh.centers[:, 0] / 10.0) ** 2, 0.0, None))
+    path = snapshot(mesh, tmp_path / "band.png", opening=opening, window_size=WINDOW)
+    coloured = _coloured_pixels(_image(path)[:, :int(0.84 * WINDOW[0])])
+    rows_per_column = coloured.sum(axis=0)
+    columns = np.flatnonzero(rows_per_column)
+    middle, near_tip = columns[columns.size // 2], columns[2]
+    pixels_per_metre = columns.size / 20.0
+    assert rows_per_column[middle] == pytest.approx(0.04 * 20.0 * pixels_per_metre, rel=0.35)
+    assert rows_per_column[middle] > 3 * rows_per_column[near_tip]
+
+
 def test_negative_openings_are_drawn_as_zero_and_said_so(tmp_path, scene2d):
     from hmatddm.render.layout import opening_colour_range
 

@@ -69,3 +69,22 @@ def test_field_checks_name_the_field():
     with pytest.raises(hd.InputError, match=r"window_size height must be an integer in \[16, 16384\], got 8"):
         check_window_size((400, 8))
     assert check_window_size((np.int64(400), 300)) == (400, 300)
+
+
+def test_the_opening_band_of_a_2d_picture_is_each_opening_times_one_exaggeration():
+    from hmatddm.render.layout import opening_ribbon
+
+    mesh = hd.mesh.concatenate([hd.mesh.line([-1.0, 0.0], [1.0, 0.0], 4),
+                                hd.mesh.line([0.0, -1.0], [0.0, 1.0], 2, fracture_id=1)])
+    opening = np.array([1e-3, 2e-3, 4e-3, -1e-3, 0.0, 2e-3])  # a closed element: no band
+    points, quads, exaggeration = opening_ribbon(mesh, opening, diagonal=10.0, share=0.05)
+    assert exaggeration == pytest.approx(0.05 * 10.0 / 4e-3)
+    corners = points[quads]  # (6, 4, 2): start - n w/2, end - n w/2, end + n w/2, start + n w/2
+    width = np.linalg.norm(corners[:, 3] - corners[:, 0], axis=1)
+    assert np.allclose(width, exaggeration * np.clip(opening, 0.0, None))
+    assert np.allclose(corners[2, 3, 1] - corners[2, 0, 1], 0.5)  # horizontal: the band spans y
+    assert np.allclose(corners[5, 0, 0] - corners[5, 3, 0], 0.05 * 10.0 / 2.0)  # vertical: it spans x
+    assert np.allclose(0.5 * (corners[:, 0] + corners[:, 3]), np.stack(mesh.endpoints, axis=1)[:, 0])
+    assert opening_ribbon(mesh, np.zeros(6), 10.0) == (None, None, None)
+    with pytest.raises(hd.InputError, match="Mesh2D"):
+        opening_ribbon(hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 1, 1, 1, 1), [1e-3], 1.0)
