@@ -68,12 +68,15 @@ def element_front(mesh, state=None):
 
 def reference_front(scene, time_value, mesh):
     """The closed form's front at ``time_value`` (s): a list of (n, d) polylines, or [] when
-    the scene has no [reference] (or at t = 0)."""
+    the scene has no [reference] (or at t = 0) or one without a front of its own in time
+    (``three-layer-height``: its tips follow the run's pressure, drawn in the history plot)."""
     from ..scene import reference_curves
 
     if scene is None or "reference" not in scene or not time_value > 0.0:
         return []
     curves = reference_curves(scene, end_time=float(time_value), samples=2)
+    if curves is None:
+        return []
     well = np.asarray(scene["cluster"][0]["position"], dtype=float)
     home = int(np.argmin(np.sum((mesh.centers - well) ** 2, axis=1)))
     if "radius" in curves:

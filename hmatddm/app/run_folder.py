@@ -167,13 +167,11 @@ def write_history(out, records, scene):
     if not records:
         return None
     interfaces = layer_interfaces(scene)
-    if scene is not None and "reference" not in scene:  # a symmetric three-layer stack: its equilibrium tips
-        from .height import three_layer_stack
+    if scene is not None and scene.get("reference", {}).get("kind") == "three-layer-height":  # equilibrium tips
+        from ..scene.height_reference import equilibrium_tips
 
-        stack = three_layer_stack(scene)
-        if stack is not None:
-            return plot_history(records, Path(out) / HISTORY, reference=_height_curves(scene, records),
-                                interfaces=interfaces)
+        return plot_history(records, Path(out) / HISTORY, reference=equilibrium_tips(scene, records),
+                            interfaces=interfaces)
     end_time = max(r["time"] for r in records)
     # (a run stopped in its first step has the initial state only: no closed form at t = 0)
     reference = reference_curves(scene, end_time=end_time) if scene is not None and end_time > 0.0 else None
@@ -183,19 +181,6 @@ def write_history(out, records, scene):
     return plot_history(records, Path(out) / HISTORY, reference=reference, confining_stress=confining,
                         interfaces=interfaces)
 
-
-def _height_curves(scene, records):
-    """The equilibrium tips ``middle +- height/2`` of :func:`hmatddm.app.height.height_reference`
-    at the records where there is an equilibrium (None when there is none)."""
-    from .height import height_reference
-
-    rows = [row for row in height_reference(scene, records) if row["height"] is not None]
-    if not rows:
-        return None
-    layers = scene["layer"]
-    middle = 0.5 * (layers[0]["bottom"] + layers[1]["bottom"])
-    return {"time": [row["time"] for row in rows], "top": [middle + 0.5 * row["height"] for row in rows],
-            "bottom": [middle - 0.5 * row["height"] for row in rows]}
 
 
 # ---------------------------------------------------------------------------------

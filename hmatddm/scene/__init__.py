@@ -137,13 +137,16 @@ The format, annotated (``=`` values are the defaults unless marked REQUIRED)::
     [reference]                    # optional closed form reported at every step
     kind = "radial-k"              # "radial-k", "radial-m", "radial-km" (3D; K-M transition,
                                    # Dontsov 2016), "kgd-k", "kgd-m" (2D);
-                                   # needs one cluster, [propagation] and no leak-off
+                                   # needs one cluster, [propagation] and no leak-off;
+                                   # or "three-layer-height" (2D, three [[layer]]s: the
+                                   # equilibrium height of a symmetric stack under a
+                                   # stress contrast, Simonson et al. 1978)
                                    # summary.json's reference rows record the regime number
                                    # K_m and the solution (formula, source); `hmatddm run`
                                    # warns when the vertex does not apply over the run
 
-    # Natural fractures: the schema is defined and validated, but the engine has no
-    # natural-fracture physics yet, so `hmatddm run` refuses such scenes (exit code 2).
+    # Natural fractures (ref. Ch. 5-6): activated by shear or opening, crossed or
+    # deflected at encounters, failed remotely; explicit segments or a generated network.
     [network]                      # properties of every natural fracture (ref. Table 6.2)
     friction_coefficient = 0.25    # >= 0
     cohesion = 0.0                 # Pa, >= 0

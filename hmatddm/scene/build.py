@@ -220,9 +220,11 @@ def _closed_form(scene, times, kind=None):
         if kind == "radial-k":
             curves["radius"], curves["max_opening"], curves["net_pressure"] = analytical.radial_k_vertex(
                 times, rate, toughness, mat)
-        elif kind == "radial-km":  # Dontsov (2016) between the vertices: no net pressure
-            curves["radius"], curves["max_opening"] = analytical.radial_transition(times, rate, viscosity,
-                                                                                   toughness, mat)
+        elif kind == "radial-km":  # Dontsov (2016) between the vertices: no net pressure; tabulated in
+            from ..analytical.transition_table import radial_transition_table  # time (one solve a decade)
+
+            table = radial_transition_table(rate, viscosity, toughness, mat)
+            curves["radius"], curves["max_opening"] = table.radius_and_width(times)
         else:
             curves["radius"], curves["max_opening"] = analytical.radial_m_vertex(times, rate, viscosity, mat)
         curves["dimensionless_toughness"] = analytical.radial_regime(times, rate, viscosity, toughness, mat)
@@ -263,8 +265,9 @@ def run_times(scene):
 def reference_warning(scene):
     """One line when the scene's ``[reference]`` closed form does not apply over the run
     (its dimensionless toughness at the first step and at the end, :func:`reference_regime`),
-    naming the solution that does; None when it applies or there is no ``[reference]``."""
-    if "reference" not in scene:
+    naming the solution that does; None when it applies, there is no ``[reference]`` or its
+    closed form has no regime (``three-layer-height``)."""
+    if "reference" not in scene or scene["reference"]["kind"] == "three-layer-height":
         return None
     times = run_times(scene)
     regime = reference_regime(scene, times)
@@ -284,8 +287,10 @@ def reference_warning(scene):
 def reference_curves(scene, end_time=None, samples=200):
     """Closed-form curves for a history plot (``time`` from a small fraction of the
     first step to ``end_time``), in the format of :func:`hmatddm.render.plot_history`;
-    None when the scene has no ``[reference]``."""
-    if "reference" not in scene:
+    None when the scene has no ``[reference]``. ``three-layer-height``: its equilibrium
+    tips need the run's net pressures, :func:`hmatddm.scene.height_reference.equilibrium_tips`
+    (None here)."""
+    if "reference" not in scene or scene["reference"]["kind"] == "three-layer-height":
         return None
     end_time = scene["numerics"]["end_time"] if end_time is None else end_time
     start = min(0.25 * first_time_step(scene["numerics"]), 0.5 * end_time)
@@ -309,11 +314,18 @@ def reference_values(scene, records):
     the confining stress (``net_pressure``) and with the injection element's
     (``injection_net_pressure``, which adds the viscous drop near the well); the KGD
     M-vertex's ``p(0)`` with the injection element's. The radial M-vertex and the transition
-    solution give none (log-singular at the well, resp. not approximated)."""
+    solution give none (log-singular at the well, resp. not approximated).
+
+    ``three-layer-height``: the equilibrium height at each record's net pressure
+    (:func:`hmatddm.scene.height_reference.height_reference`)."""
     if "reference" not in scene:
         return None
     if not records:
         return []
+    if scene["reference"]["kind"] == "three-layer-height":
+        from .height_reference import height_reference
+
+        return height_reference(scene, records)
     from ..analytical.regimes import SOLUTIONS
 
     times = [record["time"] for record in records]

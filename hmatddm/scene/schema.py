@@ -220,6 +220,13 @@ def _check_reference(scene):
     dim = scene["dimension"]
     want = 3 if kind.startswith("radial") else 2
     where = f"reference.kind = {kind!r}"
+    if kind == "three-layer-height":  # Simonson et al. 1978 (hmatddm.scene.height_reference)
+        from .height_reference import stack_problem
+
+        problem = stack_problem(scene)
+        if problem:
+            raise InputError(f"{where} is the equilibrium height of a symmetric three-layer stack: {problem}")
+        return
     if dim != want:
         raise InputError(f"{where} is a {want}D closed form; the scene has dimension = {dim}")
     if len(scene["cluster"]) != 1 or scene["cluster"][0]["rate"] <= 0.0:

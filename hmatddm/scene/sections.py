@@ -9,7 +9,7 @@ from .. import settings
 from ..settings import CLUSTER, FLUID, LEAK_OFF, MATERIAL, NATURAL_FRACTURE, PROPAGATION, REQUIRED, SCHEME
 from ..settings import Setting as Key  # a key of a scene section is one setting
 
-REFERENCE_KINDS = ("radial-k", "radial-m", "radial-km", "kgd-k", "kgd-m")
+REFERENCE_KINDS = ("radial-k", "radial-m", "radial-km", "kgd-k", "kgd-m", "three-layer-height")
 SHAPES = {2: ("line",), 3: ("rectangle", "penny")}
 CROSSING_CRITERIA = ("mohr-coulomb", "energy-release-rate", "stress-intensity")
 
