@@ -1,7 +1,10 @@
 """Growing tips that meet natural fractures (ref. Ch. 5; see
 :mod:`hmatddm.simulation.natural`): the candidate element of a tip may activate an
 intact natural element instead (deflection, or the fluid running along the natural
-fracture), connect the tip to a natural element already in the system, or cross."""
+fracture), connect the tip to a natural element already in the system, or cross. A
+candidate whose path cuts a natural element, intact or already in the system (activated,
+failed remotely), is put to the crossing criterion; at one already in the system the tip
+is connected to it whether it crosses (a branch) or not."""
 import numpy as np
 
 from ..mesh import concatenate
@@ -24,6 +27,9 @@ def meet_natural_fractures(simulation, state, edges, faces, tips, grown, parent,
     joined = state.natural_index >= 0
     active_of[state.natural_index[joined]] = np.flatnonzero(joined)
     reachable = available | (active_of >= 0)
+    # what a candidate's path may cut: intact elements and those in the system (kept
+    # through the pass: an element activated in it is connected to, not activated again)
+    on_path = reachable.copy()
     # pairs already connected (a tip never links to itself or to a neighbour twice)
     linked = {(int(a), int(b)) for a, b in zip(faces.first, faces.second)}
     linked |= {(b, a) for a, b in linked}
@@ -67,7 +73,7 @@ def meet_natural_fractures(simulation, state, edges, faces, tips, grown, parent,
                 connect(tip, row, nearest, grown.centers[k], size)
             continue
         hinge = edges.midpoints[tip, tips.edge[row]]
-        hit = network.encounter(grown, k, hinge, available)  # intact elements only
+        hit = network.encounter(grown, k, hinge, on_path)
         if hit is None:
             kept.append(k)
             continue
@@ -78,8 +84,20 @@ def meet_natural_fractures(simulation, state, edges, faces, tips, grown, parent,
 
             far_field, toughness = crossing_setting(simulation.medium, hinge[-1] if mesh.dim == 3 else point[-1],
                                                     far_field, toughness)
-        if network.decide_crossing(tips.k_1[row], tips.k_2[row], tips.theta[row], edges.ahead[tip, tips.edge[row]],
-                                   mesh.normals[tip], target, far_field, toughness):
+        crosses = network.decide_crossing(tips.k_1[row], tips.k_2[row], tips.theta[row],
+                                          edges.ahead[tip, tips.edge[row]], mesh.normals[tip], target, far_field,
+                                          toughness)
+        if not available[target]:
+            # in the system already (activated, failed remotely, or activated in this pass):
+            # the tip joins its flow either way, and goes on across it where it crosses (a
+            # branch, ref. Sec. 6.4: remote failure creates branches at intersections)
+            events.natural_crossed += int(crosses)
+            events.natural_deflected += int(not crosses)
+            if crosses:
+                kept.append(k)
+            connect(tip, row, target, point, size)
+            continue
+        if crosses:
             events.natural_crossed += 1
             kept.append(k)
             continue

@@ -181,6 +181,55 @@ def test_two_tips_reaching_one_natural_element_activate_it_once(monkeypatch, hyd
     assert len(faces.first) == len(plain.first) + len(deflected)
 
 
+@pytest.mark.parametrize("crosses", [False, True], ids=["arrested", "crosses"])
+def test_a_tip_that_cuts_a_natural_element_already_in_the_system_decides_and_connects(monkeypatch, crosses):
+    """A hydraulic candidate whose path cuts a natural element that is already in the
+    system (activated earlier, or failed remotely) without landing on it: the crossing
+    criterion decides, and the tip joins that element's flow either way (arrested into it,
+    or a branch that goes on across it). Before, only intact elements were looked for on
+    the path, and the candidate went through the open natural fracture unconnected."""
+    from types import SimpleNamespace
+
+    from hmatddm.mesh import topology
+    from hmatddm.simulation import growth_pass
+    from hmatddm.simulation.state import State, StepEvents
+
+    natural = hd.mesh.rectangle([2.0, 0.0, 0.0], [1, 0, 0], [0, 0, 1], 4.0, 2.0, 4, 2)
+    target = int(np.argmin(np.linalg.norm(natural.centers - [2.5, 0.0, -0.5], axis=1)))
+    hydraulic = hd.mesh.rectangle([2.1, -1.0, -0.5], [0, 1, 0], [0, 0, 1], 1.0, 1.0, 1, 1)
+    sim = hd.Simulation(hydraulic, hd.Elastic(10e9, 0.25), hd.Fluid(1e-3, 4.4e-10),
+                        [hd.Cluster((2.1, -1.0, -0.5), 1e-3, 0.0)], -np.diag([20e6, 30e6, 40e6]), 1.0,
+                        propagation=hd.Propagation(toughness=1e6), backend="dense", natural_fractures=natural,
+                        natural=NaturalFractureProperties(**TABLE_5_1, crossing="mohr-coulomb"))
+    mesh = hd.mesh.concatenate([hydraulic, natural.subset(np.array([target]))])  # the target is in the system
+    origin, natural_index = np.array([0, 1]), np.array([-1, target])
+    intact = np.ones(natural.n_elements, bool)
+    intact[target] = False
+    edges = topology.element_edges(mesh, None)
+    faces = topology.element_faces(mesh, edges)
+    tip_edge = int(np.argmax(edges.ahead[0, :, 1]))  # +y, towards the natural fracture
+    # the candidate continues the hydraulic plane across y = 0, 0.4 m beside the target's centre
+    candidate = hd.mesh.rectangle([2.1, 0.0, -0.5], [0, 1, 0], [0, 0, 1], 1.0, 1.0, 1, 1)
+    tips = SimpleNamespace(edge=np.array([tip_edge]), k_1=np.zeros(1), k_2=np.zeros(1), theta=np.zeros(1))
+    monkeypatch.setattr(growth_pass, "evaluate_tips", lambda *args, **kwargs: tips)
+    monkeypatch.setattr(growth_pass, "new_elements", lambda *args, **kwargs: (candidate, np.array([0]), np.array([0])))
+    decisions = []
+    monkeypatch.setattr(sim.network, "decide_crossing", lambda *args, **kwargs: decisions.append(args[5]) or crosses)
+    events = StepEvents()
+    state = State(mesh, np.zeros((2, 3)), np.zeros(2), np.zeros(2), 0.0, 0, 1.0, 0.0, 0.0, origin=origin,
+                  natural_index=natural_index, intact=intact, failed=np.zeros(natural.n_elements, bool),
+                  extra_faces=np.zeros((0, 6)))
+    growth = growth_pass.grow(sim, state, edges, faces, None, events)
+    assert decisions == [target]  # the criterion was asked about the element on the path
+    assert [(c.target, c.tip, c.target_is_new) for c in growth.connections] == [(1, 0, False)]
+    if crosses:
+        assert events.natural_crossed == 1 and events.natural_deflected == 0
+        assert growth.elements.mesh.n_elements == 1 and list(growth.elements.origin) == [0]
+    else:
+        assert events.natural_deflected == 1 and events.natural_crossed == 0
+        assert growth.elements is None or growth.elements.mesh.n_elements == 0
+
+
 def test_energy_criterion_with_mode_two_toughness():
     """G / G_c in each direction with G_c = (K_Ic^2 + K_IIc^2) / E' (ref. Eqs 5.11-5.16,
     squares restored), written out here from Nuismer's K-bar (ref. Eqs 5.13-5.14); E'
