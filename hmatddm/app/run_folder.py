@@ -23,6 +23,7 @@ CHECKPOINT_DIR = "checkpoints"
 SNAPSHOT_DIR = "snapshots"
 HISTORY = "history.png"
 MOVIE = "movie.gif"
+PROPPANT_HISTORY = "proppant_history.png"
 SUMMARY_KEYS = ("scene", "versions", "steps", "reference", "wall_seconds")
 HYDRAULIC = 0
 
@@ -349,6 +350,10 @@ def render_folder(out, movie=False):
     written += profiles
     if summary is not None and summary.get("steps"):
         written.append(write_history(out, summary["steps"], scene))
+        if any("proppant_mass" in step for step in summary["steps"]):  # a run with [proppant]
+            from .proppant import write_proppant_history
+
+            written.append(write_proppant_history(out, summary["steps"], name))
     if movie:
         written.append(write_movie(out, profiles))
     return written
@@ -357,4 +362,5 @@ def render_folder(out, movie=False):
 __all__ = ["SUMMARY", "SCENE_FILE", "PVD", "VTU_DIR", "CHECKPOINT_DIR", "SNAPSHOT_DIR", "HISTORY", "SUMMARY_KEYS",
            "versions", "write_json", "read_summary", "vtu_name", "vtu_steps", "cell_fields", "snapshot_views",
            "snapshot_title", "layer_interfaces", "write_snapshots", "write_history", "mesh_from_vtu", "latest_state",
-           "read_pvd_entries", "render_folder", "saved_states", "write_profiles", "write_movie", "MOVIE"]
+           "read_pvd_entries", "render_folder", "saved_states", "write_profiles", "write_movie", "MOVIE",
+           "PROPPANT_HISTORY"]
