@@ -166,3 +166,30 @@ def test_bad_proppant_arguments_are_refused():
         vertical_run(schedule=None)
     with pytest.raises(InputError, match=r"pump_schedule concentrations must be below proppant\.packing_limit"):
         vertical_run(proppant=Proppant(diameter=2e-4, packing_limit=0.25))
+
+
+def test_packed_bed_stays_when_the_fracture_closes_on_it():
+    # a fixed KGD crack (plan view) pumped with slurry for 6 s, then shut in: leak-off drains it
+    # and its elements close (contact = "all") onto the proppant they hold, at its packed width
+    sand = Proppant(diameter=1e-4, bridging_factor=1.0)
+    sim = hd.Simulation(hd.mesh.line([-5.0, 0.0], [5.0, 0.0], 10), hd.Elastic(10e9, 0.25),
+                        hd.Fluid(viscosity=0.05, compressibility=4.4e-10), [hd.Cluster((0.0, 0.0), rate=2e-3)],
+                        -np.diag([10e6, 5e6]), 1.0, leak_off=hd.LeakOff(coefficient=1e-11),
+                        initial_pressure=5e6, initial_opening=1e-4, minimum_width=1e-6, contact="all",
+                        backend="dense", proppant=sand, pump_schedule=PumpSchedule((0.0,), (0.3,)))
+    sim.run(6.0)
+    pumped = sim.records[-1]["proppant_injected_mass"]
+    assert np.count_nonzero(sim.state.proppant_volume > 0.0) >= 8  # spread along the open crack
+    assert sim.records[-1]["proppant_mass"] == pytest.approx(pumped)
+    sim.clusters = [hd.Cluster((0.0, 0.0), rate=0.0)]  # shut-in
+    sim.run(40.0)
+    from hmatddm.simulation.proppant_step import propped_width
+
+    closed = sim.state.contact_status != OPEN
+    width = opening(sim)
+    bed = propped_width(sim, sim.state)
+    assert np.count_nonzero(closed) >= 5
+    assert np.all(bed[closed] > 2e-5)  # they hold proppant: closed, not shut
+    np.testing.assert_allclose(width[closed], bed[closed], rtol=1e-6)  # at the packed bed's width
+    assert sim.records[-1]["proppant_injected_mass"] == pumped  # nothing pumped after the shut-in
+    assert abs(sim.records[-1]["proppant_mass"] - pumped) <= 1e-10 * pumped  # the bed stays
