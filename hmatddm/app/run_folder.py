@@ -351,9 +351,10 @@ def render_folder(out, movie=False):
     if summary is not None and summary.get("steps"):
         written.append(write_history(out, summary["steps"], scene))
         if any("proppant_mass" in step for step in summary["steps"]):  # a run with [proppant]
-            from .proppant import write_proppant_history
+            from ..render.proppant import plot_proppant_history
 
-            written.append(write_proppant_history(out, summary["steps"], name))
+            written.append(plot_proppant_history(summary["steps"], out / PROPPANT_HISTORY,
+                                                 title=f"{name}: proppant mass"))
     if movie:
         written.append(write_movie(out, profiles))
     return written
