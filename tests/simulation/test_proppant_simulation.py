@@ -193,3 +193,23 @@ def test_packed_bed_stays_when_the_fracture_closes_on_it():
     np.testing.assert_allclose(width[closed], bed[closed], rtol=1e-6)  # at the packed bed's width
     assert sim.records[-1]["proppant_injected_mass"] == pumped  # nothing pumped after the shut-in
     assert abs(sim.records[-1]["proppant_mass"] - pumped) <= 1e-10 * pumped  # the bed stays
+
+
+def test_asymptotic_front_with_a_power_law_slurry_balances_its_mass():
+    # the kgd-power-law set-up (plan view: no settling), sand from 3 s on; the front's own step
+    # path (hmatddm.simulation.asymptotic) moves the proppant too
+    fluid = hd.Fluid(compressibility=4.5e-10, rheology="power-law", consistency=0.1, flow_index=0.5)
+    sand = Proppant(diameter=1e-4, bridging_factor=2.0)
+    sim = hd.Simulation(hd.mesh.line([-1.5, 0.0], [1.5, 0.0], 3), hd.Elastic(10e9, 0.25), fluid,
+                        [hd.Cluster((0.0, 0.0), 5e-4, 0.5)], far_field_stress=np.diag([-1e6, -0.5e6]), time_step=3.0,
+                        propagation=hd.Propagation(toughness=0.05e6, front="asymptotic"), initial_pressure=1e6,
+                        initial_opening=1e-4, backend="dense", proppant=sand,
+                        pump_schedule=PumpSchedule((0.0, 3.0), (0.0, 0.2)))
+    records = sim.run(18.0)
+    assert records[-1]["n_elements"] > 6
+    for record in records:
+        pumped = record["proppant_injected_mass"]
+        assert pumped == pytest.approx(2650.0 * 5e-4 * 0.2 * max(record["time"] - 3.0, 0.0), rel=1e-12, abs=1e-12)
+        assert abs(pumped - record["proppant_mass"] - record["proppant_screened_mass"]) <= 1e-10 * max(pumped, 1e-30)
+        assert 0.0 <= record["max_proppant_fraction"] <= sand.packing_limit
+    assert records[-1]["proppant_mass"] > 0.0 and records[-1]["propped_elements"] >= 3
