@@ -57,9 +57,17 @@ def flow_areas(simulation, mesh):
 
 
 def concentration(simulation, volume, width, areas):
-    """Proppant volume fractions ``V / (S max(w, w_min))`` in [0, c_max]."""
-    slurry = areas * np.maximum(width, simulation.minimum_width)
-    return np.clip(volume / slurry, 0.0, simulation.proppant.packing_limit)
+    """Proppant volume fractions ``V / (S max(w, w_min))`` in [0, c_max] of ``simulation``'s
+    elements (:func:`volume_fraction`)."""
+    return volume_fraction(volume, width, areas, simulation.minimum_width, simulation.proppant.packing_limit)
+
+
+def volume_fraction(volume, width, areas, minimum_width, packing_limit):
+    """Proppant volume fractions ``V / (S max(w, w_min))`` clipped to [0, c_max]: proppant
+    volumes ``V`` (m^3) in elements of flow areas ``S`` (m^2) and openings ``w`` (m), the flow's
+    width floor ``w_min``."""
+    slurry = np.asarray(areas, float) * np.maximum(width, minimum_width)
+    return np.clip(np.asarray(volume, float) / slurry, 0.0, packing_limit)
 
 
 def viscosity_factor(simulation, state, start_width):
@@ -149,4 +157,4 @@ def cell_fields(simulation):
 
 
 __all__ = ["advance", "record", "cell_fields", "viscosity_factor", "propped_width", "vertical_axis",
-           "carrier_viscosity", "concentration"]
+           "carrier_viscosity", "concentration", "volume_fraction"]

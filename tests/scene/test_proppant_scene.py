@@ -81,3 +81,13 @@ def test_proppant_scene_writes_fields_snapshot_and_history(finished):
     assert np.count_nonzero(fraction == 0.0) > 0  # the bridged tip ring is clean
     assert not_blank(out / "snapshots" / "step-000008_proppant.png")
     assert not_blank(out / "proppant_history.png")
+
+
+def test_render_draws_the_proppant_pictures_again(finished):
+    out, _ = finished
+    (out / "proppant_history.png").unlink()
+    (out / "snapshots" / "step-000008_proppant.png").unlink()
+    written = runner.render_folder(out)
+    assert out / "proppant_history.png" in written and not_blank(out / "proppant_history.png")
+    assert out / "snapshots" / "step-000008_proppant.png" in written
+    assert not_blank(out / "snapshots" / "step-000008_proppant.png")
