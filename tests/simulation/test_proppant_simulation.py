@@ -213,3 +213,29 @@ def test_asymptotic_front_with_a_power_law_slurry_balances_its_mass():
         assert abs(pumped - record["proppant_mass"] - record["proppant_screened_mass"]) <= 1e-10 * max(pumped, 1e-30)
         assert 0.0 <= record["max_proppant_fraction"] <= sand.packing_limit
     assert records[-1]["proppant_mass"] > 0.0 and records[-1]["propped_elements"] >= 3
+
+
+def test_sand_settles_down_a_vertical_fracture_and_neutral_grains_do_not():
+    def centroid(density):
+        sim = vertical_run(proppant=Proppant(diameter=3e-4, density=density, bridging_factor=2.0),
+                           schedule=PumpSchedule((0.0,), (0.1,)))
+        sim.run(6.0)
+        volume = sim.state.proppant_volume
+        return float(volume @ sim.state.mesh.centers[:, 2] / volume.sum()), volume.sum()
+
+    neutral, _ = centroid(1000.0)  # as dense as the fluid: no settling, symmetric about z = 0
+    sinking, _ = centroid(2650.0)  # v_Stokes = 1650 g d^2 / (18 * 0.02) = 4 mm/s
+    assert abs(neutral) < 1e-9
+    assert -0.2 < sinking < -1e-3
+
+
+def test_the_next_step_sees_the_slurry_viscosity(stepped):
+    from hmatddm.simulation.proppant_step import viscosity_factor
+
+    sim, steps = stepped
+    width, volume = steps[-1][1]
+    factor = viscosity_factor(sim, sim.state, width)
+    c = volume / (sim.state.mesh.areas * np.maximum(width, sim.minimum_width))
+    np.testing.assert_allclose(factor, (1.0 - c / 0.6) ** -2, rtol=1e-12)  # Maron-Pierce, below its cap
+    assert factor.max() == pytest.approx(4.0, rel=0.1)  # the 0.3 stage at the well: (1 - 0.5)^-2
+    assert np.all(factor[volume == 0.0] == 1.0)
