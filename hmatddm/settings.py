@@ -42,7 +42,8 @@ class Setting:
     ``boolean``, ``string``, ``choice`` (one of ``choices``),
     ``point`` (``length`` numbers; ``length="dim"`` is the scene dimension),
     ``numbers`` (a non-empty list of numbers, or one number), ``integers`` (a list of
-    integers >= 0), ``matrix`` (dim x dim numbers), ``pairs`` (a list of [low, high]).
+    integers >= 0), ``matrix`` (dim x dim numbers), ``pairs`` (a list of [low, high]), ``rows`` (a
+    non-empty list of rows of ``length`` numbers).
     ``low``/``high`` bound numbers (and every entry of a list), open when
     ``low_open``/``high_open``.
     """
@@ -159,6 +160,15 @@ class Setting:
             self._list(path, value, None, f"[{', '.join(['x', 'y', 'z'][:self.length])}] points")
             return [Setting("point", length=self.length, unit=self.unit).check(f"{path}[{i}]", v, dim)
                     for i, v in enumerate(value)]
+        if kind == "rows":  # a non-empty table of rows of `length` finite numbers (e.g. a pump schedule)
+            self._list(path, value, None, f"rows of {self.length} numbers")
+            if not value:
+                raise InputError(f"{path} must hold at least one row of {self.length} numbers, got []")
+            rows = []
+            for i, row in enumerate(value):
+                self._list(f"{path}[{i}]", row, self.length, "numbers")
+                rows.append([Setting("number")._number(path, v, f"{path}[{i}][{j}]") for j, v in enumerate(row)])
+            return rows
         if kind == "pairs":
             self._list(path, value, None, "[low, high] pairs")
             pairs = []
@@ -287,6 +297,14 @@ PROPPANT = {  # -> hmatddm.flow.proppant.Proppant (issue 34, beyond the referenc
                                doc="faces narrower than this many particle diameters carry no proppant"),
     "hindrance_exponent": Setting("number", 4.65, low=0.0,
                                   doc="m of the hindered settling velocity v_Stokes (1 - c)^m (Richardson-Zaki)"),
+}
+
+#: [proppant] of a scene: the particles (PROPPANT) and the pump schedule (hmatddm.flow.pump_schedule)
+PROPPANT_SECTION = {
+    **PROPPANT,
+    "schedule": Setting("rows", REQUIRED, length=2,
+                        doc="stages [time (s), proppant volume fraction of the pumped slurry, in "
+                            "[0, packing_limit)]: each from its time until the next (0 before the first)"),
 }
 
 CLUSTER = {  # -> hmatddm.flow.fluid.Cluster (ref. Eqs 4.34-4.35)

@@ -23,6 +23,7 @@ CHECKPOINT_DIR = "checkpoints"
 SNAPSHOT_DIR = "snapshots"
 HISTORY = "history.png"
 MOVIE = "movie.gif"
+PROPPANT_HISTORY = "proppant_history.png"
 SUMMARY_KEYS = ("scene", "versions", "steps", "reference", "wall_seconds")
 HYDRAULIC = 0
 
@@ -229,6 +230,8 @@ def latest_state(out):
         fields = cell_fields(mesh, arrays["dd"], arrays["pressure"], stress, state)
         if "front_class" in arrays:  # the asymptotic front's arrays (hmatddm.app.fronts)
             fields["front"] = (arrays["front_distance"], arrays["front_velocity"], arrays["front_class"])
+        if "proppant_volume" in arrays:  # a run with [proppant] (issue 34)
+            fields["proppant_volume"] = np.asarray(arrays["proppant_volume"], dtype=float)
         return mesh, fields, int(metadata["step"]), float(metadata["time"])
     steps = vtu_steps(out)
     if not steps:
@@ -240,6 +243,8 @@ def latest_state(out):
     fields = {"opening": np.asarray(data["opening"], dtype=float),
               "slip": np.asarray(data["slip"], dtype=float)[:, :mesh.dim],
               "state": np.asarray(data.get("state", np.zeros(mesh.n_elements)), dtype=np.int64)}
+    if "proppant_fraction" in data:  # a run with [proppant] (issue 34)
+        fields["proppant_fraction"] = np.asarray(data["proppant_fraction"], dtype=float)
     times = dict(read_pvd_entries(out))
     return mesh, fields, step, float(times.get(vtu_name(step), float("nan")))
 
@@ -302,6 +307,27 @@ def write_movie(out, pictures, seconds_per_frame=0.4):
     return path
 
 
+def _proppant_snapshot(out, mesh, fields, step, time_value, scene, name):
+    """``snapshots/step-NNNNNN_proppant.png`` of a state read back (a checkpoint's proppant
+    volumes, or a .vtu's ``proppant_fraction``); None when the state holds neither."""
+    from ..render.proppant import plot_proppant
+    from ..simulation.proppant_step import volume_fraction
+
+    section = scene["proppant"]
+    fraction = fields.get("proppant_fraction")
+    if fraction is None and "proppant_volume" in fields:
+        numerics = scene["numerics"]
+        areas = mesh.areas * (scene.get("height", 1.0) if mesh.dim == 2 else 1.0)
+        minimum = numerics.get("minimum_width", numerics["initial_opening"])
+        fraction = volume_fraction(fields["proppant_volume"], fields["opening"], areas, minimum,
+                                   section["packing_limit"])
+    if fraction is None:
+        return None
+    title = f"{snapshot_title(name, time_value, mesh)}: proppant volume fraction"
+    return plot_proppant(mesh, fraction, Path(out) / SNAPSHOT_DIR / f"step-{step:06d}_proppant.png",
+                         section["packing_limit"], title, hydraulic=np.asarray(fields.get("state", 0)) != 1)
+
+
 def render_folder(out, movie=False):
     """Snapshots and profile of the newest state, the profile pictures of every saved step,
     the history plot of an output folder (a finished or partial run), and with
@@ -323,6 +349,9 @@ def render_folder(out, movie=False):
         regime = write_tip_regime(out / SNAPSHOT_DIR, mesh, fields, fields["front"], scene, step, time_value,
                                   snapshot_title(name, time_value, mesh))
         written += [regime] if regime is not None else []
+    if scene is not None and "proppant" in scene:  # the proppant snapshot of the newest state
+        picture = _proppant_snapshot(out, mesh, fields, step, time_value, scene, name)
+        written += [picture] if picture is not None else []
     profiles = write_profiles(out, scene, name)
     if step not in vtu_steps(out) and "net_pressure" in fields:  # the newest state is a checkpoint's
         from .profiles import write_profile
@@ -333,6 +362,11 @@ def render_folder(out, movie=False):
     written += profiles
     if summary is not None and summary.get("steps"):
         written.append(write_history(out, summary["steps"], scene))
+        if any("proppant_mass" in step for step in summary["steps"]):  # a run with [proppant]
+            from ..render.proppant import plot_proppant_history
+
+            written.append(plot_proppant_history(summary["steps"], out / PROPPANT_HISTORY,
+                                                 title=f"{name}: proppant mass"))
     if movie:
         written.append(write_movie(out, profiles))
     return written
@@ -341,4 +375,5 @@ def render_folder(out, movie=False):
 __all__ = ["SUMMARY", "SCENE_FILE", "PVD", "VTU_DIR", "CHECKPOINT_DIR", "SNAPSHOT_DIR", "HISTORY", "SUMMARY_KEYS",
            "versions", "write_json", "read_summary", "vtu_name", "vtu_steps", "cell_fields", "snapshot_views",
            "snapshot_title", "layer_interfaces", "write_snapshots", "write_history", "mesh_from_vtu", "latest_state",
-           "read_pvd_entries", "render_folder", "saved_states", "write_profiles", "write_movie", "MOVIE"]
+           "read_pvd_entries", "render_folder", "saved_states", "write_profiles", "write_movie", "MOVIE",
+           "PROPPANT_HISTORY"]

@@ -15,7 +15,9 @@ The folder (``--out DIR``) holds::
     vtu/step-NNNNNN.vtu cell data: opening (m), slip (vector, m), pressure (Pa),
                         net_pressure (Pa, pressure minus the compressive normal far-field
                         stress), fracture_id, state (0 hydraulic, 1 intact natural,
-                        2 activated or failed natural), dd (vector, m)
+                        2 activated or failed natural), dd (vector, m); with [proppant]
+                        proppant_fraction (volume fraction) and propped_width (m, the
+                        packed bed's width V / (c_max S))
     checkpoints/        the simulation's atomic checkpoints (one per step, newest kept)
     snapshots/step-NNNNNN_plan.png, _oblique.png   views of the last state (plan
                         only in 2D; the plan view of vertical 3D fractures shows their
@@ -27,6 +29,10 @@ The folder (``--out DIR``) holds::
     snapshots/step-NNNNNN_front.png     the last state of an asymptotic front: the tip
                         regime K^ = K' s^(1/2) / (E' w) of its ribbon elements round
                         the injection point (1 toughness, 0 viscosity)
+    snapshots/step-NNNNNN_proppant.png  with [proppant]: the proppant volume fraction of
+                        the last state on the fractures (side view of vertical 3D fractures)
+    proppant_history.png  with [proppant]: proppant mass pumped and in the fractures
+                        against time (summary.json's proppant_injected_mass, proppant_mass)
     history.png         size, opening and wellbore pressure against time, with the
                         closed form overlaid when the scene has a [reference]; the
                         tips against the interfaces in a layered run; the fluid budget
@@ -45,11 +51,12 @@ from pathlib import Path
 from ..errors import HmatddmError, InputError, OutputError
 from ..io import atomic_output, write_pvd, write_vtu
 from ..simulation.progress import Progress
-from .run_folder import (CHECKPOINT_DIR, HISTORY, MOVIE, PVD,  # noqa: F401  (re-exported)
+from .run_folder import (CHECKPOINT_DIR, HISTORY, MOVIE, PROPPANT_HISTORY, PVD,  # noqa: F401  (re-exported)
                          SCENE_FILE, SNAPSHOT_DIR, SUMMARY, SUMMARY_KEYS, VTU_DIR,
                          cell_fields, latest_state, layer_interfaces, mesh_from_vtu, read_pvd_entries,
                          read_summary, render_folder, snapshot_title, snapshot_views, versions, vtu_name,
                          vtu_steps, write_history, write_json, write_snapshots)
+from .proppant import proppant_fields, write_proppant_history, write_proppant_snapshot
 from ..simulation import checkpoint as checkpoints
 
 
@@ -205,7 +212,8 @@ class SceneRun:
 
     def _clear(self):
         """Remove the files an earlier run wrote (only ours, by name)."""
-        names = [self.out / SUMMARY, self.out / PVD, self.out / HISTORY, self.out / SCENE_FILE, self.out / MOVIE]
+        names = [self.out / SUMMARY, self.out / PVD, self.out / HISTORY, self.out / SCENE_FILE, self.out / MOVIE,
+                 self.out / PROPPANT_HISTORY]
         names += [self.out / name for name in ("events.csv", "microseismic_map.png")]  # hmatddm.microseismic
         names += [self.out / name for name in ("monitor.csv", "monitor.png")]  # hmatddm.app.monitor
         folder = self.out / CHECKPOINT_DIR
@@ -271,6 +279,7 @@ class SceneRun:
             return
         mesh, dd, pressure, codes = self.simulation.view()
         fields = cell_fields(mesh, dd, pressure, self._stress, codes)
+        fields.update(proppant_fields(self.simulation))  # proppant_fraction, propped_width ([proppant])
         if profile:
             self._write_profile(mesh, fields, state)
         self._last_saved_step = state.step
@@ -363,8 +372,12 @@ class SceneRun:
                 raise
             except HmatddmError as error:  # e.g. no offscreen OpenGL on this machine
                 self.note(f"hmatddm: warning: no snapshots written: {error}")
+        if output["snapshots"] and self.simulation.proppant is not None:  # concentration on the fractures
+            self.written["snapshots"].append(write_proppant_snapshot(self.out, self.simulation, self.scene.name))
         if output["history_plot"]:
             self.written["history"] = write_history(self.out, self.steps, self.scene.data)
+            if self.simulation.proppant is not None:  # proppant mass pumped and in place
+                self.written["proppant_history"] = write_proppant_history(self.out, self.steps, self.scene.name)
         if self._monitor is not None:
             self.written["monitor"] = self._monitor.plot(self.scene.name)
         if "microseismic" in self.scene.data:  # events.csv and the event map (ref. Ch. 7)

@@ -14,6 +14,8 @@ Coulomb law for intact natural fractures)::
     stick:  w_i = 0,   s_i = s_i^n,                |c_s| <= C_0 - mu c_n,  c_n <= 0
     slip:   w_i = 0,   c_s = (C_0 - mu c_n) m,     m = (s_i - s_i^n)/|s_i - s_i^n|
 
+(with a packed proppant bed, ``w_i = 0`` reads ``w_i = w_p``, its width: ``propped_width``).
+
 (``c_n = c.n`` is compressive, ``c_s`` the tangential part.) Each status replaces the
 element's rows of the elasticity equation by a block-diagonal combination
 ``S_i (A DD + B p - f)_i + D_i DD_i = g_i``:
@@ -163,9 +165,15 @@ class ContactModel:
     stiffness : (N,) the elements' own normal stiffness ``|n.A_ii.n|``, Pa/m
     max_flips : int
     relative_tolerance : float, the band ``tol_w / max|DD|`` of the status tests
+    propped_width : (N,) or None
+        The opening ``w_p`` a closed element keeps (m, >= 0; None: 0): the width of the packed
+        proppant bed it holds (issue 34, :func:`hmatddm.flow.proppant.propped_width`). A closed
+        element's normal row is ``k (n.DD - w_p) = 0`` and an open one closes below
+        ``w_p - tol_w`` (a rigid bed: the proppant's own compliance is not modelled).
     """
 
-    def __init__(self, law, normals, dd_start, status, direction, stiffness, max_flips=4, relative_tolerance=1e-3):
+    def __init__(self, law, normals, dd_start, status, direction, stiffness, max_flips=4, relative_tolerance=1e-3,
+                 propped_width=None):
         self.law = law
         self.normals = np.asarray(normals, dtype=np.float64)
         self.n, self.d = self.normals.shape
@@ -177,6 +185,8 @@ class ContactModel:
         self.stiffness = np.asarray(stiffness, dtype=np.float64)
         self.max_flips = int(max_flips)
         self.relative_tolerance = float(relative_tolerance)
+        self.propped_width = (np.zeros(self.n) if propped_width is None
+                              else np.maximum(np.asarray(propped_width, dtype=np.float64), 0.0))
         self.reset()
 
     def reset(self):
@@ -234,6 +244,7 @@ class ContactModel:
         # normal row
         select[:, 0, :] = np.where(closed[:, None], 0.0, normals)
         direct[closed, 0, :] = k[closed, None] * normals[closed]
+        g[closed, 0] = k[closed] * self.propped_width[closed]  # a packed proppant bed keeps w_p
         # tangential rows
         for j in range(d - 1):
             t = tangents[:, j, :]
@@ -303,7 +314,7 @@ class ContactModel:
         tol_c = self.stiffness * tol_w
         is_open, closed, slip = self.status == OPEN, self.status != OPEN, self.status == SLIP
         # open -> stick when the faces interpenetrate
-        close = enabled & is_open & (opening < -tol_w)
+        close = enabled & is_open & (opening < self.propped_width - tol_w)
         new_status[close] = STICK
         # closed -> open when the contact traction turns tensile
         release = enabled & closed & (c_n > tol_c)

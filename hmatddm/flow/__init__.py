@@ -3,8 +3,10 @@ from .._lazy import attach
 
 _EXPORTS = {
     "Cluster": ".fluid", "Fluid": ".fluid", "LeakOff": ".fluid", "LubricationModel": ".lubrication",
-    "fracture_compliance": ".lubrication", "Proppant": ".proppant", "carter_coefficient": ".carter",
+    "fracture_compliance": ".lubrication", "Proppant": ".proppant", "PumpSchedule": ".pump_schedule",
+    "carter_coefficient": ".carter",
 }
 __getattr__, __dir__ = attach(__name__, _EXPORTS)
 
-__all__ = ["Fluid", "LeakOff", "Cluster", "LubricationModel", "fracture_compliance", "Proppant", "carter_coefficient"]
+__all__ = ["Fluid", "LeakOff", "Cluster", "LubricationModel", "fracture_compliance", "Proppant", "PumpSchedule",
+           "carter_coefficient"]

@@ -42,6 +42,11 @@ viscosity there, continuous at ``dp_0``): a still fluid keeps a finite conductiv
 the first iterate of a uniform pressure is defined. At n = 1 the linearisation is the
 Newtonian row itself (``k_e = c_e``, ``r_e = 0``).
 
+Slurry (issue 34, :mod:`hmatddm.flow.proppant`): ``viscosity_factor`` (per element, default 1)
+multiplies the viscosity (Newtonian ``mu'``; power-law ``K``, so ``M'`` and the shear-rate floor)
+by the Maron-Pierce factor of the proppant the element holds; a face takes the mean of its two
+elements' factors (``K_e`` divided by it, resp. ``c_e`` by its ``1/n``-th power).
+
 Carter leak-off over a step is integrated exactly: ``Lambda_i dt = 2 c_l
 (sqrt(t^{n+1} - tau_i) - sqrt(max(t^n - tau_i, 0)))``, finite for elements created
 during the step (``t - tau -> 0`` in ref. Eq. 4.25).
@@ -81,6 +86,8 @@ class LubricationModel:
         Floor of the width used in the transmissibility and the storage term, m (a
         closed or not yet opened element keeps a small conductivity; the reference's
         "initial fracture width").
+    viscosity_factor : (N,) array or None
+        Slurry viscosity over the carrier fluid's per element (>= 1; None: clean fluid).
     """
 
     areas: np.ndarray
@@ -92,6 +99,7 @@ class LubricationModel:
     injection_rates: np.ndarray
     wellbore_volumes: np.ndarray
     minimum_width: float
+    viscosity_factor: np.ndarray = None
 
     @property
     def n_elements(self):
@@ -114,7 +122,16 @@ class LubricationModel:
             raise ValueError("a power-law fluid's conductivity depends on the pressure: use "
                              "power_law_conductance(width, pressure)")
         face_width, distance = self.face_width(width)
-        return self.faces.length * face_width**3 / (self.fluid.viscosity_prime * distance)
+        return self.faces.length * face_width**3 / (self.fluid.viscosity_prime * self.face_viscosity_factor()
+                                                    * distance)
+
+    def face_viscosity_factor(self):
+        """The slurry's viscosity factor of every face: the mean of its two elements' (1 for a
+        clean fluid)."""
+        if self.viscosity_factor is None:
+            return 1.0
+        f = self.faces
+        return 0.5 * (self.viscosity_factor[f.first] + self.viscosity_factor[f.second])
 
     def power_law_conductance(self, width, pressure):
         """``(k_e, r_e)`` of every face: the power-law flux linearised at ``pressure`` (module
@@ -124,9 +141,10 @@ class LubricationModel:
         m = 1.0 / n
         f = self.faces
         face_width, distance = self.face_width(width)
-        coefficient = f.length * (face_width ** (2.0 * n + 1.0) / fluid.viscosity_prime) ** m / distance**m
+        factor = self.face_viscosity_factor()
+        coefficient = f.length * (face_width ** (2.0 * n + 1.0) / (fluid.viscosity_prime * factor)) ** m / distance**m
         difference = pressure[f.first] - pressure[f.second]
-        floor = 2.0 * fluid.consistency * fluid.minimum_shear_rate**n * distance / face_width
+        floor = 2.0 * fluid.consistency * factor * fluid.minimum_shear_rate**n * distance / face_width
         magnitude = np.abs(difference)
         sheared = magnitude > floor
         scale = coefficient * np.maximum(magnitude, floor) ** (m - 1.0)

@@ -31,9 +31,10 @@ upwind fluxes the scheme is monotone (a uniform concentration stays uniform, no 
 Slurry viscosity (:func:`slurry_viscosity_factor`): Maron and Pierce (1956),
 ``mu_s / mu = (1 - c / c_max)^-2``, which diverges at the packing limit.
 
-This module is the transport engine and its physics, checked in ``tests/flow/test_proppant.py``.
-It is not yet wired into :class:`hmatddm.Simulation`: no proppant state, pump schedule, scene
-section, outputs or contact rows of a packed bed there (issue 34's report says so).
+This module is the transport engine and its physics, checked in ``tests/flow/test_proppant.py``;
+:mod:`hmatddm.simulation.proppant_step` runs it after every time step of a
+:class:`hmatddm.Simulation` (operator splitting) with the pump schedule of
+:mod:`hmatddm.flow.pump_schedule`.
 """
 from dataclasses import dataclass
 
@@ -105,6 +106,17 @@ def slurry_viscosity_factor(concentration, packing_limit):
     ratio = np.asarray(concentration, float) / packing_limit
     with np.errstate(divide="ignore"):
         return np.where(ratio < 1.0, (1.0 - np.minimum(ratio, 1.0)) ** -2.0, np.inf)
+
+
+#: The largest slurry viscosity factor the flow sees (Maron-Pierce at c = 0.9 c_max): a packed
+#: bed still conducts the carrier fluid through its pores, where the suspension law diverges.
+MAX_VISCOSITY_FACTOR = 100.0
+
+
+def flow_viscosity_factor(concentration, packing_limit):
+    """:func:`slurry_viscosity_factor` capped at :data:`MAX_VISCOSITY_FACTOR` (what the
+    lubrication flow of a time step takes, :mod:`hmatddm.flow.lubrication`)."""
+    return np.minimum(slurry_viscosity_factor(concentration, packing_limit), MAX_VISCOSITY_FACTOR)
 
 
 def propped_width(volume, areas, packing_limit):
@@ -188,13 +200,20 @@ def transport(geometry, proppant, volume, width_old, width_new, face_flux, dt, v
         return out
 
     # sub-steps (CFL): the slurry leaving an element per sub-step is at most `courant` of its
-    # volume (the fluid fluxes, and the settling through the faces below it)
-    slurry_volume = areas * np.maximum(np.minimum(w_old, w_new), 1e-300)
+    # volume (the fluid fluxes, and the settling through the faces below it), counted on the
+    # faces that may carry proppant in the step (both sides at least b d wide at one end of
+    # it; a bridged face carries none), whose elements then hold at least S b d of slurry
+    bridge = proppant.bridging_factor * proppant.diameter
+    widest = np.maximum(w_old, w_new)
+    may_carry = np.minimum(widest[first], widest[second]) >= bridge
+    slurry_volume = areas * np.maximum(np.minimum(w_old, w_new), bridge)
     settling_rate = proppant.settling_velocity(0.0, viscosity) * geometry.length * np.maximum(
         face_width(w_old), face_width(w_new)) * np.abs(slope)
     leaving = np.zeros(n)
-    np.add.at(leaving, first, np.maximum(face_flux, 0.0) + np.where(slope < 0.0, settling_rate, 0.0))
-    np.add.at(leaving, second, np.maximum(-face_flux, 0.0) + np.where(slope > 0.0, settling_rate, 0.0))
+    np.add.at(leaving, first, np.where(may_carry, np.maximum(face_flux, 0.0)
+                                       + np.where(slope < 0.0, settling_rate, 0.0), 0.0))
+    np.add.at(leaving, second, np.where(may_carry, np.maximum(-face_flux, 0.0)
+                                        + np.where(slope > 0.0, settling_rate, 0.0), 0.0))
     rate_scale = float(np.max(leaving / slurry_volume, initial=0.0))
     substeps = max(1, int(np.ceil(dt * rate_scale / courant)))
     tau = dt / substeps

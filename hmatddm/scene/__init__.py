@@ -200,6 +200,23 @@ The format, annotated (``=`` values are the defaults unless marked REQUIRED)::
     fluid_bulk_modulus = 2.2e9     # REQUIRED, K_f of the reservoir fluid, Pa (gas: 30e6)
     porosity = 0.15                # REQUIRED, in (0, 1)
 
+    [proppant]                     # sand carried by the slurry (issue 34; hmatddm.simulation.proppant_step):
+                                   # advected with the fluid after each step's solve, hindered settling
+                                   # along the vertical (z; 2D only in a layered cross-section),
+                                   # Maron-Pierce slurry viscosity, bridging, the packed bed a closing
+                                   # element keeps (with contact); summary.json proppant_injected_mass,
+                                   # proppant_mass (kg), .vtu proppant_fraction, propped_width,
+                                   # snapshots/step-NNNNNN_proppant.png, proppant_history.png
+    diameter = 2e-4                # REQUIRED, m, > 0, particle diameter
+    density = 2650.0               # kg/m^3, > 0
+    fluid_density = 1000.0         # kg/m^3, > 0, carrier fluid (settling)
+    packing_limit = 0.6            # (0, 1), volume fraction of a packed bed
+    bridging_factor = 3.0          # >= 1: faces narrower than this many diameters carry no proppant
+    hindrance_exponent = 4.65      # >= 0, Richardson-Zaki: v = v_Stokes (1 - c)^m
+    schedule = [[0.0, 0.0], [5.0, 0.1]]   # REQUIRED, [time (s), volume fraction in [0, packing_limit)]
+                                   # stages in increasing time, each held until the next (0 before
+                                   # the first); every cluster pumps this slurry
+
     [[monitor]]                    # displacement and tilt at a point after every step: DIR/monitor.csv
     position = [0.0, 0.0, 50.0]    # and DIR/monitor.png (hmatddm.app.monitor); uniform rock only
 '''

@@ -132,7 +132,20 @@ def build_simulation(scene, checkpoint_dir=None):
         checkpoint_dir=checkpoint_dir, keep_checkpoints=numerics["keep_checkpoints"],
         natural_fractures=natural_mesh(scene), natural=natural_properties(scene),
         remote_failure=scene.get("network", {}).get("remote_failure", True), contact=numerics["contact"],
-        max_elements=numerics.get("max_elements"), step_control=step_control(numerics))
+        max_elements=numerics.get("max_elements"), step_control=step_control(numerics), **proppant(scene))
+
+
+def proppant(scene):
+    """``{proppant, pump_schedule}`` of ``[proppant]`` (:class:`hmatddm.flow.Proppant`,
+    :class:`hmatddm.flow.PumpSchedule`), or {} without the section."""
+    section = scene.get("proppant")
+    if section is None:
+        return {}
+    from ..flow import Proppant, PumpSchedule
+
+    particles = Proppant(**{key: value for key, value in section.items() if key != "schedule"})
+    return {"proppant": particles,
+            "pump_schedule": PumpSchedule.from_rows(section["schedule"], particles.packing_limit)}
 
 
 def step_control(numerics):

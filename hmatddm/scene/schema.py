@@ -307,6 +307,8 @@ def validate(raw, name=None):
             echo = _check_fluid(echo)
         elif section == "network":
             echo = _check_network(echo, set(value))
+        elif section == "proppant":
+            _check_proppant(echo)
         elif section == "microseismic":
             from ..microseismic.monitoring import check_section
 
@@ -355,6 +357,15 @@ def validate(raw, name=None):
         # the Picard iteration with contact = "natural": in a network every element closes
         numerics["contact"] = "all"
     return scene
+
+
+def _check_proppant(echo):
+    """[proppant] (issue 34): the particles and a schedule of stages in increasing time whose
+    concentrations lie in [0, packing_limit) (:class:`hmatddm.flow.pump_schedule.PumpSchedule`
+    names ``proppant.schedule[k]``)."""
+    from ..flow.pump_schedule import PumpSchedule
+
+    PumpSchedule.from_rows(echo["schedule"], echo["packing_limit"])
 
 
 RESERVOIR_KEYS = ("permeability", "porosity", "reservoir_compressibility", "reservoir_viscosity")

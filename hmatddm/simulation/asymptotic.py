@@ -37,6 +37,7 @@ from ..errors import ConvergenceError, InputError
 from ..flow import fracture_compliance
 from ..fracture.front import CHANNEL, EMPTY, FILLED, TIP, FrontField, PlanarGrid, fill, front_radii, level_set
 from ..analytical.power_law_tip import tip_asymptote
+from . import proppant_step
 from .records import StepTally, step_record
 from .step_solve import mesh_topology
 from .state import NewElements, StepStart
@@ -134,7 +135,7 @@ class AsymptoticFront:
         of the modified rows) is kept across the front iterations of one operator."""
         mesh = trial.mesh
         _, faces = mesh_topology(mesh, sim.height)
-        flow = sim.flow_model(mesh, faces)
+        flow = sim.flow_model(mesh, faces, proppant_step.viscosity_factor(sim, trial, start.width))
         op = sim.operator(mesh)
         if self._solver is None or self._solver.operator is not op:
             self._solver = ElasticSolver(op, rtol=sim.settings.linear_rtol)
@@ -250,7 +251,7 @@ class AsymptoticFront:
         front_velocity = np.full(mesh.n_elements, np.nan)
         front_distance[ribbon], front_velocity[ribbon] = distance, velocity
         tally.growth_passes = iterations
-        sim.state = replace(sim._finished(begin, trial, flow, t_old, t_new, relaxation, tally),
+        sim.state = replace(sim._finished(begin, trial, flow, t_old, t_new, relaxation, tally, start),
                             front_distance=front_distance, front_velocity=front_velocity, front_class=state)
         tally.operator_builds = sim.operator_builds - builds
         width = np.sum(trial.dd * mesh.normals, axis=1)

@@ -103,6 +103,10 @@ def _state_record(sim, s, flow, width, tally, relaxation, seconds, previous_time
         record["half_length"] = float(np.sum(mesh.areas) / 2.0)
     if sim.medium is not None:
         record.update(height_growth(mesh, s.origin, sim.medium))
+    if sim.proppant is not None:  # masses pumped, in place, screened out (hmatddm.simulation.proppant_step)
+        from .proppant_step import record as proppant_record
+
+        record.update(proppant_record(sim, s, flow, width))
     return record
 
 

@@ -35,7 +35,7 @@ from ..layered.medium import LayeredMedium
 from ..material import Elastic
 from ..mesh import Mesh2D, Mesh3D, check_mesh
 from ..settings import NUMERICS
-from . import checkpoint, growth_pass, step_solve
+from . import checkpoint, growth_pass, proppant_step, step_solve
 from .growing_operator import GrowingOperator
 from .natural import natural_network
 from .records import RECORD_KEYS, StepTally, output_view, step_record
@@ -122,6 +122,13 @@ class Simulation:
     checkpoint_settings : CheckpointSettings or None
         Or its keywords ``checkpoint_dir, keep_checkpoints``: where to write a
         checkpoint after every step, and how many to keep.
+    proppant : Proppant or None
+        Proppant carried by the slurry (issue 34, :mod:`hmatddm.simulation.proppant_step`:
+        transport after each step's coupled solve, slurry viscosity, bridging, the packed bed
+        a closing element keeps); needs ``pump_schedule``.
+    pump_schedule : PumpSchedule or None
+        The proppant volume fraction the clusters pump against time
+        (:class:`hmatddm.flow.pump_schedule.PumpSchedule`).
 
     (The settings classes are in :mod:`hmatddm.simulation.settings`.)
     """
@@ -130,7 +137,7 @@ class Simulation:
                  leak_off=None, initial_pressure=0.0, initial_opening=1e-5, minimum_width=None, height=1.0, *,
                  scheme="krylov", growing_fractures=None, natural_fractures=None, natural=None, remote_failure=True,
                  contact="natural", max_elements=None, step_control=None, operator_settings=None,
-                 rebuild_settings=None, checkpoint_settings=None, **options):
+                 rebuild_settings=None, checkpoint_settings=None, proppant=None, pump_schedule=None, **options):
         if not isinstance(mesh, (Mesh2D, Mesh3D)):
             raise InputError(f"mesh must be a Mesh2D or Mesh3D, got {type(mesh).__name__}")
         check_mesh(mesh)
@@ -201,6 +208,7 @@ class Simulation:
         # that a run stopped by it resumes with a higher one
         self.max_elements = None if max_elements is None else NUMERICS["max_elements"].value("max_elements",
                                                                                              max_elements)
+        self.proppant, self.pump_schedule = _checked_proppant(proppant, pump_schedule)
         self.records = []
         self.front = None  # propagation.front == "asymptotic": its AsymptoticFront (raises for unsupported setups)
         if propagation is not None and propagation.front == "asymptotic":
@@ -222,7 +230,8 @@ class Simulation:
         return State(mesh, dd, pressure, np.zeros(mesh.n_elements), 0.0, 0, self.settings.relaxation, 0.0, 0.0,
                      time_step=self.time_step, origin=np.full(mesh.n_elements, Origin.HYDRAULIC, np.int64),
                      natural_index=-np.ones(mesh.n_elements, np.int64), intact=np.ones(n_natural, bool),
-                     failed=np.zeros(n_natural, bool), extra_faces=np.zeros((0, 6)), **front)
+                     failed=np.zeros(n_natural, bool), extra_faces=np.zeros((0, 6)),
+                     proppant_volume=None if self.proppant is None else np.zeros(mesh.n_elements), **front)
 
     def fingerprint(self):
         """SHA-256 of everything that defines the run (a resume must match it)."""
@@ -235,6 +244,8 @@ class Simulation:
                      minimum_width=self.minimum_width, height=self.height, operator=asdict(self.operator_settings),
                      settings=repr(self.settings), contact=self.contact, remote_failure=self.remote_failure,
                      growing=None if self.growing_fractures is None else self.growing_fractures.tolist())
+        if self.proppant is not None:  # (absent without proppant: the fingerprints of other runs stay)
+            parts.update(proppant=asdict(self.proppant), pump_schedule=self.pump_schedule.rows())
         digest = hashlib.sha256(json.dumps(parts, sort_keys=True, default=str).encode())
         meshes = [self.mesh0] + ([] if self.network is None else [self.network.mesh])
         for value in [v for m in meshes for v in mesh_arrays(m).values()]:
@@ -287,13 +298,15 @@ class Simulation:
             return materials
         return layered_engine.ElementMaterials(materials.shear_modulus[elements], materials.poisson_ratio[elements])
 
-    def flow_model(self, mesh, faces):
+    def flow_model(self, mesh, faces, viscosity_factor=None):
+        """The :class:`LubricationModel` of ``mesh`` with flow ``faces``; ``viscosity_factor``:
+        the slurry's per element (:func:`hmatddm.simulation.proppant_step.viscosity_factor`)."""
         areas = mesh.areas * (self.height if mesh.dim == 2 else 1.0)
         return LubricationModel(areas=areas, normals=mesh.normals, faces=faces, fluid=self.fluid,
                                 leak_off=self.leak_off, injection_elements=self.injection_elements,
                                 injection_rates=np.array([c.rate for c in self.clusters]),
                                 wellbore_volumes=np.array([c.wellbore_volume for c in self.clusters]),
-                                minimum_width=self.minimum_width)
+                                minimum_width=self.minimum_width, viscosity_factor=viscosity_factor)
 
     # -- one step -------------------------------------------------------------------------
     def step(self, end_time=None):
@@ -362,7 +375,7 @@ class Simulation:
                 break
             tally.growth_passes += 1
             trial, start = self._joined(begin, trial, start, growth, t_old, t_new, tally)
-        self.state = self._finished(begin, trial, solved.flow, t_old, t_new, relaxation, tally)
+        self.state = self._finished(begin, trial, solved.flow, t_old, t_new, relaxation, tally, start)
         tally.operator_builds = self.operator_builds - builds
         width = np.sum(trial.dd * trial.mesh.normals, axis=1)
         record = step_record(self, solved.flow, width, tally, relaxation, time.perf_counter() - clock, start)
@@ -414,9 +427,11 @@ class Simulation:
                 f"elements, more than max_elements = {self.max_elements}", elements=n_elements,
                 limit=self.max_elements)
 
-    def _finished(self, begin, trial, flow, t_old, t_new, relaxation, tally):
-        """The state at the end of the step from ``begin`` whose last solve is ``trial``:
-        volumes injected and leaked, natural elements failed, the next relaxation."""
+    def _finished(self, begin, trial, flow, t_old, t_new, relaxation, tally, start):
+        """The state at the end of the step from ``begin`` (whose start is ``start``, a
+        :class:`StepStart`) whose last solve is ``trial``: volumes injected and leaked,
+        natural elements failed, the next relaxation, the proppant moved over the step
+        (:func:`hmatddm.simulation.proppant_step.advance`)."""
         dt = t_new - t_old
         leak = (flow.leak_off_rate(trial.creation_time, t_old, t_new) * flow.areas
                 * (trial.pressure - self.leak_off.pore_pressure))
@@ -438,7 +453,8 @@ class Simulation:
             next_step = self.step_control.next_step(max(dt, planned), advance)
         return replace(trial, time=t_new, step=begin.step + 1, relaxation=next_relaxation, time_step=next_step,
                        injected_volume=begin.injected_volume + dt * sum(c.rate for c in self.clusters),
-                       leaked_volume=begin.leaked_volume + float(np.sum(leak)) * dt, failed=failed)
+                       leaked_volume=begin.leaked_volume + float(np.sum(leak)) * dt, failed=failed,
+                       **proppant_step.advance(self, begin, trial, start, flow, t_old, t_new))
 
     def view(self):
         """Every element of the run for output: ``(mesh, dd, pressure, state)`` with the
@@ -510,6 +526,26 @@ class Simulation:
         # resumed run applies the same operator (bit for bit)
         self.operators.restore(self.state.mesh, int(metadata.get("compressed_elements", 0)))
         return self.state
+
+
+def _checked_proppant(proppant, schedule):
+    """``(proppant, schedule)``, both None or both given, the schedule below the packing limit."""
+    from ..flow.proppant import Proppant
+    from ..flow.pump_schedule import PumpSchedule
+
+    if proppant is None and schedule is None:
+        return None, None
+    if not isinstance(proppant, Proppant):
+        raise InputError(f"proppant must be an hmatddm.flow.Proppant when a pump_schedule is given, got "
+                         f"{type(proppant).__name__}")
+    if not isinstance(schedule, PumpSchedule):
+        raise InputError(f"pump_schedule must be an hmatddm.flow.PumpSchedule when proppant is given, got "
+                         f"{type(schedule).__name__}")
+    highest = max(schedule.concentrations)
+    if highest >= proppant.packing_limit:
+        raise InputError(f"pump_schedule concentrations must be below proppant.packing_limit = "
+                         f"{proppant.packing_limit:g}, got {highest:g}")
+    return proppant, schedule
 
 
 def _paused_margin(info):

@@ -123,6 +123,7 @@ _SCALARS = ("time", "step", "relaxation", "injected_volume", "leaked_volume", "t
 _ALWAYS = ("dd", "pressure", "creation_time", "origin", "natural_index", "intact", "failed", "extra_faces",
            "contact_status", "slip_direction", "failure_pressure")
 _FRONT = ("front_distance", "front_velocity", "front_class")
+_PROPPANT = ("proppant_injected_volume", "proppant_screened_volume", "proppant_substeps")
 
 
 @dataclass
@@ -150,6 +151,11 @@ class State:
     front_velocity: np.ndarray = None  # (N,) asymptotic front: ribbon front velocity (NaN elsewhere)
     front_class: np.ndarray = None     # (N,) asymptotic front: channel, tip, empty, filled (hmatddm.fracture.front)
     time_step: float = None            # the next step's length, s (hmatddm.simulation.step_control)
+    # proppant (issue 34, hmatddm.simulation.proppant_step): None / 0 without proppant
+    proppant_volume: np.ndarray = None   # (N,) proppant (solid) volume in each element, m^3
+    proppant_injected_volume: float = 0.0  # pumped by the clusters so far, m^3
+    proppant_screened_volume: float = 0.0  # found a packed injection element: stays in the wellbore, m^3
+    proppant_substeps: int = 0           # transport sub-steps of the last step
 
     def __post_init__(self):
         n, d = self.dd.shape
@@ -174,7 +180,7 @@ class State:
     def joined(self, new, guess, creation_time):
         """The state with :class:`NewElements` ``new`` appended: DD ``guess``, pressure of
         the parent (or the new elements' own), created at ``creation_time``; failed
-        elements start stuck at their failure pressure, the others open. The asymptotic
+        elements start stuck at their failure pressure, the others open, and without proppant. The asymptotic
         front's arrays, where carried, mark the new elements off the ribbon (no front
         distance) and EMPTY until its front iteration classifies them."""
         m = new.mesh.n_elements
@@ -194,7 +200,9 @@ class State:
             natural_index=np.concatenate([self.natural_index, new.natural_index]), intact=intact,
             failure_pressure=np.concatenate([self.failure_pressure, np.where(failed, new.pressure, np.nan)]),
             contact_status=np.concatenate([self.contact_status, np.where(failed, STICK, OPEN).astype(np.int64)]),
-            slip_direction=np.concatenate([self.slip_direction, np.zeros((m, self.mesh.dim))]))
+            slip_direction=np.concatenate([self.slip_direction, np.zeros((m, self.mesh.dim))]),
+            proppant_volume=None if self.proppant_volume is None else np.concatenate([self.proppant_volume,
+                                                                                      np.zeros(m)]))
 
     # -- checkpoints ------------------------------------------------------------------
     def arrays(self):
@@ -202,11 +210,16 @@ class State:
         arrays = dict(mesh_arrays(self.mesh), **{name: getattr(self, name) for name in _ALWAYS})
         if self.front_class is not None:
             arrays.update({name: getattr(self, name) for name in _FRONT})
+        if self.proppant_volume is not None:
+            arrays["proppant_volume"] = self.proppant_volume
         return arrays
 
     def scalars(self):
         """The state's numbers (in a checkpoint's metadata)."""
-        return {name: getattr(self, name) for name in _SCALARS}
+        scalars = {name: getattr(self, name) for name in _SCALARS}
+        if self.proppant_volume is not None:
+            scalars.update({name: getattr(self, name) for name in _PROPPANT})
+        return scalars
 
     @classmethod
     def from_checkpoint(cls, arrays, metadata):
@@ -215,6 +228,8 @@ class State:
                    float(metadata["time"]), int(metadata["step"]), float(metadata["relaxation"]),
                    float(metadata["injected_volume"]), float(metadata["leaked_volume"]),
                    time_step=None if metadata.get("time_step") is None else float(metadata["time_step"]),
+                   proppant_volume=arrays.get("proppant_volume"),
+                   **{name: type(getattr(cls, name))(metadata.get(name, 0)) for name in _PROPPANT},
                    **{name: arrays.get(name) for name in _ALWAYS[3:] + _FRONT})
 
 

@@ -11,6 +11,7 @@ from ..mesh import topology
 from ..coupled import ElasticSolver, StepProblem, solve_step
 from ..coupled.contact import ContactLaw, ContactModel
 from ..flow import fracture_compliance
+from . import proppant_step
 from .linking import with_links
 from .state import Origin
 
@@ -90,13 +91,14 @@ def solve(simulation, trial, start, t_old, t_new, relaxation, provisional=False)
     sim, mesh = simulation, trial.mesh
     edges, faces = mesh_topology(mesh, sim.height)
     faces = with_links(faces, trial.extra_faces)
-    flow = sim.flow_model(mesh, faces)
+    flow = sim.flow_model(mesh, faces, proppant_step.viscosity_factor(sim, trial, start.width))
     elastic = ElasticSolver(sim.operator(mesh), rtol=sim.settings.linear_rtol)
     contact, fixed_pressure, pressure_guess = None, None, trial.pressure
     law = contact_law(sim, trial.origin)
     if np.any(law.enabled):
         contact = ContactModel(law, mesh.normals, start.dd, trial.contact_status, trial.slip_direction,
-                               elastic.normal_stiffness(mesh.normals))
+                               elastic.normal_stiffness(mesh.normals),
+                               propped_width=proppant_step.propped_width(sim, trial))
     no_fluid = drained(sim, mesh, faces, trial.origin)
     if np.any(no_fluid):
         fixed_pressure = np.where(no_fluid, trial.failure_pressure, np.nan)
