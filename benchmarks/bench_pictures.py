@@ -47,7 +47,8 @@ def run_once(name, snapshots):
 def in_child(name, snapshots, source):
     """:func:`run_once` in a fresh child process with the hmatddm source tree ``source``, so
     that every row pays the same imports and cached compilations."""
-    env = dict(os.environ, PYTHONPATH=str(Path(source).resolve()))
+    # -P: not the script's folder first on sys.path, so that the package comes from ``source``
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(Path(source).resolve()), str(Path(__file__).parent)]))
     arguments = [sys.executable, "-P", __file__, name, "--child"] + ([] if snapshots else ["--no-snapshots"])
     child = subprocess.run(arguments, env=env, capture_output=True, text=True, check=True, cwd=Path(__file__).parent)
     return json.loads(child.stdout.strip().splitlines()[-1])
