@@ -269,10 +269,11 @@ class SceneRun:
         """The .vtu file (``output.vtu``) and the profile picture (``output.snapshots``) of
         a saved step (every ``output.every``-th step and the last).
 
-        Every saved step gets its picture: about 0.1 s of CPU each (matplotlib on one reused
+        Every saved step gets its picture: 0.13 s of CPU each (matplotlib on one reused
         figure; the closed form of a [reference] is tabulated in time,
-        :mod:`hmatddm.analytical.transition_table`), 4 % of the default run of 50 saved
-        steps on an Intel Xeon at dgemm 70 GFLOP/s (benchmarks/RESULTS.md, issue 38)."""
+        :mod:`hmatddm.analytical.transition_table`), 15 % of the default run of 50 saved
+        steps on an Intel Xeon at dgemm 67 GFLOP/s (``benchmarks/bench_pictures.py``,
+        RESULTS.md, issue 38)."""
         output = self.scene.data["output"]
         profile = output["snapshots"]
         if not (output["vtu"] or profile):
