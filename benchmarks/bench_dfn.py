@@ -99,8 +99,9 @@ class Scene:
     length_exponent: float = 2.0                    # a (Eq. 6.1)
     l_min: float = 1.0
     l_max: float = 30.0
-    mean_azimuth_deg: float = 45.0                  # mu
-    kappa: float = 5.0
+    mean_azimuths_deg: tuple = (45.0,)              # mu of each orientation set
+    kappas: tuple = (5.0,)                          # kappa of each set
+    weights: tuple = None                           # mixing factors (None: equal)
     seed: int = 1
     height: float = 10.0                            # full height of every fracture, m
     elements_over_height: int = 10
@@ -145,8 +146,9 @@ REDUCED = Scene(region=(-20.0, 20.0, -30.0, 30.0), height=4.0, elements_over_hei
 def natural_mesh(scene):
     """The network of Table 6.1 as full-height vertical rectangles (Mesh3D)."""
     spec = NetworkSpec(region=scene.region, density=scene.density, length_exponent=scene.length_exponent,
-                       l_min=scene.l_min, l_max=scene.l_max, mean_azimuths_deg=(scene.mean_azimuth_deg,),
-                       kappas=(scene.kappa,), height=scene.height, z_center=0.0, seed=scene.seed)
+                       l_min=scene.l_min, l_max=scene.l_max, mean_azimuths_deg=scene.mean_azimuths_deg,
+                       kappas=scene.kappas, weights=scene.weights, height=scene.height, z_center=0.0,
+                       seed=scene.seed)
     return generate_network(spec).to_mesh3d(scene.element_size, scene.elements_over_height)
 
 
@@ -297,7 +299,7 @@ def run(scene, backend="hmatrix", end_time=None, checkpoint_dir=None, keep_centr
             step_start, step_cpu = time.perf_counter(), time.process_time()
             t_next = sim.state.time + sim.time_step
             try:
-                record = sim.step()
+                record = sim.step(end_time)  # (front-following steps: the last one ends at end_time)
                 if checkpoint_dir is not None:
                     sim.save_checkpoint()
             except hd.HmatddmError as exc:

@@ -60,6 +60,18 @@ def meet_natural_fractures(simulation, state, edges, faces, tips, grown, parent,
         linked.add((tip, other))
         connections.append(link(edges, tip, tips.edge[row], network, target, point, size, number, is_new))
 
+    def joined(tip, target):
+        """Whether ``tip`` already joins natural element ``target`` (in the system or
+        activated in this pass): it is that element, or linked to it."""
+        if active_of[target] >= 0:
+            other = int(active_of[target])
+        else:
+            place = activated_at[int(target)]
+            if activated_parent[place] == tip:
+                return True
+            other = ("new", place)
+        return other == tip or (tip, other) in linked
+
     for k in range(grown.n_elements):
         row, tip = rows[k], int(parent[k])
         distance, nearest = network.tree.query(grown.centers[k])
@@ -73,11 +85,18 @@ def meet_natural_fractures(simulation, state, edges, faces, tips, grown, parent,
                 connect(tip, row, nearest, grown.centers[k], size)
             continue
         hinge = edges.midpoints[tip, tips.edge[row]]
-        hit = network.encounter(grown, k, hinge, on_path)
+        path = on_path
+        own = int(state.natural_index[tip])
+        if own >= 0 and on_path[own]:  # a natural tip's path starts on its own element
+            path = on_path.copy()
+            path[own] = False
+        hit = network.encounter(grown, k, hinge, path)
         if hit is None:
             kept.append(k)
             continue
         target, point = hit
+        if not available[target] and joined(tip, target):
+            continue  # arrested at this natural element before (or by another tip in this pass): it stays so
         far_field, toughness = simulation.far_field_stress, simulation.propagation.toughness
         if simulation.medium is not None:  # the layer where the tip meets it (hmatddm.layered.engine)
             from ..layered.engine import crossing_setting
@@ -88,9 +107,10 @@ def meet_natural_fractures(simulation, state, edges, faces, tips, grown, parent,
                                           edges.ahead[tip, tips.edge[row]], mesh.normals[tip], target, far_field,
                                           toughness)
         if not available[target]:
-            # in the system already (activated, failed remotely, or activated in this pass):
-            # the tip joins its flow either way, and goes on across it where it crosses (a
-            # branch, ref. Sec. 6.4: remote failure creates branches at intersections)
+            # in the system already (activated, failed remotely, or activated in this pass)
+            # and not yet joined by this tip: it joins its flow either way, and goes on
+            # across it where it crosses (a branch, ref. Sec. 6.4: remote failure creates
+            # branches at intersections)
             events.natural_crossed += int(crosses)
             events.natural_deflected += int(not crosses)
             if crosses:

@@ -228,6 +228,14 @@ def test_a_tip_that_cuts_a_natural_element_already_in_the_system_decides_and_con
     else:
         assert events.natural_deflected == 1 and events.natural_crossed == 0
         assert growth.elements is None or growth.elements.mesh.n_elements == 0
+        # the next pass: the tip, now linked to the element, stays arrested there (no new
+        # decision, no event counted again, nothing grows)
+        from hmatddm.simulation import linking
+
+        linked = linking.with_links(faces, np.array([c.face(first_new=2) for c in growth.connections]))
+        again = StepEvents()
+        assert growth_pass.grow(sim, state, edges, linked, None, again) is None
+        assert decisions == [target] and again.natural_deflected == again.natural_crossed == 0
 
 
 def test_energy_criterion_with_mode_two_toughness():
