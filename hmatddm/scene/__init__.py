@@ -137,7 +137,9 @@ The format, annotated (``=`` values are the defaults unless marked REQUIRED)::
     [reference]                    # optional closed form reported at every step
     kind = "radial-k"              # "radial-k", "radial-m", "radial-km" (3D; K-M transition,
                                    # Dontsov 2016), "kgd-k", "kgd-m" (2D);
-                                   # needs one cluster, [propagation] and no leak-off
+                                   # needs one cluster, [propagation] and no leak-off;
+                                   # with leak-off: "kgd-k-leak-off", "radial-k-leak-off"
+                                   # (the K-K~ edge, Carter leak-off; records C_m too)
                                    # summary.json's reference rows record the regime number
                                    # K_m and the solution (formula, source); `hmatddm run`
                                    # warns when the vertex does not apply over the run
