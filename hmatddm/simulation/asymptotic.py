@@ -49,6 +49,20 @@ KGD): the asymptote holds far from the front only at the K vertex (Griffith's op
 at a viscous tip a far ribbon measured worse -- the KGD M-vertex (K_m 0.2, 1 m, 24 s) opening
 +1.9% instead of +0.6%, the power-law M-vertex runs' past +2%. 3D keeps ``s_r >= h/2`` (the
 radial runs converge with it, issue 39; not re-measured with this rule).
+
+**Carter leak-off** (a Newtonian fluid): the tip asymptote is the one with leak-off
+(:class:`~hmatddm.analytical.tip_leak_off.LeakOffTipAsymptote`, ``C' = c_l (p - p_r)`` at
+the ribbon's mean pressure at the start of the step), and an element leaks (Carter's
+``tau_i``, the state's ``creation_time``) from the time the front crosses its centre --
+linear between the front at the start of the step and the trial front -- not from when it
+joined the mesh: a tip element's filled part leaks, roughly, and one the front has barely
+touched does not (:meth:`AsymptoticFront._crossing_times`; +inf while the centre is outside).
+Leaking the whole element from the first touch made the solve fail or the front stall
+(issue 36). Measured against the K-K~ edge (benchmarks/RESULTS.md, issue 39): KGD from K to
+K~ (0.1 m elements, 1 s steps, 52% leaked by 20 s) within 0.15% in half-length and 0.6% in
+net pressure from 5 s on; K~ (85% leaked by 40 s) within 0.5% with 0.25 s steps (1 s steps
+do not converge in the first step, which grows the fracture by seven elements -- without
+leak-off too); radial K to K~ -1.1% in radius.
 """
 import logging
 import time
@@ -63,6 +77,7 @@ from ..flow import fracture_compliance
 from ..fracture.front import CHANNEL, EMPTY, FILLED, TIP, FrontField, PlanarGrid, fill, front_radii, level_set
 from ..analytical.power_law_tip import tip_asymptote
 from ..analytical.tip_asymptote import finite_fracture_factor
+from ..analytical.tip_leak_off import LeakOffTipAsymptote
 from .records import StepTally, step_record
 from .step_solve import mesh_topology
 from .state import NewElements, StepStart
@@ -118,8 +133,8 @@ class AsymptoticFront:
         unsupported = []
         if sim.network is not None:
             unsupported.append("natural fractures")
-        if sim.leak_off.coefficient != 0.0:
-            unsupported.append("leak-off (leak_off.coefficient > 0)")
+        if sim.leak_off.coefficient != 0.0 and sim.fluid.flow_index != 1.0:
+            unsupported.append("leak-off (leak_off.coefficient > 0) with a power-law fluid")
         if prop.bounds is not None:
             unsupported.append("propagation.bounds")
         if sim.contact == "all":
@@ -133,6 +148,10 @@ class AsymptoticFront:
         # a power-law fluid (n < 1): its own k-m asymptote (hmatddm.analytical.power_law_tip)
         self.asymptote = tip_asymptote(sim.material.plane_strain_modulus, prop.toughness, sim.fluid.viscosity_prime,
                                        sim.fluid.flow_index)
+        self.leak_off = sim.leak_off
+        if sim.leak_off.coefficient != 0.0:  # Carter's leak-off in the tip (C' set per step, step())
+            self.asymptote = LeakOffTipAsymptote(sim.material.plane_strain_modulus, prop.toughness,
+                                                 sim.fluid.viscosity_prime)
         self._solver = None
 
     # -- the front at t = 0 -------------------------------------------------------------
@@ -221,6 +240,10 @@ class AsymptoticFront:
         around = grid.key(grid.neighbours(cells[channel]).reshape(-1, grid.k)).reshape(int(channel.sum()), -1)
         ribbon = np.flatnonzero(channel)[~np.all(np.isin(around, channel_keys), axis=1)]
         distance_old = np.maximum(-old.at_cells(cells[ribbon]), 0.0)
+        leaking = self.leak_off.coefficient != 0.0
+        if leaking:  # C' = c_l (p - p_r) at the ribbon's mean pressure at t_old
+            self.asymptote.carter = self.leak_off.coefficient * max(
+                float(np.mean(begin.pressure[ribbon])) - self.leak_off.pore_pressure, 0.0)
         velocity = old.velocity(cells[ribbon] * h)
         length_old = size if self.finite_fracture else np.inf
         distance = distance_old + velocity * dt
@@ -252,6 +275,9 @@ class AsymptoticFront:
             state[filled] = FILLED
             state[channel] = CHANNEL
             width[where[kept]] = mean_width[kept]
+            if leaking:  # an element leaks from when the front crosses its centre (module docstring)
+                trial = replace(trial, creation_time=self._crossing_times(
+                    trial.creation_time, cells, channel, old, field, t_old, t_new))
             prescribed = (state == TIP) | (state == EMPTY)
             if far_ribbon:  # a filled element keeps the asymptote's opening (module docstring)
                 prescribed |= state == FILLED
@@ -295,6 +321,25 @@ class AsymptoticFront:
         record["front_iterations"] = int(iterations)
         sim.records.append(record)
         return record
+
+    @staticmethod
+    def _crossing_times(creation_time, cells, channel, old, field, t_old, t_new):
+        """Carter's ``tau`` of the elements that are not channel: the time the front crosses
+        the element's centre, linear between the front at ``t_old`` (``old``) and the trial
+        front at ``t_new`` (``field``); +inf (no leak-off yet) while the centre is outside.
+        Elements whose centre was inside at ``t_old`` keep theirs."""
+        tau = creation_time.copy()
+        open_ = ~channel
+        phi_old = old.at_cells(cells[open_])
+        phi_new = field.at_cells(cells[open_])
+        crossed = (phi_old > 0.0) & (phi_new <= 0.0)
+        far = crossed & ~np.isfinite(phi_old)  # beyond the old front's box: crossed mid-step
+        ratio = np.where(crossed & ~far, phi_old / np.where(crossed & ~far, phi_old - phi_new, 1.0), 0.5)
+        fraction = np.clip(ratio, 0.0, 1.0)
+        new = np.where(phi_new > 0.0, np.inf, np.where(crossed, t_old + fraction * (t_new - t_old), tau[open_]))
+        new = np.where((phi_old <= 0.0) & ~np.isfinite(tau[open_]), t_old, new)  # inside before, never timed
+        tau[open_] = new
+        return tau
 
     def toughness_share(self, state, length):
         """``K^ = K' s^(1/2) (1 - s/(2L))^(1/2) / (E' w)`` averaged over the ribbon of ``state``

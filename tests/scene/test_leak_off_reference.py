@@ -143,3 +143,23 @@ def test_the_profile_beside_a_leak_off_run_is_the_edges_griffith_crack():
     assert max(profile["position"]) == pytest.approx(float(curves["half_length"][0]), rel=1e-9)
     assert np.allclose(profile["net_pressure"], float(curves["net_pressure"][0]))
     assert "K-K~ edge" in profile["label"]
+
+
+def test_the_asymptotic_front_with_leak_off_follows_the_edge():
+    # the same scene on the asymptotic front (5 initial elements: the well at a centre); the tip
+    # asymptote with leak-off, each element leaking from when the front crosses its centre.
+    # Measured: half-length -0.12 / +0.05 / -0.03%, net pressure +0.54 / +0.09 / +0.13% at 5,
+    # 10, 20 s (the element front: -1.4 / +1.1 / -1.3% and -5.9 / -7.9 / -0.3%); 2.6 s CPU
+    raw = hs.parse_scene(KGD_LEAK_OFF).data
+    raw["propagation"]["front"] = "asymptotic"
+    raw["initial_fracture"][0].update(p0=[-0.25, 0.0], p1=[0.25, 0.0])
+    data = hs.scene_from_dict(raw, "leak-off-asymptotic").data
+    records = hs.build_simulation(data).run(20.0)
+    rows = hs.reference_values(data, records)
+    assert records[-1]["leaked_volume"] > 0.45 * records[-1]["injected_volume"]
+    for record, row in zip(records, rows):
+        if record["time"] >= 5.0:
+            assert abs(row["relative_error"]["half_length"]) < 0.005
+            assert abs(row["relative_error"]["max_opening"]) < 0.01
+            assert abs(row["relative_error"]["net_pressure"]) < 0.01
+        assert abs(record["budget"]["residual"]) < 1e-8 * record["injected_volume"]

@@ -90,8 +90,12 @@ def test_growth_past_max_elements_is_refused_and_keeps_the_last_step(front):
 def test_unsupported_setups_are_refused():
     with pytest.raises(InputError, match="front"):
         hd.Propagation(toughness=1e6, front="level-set")
-    with pytest.raises(InputError, match="leak-off"):
-        radial(leak_off=hd.LeakOff(coefficient=1e-12))
+    power_law = hd.Fluid(compressibility=4.4e-10, rheology="power-law", consistency=0.01, flow_index=0.5)
+    with pytest.raises(InputError, match="leak-off.*power-law"):
+        hd.Simulation(hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 3.0, 3.0, 3, 3), MATERIAL, power_law,
+                      [hd.Cluster((0, 0, 0), 0.01)], np.diag([0, 0, -8e6]), 1.0,
+                      propagation=hd.Propagation(toughness=1e6, front="asymptotic"),
+                      leak_off=hd.LeakOff(coefficient=1e-12))
     with pytest.raises(InputError, match="contact"):
         radial(contact="all")
     mesh = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 3.0, 3.0, 3, 3)
