@@ -29,8 +29,12 @@ viscosity width scale ``W_m = eps_m L_m``; zero at a storage vertex):
   growing as ``t^(1/6)``.
 
 Every closed form of :mod:`.solutions` for a growing fracture is a zero-leak-off
-solution, so a scene's ``[reference]`` refuses leak-off (:mod:`hmatddm.scene.schema`);
-the leak-off numbers say how far a scene with leak-off is from them.
+solution, so a scene's ``[reference]`` with them refuses leak-off (:mod:`hmatddm.scene.schema`);
+the leak-off numbers say how far a scene with leak-off is from them. A scene with leak-off
+is judged by a K-K~ edge (``kgd-k-leak-off``, ``radial-k-leak-off``; :mod:`.leak_off`,
+zero viscosity at any leak-off number): it applies where the toughness number says K (the
+viscosity is negligible; :data:`LEAK_OFF_VERTEX`), and its reference block records ``C_m``
+beside ``K_m``, with ``C' = c_l (sigma_0 - p_r)`` (:func:`carter_prime`).
 """
 from dataclasses import dataclass
 
@@ -99,6 +103,14 @@ def kgd_leak_off_number(t, injection_rate, viscosity, leak_off, material):
     return c_prime * (e_prime * t / (mu_prime * q**3)) ** (1.0 / 6.0)
 
 
+def carter_prime(carter_per_pressure, pressure_excess):
+    """``C' = c_l (sigma_0 - p_r)`` (m/s^(1/2)) of this project's leak-off ``c_l (p - p_r) /
+    (t - t_0)^(1/2)`` (ref. Eq. 4.25) at the confining stress ``sigma_0``: the net pressure,
+    small against ``sigma_0 - p_r`` where leak-off matters, left out (``pressure_excess`` =
+    ``sigma_0 - p_r`` in Pa, ``carter_per_pressure`` ``c_l`` in m/(s^(1/2) Pa), both >= 0)."""
+    return _leak_off(float(carter_per_pressure) * max(float(pressure_excess), 0.0))
+
+
 def _leak_off(value):
     value = float(value)
     if not np.isfinite(value) or value < 0.0:
@@ -162,6 +174,24 @@ SOLUTIONS = {
         "Spence and Sharp 1985; Adachi and Detournay 2002"),
 }
 
+# closed forms with Carter leak-off (hmatddm.analytical.leak_off): the K-K~ edges
+SOLUTIONS.update({
+    "kgd-k-leak-off": Solution(
+        "kgd-k-leak-off", "plane-strain (KGD) K-K~ edge (zero viscosity, Carter leak-off; mass balance integrated "
+        "in time)",
+        "p = K_Ic / (pi l)^(1/2), w0 = 4 p l / E', Q t = 2 pi p l^2 / E' + int int c_l (sigma_0 - p_r + p) / "
+        "(t' - t_0(x))^(1/2) dx dt'",
+        "Carter 1957; Bunger, Detournay and Garagash 2005; hmatddm.analytical.kgd_toughness_leak_off_edge"),
+    "radial-k-leak-off": Solution(
+        "radial-k-leak-off", "radial K-K~ edge (zero viscosity, Carter leak-off; mass balance integrated in time)",
+        "p = pi^(1/2) K_Ic / (2 R^(1/2)), w0 = 8 p R / (pi E'), Q t = 16 p R^3 / (3 E') + int int c_l (sigma_0 "
+        "- p_r + p) / (t' - t_0(r))^(1/2) dA dt'",
+        "Carter 1957; Madyarova 2003; Detournay 2016; hmatddm.analytical.radial_toughness_leak_off_edge"),
+})
+# the vertex of the toughness number whose side each leak-off edge lies on (zero viscosity:
+# the K side at any leak-off number)
+LEAK_OFF_VERTEX = {"kgd-k-leak-off": "kgd-k", "radial-k-leak-off": "radial-k"}
+
 # what applies where a vertex does not: the transition solutions
 _TRANSITION = {
     "radial": "radial-km (Dontsov 2016, in this package)",
@@ -183,6 +213,7 @@ def applicable_solution(kind, toughness_numbers):
     geometry = "radial" if kind.startswith("radial") else "kgd"
     if kind == "radial-km":
         return True, None
+    kind = LEAK_OFF_VERTEX.get(kind, kind)  # a K-K~ edge: where the K-vertex's toughness number says K
     vertices = {vertex(float(k), geometry) for k in np.ravel(toughness_numbers)}
     wanted = kind.rsplit("-", 1)[1].upper()
     if vertices == {wanted}:

@@ -11,13 +11,11 @@ into it, so the opening is wider than without leak-off at the same ``(s, V)``. A
 rest (``V = 0``) opens as the toughness asymptote (``K^ = 1`` makes ``g_delta`` vanish for
 any ``C^``). :class:`LeakOffTipAsymptote` takes one ``C'`` for every point of a call.
 
-Not yet used by the asymptotic front (:mod:`hmatddm.simulation.asymptotic` still refuses a
-Carter coefficient): tried with one ``C'`` per step at the ribbon's mean pressure, the
-coupled solve of a KGD step did not converge (M~ case of benchmarks/bench_leak_off.py) or
-the front stalled (K~), because a tip element then leaks ``c_l (p - p_r)`` through its
-whole area from the time the front first touched it, where only its filled part leaks,
-each point from when the front crossed it -- the flow model's Carter term would have to
-take the tip elements' filled fractions and crossing times.
+Used by the asymptotic front (:mod:`hmatddm.simulation.asymptotic`) with one ``C'`` per
+step at the ribbon's mean pressure. A first try (issue 36) failed -- the coupled solve of a
+KGD step did not converge (M~ case of benchmarks/bench_leak_off.py) or the front stalled
+(K~) -- because a tip element leaked ``c_l (p - p_r)`` through its whole area from the time
+the front first touched it; it now leaks from the time the front crosses its centre.
 """
 import numpy as np
 

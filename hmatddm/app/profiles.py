@@ -77,6 +77,16 @@ def closed_form_profile(scene, time_value):
                              float(size))
         profile["label"] = f"{kind} vertex"
         return profile
+    if kind in ("kgd-k-leak-off", "radial-k-leak-off"):  # the K-K~ edge: Griffith's / Sneddon's opening
+        from ..scene.build import _closed_form
+
+        curves = _closed_form(scene, [t])
+        size = float(curves["radius" if kind.startswith("radial") else "half_length"][0])
+        rho = np.linspace(0.0, 1.0, SAMPLES)
+        profile = _symmetric(rho, float(curves["max_opening"][0]) * np.sqrt(1.0 - rho ** 2),
+                             np.full(SAMPLES, float(curves["net_pressure"][0])), size)
+        profile["label"] = f"{kind.split('-')[0]} K-K~ edge (leak-off)"
+        return profile
     if kind == "kgd-m":
         size, _, _ = analytical.kgd_m_vertex(t, rate / scene["height"], viscosity, rock)
         rho = np.linspace(0.0, _M_RHO[1], SAMPLES)

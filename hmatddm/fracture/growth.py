@@ -57,9 +57,9 @@ class Propagation:
         inverting the universal tip asymptote (:mod:`hmatddm.analytical.tip_asymptote`,
         :mod:`hmatddm.fracture.front`); partially filled tip elements carry the
         asymptote's opening. Planar fractures only (one fracture, square elements on one
-        grid in 3D, equal segments on a line in 2D), without leak-off, natural
-        fractures, contact or bounds: :class:`~hmatddm.Simulation` raises InputError
-        otherwise. ``criterion`` and ``turning`` are not used by it.
+        grid in 3D, equal segments on a line in 2D), without natural fractures, contact
+        or bounds, and leak-off only with a Newtonian fluid (the tip asymptote with
+        leak-off): :class:`~hmatddm.Simulation` raises InputError otherwise. ``criterion`` and ``turning`` are not used by it.
     front_iterations : int
         Asymptotic front: fixed-point iterations of the front per time step, >= 1.
     front_tolerance : float

@@ -138,6 +138,8 @@ The format, annotated (``=`` values are the defaults unless marked REQUIRED)::
     kind = "radial-k"              # "radial-k", "radial-m", "radial-km" (3D; K-M transition,
                                    # Dontsov 2016), "kgd-k", "kgd-m" (2D);
                                    # needs one cluster, [propagation] and no leak-off;
+                                   # with leak-off: "kgd-k-leak-off", "radial-k-leak-off"
+                                   # (the K-K~ edge, Carter leak-off; records C_m too);
                                    # or "three-layer-height" (2D, three [[layer]]s: the
                                    # equilibrium height of a symmetric stack under a
                                    # stress contrast, Simonson et al. 1978)

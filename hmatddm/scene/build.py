@@ -12,6 +12,7 @@ from ..settings import NATURAL_FRACTURE
 from .meshes import check_clusters, fracture_mesh, initial_mesh, natural_mesh
 from .preflight import estimate, refuse_too_many_elements
 from .schema import SCHEME_KEYS, far_field_stress, has_natural_fractures
+from .sections import LEAK_OFF_REFERENCE_KINDS
 
 _CROSSING_NAMES = {"mohr-coulomb": "mohr-coulomb", "energy-release-rate": "energy", "stress-intensity": "sif"}
 
@@ -208,6 +209,8 @@ def _closed_form(scene, times, kind=None):
     toughness = scene["propagation"]["toughness"]
     times = np.asarray(times, dtype=float)
     curves = {"time": times}
+    if kind in LEAK_OFF_REFERENCE_KINDS:
+        return _leak_off_closed_form(scene, times, kind, curves)
     if scene["fluid"]["rheology"] == "power-law":  # the power-law vertices (hmatddm.analytical.power_law)
         from ..analytical import power_law
 
@@ -250,6 +253,40 @@ def _closed_form(scene, times, kind=None):
         curves["half_length"], curves["max_opening"], curves["net_pressure"] = values
         curves["dimensionless_toughness"] = np.full(times.shape, analytical.kgd_regime(rate, viscosity,
                                                                                          toughness, mat))
+    return curves
+
+
+def _leak_off_closed_form(scene, times, kind, curves):
+    """The K-K~ edge of a scene with Carter leak-off (``kind`` in
+    :data:`~hmatddm.scene.sections.LEAK_OFF_REFERENCE_KINDS`; zero viscosity, the leak-off
+    ``c_l (sigma_0 + p_net - p_r) / (t - t_0)^(1/2)`` with ``sigma_0`` the confining stress):
+    size and net pressure from :mod:`hmatddm.analytical.leak_off`, the opening at the well
+    Griffith's ``4 p l / E'`` or Sneddon's ``8 p R / (pi E')``; ``dimensionless_toughness`` as
+    for the K vertex, and ``leak_off_number`` ``C_m`` with ``C' = c_l (sigma_0 - p_r)``
+    (:func:`hmatddm.analytical.regimes.carter_prime`)."""
+    from .. import analytical
+    from ..analytical import regimes
+
+    mat = material(scene)
+    e_prime = mat.plane_strain_modulus
+    rate = scene["cluster"][0]["rate"]
+    toughness = scene["propagation"]["toughness"]
+    viscosity = scene["fluid"]["viscosity"]
+    c_l = leak_off(scene).coefficient
+    excess = confining_stress(scene) - scene["leak_off"]["pore_pressure"]
+    c_prime = regimes.carter_prime(c_l, excess)
+    if kind == "radial-k-leak-off":
+        radius, net = analytical.radial_toughness_leak_off_edge(times, rate, c_l, excess, toughness, e_prime)
+        curves.update(radius=radius, max_opening=8.0 * net * radius / (np.pi * e_prime), net_pressure=net)
+        curves["dimensionless_toughness"] = analytical.radial_regime(times, rate, viscosity, toughness, mat)
+        curves["leak_off_number"] = regimes.radial_leak_off_number(times, rate, viscosity, c_prime, mat)
+    else:
+        rate = rate / scene["height"]  # per unit height
+        half_length, net = analytical.kgd_toughness_leak_off_edge(times, rate, c_l, excess, toughness, e_prime)
+        curves.update(half_length=half_length, max_opening=4.0 * net * half_length / e_prime, net_pressure=net)
+        curves["dimensionless_toughness"] = np.full(times.shape, analytical.kgd_regime(rate, viscosity, toughness,
+                                                                                        mat))
+        curves["leak_off_number"] = regimes.kgd_leak_off_number(times, rate, viscosity, c_prime, mat)
     return curves
 
 
@@ -352,11 +389,15 @@ def reference_values(scene, records):
     rows = []
     for index, record in enumerate(records):
         row = {key: float(values[index]) for key, values in curves.items()}
-        simulated = _simulated(record, size_key, confining, uniform_pressure=kind.endswith("-k"))
+        uniform = kind.endswith("-k") or kind in LEAK_OFF_REFERENCE_KINDS  # a K vertex or a K-K~ edge
+        simulated = _simulated(record, size_key, confining, uniform_pressure=uniform)
         row["relative_error"] = _relative(simulated, row)
         row["regime"] = {"number": regime["number"], "value": row["dimensionless_toughness"],
                          "vertex": regime["vertex"][index + 1], "applies_over_run": regime["applies"],
                          "solution_that_applies": regime["instead"]}
+        if "leak_off_number" in row:  # a closed form with leak-off: its number C_m beside K_m
+            row["regime"]["leak_off"] = {"number": "C_m", "value": row.pop("leak_off_number"),
+                                         "carter_prime": "C' = c_l (sigma_0 - p_r)"}
         row["solution"] = solution
         if beside is not None:
             vertex = {key: float(beside[key][index]) for key in (size_key, "max_opening", "net_pressure")}

@@ -26,6 +26,7 @@ from ..settings import ABSENT, REQUIRED, show  # noqa: F401  (show: re-exported 
 from .echo import far_field_stress, has_natural_fractures, to_toml  # noqa: F401  (the scene's public names)
 from .sections import (FILLED_WHEN_ABSENT, INITIAL_FRACTURE, NETWORK_GENERATOR, SCHEME_KEYS, SECTIONS,
                        SHAPE_KEYS, SHAPES, TOP)
+from .sections import LEAK_OFF_REFERENCE_KINDS
 
 
 # ---------------------------------------------------------------------------------
@@ -238,9 +239,19 @@ def _check_reference(scene):
         raise InputError(f"{where} is a Newtonian closed form (Dontsov 2016); a power-law fluid "
                          "(fluid.rheology = 'power-law') is compared with kind = 'radial-m', 'radial-k', 'kgd-m' "
                          "or 'kgd-k'")
-    if scene["leak_off"]["coefficient"] != 0.0:
+    if kind in LEAK_OFF_REFERENCE_KINDS:  # a K-K~ edge: Carter leak-off, a Newtonian fluid
+        if scene["leak_off"]["coefficient"] <= 0.0 and "permeability" not in scene["leak_off"]:
+            raise InputError(f"{where} is a closed form with Carter leak-off: leak_off.coefficient must be > 0 "
+                             f"(or the reservoir keys), got {show(scene['leak_off']['coefficient'])}; without "
+                             f"leak-off use kind = {kind.removesuffix('-leak-off')!r}")
+        if scene["fluid"]["rheology"] == "power-law":
+            raise InputError(f"{where}: its regime numbers are a Newtonian fluid's; a power-law fluid "
+                             "(fluid.rheology = 'power-law') is compared with kind = 'radial-m', 'radial-k', 'kgd-m' "
+                             "or 'kgd-k'")
+    elif scene["leak_off"]["coefficient"] != 0.0:
         raise InputError(f"{where} assumes no leak-off: leak_off.coefficient must be 0, got "
-                         f"{show(scene['leak_off']['coefficient'])}")
+                         f"{show(scene['leak_off']['coefficient'])}; with leak-off use kind = "
+                         f"{kind.split('-')[0] + '-k-leak-off'!r} (the K-K~ edge)")
 
 
 # ---------------------------------------------------------------------------------

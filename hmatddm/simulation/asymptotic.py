@@ -24,6 +24,45 @@ Both the inversion (3) and the tip openings (1) use the asymptote of a fracture 
 ``L`` (:func:`~hmatddm.analytical.tip_asymptote.finite_fracture_factor`), with ``L`` the radius
 ``sqrt(A/pi)`` (3D) or the half-length (2D) at the start of the step plus the trial front's
 mean advance (``AsymptoticFront.finite_fracture = False``: the bare semi-infinite asymptote).
+
+**The ribbon stays away from the front (2D).** In a plane-strain run an element the front
+has crossed (*filled*) keeps its prescribed opening (the asymptote, fully inside the front)
+and joins the channel only at the start of a step where its centre lies at least ``c h``
+behind the front, ``c = max(ribbon_elements, ribbon_growth (L/h)^(1/2))``
+(:meth:`AsymptoticFront.ribbon_distance`), so the ribbon's distance to the front is
+``s_r >= c h``. Why, measured on a Griffith crack of constant elements under uniform pressure
+whose elements within ``c h`` of the front hold the exact opening averaged over them
+(benchmarks/bench_asymptotic_ribbon.py, an independent solve): the ribbon's opening is off
+the exact one at its centre by +20% at ``s_r = 0.55 h``, +5% at 0.8 h, -1.4% at 1.3 h,
+-0.2..-0.3% at 1.5-2.3 h, -0.1% at 3 h, whatever ``L/h``. The old rule (a filled element joined
+the channel at once, the ribbon at ``s_r >= h/2``) read the ribbon 5-20% too wide after each
+element the front crossed: the front ran ahead by an element, stalled while the fluid caught
+up, and the 40-iteration cap cut the drift (the KGD half-length error +0.8, +0.8, +4.9, +1.0%
+at 1, 0.5, 0.25, 0.125 m, a sawtooth in time). With ``s_r >= 1.5 h`` the error of the ribbon
+is a fixed fraction of its opening at every ``h`` (a sqrt profile has no length scale), which
+reads the toughness ~0.3% high at every mesh; growing ``c`` as ``(L/h)^(1/2)`` moves the
+ribbon more elements from the front as the mesh is refined (its error falls) while its
+distance ``c h = ribbon_growth (L h)^(1/2)`` still shrinks (kgd, K_m 8.7: every error falls
+from h = 1 to 0.125 m, benchmarks/RESULTS.md, issue 39). Only at a toughness-dominated tip
+(:meth:`AsymptoticFront.toughness_share` at least ``toughness_tip`` = 0.95; K_m >~ 4 in
+KGD): the asymptote holds far from the front only at the K vertex (Griffith's opening), and
+at a viscous tip a far ribbon measured worse -- the KGD M-vertex (K_m 0.2, 1 m, 24 s) opening
++1.9% instead of +0.6%, the power-law M-vertex runs' past +2%. 3D keeps ``s_r >= h/2`` (the
+radial runs converge with it, issue 39; not re-measured with this rule).
+
+**Carter leak-off** (a Newtonian fluid): the tip asymptote is the one with leak-off
+(:class:`~hmatddm.analytical.tip_leak_off.LeakOffTipAsymptote`, ``C' = c_l (p - p_r)`` at
+the ribbon's mean pressure at the start of the step), and an element leaks (Carter's
+``tau_i``, the state's ``creation_time``) from the time the front crosses its centre --
+linear between the front at the start of the step and the trial front -- not from when it
+joined the mesh: a tip element's filled part leaks, roughly, and one the front has barely
+touched does not (:meth:`AsymptoticFront._crossing_times`; +inf while the centre is outside).
+Leaking the whole element from the first touch made the solve fail or the front stall
+(issue 36). Measured against the K-K~ edge (benchmarks/RESULTS.md, issue 39): KGD from K to
+K~ (0.1 m elements, 1 s steps, 52% leaked by 20 s) within 0.15% in half-length and 0.6% in
+net pressure from 5 s on; K~ (85% leaked by 40 s) within 0.5% with 0.25 s steps (1 s steps
+do not converge in the first step, which grows the fracture by seven elements -- without
+leak-off too); radial K to K~ -1.1% in radius.
 """
 import logging
 import time
@@ -37,6 +76,8 @@ from ..errors import ConvergenceError, InputError
 from ..flow import fracture_compliance
 from ..fracture.front import CHANNEL, EMPTY, FILLED, TIP, FrontField, PlanarGrid, fill, front_radii, level_set
 from ..analytical.power_law_tip import tip_asymptote
+from ..analytical.tip_asymptote import finite_fracture_factor
+from ..analytical.tip_leak_off import LeakOffTipAsymptote
 from . import proppant_step
 from .records import StepTally, step_record
 from .step_solve import mesh_topology
@@ -81,6 +122,11 @@ class AsymptoticFront:
     """The asymptotic front of one :class:`~hmatddm.Simulation` (checks its setup)."""
 
     finite_fracture = True  # the asymptote of a fracture of the current size (module docstring)
+    # 2D: a filled element joins the channel where its centre is >= c h behind the front,
+    # c = max(ribbon_elements, ribbon_growth (L/h)^(1/2)) (module docstring)
+    ribbon_elements = 1.5
+    ribbon_growth = 0.5
+    toughness_tip = 0.95  # ... where the toughness share of the ribbon (toughness_share) is at least this
 
     def __init__(self, simulation):
         sim = simulation
@@ -88,8 +134,8 @@ class AsymptoticFront:
         unsupported = []
         if sim.network is not None:
             unsupported.append("natural fractures")
-        if sim.leak_off.coefficient != 0.0:
-            unsupported.append("leak-off (leak_off.coefficient > 0)")
+        if sim.leak_off.coefficient != 0.0 and sim.fluid.flow_index != 1.0:
+            unsupported.append("leak-off (leak_off.coefficient > 0) with a power-law fluid")
         if prop.bounds is not None:
             unsupported.append("propagation.bounds")
         if sim.contact == "all":
@@ -103,6 +149,10 @@ class AsymptoticFront:
         # a power-law fluid (n < 1): its own k-m asymptote (hmatddm.analytical.power_law_tip)
         self.asymptote = tip_asymptote(sim.material.plane_strain_modulus, prop.toughness, sim.fluid.viscosity_prime,
                                        sim.fluid.flow_index)
+        self.leak_off = sim.leak_off
+        if sim.leak_off.coefficient != 0.0:  # Carter's leak-off in the tip (C' set per step, step())
+            self.asymptote = LeakOffTipAsymptote(sim.material.plane_strain_modulus, prop.toughness,
+                                                 sim.fluid.viscosity_prime)
         self._solver = None
 
     # -- the front at t = 0 -------------------------------------------------------------
@@ -177,19 +227,26 @@ class AsymptoticFront:
         circle = np.isfinite(begin.front_distance)
         # the ribbon: channel elements with an edge neighbour that is not channel
         cells = grid.cells(mesh.centers)
-        channel = (begin.front_class == CHANNEL) | (begin.front_class == FILLED)
-        channel_keys = grid.key(cells[channel])
-        around = grid.key(grid.neighbours(cells[channel]).reshape(-1, grid.k)).reshape(int(channel.sum()), -1)
-        ribbon = np.flatnonzero(channel)[~np.all(np.isin(around, channel_keys), axis=1)]
         # (the field of the old ribbon: inward through the cells that were channel before it)
         old = self.field(cells[circle], begin.front_distance[circle], begin.front_velocity[circle],
                          cells[begin.front_class == CHANNEL])
+        size = self.measures(begin, sim)
+        size = size["radius"] if grid.k == 2 else size["half_length"]
+        filled_old = begin.front_class == FILLED
+        far_ribbon = grid.k == 1 and self.toughness_share(begin, size) >= self.toughness_tip
+        if far_ribbon:  # 2D, toughness tip: a filled element joins the channel c h behind the front
+            filled_old &= old.at_cells(cells) <= -self.ribbon_distance(size) * h
+        channel = (begin.front_class == CHANNEL) | filled_old
+        channel_keys = grid.key(cells[channel])
+        around = grid.key(grid.neighbours(cells[channel]).reshape(-1, grid.k)).reshape(int(channel.sum()), -1)
+        ribbon = np.flatnonzero(channel)[~np.all(np.isin(around, channel_keys), axis=1)]
         distance_old = np.maximum(-old.at_cells(cells[ribbon]), 0.0)
+        leaking = self.leak_off.coefficient != 0.0
+        if leaking:  # C' = c_l (p - p_r) at the ribbon's mean pressure at t_old
+            self.asymptote.carter = self.leak_off.coefficient * max(
+                float(np.mean(begin.pressure[ribbon])) - self.leak_off.pore_pressure, 0.0)
         velocity = old.velocity(cells[ribbon] * h)
-        length_old = np.inf
-        if self.finite_fracture:
-            size = self.measures(begin, sim)
-            length_old = size["radius"] if grid.k == 2 else size["half_length"]
+        length_old = size if self.finite_fracture else np.inf
         distance = distance_old + velocity * dt
         length = length_old + float(np.mean(distance - distance_old))
 
@@ -219,7 +276,12 @@ class AsymptoticFront:
             state[filled] = FILLED
             state[channel] = CHANNEL
             width[where[kept]] = mean_width[kept]
+            if leaking:  # an element leaks from when the front crosses its centre (module docstring)
+                trial = replace(trial, creation_time=self._crossing_times(
+                    trial.creation_time, cells, channel, old, field, t_old, t_new))
             prescribed = (state == TIP) | (state == EMPTY)
+            if far_ribbon:  # a filled element keeps the asymptote's opening (module docstring)
+                prescribed |= state == FILLED
             trial, info, flow = self._solve(sim, trial, start, prescribed, width, t_old, t_new, relaxation)
             relaxation = info["relaxation"]
             tally.add_solve(info)
@@ -260,6 +322,44 @@ class AsymptoticFront:
         record["front_iterations"] = int(iterations)
         sim.records.append(record)
         return record
+
+    @staticmethod
+    def _crossing_times(creation_time, cells, channel, old, field, t_old, t_new):
+        """Carter's ``tau`` of the elements that are not channel: the time the front crosses
+        the element's centre, linear between the front at ``t_old`` (``old``) and the trial
+        front at ``t_new`` (``field``); +inf (no leak-off yet) while the centre is outside.
+        Elements whose centre was inside at ``t_old`` keep theirs."""
+        tau = creation_time.copy()
+        open_ = ~channel
+        phi_old = old.at_cells(cells[open_])
+        phi_new = field.at_cells(cells[open_])
+        crossed = (phi_old > 0.0) & (phi_new <= 0.0)
+        far = crossed & ~np.isfinite(phi_old)  # beyond the old front's box: crossed mid-step
+        ratio = np.where(crossed & ~far, phi_old / np.where(crossed & ~far, phi_old - phi_new, 1.0), 0.5)
+        fraction = np.clip(ratio, 0.0, 1.0)
+        new = np.where(phi_new > 0.0, np.inf, np.where(crossed, t_old + fraction * (t_new - t_old), tau[open_]))
+        new = np.where((phi_old <= 0.0) & ~np.isfinite(tau[open_]), t_old, new)  # inside before, never timed
+        tau[open_] = new
+        return tau
+
+    def toughness_share(self, state, length):
+        """``K^ = K' s^(1/2) (1 - s/(2L))^(1/2) / (E' w)`` averaged over the ribbon of ``state``
+        (``s`` its distance to the front, ``w`` its opening, ``L`` = ``length``): the share of
+        the ribbon's opening the toughness asymptote explains, 1 at a toughness-dominated tip,
+        small at a viscosity-dominated one (module docstring)."""
+        ribbon = np.isfinite(state.front_distance)
+        if not np.any(ribbon):
+            return 0.0
+        s = state.front_distance[ribbon]
+        w = np.sum(state.dd[ribbon] * state.mesh.normals[ribbon], axis=1)
+        share = self.asymptote.toughness_width(s) * finite_fracture_factor(s, length) / np.maximum(w, 1e-300)
+        return float(np.mean(np.minimum(share, 1.0)))
+
+    def ribbon_distance(self, length):
+        """``c``, the fewest element sizes between a 2D ribbon's centre and the front, for a
+        fracture of half-length ``length``: ``max(ribbon_elements, ribbon_growth (L/h)^(1/2))``
+        (module docstring)."""
+        return max(self.ribbon_elements, self.ribbon_growth * float(np.sqrt(max(length, 0.0) / self.grid.h)))
 
     def _joined(self, sim, trial, start, new_cells, channel, tally, t_old, t_new):
         """``(trial, start)`` with elements at ``new_cells`` (reached by the trial front for

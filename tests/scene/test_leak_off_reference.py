@@ -1,0 +1,165 @@
+"""A scene with Carter leak-off judged by a closed form with leak-off (issue 39): the
+``[reference] kind`` ``kgd-k-leak-off`` / ``radial-k-leak-off`` (the K-K~ edges of
+:mod:`hmatddm.analytical.leak_off`), its leak-off number in the reference block, the
+schema's refusals, and a short run against it."""
+import numpy as np
+import pytest
+
+import hmatddm.scene as hs
+from hmatddm.errors import InputError
+from hmatddm.scene.build import _closed_form
+
+# bench_leak_off.py's "K to K~" case as a scene: G 1 GPa, sigma_0 - p_r = 20 MPa, Q 1e-3
+# m^2/s, c_l 1e-11 m/(s^1/2 Pa) (C' = 2e-4 m/s^1/2), K_Ic 1 MPa m^1/2, mu 1e-5 Pa s;
+# 0.4 m initial fracture of 0.1 m elements, the element front (the asymptotic front refuses
+# leak-off)
+KGD_LEAK_OFF = """
+dimension = 2
+[material]
+shear_modulus = 1e9
+poisson_ratio = 0.25
+[fluid]
+viscosity = 1e-5
+compressibility = 0.0
+[stress]
+s_hmin = 20e6
+s_hmax = 40e6
+[[cluster]]
+position = [0.0, 0.0]
+rate = 1e-3
+[[initial_fracture]]
+shape = "line"
+p0 = [-0.2, 0.0]
+p1 = [0.2, 0.0]
+element_size = 0.1
+[propagation]
+toughness = 1e6
+front = "element"
+[leak_off]
+coefficient = 1e-11
+pore_pressure = 0.0
+[numerics]
+time_step = 1.0
+end_time = 20.0
+backend = "dense"
+initial_pressure = 21.28e6
+initial_opening = 1e-5
+[reference]
+kind = "kgd-k-leak-off"
+"""
+
+
+def scene(text=KGD_LEAK_OFF, **changes):
+    raw = hs.parse_scene(text).data
+    for dotted, value in changes.items():
+        section, key = dotted.split(".")
+        raw[section][key] = value
+    return hs.scene_from_dict(raw, "leak-off").data
+
+
+def test_the_edge_is_the_k_vertex_without_leak_off_and_the_carter_size_with_much():
+    # independent limits: tiny c_l -> the KGD K vertex l = (E' Q t / (2 pi^1/2 K_Ic))^(2/3);
+    # much leak-off (sigma_0 - p_r = 200 MPa) -> the leak-off vertex l = Q t^1/2 / (pi C'), C' = c_l (sigma_0 - p_r + p_net)
+    e_prime = 2.0 * 1e9 / (1.0 - 0.25)
+    t = np.array([5.0, 20.0])
+    storage = _closed_form(scene(**{"leak_off.coefficient": 1e-16}), t)
+    k_vertex = (e_prime * 1e-3 * t / (2.0 * np.sqrt(np.pi) * 1e6)) ** (2.0 / 3.0)
+    np.testing.assert_allclose(storage["half_length"], k_vertex, rtol=2e-3)
+    leaky = _closed_form(scene(**{"leak_off.coefficient": 1e-10, "stress.s_hmin": 200e6, "stress.s_hmax": 400e6}), t)
+    carter = 1e-3 * np.sqrt(t) / (np.pi * 1e-10 * (200e6 + leaky["net_pressure"]))
+    np.testing.assert_allclose(leaky["half_length"], carter, rtol=0.01)
+    # Griffith's opening at the well and the uniform net pressure K_Ic / (pi l)^(1/2)
+    np.testing.assert_allclose(leaky["net_pressure"], 1e6 / np.sqrt(np.pi * leaky["half_length"]), rtol=1e-12)
+    np.testing.assert_allclose(leaky["max_opening"], 4.0 * leaky["net_pressure"] * leaky["half_length"] / e_prime,
+                               rtol=1e-12)
+
+
+def test_the_reference_block_records_the_leak_off_number():
+    data = scene()
+    rows = hs.reference_values(data, [{"time": 10.0, "half_length": 4.0, "max_opening": 1e-3,
+                                       "wellbore_pressure": [20.2e6], "mean_pressure": 20.2e6}])
+    regime = rows[0]["regime"]
+    # C_m = (C'^6 E' t / (mu' Q^3))^(1/6), C' = c_l (sigma_0 - p_r), written out here
+    e_prime = 2.0 * 1e9 / (1.0 - 0.25)
+    c_prime = 1e-11 * 20e6
+    c_m = (c_prime**6 * e_prime * 10.0 / (12.0 * 1e-5 * 1e-3**3)) ** (1.0 / 6.0)
+    assert regime["leak_off"]["number"] == "C_m"
+    assert regime["leak_off"]["value"] == pytest.approx(c_m, rel=1e-12)
+    k_m = 4.0 * np.sqrt(2.0 / np.pi) * 1e6 / (e_prime**3 * 12.0 * 1e-5 * 1e-3) ** 0.25
+    assert regime["value"] == pytest.approx(k_m, rel=1e-12) and regime["vertex"] == "K"
+    assert regime["applies_over_run"] and regime["solution_that_applies"] is None
+    assert rows[0]["solution"]["kind"] == "kgd-k-leak-off" and "Carter" in rows[0]["solution"]["source"]
+    assert hs.reference_warning(data) is None
+
+
+def test_a_viscous_leak_off_scene_is_warned_off_the_edge():
+    line = hs.reference_warning(scene(**{"fluid.viscosity": 1.0}))
+    assert line is not None and "'kgd-k-leak-off'" in line
+
+
+def test_the_schema_pairs_leak_off_with_the_leak_off_kinds():
+    with pytest.raises(InputError, match="leak_off.coefficient must be > 0.*kind = 'kgd-k'"):
+        scene(**{"leak_off.coefficient": 0.0})
+    with pytest.raises(InputError, match="assumes no leak-off.*'kgd-k-leak-off'"):
+        scene(**{"reference.kind": "kgd-k"})
+    with pytest.raises(InputError, match="reference.kind"):
+        scene(**{"reference.kind": "kgd-k-leakoff"})
+
+
+def test_a_radial_leak_off_edge_starts_at_the_radial_k_vertex():
+    raw = hs.parse_scene(hs.embedded_text("radial-k")).data
+    raw["leak_off"] = {"coefficient": 1e-18}
+    raw["propagation"]["front"] = "element"
+    raw["reference"]["kind"] = "radial-k-leak-off"
+    data = hs.scene_from_dict(raw, "radial-leak-off").data
+    t = np.array([10.0, 50.0])
+    edge = _closed_form(data, t)
+    vertex = _closed_form(data, t, kind="radial-k")
+    np.testing.assert_allclose(edge["radius"], vertex["radius"], rtol=2e-3)
+    np.testing.assert_allclose(edge["max_opening"], vertex["max_opening"], rtol=2e-3)
+    assert np.all(edge["leak_off_number"] > 0.0)
+
+
+def test_a_leak_off_run_follows_the_edge():
+    # measured: half-length -1.4..+1.4% from 5 s on (-2.7% at 2 s), opening and net pressure
+    # -1..-8% (the element front's steps); 52% of the fluid leaked off by 20 s, C_m 1.4-1.7,
+    # K_m 14.6 (0.4 s CPU)
+    data = scene()
+    simulation = hs.build_simulation(data)
+    records = simulation.run(20.0)
+    rows = hs.reference_values(data, records)
+    assert records[-1]["leaked_volume"] > 0.4 * records[-1]["injected_volume"]
+    for row in rows[4:]:
+        assert abs(row["relative_error"]["half_length"]) < 0.03
+
+
+def test_the_profile_beside_a_leak_off_run_is_the_edges_griffith_crack():
+    from hmatddm.app.profiles import closed_form_profile
+
+    data = scene()
+    profile = closed_form_profile(data, 10.0)
+    curves = _closed_form(data, [10.0])
+    assert max(profile["opening"]) == pytest.approx(float(curves["max_opening"][0]), rel=1e-3)
+    assert max(profile["position"]) == pytest.approx(float(curves["half_length"][0]), rel=1e-9)
+    assert np.allclose(profile["net_pressure"], float(curves["net_pressure"][0]))
+    assert "K-K~ edge" in profile["label"]
+
+
+def test_the_asymptotic_front_with_leak_off_follows_the_edge():
+    # the same scene on the asymptotic front (5 initial elements: the well at a centre); the tip
+    # asymptote with leak-off, each element leaking from when the front crosses its centre.
+    # Measured: half-length -0.12 / +0.05 / -0.03%, net pressure +0.54 / +0.09 / +0.13% at 5,
+    # 10, 20 s (the element front: -1.4 / +1.1 / -1.3% and -5.9 / -7.9 / -0.3%); 2.6 s CPU
+    raw = hs.parse_scene(KGD_LEAK_OFF).data
+    raw["propagation"]["front"] = "asymptotic"
+    raw["initial_fracture"][0].update(p0=[-0.25, 0.0], p1=[0.25, 0.0])
+    data = hs.scene_from_dict(raw, "leak-off-asymptotic").data
+    records = hs.build_simulation(data).run(20.0)
+    rows = hs.reference_values(data, records)
+    assert records[-1]["leaked_volume"] > 0.45 * records[-1]["injected_volume"]
+    for record, row in zip(records, rows):
+        if record["time"] >= 5.0:
+            assert abs(row["relative_error"]["half_length"]) < 0.005
+            assert abs(row["relative_error"]["max_opening"]) < 0.01
+            assert abs(row["relative_error"]["net_pressure"]) < 0.01
+        assert abs(record["budget"]["residual"]) < 1e-8 * record["injected_volume"]
