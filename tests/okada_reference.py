@@ -70,3 +70,30 @@ def rectangle(depth, dip, length, width):
     e2 = np.array([0.0, cs, sn])
     center = np.array([0.5 * length, 0.5 * width * cs, -depth + 0.5 * width * sn])
     return center, np.array([e1, e2, np.cross(e1, e2)]), 0.5 * length, 0.5 * width
+
+
+def plane_strain_surface_displacement(x, depth, x1, x2, shear, opening):
+    """Plane strain: surface displacement ``(u_x, u_y)`` at ``(x, 0)`` (``y`` up) of a
+    horizontal segment ``x1 <= x <= x2`` at ``y = -depth`` with uniform DD ``(shear,
+    opening)`` (``u(+) - u(-)``, ``+`` above): Okada's point sources (1985, Eqs 15-17 at
+    dip 0: ``u_z = U3 3 d^3 / (2 pi R^5)``, ``u_y = U3 3 y d^2 / (2 pi R^5)``, and
+    ``U2 3 d^2 y / (2 pi R^5)``, ``U2 3 d y^2 / (2 pi R^5)``) integrated along the strike
+    (``int 3 dx / R^5 = 4 / r^4``) and across the segment in closed form. Independent of
+    Poisson's ratio, as every surface displacement of a horizontal dislocation."""
+    d = depth
+
+    def atan_part(s):
+        return math.atan(s / d)
+
+    def rational(s):
+        return d * s / (s * s + d * d)
+
+    def bell(s):
+        return d * d / (s * s + d * d)
+
+    s1, s2 = x - x1, x - x2
+    uy = opening / math.pi * (atan_part(s1) + rational(s1) - atan_part(s2) - rational(s2))
+    ux = opening / math.pi * (bell(s2) - bell(s1))
+    uy += shear / math.pi * (bell(s2) - bell(s1))
+    ux += shear / math.pi * (atan_part(s1) - rational(s1) - atan_part(s2) + rational(s2))
+    return np.array([ux, uy])
