@@ -198,7 +198,7 @@ The format, annotated (``=`` values are the defaults unless marked REQUIRED)::
     porosity = 0.15                # REQUIRED, in (0, 1)
 
     [[monitor]]                    # displacement and tilt at a point after every step: DIR/monitor.csv
-    position = [0.0, 0.0, 50.0]    # and DIR/monitor.png (hmatddm.app.monitor); uniform rock only
+    position = [0.0, 0.0, 50.0]    # and DIR/monitor.png (hmatddm.app.monitor); layered rock too
 '''
 import difflib
 import tomllib
