@@ -56,9 +56,9 @@ def displacement_and_tilt(mesh, material, dd, positions):
             moved = positions.copy()
             moved[:, axis] += sign * step
             shifted.append(moved)
-    from ..layered.medium import LayeredMedium
+    from ..material import Elastic
 
-    if isinstance(material, LayeredMedium):  # closed form + image terms (ref. Ch. 3)
+    if not isinstance(material, Elastic):  # a LayeredMedium: closed form + image terms (ref. Ch. 3)
         values = _layered_values(mesh, material, dd, np.vstack(shifted))
     else:
         values = StressField(mesh, material, np.vstack(shifted), "displacement", method="direct", dd=dd)()
@@ -75,7 +75,7 @@ def displacement_and_tilt(mesh, material, dd, positions):
 def _layered_values(mesh, medium, dd, points):
     """The layered displacement at ``points``, NaN rows where it is singular (on an
     element edge: the uniform path's convention) instead of the InputError."""
-    from ..layered.displacement import displacement_at
+    from ..elasticity.fields import displacement_at
 
     try:
         return displacement_at(mesh, medium, dd, points)
