@@ -16,8 +16,8 @@ rectangle is
   (:func:`.potentials3d._pair_displacement_gradient`, the same potential tables the stress
   differentiates once more), minus the source material's whole-space field when the
   receiver is in another layer; Gauss quadrature over the rectangle, subdivided near the
-  rectangle's mirror images (:func:`.rectangle_quadrature._image_order`, the rule of the
-  stress: the displacement is one order smoother, so it is at least as accurate).
+  rectangle's images (:func:`image_order`: the triples that reach the receiver's layer;
+  the displacement is one order smoother than the stress, whose Gauss rules it takes).
 
 A point on an interface below a void layer (the free surface) is in the solid layer: the
 surface displacement is what a tiltmeter or a GPS station measures. A point inside a
@@ -27,13 +27,15 @@ import numpy as np
 from numba import njit
 
 from ..kernels.displacement import rectangle_local_displacement
+from ..kernels.rectangle3d import distance_to_rectangle, rectangle_distance
 from .image_tracer import trace_capacity
-from .image_tracer3d import _trace_range, _traced_buffer
+from .image_tracer3d import trace
 from .images2d import _lame
 from .potentials3d import Workspace, _original, _pair_displacement_gradient
-from .rectangle_quadrature import _image_order, square_rule
+from .rectangle_quadrature import _sub_count, far_order, square_rule
+from .segment_quadrature import subdivision_level
 
-__all__ = ["image_rectangle_displacement", "element_displacement", "displacement_block"]
+__all__ = ["image_order", "image_rectangle_displacement", "element_displacement", "displacement_block"]
 
 
 @njit(cache=True, inline="always")
@@ -80,42 +82,95 @@ def _contract_displacement(gradient, normal, shear_modulus, lame, weight, out):
 
 
 @njit(cache=True)
+def _buffers(shear_modulus, n_images):
+    """Room for the triples of one source height in any solid layer: ``(layer, z, eps,
+    sigma, coef, dcoef)``."""
+    cap = 1
+    n_orders = 1
+    for source_layer in range(shear_modulus.shape[0]):
+        if shear_modulus[source_layer] > 0.0:
+            c, o = trace_capacity(source_layer, shear_modulus, n_images)
+            cap = max(cap, c)
+            n_orders = max(n_orders, o)
+    return (np.empty(cap, dtype=np.int64), np.empty(cap), np.empty(cap), np.empty(cap),
+            np.zeros((cap, 3, 3, n_orders)), np.zeros((cap, 3, 3, n_orders)))
+
+
+@njit(cache=True)
+def image_order(y, receiver_layer, center, frame, a, b, source_layer, n_pairs, triples, gauss_points, max_sub,
+                far_tol):
+    """``(n_gauss, n_sub)`` of the image quadrature at ``y``: sub-squares so that each is at
+    most half as large as the distance to the nearest singular point of the integrand,
+    Gauss points by :func:`.rectangle_quadrature.far_order` on one square. The singular
+    points are those of the triples that reach the receiver's layer (``triples``: traced
+    at the centre's height; a triple of point ``z(t) = z_c + eps (t - t_c)`` is singular
+    where the receiver, moved back to ``t_c + (y3 - z_c) / eps``, meets the rectangle) and,
+    in another layer, the rectangle itself (the subtracted whole-space field). Sharper than
+    :func:`.rectangle_quadrature.nearest_singularity`, which takes the receiver's mirror
+    in every interface of both layers: with interfaces between a surface receiver and the
+    source most of those mirrors are not where any triple of the receiver's layer is, and
+    their subdivision cost ~100x (a sill twice as deep as an interface)."""
+    layer, z, eps = triples[0], triples[1], triples[2]
+    dmin = np.inf
+    if receiver_layer != source_layer:
+        dmin = rectangle_distance(y, center, frame, a, b)
+    for k in range(n_pairs):
+        if layer[k] == receiver_layer:
+            height = center[2] + (y[2] - z[k]) / eps[k]
+            dmin = min(dmin, distance_to_rectangle(y[0], y[1], height, center, frame, a, b))
+    n_sub = 2 ** subdivision_level(_sub_count(dmin, a, b, max_sub))
+    if n_sub == 1:
+        return far_order(dmin / max(a, b), gauss_points, far_tol), 1
+    return gauss_points, n_sub
+
+
+@njit(cache=True)
 def image_rectangle_displacement(y, receiver_layer, center, frame, a, b, source_layer, interfaces, shear_modulus,
-                                 poisson_ratio, n_images, n_gauss, n_sub, out):
+                                 poisson_ratio, n_images, n_gauss, n_sub, triples, n_pairs, traced_height, out):
     """Complementary displacement ``out[b, i]`` (3, 3) at ``y`` of a unit global DD ``b``
-    on the rectangle (``n_gauss^2`` points on each of ``n_sub^2`` sub-squares)."""
+    on the rectangle (``n_gauss^2`` points on each of ``n_sub^2`` sub-squares). The points
+    are taken in order of height and the triples traced once per distinct height into
+    ``triples`` (:func:`_buffers`), which may hold the ``n_pairs`` triples of
+    ``traced_height`` already (NaN: none): a horizontal rectangle traced at its centre is
+    not traced again, and no room is taken per point (a point's triples number hundreds
+    with several interfaces, and tracing them costs milliseconds)."""
     xi, eta, wt = square_rule(n_gauss, n_sub)
-    cap, n_orders = trace_capacity(source_layer, shear_modulus, n_images)
-    traced = _traced_buffer(xi.shape[0], cap, n_orders)
-    first = np.int64(0)
-    _trace_range(center, frame, a, b, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, xi, eta, first,
-                 xi.shape[0], traced)
-    n_pairs, layer, z, eps, sigma, coef, dcoef = traced
+    n_points = xi.shape[0]
+    heights = np.empty(n_points)
+    for g in range(n_points):
+        heights[g] = center[2] + xi[g] * a * frame[0, 2] + eta[g] * b * frame[1, 2]
+    order = np.argsort(heights, kind="mergesort")
+    layer, z, eps, sigma, coef, dcoef = triples
     normal = frame[2]
     g_s = shear_modulus[source_layer]
     lame_s = _lame(g_s, poisson_ratio[source_layer])
     jac = a * b
     gradient = np.empty((3, 3, 3))
-    work = Workspace(n_orders)
+    work = Workspace(coef.shape[-1])
     work1 = Workspace(1)
     kelvin = np.zeros((2, 3, 3, 1))
     x = np.empty(3)
     out[:] = 0.0
-    for g in range(xi.shape[0]):
+    for g in order:
+        if heights[g] != traced_height:
+            traced_height = heights[g]
+            n_pairs = trace(traced_height, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, layer, z,
+                            eps, sigma, coef, dcoef)
         for c in range(3):
             x[c] = center[c] + xi[g] * a * frame[0, c] + eta[g] * b * frame[1, c]
-        _complementary_displacement_gradient(y, receiver_layer, x, n_pairs[g], source_layer, layer[g], z[g], eps[g],
-                                             sigma[g], coef[g], dcoef[g], shear_modulus, poisson_ratio, gradient,
-                                             work, work1, kelvin)
+        _complementary_displacement_gradient(y, receiver_layer, x, n_pairs, source_layer, layer, z, eps, sigma, coef,
+                                             dcoef, shear_modulus, poisson_ratio, gradient, work, work1, kelvin)
         _contract_displacement(gradient, normal, g_s, lame_s, wt[g] * jac, out)
 
 
 @njit(cache=True)
-def element_displacement(data, point, point_layer, j, local, image, out):
+def element_displacement(data, point, point_layer, j, local, image, center_triples, n_center, work_triples, out):
     """``out[q, i]``: displacement ``u_i`` at ``point`` (in the solid ``point_layer``) of a
     unit global DD ``q`` of rectangle ``j`` of the :class:`.images3d.LayeredRectangles`
     ``data``: closed form of the source layer's material plus images. ``local``,
-    ``image``: (3, 3) scratch. NaN on an edge of the rectangle (log-singular)."""
+    ``image``: (3, 3) scratch; ``center_triples``: the ``n_center`` triples traced at the
+    rectangle's centre height (:func:`_buffers`, :func:`trace`); ``work_triples``: room for
+    other heights (a tilted rectangle). NaN on an edge of the rectangle (log-singular)."""
     ls = data.layer[j]
     center = data.centers[j]
     frame = data.frames[j]
@@ -137,10 +192,16 @@ def element_displacement(data, point, point_layer, j, local, image, out):
                     acc += frame[k, q] * local[k, p] * frame[p, i]
             out[q, i] = acc
     if data.interfaces.shape[0] > 0:
-        n_gauss, n_sub = _image_order(point, point_layer, center, frame, a, b, ls, data.interfaces,
-                                      data.gauss_points, data.max_subdivisions, data.far_tol, 0.0)
-        image_rectangle_displacement(point, point_layer, center, frame, a, b, ls, data.interfaces,
-                                     data.shear_modulus, data.poisson_ratio, data.n_images, n_gauss, n_sub, image)
+        n_gauss, n_sub = image_order(point, point_layer, center, frame, a, b, ls, n_center, center_triples,
+                                     data.gauss_points, data.max_subdivisions, data.far_tol)
+        if frame[0, 2] == 0.0 and frame[1, 2] == 0.0:  # horizontal: every point at the centre's height
+            image_rectangle_displacement(point, point_layer, center, frame, a, b, ls, data.interfaces,
+                                         data.shear_modulus, data.poisson_ratio, data.n_images, n_gauss, n_sub,
+                                         center_triples, n_center, center[2], image)
+        else:
+            image_rectangle_displacement(point, point_layer, center, frame, a, b, ls, data.interfaces,
+                                         data.shear_modulus, data.poisson_ratio, data.n_images, n_gauss, n_sub,
+                                         work_triples, 0, np.nan, image)
         for q in range(3):
             for i in range(3):
                 out[q, i] += image[q, i]
@@ -150,17 +211,27 @@ def element_displacement(data, point, point_layer, j, local, image, out):
 def displacement_block(data, points, point_layer, dd, out):
     """Global displacement ``out`` (M, 3) at ``points`` (M, 3) in the solid layers
     ``point_layer`` (M,) induced by the global DDs ``dd`` (N, 3) of every rectangle
-    (direct sum, elements in order)."""
+    (direct sum; each point's sum in element order). Elements outside, points inside: a
+    rectangle's triples are traced once for all the points."""
     local = np.empty((3, 3))
     image = np.empty((3, 3))
     pair = np.empty((3, 3))
+    center_triples = _buffers(data.shear_modulus, data.n_images)  # one height at a time
+    work_triples = _buffers(data.shear_modulus, data.n_images)
+    layer, z, eps, sigma, coef, dcoef = center_triples
     for m in range(points.shape[0]):
-        acc = np.zeros(3)
-        for j in range(data.centers.shape[0]):
-            element_displacement(data, points[m], point_layer[m], j, local, image, pair)
-            for q in range(3):
-                d = dd[j, q]
-                for i in range(3):
-                    acc[i] += pair[q, i] * d
         for i in range(3):
-            out[m, i] = acc[i]
+            out[m, i] = 0.0
+    for j in range(data.centers.shape[0]):
+        n_center = 0
+        if data.interfaces.shape[0] > 0:
+            n_center = trace(data.centers[j, 2], data.layer[j], data.interfaces, data.shear_modulus,
+                             data.poisson_ratio, data.n_images, layer, z, eps, sigma, coef, dcoef)
+        for m in range(points.shape[0]):
+            element_displacement(data, points[m], point_layer[m], j, local, image, center_triples, n_center,
+                                 work_triples, pair)
+            for i in range(3):
+                acc = 0.0
+                for q in range(3):
+                    acc += pair[q, i] * dd[j, q]
+                out[m, i] += acc

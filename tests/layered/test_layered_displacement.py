@@ -176,3 +176,28 @@ def test_points_in_the_void_and_the_tree_method_are_refused():
     info = {}
     assert np.isfinite(hd.displacement_at(mesh, HALF_SPACE, dd, [[0.0, 0.0, 0.0]], info=info)).all()
     assert info["method"] == "direct"
+
+
+def test_image_rule_matches_a_fine_quadrature_between_interfaces():
+    """A surface point over a sill twice as deep as the interface between them (where the
+    receiver's mirror in that interface lies on the sill, but no triple of the receiver's
+    layer does: displacement3d.image_order takes no subdivision for it): the image
+    displacement equals a fine quadrature (8 x 8 points on 16 x 16 sub-squares)."""
+    from hmatddm.layered import displacement3d
+
+    medium = LayeredMedium([0.0, -500.0, -1500.0], [0.0, G, 2 * G, 0.5 * G], [NU, NU, 0.3, 0.2], images=4)
+    interfaces, g, nu = medium.arrays()
+    center, frame, a, b = np.array([30.0, -20.0, -1000.0]), np.eye(3), 250.0, 200.0
+    triples = displacement3d._buffers(g, 4)
+    for y in ([0.0, 0.0, 0.0], [400.0, 100.0, 0.0]):
+        y = np.asarray(y, dtype=float)
+        n_pairs = displacement3d.trace(center[2], 2, interfaces, g, nu, 4, *triples)
+        n_gauss, n_sub = displacement3d.image_order(y, 1, center, frame, a, b, 2, n_pairs, triples, 4, 16, 1e-6)
+        assert n_sub == 1
+        rule, fine = np.empty((3, 3)), np.empty((3, 3))
+        displacement3d.image_rectangle_displacement(y, 1, center, frame, a, b, 2, interfaces, g, nu, 4, n_gauss, n_sub,
+                                                    triples, n_pairs, center[2], rule)
+        displacement3d.image_rectangle_displacement(y, 1, center, frame, a, b, 2, interfaces, g, nu, 4, 8, 16,
+                                                    triples, 0, np.nan, fine)
+        # far_order's error model (rectangle_quadrature.FAR_TOL = 1e-6 of the image field): measured 1.3e-6
+        assert np.abs(rule - fine).max() <= 5e-6 * np.abs(fine).max()
