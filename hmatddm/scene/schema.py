@@ -346,11 +346,6 @@ def validate(raw, name=None):
         # a hydraulic element squeezed between natural fractures can open negatively and stall
         # the Picard iteration with contact = "natural": in a network every element closes
         numerics["contact"] = "all"
-    leaks = scene["leak_off"]["coefficient"] != 0.0 or any(key in scene["leak_off"] for key in RESERVOIR_KEYS)
-    if leaks and "contact" not in raw.get("numerics", {}):
-        # a tip element that leaks more than the flow brings it would open negatively and
-        # stop the front (hmatddm.Simulation's contact): with leak-off every element closes
-        numerics["contact"] = "all"
     return scene
 
 

@@ -106,13 +106,14 @@ class Simulation:
         :mod:`hmatddm.coupled.contact`): natural-fracture elements (activated or
         failed; the friction and cohesion of ``natural``), every element (hydraulic
         elements close without friction), or none (elements may interpenetrate).
-        None (default): ``"all"`` with Carter leak-off (a coefficient > 0), else
-        ``"natural"``. With leak-off and viscous fluid a fresh tip element loses
-        ``2 c_l (p - p_r) dt^(1/2)`` of width in its first step (mm), more than the
-        flow brings it: without contact its opening goes negative (to -5 mm in the M~
-        case of ``benchmarks/bench_leak_off.py``) while it still leaks, the tip
+        Strong leak-off with a viscous fluid needs ``"all"``: a fresh tip element
+        loses ``2 c_l (p - p_r) dt^(1/2)`` of width in its first step (mm), more than
+        the flow brings it; without contact its opening goes negative (to -5 mm in the
+        M~ case of ``benchmarks/bench_leak_off.py``) while it still leaks, the tip
         overlaps, its K_I is negative and the front stops for good; closed, its
         pressure falls to the pore pressure, it stops leaking and the front goes on.
+        (Not the default with leak-off: a coarse radial start that closes whole in its
+        first step, the radial K~ case there, does not converge with it.)
     max_elements : int or None
         A step whose growth would take the mesh past it raises SizeLimitError (a
         resource limit: a run stopped by it resumes with a higher one).
@@ -136,7 +137,7 @@ class Simulation:
     def __init__(self, mesh, material, fluid, clusters, far_field_stress, time_step, propagation=None,
                  leak_off=None, initial_pressure=0.0, initial_opening=1e-5, minimum_width=None, height=1.0, *,
                  scheme="krylov", growing_fractures=None, natural_fractures=None, natural=None, remote_failure=True,
-                 contact=None, max_elements=None, step_control=None, operator_settings=None,
+                 contact="natural", max_elements=None, step_control=None, operator_settings=None,
                  rebuild_settings=None, checkpoint_settings=None, **options):
         if not isinstance(mesh, (Mesh2D, Mesh3D)):
             raise InputError(f"mesh must be a Mesh2D or Mesh3D, got {type(mesh).__name__}")
@@ -202,8 +203,6 @@ class Simulation:
         self.growing_fractures = None if growing_fractures is None else np.asarray(sorted(growing_fractures), np.int64)
         self.injection_elements = np.array([c.nearest_element(mesh) for c in clusters], dtype=np.int64)
         self.remote_failure = bool(remote_failure)
-        if contact is None:  # hydraulic elements that leak off must not interpenetrate (docstring)
-            contact = "all" if leak_off is not None and getattr(leak_off, "coefficient", 0.0) > 0.0 else "natural"
         self.contact = NUMERICS["contact"].value("contact", contact)
         self.network = None if natural_fractures is None else natural_network(mesh, natural_fractures, natural)
         # a resource limit, not part of the run's definition: left out of the fingerprint, so
