@@ -35,7 +35,7 @@ from .potentials3d import Workspace, _original, _pair_displacement_gradient
 from .rectangle_quadrature import _sub_count, far_order, square_rule
 from .segment_quadrature import subdivision_level
 
-__all__ = ["image_order", "image_rectangle_displacement", "element_displacement", "displacement_block"]
+__all__ = ["image_order", "image_rectangle_displacement", "horizontal_image_displacement", "element_displacement", "displacement_block"]
 
 
 @njit(cache=True, inline="always")
@@ -164,6 +164,69 @@ def image_rectangle_displacement(y, receiver_layer, center, frame, a, b, source_
 
 
 @njit(cache=True)
+def _triple_rule(dmin, a, b, gauss_points, max_sub, far_tol):
+    """``(n_gauss, n_sub)`` for a singular point ``dmin`` away (:func:`image_order`'s rule)."""
+    n_sub = 2 ** subdivision_level(_sub_count(dmin, a, b, max_sub))
+    if n_sub == 1:
+        return far_order(dmin / max(a, b), gauss_points, far_tol), 1
+    return gauss_points, n_sub
+
+
+@njit(cache=True)
+def horizontal_image_displacement(y, receiver_layer, center, frame, a, b, source_layer, shear_modulus,
+                                  poisson_ratio, n_pairs, triples, gauss_points, max_sub, far_tol, out):
+    """:func:`image_rectangle_displacement` of a horizontal rectangle (every point at the
+    centre's height, so one set of ``n_pairs`` traced ``triples`` for all), each triple on
+    its own rule: :func:`image_order`'s criterion applied to that triple's own singular
+    point. The triples reflected many times are far away and take one or two points per
+    side where the nearest one takes four (the rule of the whole sum): 3-5x cheaper with
+    several interfaces, and each triple's error still within ``far_tol`` of itself."""
+    layer, z, eps, sigma, coef, dcoef = triples
+    delta_r = 1.0 / (3.0 - 4.0 * poisson_ratio[receiver_layer])
+    g_s = shear_modulus[source_layer]
+    nu_s = poisson_ratio[source_layer]
+    lame_s = _lame(g_s, nu_s)
+    jac = a * b
+    work = Workspace(coef.shape[-1])
+    work1 = Workspace(1)
+    point = np.empty((3, 3, 3))
+    total = np.zeros((3, 3, 3))
+    kelvin = np.zeros((2, 3, 3, 1))
+    for k in range(-1, n_pairs):
+        if k < 0:  # in another layer: minus the whole-space field of the source's material
+            if receiver_layer == source_layer:
+                continue
+            dmin = rectangle_distance(y, center, frame, a, b)
+            side = 1.0 if y[2] >= center[2] else -1.0
+            _original(kelvin[0], 1.0 / (3.0 - 4.0 * nu_s), g_s, side, -1.0)
+        elif layer[k] != receiver_layer:
+            continue
+        else:
+            dmin = distance_to_rectangle(y[0], y[1], center[2] + (y[2] - z[k]) / eps[k], center, frame, a, b)
+        n_gauss, n_sub = _triple_rule(dmin, a, b, gauss_points, max_sub, far_tol)
+        xi, eta, wt = square_rule(n_gauss, n_sub)
+        for g in range(xi.shape[0]):
+            x0 = center[0] + xi[g] * a * frame[0, 0] + eta[g] * b * frame[1, 0]
+            x1 = center[1] + xi[g] * a * frame[0, 1] + eta[g] * b * frame[1, 1]
+            point[:] = 0.0
+            if k < 0:
+                _pair_displacement_gradient(y[0] - x0, y[1] - x1, y[2] - center[2], 1.0, side, kelvin[0], kelvin[1],
+                                            1.0 / (3.0 - 4.0 * nu_s), point, work1)
+            else:
+                _pair_displacement_gradient(y[0] - x0, y[1] - x1, y[2] - z[k], eps[k], sigma[k], coef[k], dcoef[k],
+                                            delta_r, point, work)
+            w = wt[g] * jac
+            for f in range(3):
+                for q in range(3):
+                    for i in range(3):
+                        total[f, q, i] += w * point[f, q, i]
+        if k < 0:
+            kelvin[:] = 0.0
+    out[:] = 0.0
+    _contract_displacement(total, frame[2], g_s, lame_s, 1.0, out)
+
+
+@njit(cache=True)
 def element_displacement(data, point, point_layer, j, local, image, center_triples, n_center, work_triples, out):
     """``out[q, i]``: displacement ``u_i`` at ``point`` (in the solid ``point_layer``) of a
     unit global DD ``q`` of rectangle ``j`` of the :class:`.images3d.LayeredRectangles`
@@ -192,13 +255,13 @@ def element_displacement(data, point, point_layer, j, local, image, center_tripl
                     acc += frame[k, q] * local[k, p] * frame[p, i]
             out[q, i] = acc
     if data.interfaces.shape[0] > 0:
-        n_gauss, n_sub = image_order(point, point_layer, center, frame, a, b, ls, n_center, center_triples,
-                                     data.gauss_points, data.max_subdivisions, data.far_tol)
         if frame[0, 2] == 0.0 and frame[1, 2] == 0.0:  # horizontal: every point at the centre's height
-            image_rectangle_displacement(point, point_layer, center, frame, a, b, ls, data.interfaces,
-                                         data.shear_modulus, data.poisson_ratio, data.n_images, n_gauss, n_sub,
-                                         center_triples, n_center, center[2], image)
+            horizontal_image_displacement(point, point_layer, center, frame, a, b, ls, data.shear_modulus,
+                                          data.poisson_ratio, n_center, center_triples, data.gauss_points,
+                                          data.max_subdivisions, data.far_tol, image)
         else:
+            n_gauss, n_sub = image_order(point, point_layer, center, frame, a, b, ls, n_center, center_triples,
+                                         data.gauss_points, data.max_subdivisions, data.far_tol)
             image_rectangle_displacement(point, point_layer, center, frame, a, b, ls, data.interfaces,
                                          data.shear_modulus, data.poisson_ratio, data.n_images, n_gauss, n_sub,
                                          work_triples, 0, np.nan, image)

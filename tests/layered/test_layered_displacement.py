@@ -182,7 +182,8 @@ def test_image_rule_matches_a_fine_quadrature_between_interfaces():
     """A surface point over a sill twice as deep as the interface between them (where the
     receiver's mirror in that interface lies on the sill, but no triple of the receiver's
     layer does: displacement3d.image_order takes no subdivision for it): the image
-    displacement equals a fine quadrature (8 x 8 points on 16 x 16 sub-squares)."""
+    displacement equals a fine quadrature (8 x 8 points on 16 x 16 sub-squares), with the
+    rule of the whole sum and with a rule per triple."""
     from hmatddm.layered import displacement3d
 
     medium = LayeredMedium([0.0, -500.0, -1500.0], [0.0, G, 2 * G, 0.5 * G], [NU, NU, 0.3, 0.2], images=4)
@@ -201,3 +202,8 @@ def test_image_rule_matches_a_fine_quadrature_between_interfaces():
                                                     triples, 0, np.nan, fine)
         # far_order's error model (rectangle_quadrature.FAR_TOL = 1e-6 of the image field): measured 1.3e-6
         assert np.abs(rule - fine).max() <= 5e-6 * np.abs(fine).max()
+        # the horizontal rectangle's rule per triple (what displacement_at takes for it)
+        per_triple = np.empty((3, 3))
+        displacement3d.horizontal_image_displacement(y, 1, center, frame, a, b, 2, g, nu, n_pairs, triples, 4, 16,
+                                                     1e-6, per_triple)
+        assert np.abs(per_triple - fine).max() <= 5e-6 * np.abs(fine).max()
