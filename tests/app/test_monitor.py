@@ -120,3 +120,20 @@ def test_a_layered_run_records_the_surface_uplift_and_tilt(tmp_path):
 def test_a_monitor_in_the_air_is_refused():
     with pytest.raises(InputError, match=r"monitor\[1\]\.position\[2\] must be at most 0 \(the free surface"):
         hs.parse_scene(_shallow_sill([(0.0, 0.0, 0.0), (1.0, 0.0, 0.5)]))
+
+
+def test_layered_2d_tilt_and_a_position_on_an_end():
+    """A 2D vertical section with a free surface (y = 0) over a dipping segment: the tilt
+    is the slope of hd.displacement_at's u_y along the surface; a position on the
+    segment's end is blank (NaN), as in uniform rock."""
+    medium = hd.LayeredMedium([0.0], [0.0, 10e9], [0.25, 0.25])
+    mesh = hd.mesh.line([-1.0, -2.0], [1.0, -1.5], 2)
+    dd = np.tile([1e-4, 1e-3], (2, 1))
+    positions = np.array([[0.5, 0.0], [-3.0, 0.0], [1.0, -1.5]])
+    u, tilt = displacement_and_tilt(mesh, medium, dd, positions)
+    np.testing.assert_allclose(u[:2], hd.displacement_at(mesh, medium, dd, positions[:2]), rtol=1e-12)
+    h = 1e-3
+    slope = (hd.displacement_at(mesh, medium, dd, positions[:2] + [h, 0.0])[:, 1]
+             - hd.displacement_at(mesh, medium, dd, positions[:2] - [h, 0.0])[:, 1]) / (2 * h)
+    np.testing.assert_allclose(tilt[:2, 0], slope, rtol=1e-4)
+    assert np.all(np.isnan(u[2])) and np.all(np.isnan(tilt[2]))
