@@ -27,7 +27,8 @@ import numpy as np
 from numba import njit
 
 from ..kernels.displacement import segment_local_displacement
-from .images2d import _INV_4PI, _lame, _trace_range, traced_buffer
+from .image_tracer import trace_capacity
+from .images2d import _INV_4PI, _lame, trace
 from .segment_quadrature import composite_rule, subdivision_level, subdivisions
 
 __all__ = ["image_segment_displacement", "element_displacement", "displacement_block"]
@@ -115,18 +116,37 @@ def _pair_displacement_gradient(r1, r3, eps, coef, dcoef, delta, out, work):
 
 
 @njit(cache=True)
+def _buffers(shear_modulus, n_images):
+    """Room for the image pairs of one source height in any solid layer: ``(layer, z, eps,
+    coef, dcoef)`` (the arguments of :func:`.images2d.trace`)."""
+    cap = 1
+    n_orders = 1
+    for source_layer in range(shear_modulus.shape[0]):
+        if shear_modulus[source_layer] > 0.0:
+            c, o = trace_capacity(source_layer, shear_modulus, n_images)
+            cap = max(cap, c)
+            n_orders = max(n_orders, o)
+    return (np.empty(cap, dtype=np.int64), np.empty(cap), np.empty(cap), np.zeros((cap, 2, 2, n_orders)),
+            np.zeros((cap, 2, 2, n_orders)))
+
+
+@njit(cache=True)
 def image_segment_displacement(y1, y3, receiver_layer, p0, p1, source_layer, interfaces, shear_modulus,
-                               poisson_ratio, n_images, xi, weights, out):
+                               poisson_ratio, n_images, xi, weights, pairs, n_pairs, traced_height, out):
     """Complementary displacement ``out[b, i]`` (2, 2) at ``(y1, y3)`` of a unit global DD
     ``b`` on the straight element ``p0 -> p1`` (normal: the tangent turned +90 degrees),
-    Gauss points ``xi`` in [-1, 1] with ``weights``."""
+    Gauss points ``xi`` in [-1, 1] with ``weights``. The pairs are traced into ``pairs``
+    (:func:`_buffers`) once per distinct height, in order of height; ``pairs`` may hold the
+    ``n_pairs`` pairs of ``traced_height`` already (NaN: none), so a horizontal element
+    traced once serves all its receivers."""
     n_points = xi.shape[0]
-    traced = traced_buffer(source_layer, shear_modulus, n_images, n_points)
-    _trace_range(p0, p1, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, xi, np.int64(0), n_points,
-                 traced)
-    n_pairs, layer, z, eps, coef, dcoef = traced
+    layer, z, eps, coef, dcoef = pairs
     tx = p1[0] - p0[0]
     ty = p1[1] - p0[1]
+    heights = np.empty(n_points)
+    for g in range(n_points):
+        heights[g] = 0.5 * (p0[1] + p1[1]) + 0.5 * xi[g] * ty
+    order = np.argsort(heights, kind="mergesort")
     length = math.sqrt(tx * tx + ty * ty)
     normal = np.array([-ty / length, tx / length])
     jac = 0.5 * length
@@ -146,14 +166,17 @@ def image_segment_displacement(y1, y3, receiver_layer, p0, p1, source_layer, int
     work1 = _work(1)
     gradient = np.zeros((2, 2, 2))
     out[:] = 0.0
-    for g in range(n_points):
+    for g in order:
+        t = heights[g]
+        if t != traced_height:
+            traced_height = t
+            n_pairs = trace(t, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, layer, z, eps, coef,
+                            dcoef)
         x1 = 0.5 * (p0[0] + p1[0]) + 0.5 * xi[g] * tx
-        t = 0.5 * (p0[1] + p1[1]) + 0.5 * xi[g] * ty
         gradient[:] = 0.0
-        for k in range(n_pairs[g]):
-            if layer[g, k] == receiver_layer:
-                _pair_displacement_gradient(y1 - x1, y3 - z[g, k], eps[g, k], coef[g, k], dcoef[g, k], delta_r,
-                                            gradient, work)
+        for k in range(n_pairs):
+            if layer[k] == receiver_layer:
+                _pair_displacement_gradient(y1 - x1, y3 - z[k], eps[k], coef[k], dcoef[k], delta_r, gradient, work)
         if receiver_layer != source_layer:
             _pair_displacement_gradient(y1 - x1, y3 - t, 1.0, kelvin, zero, delta_s, gradient, work1)
         weight = weights[g] * jac
@@ -171,10 +194,12 @@ def image_segment_displacement(y1, y3, receiver_layer, p0, p1, source_layer, int
 
 
 @njit(cache=True)
-def element_displacement(data, point, point_layer, j, local, image, out):
+def element_displacement(data, point, point_layer, j, local, image, center_pairs, n_center, work_pairs, out):
     """``out[q, i]``: displacement ``u_i`` at ``point`` (in the solid ``point_layer``) of a
     unit global DD ``q`` of segment ``j`` of the :class:`.segments2d.LayeredSegments`
-    ``data``: closed form of the source layer's material plus images. NaN at its ends."""
+    ``data``: closed form of the source layer's material plus images. ``center_pairs``:
+    the ``n_center`` pairs traced at the segment's centre height (used for a horizontal
+    segment); ``work_pairs``: room for other heights. NaN at its ends."""
     ls = data.layer[j]
     center = data.centers[j]
     frame = data.frames[j]
@@ -196,8 +221,14 @@ def element_displacement(data, point, point_layer, j, local, image, out):
         level = subdivision_level(subdivisions(point[0], point[1], point_layer, p0, p1, ls, data.interfaces,
                                                data.max_subdivisions))
         xi, wt = composite_rule(data.gauss_points, 2 ** level)
-        image_segment_displacement(point[0], point[1], point_layer, p0, p1, ls, data.interfaces, data.shear_modulus,
-                                   data.poisson_ratio, data.n_images, xi, wt, image)
+        if frame[0, 1] == 0.0:  # horizontal: every point at the centre's height, traced already
+            image_segment_displacement(point[0], point[1], point_layer, p0, p1, ls, data.interfaces,
+                                       data.shear_modulus, data.poisson_ratio, data.n_images, xi, wt, center_pairs,
+                                       n_center, center[1], image)
+        else:
+            image_segment_displacement(point[0], point[1], point_layer, p0, p1, ls, data.interfaces,
+                                       data.shear_modulus, data.poisson_ratio, data.n_images, xi, wt, work_pairs, 0,
+                                       np.nan, image)
         for q in range(2):
             for i in range(2):
                 out[q, i] += image[q, i]
@@ -206,17 +237,25 @@ def element_displacement(data, point, point_layer, j, local, image, out):
 @njit(cache=True, nogil=True)
 def displacement_block(data, points, point_layer, dd, out):
     """Global displacement ``out`` (M, 2) at ``points`` (M, 2) in the solid layers
-    ``point_layer`` (M,) induced by the global DDs ``dd`` (N, 2) of every segment."""
+    ``point_layer`` (M,) induced by the global DDs ``dd`` (N, 2) of every segment (each
+    point's sum in element order; elements outside, so a horizontal segment's pairs are
+    traced once for all the points)."""
     local = np.empty((2, 2))
     image = np.empty((2, 2))
     pair = np.empty((2, 2))
+    center_pairs = _buffers(data.shear_modulus, data.n_images)
+    work_pairs = _buffers(data.shear_modulus, data.n_images)
+    layer, z, eps, coef, dcoef = center_pairs
     for m in range(points.shape[0]):
-        acc = np.zeros(2)
-        for j in range(data.centers.shape[0]):
-            element_displacement(data, points[m], point_layer[m], j, local, image, pair)
-            for q in range(2):
-                d = dd[j, q]
-                for i in range(2):
-                    acc[i] += pair[q, i] * d
-        out[m, 0] = acc[0]
-        out[m, 1] = acc[1]
+        out[m, 0] = 0.0
+        out[m, 1] = 0.0
+    for j in range(data.centers.shape[0]):
+        n_center = 0
+        if data.interfaces.shape[0] > 0:
+            n_center = trace(data.centers[j, 1], data.layer[j], data.interfaces, data.shear_modulus,
+                             data.poisson_ratio, data.n_images, layer, z, eps, coef, dcoef)
+        for m in range(points.shape[0]):
+            element_displacement(data, points[m], point_layer[m], j, local, image, center_pairs, n_center,
+                                 work_pairs, pair)
+            for i in range(2):
+                out[m, i] += pair[0, i] * dd[j, 0] + pair[1, i] * dd[j, 1]
