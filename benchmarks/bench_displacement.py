@@ -22,7 +22,8 @@ over two interfaces, 2G and 0.5G below 500 m and 1500 m, the sill in the third l
 and the largest error of the half-space against Okada's (1985) closed form for the whole
 rectangle (``tests/okada_reference.py``: the sum of the elements' uniform DDs is the
 rectangle's), relative to the largest displacement; beside it what uniform rock (no
-free surface) misses.
+free surface) misses. Then the same sill in 2D plane strain (a segment, ``n`` elements),
+against the half-plane's closed form (``okada_reference.plane_strain_surface_displacement``).
 """
 import os
 
@@ -89,6 +90,31 @@ def layered():
                  "half-space / uniform CPU", "surface + 2 interfaces CPU / wall per pair (us)",
                  "3 layers / uniform CPU", "half-space max error vs Okada / max |u|",
                  "uniform rock vs Okada / max |u|"], rows)
+    # 2D plane strain: the same sill as a segment, against the closed form of the half-plane
+    plane = hd.LayeredMedium([0.0], [0.0, g], [nu, nu])
+    three_2d = hd.LayeredMedium([0.0, -500.0, -1500.0], [0.0, g, 2 * g, 0.5 * g], [nu, nu, 0.3, 0.2], images=8)
+    points2 = np.column_stack([np.linspace(-4000.0, 4000.0, 400) + 1.0, np.zeros(400)])
+    ref = np.array([okada.plane_strain_surface_displacement(px, 1000.0, -1000.0, 1000.0, 0.0, 1e-3)
+                    for px, _ in points2])
+    rows = []
+    for n in (8, 32, 128):
+        mesh = hd.mesh.line([-1000.0, -1000.0], [1000.0, -1000.0], n)
+        dd = np.tile([0.0, 1e-3], (n, 1))
+        pairs = len(points2) * n
+        hd.displacement_at(mesh, plane, dd, points2[:2])
+        u_uniform, cpu_u, wall_u = timed(lambda: hd.displacement_at(mesh, uniform, dd, points2, method="direct"))
+        u_half, cpu_h, wall_h = timed(lambda: hd.displacement_at(mesh, plane, dd, points2))
+        _, cpu_3, wall_3 = timed(lambda: hd.displacement_at(mesh, three_2d, dd, points2))
+        scale = np.max(np.abs(ref))
+        rows.append(["2D sill", n, len(points2), f"{1e6 * cpu_u / pairs:.3f} / {1e6 * wall_u / pairs:.3f}",
+                     f"{1e6 * cpu_h / pairs:.2f} / {1e6 * wall_h / pairs:.2f}", f"{cpu_h / max(cpu_u, 1e-9):.0f}x",
+                     f"{1e6 * cpu_3 / pairs:.1f} / {1e6 * wall_3 / pairs:.1f}", f"{cpu_3 / max(cpu_u, 1e-9):.0f}x",
+                     f"{np.max(np.abs(u_half - ref)) / scale:.1e}", f"{np.max(np.abs(u_uniform - ref)) / scale:.2f}"])
+        print(" | ".join(str(c) for c in rows[-1]), flush=True)
+    print_table(["case", "elements", "points", "uniform CPU / wall per pair (us)", "half-plane CPU / wall per pair (us)",
+                 "half-plane / uniform CPU", "surface + 2 interfaces CPU / wall per pair (us)",
+                 "3 layers / uniform CPU", "half-plane max error vs closed form / max |u|",
+                 "uniform rock vs closed form / max |u|"], rows)
 
 
 def main():
