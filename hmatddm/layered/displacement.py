@@ -70,7 +70,9 @@ def displacement_at(mesh, medium, dd, points, n_images=None):
     def part(start, stop):
         displacement_block(data, points[start:stop], layers[start:stop], dd, out[start:stop])
 
-    _in_parts(part, len(points))
+    # one range of points per thread: each range traces every element's image heights once
+    # (milliseconds per height with several interfaces), so fewer, longer ranges trace less
+    _in_parts(part, len(points), parts_per_thread=1)
     bad = np.flatnonzero(~np.all(np.isfinite(out), axis=1))
     if bad.size:
         raise InputError(f"points[{int(bad[0])}] lies on an element {'edge' if dim == 3 else 'end'}, where the "

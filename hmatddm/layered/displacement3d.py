@@ -97,6 +97,20 @@ def _buffers(shear_modulus, n_images):
 
 
 @njit(cache=True)
+def _height_cache(shear_modulus, n_images, rows):
+    """Room for the triples of ``rows`` source heights of one rectangle, traced when first
+    needed: ``(heights, n_pairs, layer, z, eps, sigma, coef, dcoef, used)`` (``used[0]``
+    rows filled; 0 for a new rectangle)."""
+    layer, z, eps, sigma, coef, dcoef = _buffers(shear_modulus, n_images)
+    cap = z.shape[0]
+    n_orders = coef.shape[-1]
+    return (np.empty(rows), np.zeros(rows, dtype=np.int64), np.empty((rows, cap), dtype=np.int64),
+            np.empty((rows, cap)), np.empty((rows, cap)), np.empty((rows, cap)),
+            np.empty((rows, cap, 3, 3, n_orders)), np.empty((rows, cap, 3, 3, n_orders)),
+            np.zeros(1, dtype=np.int64))
+
+
+@njit(cache=True)
 def image_order(y, receiver_layer, center, frame, a, b, source_layer, n_pairs, triples, gauss_points, max_sub,
                 far_tol):
     """``(n_gauss, n_sub)`` of the image quadrature at ``y``: sub-squares so that each is at
@@ -126,20 +140,22 @@ def image_order(y, receiver_layer, center, frame, a, b, source_layer, n_pairs, t
 
 @njit(cache=True)
 def image_rectangle_displacement(y, receiver_layer, center, frame, a, b, source_layer, interfaces, shear_modulus,
-                                 poisson_ratio, n_images, n_gauss, n_sub, triples, n_pairs, traced_height, out):
+                                 poisson_ratio, n_images, n_gauss, n_sub, triples, cache, out):
     """Complementary displacement ``out[b, i]`` (3, 3) at ``y`` of a unit global DD ``b``
     on the rectangle (``n_gauss^2`` points on each of ``n_sub^2`` sub-squares). The points
-    are taken in order of height and the triples traced once per distinct height into
-    ``triples`` (:func:`_buffers`), which may hold the ``n_pairs`` triples of
-    ``traced_height`` already (NaN: none): a horizontal rectangle traced at its centre is
-    not traced again, and no room is taken per point (a point's triples number hundreds
-    with several interfaces, and tracing them costs milliseconds)."""
+    are taken in order of height; each distinct height's triples come from ``cache``
+    (:func:`_height_cache` of this rectangle: traced there the first time a receiver needs
+    that height, so a vertical rectangle's rows are traced once for all receivers) or,
+    once the cache is full, are traced into ``triples`` (:func:`_buffers`). Tracing with
+    several interfaces costs milliseconds per height (9 ms with two interfaces and 8
+    images): traced per pair it dominated (9.7 ms per pair for a vertical fracture)."""
     xi, eta, wt = square_rule(n_gauss, n_sub)
     n_points = xi.shape[0]
     heights = np.empty(n_points)
     for g in range(n_points):
         heights[g] = center[2] + xi[g] * a * frame[0, 2] + eta[g] * b * frame[1, 2]
     order = np.argsort(heights, kind="mergesort")
+    cached_heights, cached_n, c_layer, c_z, c_eps, c_sigma, c_coef, c_dcoef, used = cache
     layer, z, eps, sigma, coef, dcoef = triples
     normal = frame[2]
     g_s = shear_modulus[source_layer]
@@ -151,15 +167,36 @@ def image_rectangle_displacement(y, receiver_layer, center, frame, a, b, source_
     kelvin = np.zeros((2, 3, 3, 1))
     x = np.empty(3)
     out[:] = 0.0
+    current = np.nan
+    row = -1  # the cache row of ``current`` (-1: the triples buffer)
+    n_pairs = 0
     for g in order:
-        if heights[g] != traced_height:
-            traced_height = heights[g]
-            n_pairs = trace(traced_height, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, layer, z,
-                            eps, sigma, coef, dcoef)
+        if heights[g] != current:
+            current = heights[g]
+            row = -1
+            for r in range(used[0]):
+                if cached_heights[r] == current:
+                    row = r
+                    break
+            if row < 0 and used[0] < cached_heights.shape[0]:
+                row = used[0]
+                cached_heights[row] = current
+                cached_n[row] = trace(current, source_layer, interfaces, shear_modulus, poisson_ratio, n_images,
+                                      c_layer[row], c_z[row], c_eps[row], c_sigma[row], c_coef[row], c_dcoef[row])
+                used[0] += 1
+            if row < 0:
+                n_pairs = trace(current, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, layer, z,
+                                eps, sigma, coef, dcoef)
         for c in range(3):
             x[c] = center[c] + xi[g] * a * frame[0, c] + eta[g] * b * frame[1, c]
-        _complementary_displacement_gradient(y, receiver_layer, x, n_pairs, source_layer, layer, z, eps, sigma, coef,
-                                             dcoef, shear_modulus, poisson_ratio, gradient, work, work1, kelvin)
+        if row >= 0:
+            _complementary_displacement_gradient(y, receiver_layer, x, cached_n[row], source_layer, c_layer[row],
+                                                 c_z[row], c_eps[row], c_sigma[row], c_coef[row], c_dcoef[row],
+                                                 shear_modulus, poisson_ratio, gradient, work, work1, kelvin)
+        else:
+            _complementary_displacement_gradient(y, receiver_layer, x, n_pairs, source_layer, layer, z, eps, sigma,
+                                                 coef, dcoef, shear_modulus, poisson_ratio, gradient, work, work1,
+                                                 kelvin)
         _contract_displacement(gradient, normal, g_s, lame_s, wt[g] * jac, out)
 
 
@@ -178,9 +215,9 @@ def horizontal_image_displacement(y, receiver_layer, center, frame, a, b, source
     """:func:`image_rectangle_displacement` of a horizontal rectangle (every point at the
     centre's height, so one set of ``n_pairs`` traced ``triples`` for all), each triple on
     its own rule: :func:`image_order`'s criterion applied to that triple's own singular
-    point. The triples reflected many times are far away and take one or two points per
-    side where the nearest one takes four (the rule of the whole sum): 3-5x cheaper with
-    several interfaces, and each triple's error still within ``far_tol`` of itself."""
+    point: the triples reflected many times are farther away and may take fewer points per
+    side than the nearest one (measured 1.3x cheaper with two interfaces under a free
+    surface, benchmarks/RESULTS.md), each triple's error within ``far_tol`` of itself."""
     layer, z, eps, sigma, coef, dcoef = triples
     delta_r = 1.0 / (3.0 - 4.0 * poisson_ratio[receiver_layer])
     g_s = shear_modulus[source_layer]
@@ -227,13 +264,15 @@ def horizontal_image_displacement(y, receiver_layer, center, frame, a, b, source
 
 
 @njit(cache=True)
-def element_displacement(data, point, point_layer, j, local, image, center_triples, n_center, work_triples, out):
+def element_displacement(data, point, point_layer, j, local, image, center_triples, n_center, work_triples, cache,
+                         out):
     """``out[q, i]``: displacement ``u_i`` at ``point`` (in the solid ``point_layer``) of a
     unit global DD ``q`` of rectangle ``j`` of the :class:`.images3d.LayeredRectangles`
     ``data``: closed form of the source layer's material plus images. ``local``,
     ``image``: (3, 3) scratch; ``center_triples``: the ``n_center`` triples traced at the
     rectangle's centre height (:func:`_buffers`, :func:`trace`); ``work_triples``: room for
-    other heights (a tilted rectangle). NaN on an edge of the rectangle (log-singular)."""
+    other heights and ``cache`` (:func:`_height_cache`) this rectangle's traced heights (a
+    tilted rectangle). NaN on an edge of the rectangle (log-singular)."""
     ls = data.layer[j]
     center = data.centers[j]
     frame = data.frames[j]
@@ -264,7 +303,7 @@ def element_displacement(data, point, point_layer, j, local, image, center_tripl
                                          data.gauss_points, data.max_subdivisions, data.far_tol)
             image_rectangle_displacement(point, point_layer, center, frame, a, b, ls, data.interfaces,
                                          data.shear_modulus, data.poisson_ratio, data.n_images, n_gauss, n_sub,
-                                         work_triples, 0, np.nan, image)
+                                         work_triples, cache, image)
         for q in range(3):
             for i in range(3):
                 out[q, i] += image[q, i]
@@ -281,18 +320,23 @@ def displacement_block(data, points, point_layer, dd, out):
     pair = np.empty((3, 3))
     center_triples = _buffers(data.shear_modulus, data.n_images)  # one height at a time
     work_triples = _buffers(data.shear_modulus, data.n_images)
+    rows = 0
+    for n in range(1, data.gauss_points + 1):  # the heights of the one-square rules of a tilted rectangle
+        rows += n * n
+    cache = _height_cache(data.shear_modulus, data.n_images, rows)
     layer, z, eps, sigma, coef, dcoef = center_triples
     for m in range(points.shape[0]):
         for i in range(3):
             out[m, i] = 0.0
     for j in range(data.centers.shape[0]):
+        cache[-1][0] = 0  # a new rectangle: nothing traced
         n_center = 0
         if data.interfaces.shape[0] > 0:
             n_center = trace(data.centers[j, 2], data.layer[j], data.interfaces, data.shear_modulus,
                              data.poisson_ratio, data.n_images, layer, z, eps, sigma, coef, dcoef)
         for m in range(points.shape[0]):
             element_displacement(data, points[m], point_layer[m], j, local, image, center_triples, n_center,
-                                 work_triples, pair)
+                                 work_triples, cache, pair)
             for i in range(3):
                 acc = 0.0
                 for q in range(3):

@@ -197,9 +197,9 @@ def test_image_rule_matches_a_fine_quadrature_between_interfaces():
         assert n_sub == 1
         rule, fine = np.empty((3, 3)), np.empty((3, 3))
         displacement3d.image_rectangle_displacement(y, 1, center, frame, a, b, 2, interfaces, g, nu, 4, n_gauss, n_sub,
-                                                    triples, n_pairs, center[2], rule)
+                                                    triples, displacement3d._height_cache(g, 4, 2), rule)
         displacement3d.image_rectangle_displacement(y, 1, center, frame, a, b, 2, interfaces, g, nu, 4, 8, 16,
-                                                    triples, 0, np.nan, fine)
+                                                    triples, displacement3d._height_cache(g, 4, 0), fine)
         # far_order's error model (rectangle_quadrature.FAR_TOL = 1e-6 of the image field): measured 1.3e-6
         assert np.abs(rule - fine).max() <= 5e-6 * np.abs(fine).max()
         # the horizontal rectangle's rule per triple (what displacement_at takes for it)
@@ -207,3 +207,32 @@ def test_image_rule_matches_a_fine_quadrature_between_interfaces():
         displacement3d.horizontal_image_displacement(y, 1, center, frame, a, b, 2, g, nu, n_pairs, triples, 4, 16,
                                                      1e-6, per_triple)
         assert np.abs(per_triple - fine).max() <= 5e-6 * np.abs(fine).max()
+
+
+def test_traced_heights_are_shared_by_the_receivers_of_a_tilted_rectangle():
+    """A vertical and a tilted rectangle in three layers: displacement_at (each rectangle's
+    heights traced once, for all the points) equals each point computed alone with nothing
+    cached (every height traced for it)."""
+    from hmatddm.layered import displacement3d
+    from hmatddm.layered.influence3d import influence_data, with_images
+
+    medium = _three_layers(3)
+    for e2 in ([0.0, 0.0, 1.0], [0.0, math.cos(0.6), math.sin(0.6)]):
+        mesh = hd.mesh.rectangle([0.1, 0.2, 0.5], [1.0, 0.0, 0.0], e2, 0.8, 0.6, 2, 2)
+        dd = np.tile([0.4, -0.2, 1.0], (4, 1))
+        points = np.array([[2.0, 0.3, 1.4], [-1.0, 1.5, 0.4], [0.5, -2.0, -0.7]])
+        together = hd.displacement_at(mesh, medium, dd, points)
+        data = with_images(influence_data(mesh, medium, 0.0, 0.0, 0.0, 0), 3)
+        interfaces, g, nu = medium.arrays()
+        alone = np.zeros((3, 3))
+        for m, point in enumerate(points):
+            layer = int(medium.layer_of(point[2]))
+            for j in range(mesh.n_elements):
+                triples = displacement3d._buffers(g, 3)
+                n_center = displacement3d.trace(mesh.centers[j, 2], int(data.layer[j]), interfaces, g, nu, 3, *triples)
+                pair = np.empty((3, 3))
+                displacement3d.element_displacement(data, point, layer, j, np.empty((3, 3)), np.empty((3, 3)), triples,
+                                                    n_center, displacement3d._buffers(g, 3),
+                                                    displacement3d._height_cache(g, 3, 0), pair)
+                alone[m] += dd[j] @ pair
+        assert np.abs(together - alone).max() <= 1e-13 * np.abs(alone).max()
