@@ -86,7 +86,8 @@ def layered():
             row += [f"{np.max(np.abs(u_half - ref)) / scale:.1e}", f"{np.max(np.abs(u_uniform - ref)) / scale:.2f}"]
             rows.append(row)
             print(" | ".join(str(c) for c in row), flush=True)
-    print_table(["case", "elements", "points", "uniform CPU / wall per pair (us)", "half-space CPU / wall per pair (us)",
+    print_table(["case", "elements", "points", "uniform CPU / wall per pair (us)",
+                 "half-space CPU / wall per pair (us)",
                  "half-space / uniform CPU", "surface + 2 interfaces CPU / wall per pair (us)",
                  "3 layers / uniform CPU", "half-space max error vs Okada / max |u|",
                  "uniform rock vs Okada / max |u|"], rows)
@@ -111,7 +112,8 @@ def layered():
                      f"{1e6 * cpu_3 / pairs:.1f} / {1e6 * wall_3 / pairs:.1f}", f"{cpu_3 / max(cpu_u, 1e-9):.0f}x",
                      f"{np.max(np.abs(u_half - ref)) / scale:.1e}", f"{np.max(np.abs(u_uniform - ref)) / scale:.2f}"])
         print(" | ".join(str(c) for c in rows[-1]), flush=True)
-    print_table(["case", "elements", "points", "uniform CPU / wall per pair (us)", "half-plane CPU / wall per pair (us)",
+    print_table(["case", "elements", "points", "uniform CPU / wall per pair (us)",
+                 "half-plane CPU / wall per pair (us)",
                  "half-plane / uniform CPU", "surface + 2 interfaces CPU / wall per pair (us)",
                  "3 layers / uniform CPU", "half-plane max error vs closed form / max |u|",
                  "uniform rock vs closed form / max |u|"], rows)

@@ -35,7 +35,8 @@ from .potentials3d import Workspace, _original, _pair_displacement_gradient
 from .rectangle_quadrature import _sub_count, far_order, square_rule
 from .segment_quadrature import subdivision_level
 
-__all__ = ["image_order", "image_rectangle_displacement", "horizontal_image_displacement", "element_displacement", "displacement_block"]
+__all__ = ["image_order", "image_rectangle_displacement", "horizontal_image_displacement", "element_displacement",
+           "displacement_block"]
 
 
 @njit(cache=True, inline="always")
