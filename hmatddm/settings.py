@@ -375,7 +375,8 @@ NUMERICS = {  # [numerics] of a scene -> hmatddm.Simulation, its operator and it
     "alpha": OPERATOR["alpha"],
     "contact": Setting("choice", "natural", choices=CONTACT_MODES,
                        doc="elements that close with contact and Coulomb friction: natural, all, none "
-                           "(default: all in a scene with natural fractures, natural otherwise)"),
+                           "(default: all in a scene with natural fractures, natural otherwise; "
+                           "all for strong leak-off with a viscous fluid, see hmatddm.Simulation)"),
     "keep_checkpoints": Setting("integer", 3, low=1),
     "max_elements": Setting("integer", 200_000, low=1,
                             doc="refuse a scene (or stop a run, resumably) with more elements than this"),

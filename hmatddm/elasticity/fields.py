@@ -270,8 +270,8 @@ def induced(mesh, material, dd, points, quantity, singular_correction="none", me
 
 def displacement_at(mesh, material, dd, points, method="auto", eps=None, info=None):
     """Displacement (M, d) induced at ``points`` (M, d) by the DDs ``dd`` (global frame,
-    (N, d) or (N*d,)) of the constant elements of ``mesh`` in a homogeneous ``material``
-    (ref. Eqs 2.43, 2.55-2.57; 2D: the in-plane components of plane strain).
+    (N, d) or (N*d,)) of the constant elements of ``mesh`` in ``material`` (ref. Eqs 2.43,
+    2.55-2.57; 2D: the in-plane components of plane strain).
 
     The far-field displacement decays as 1/r^2 (3D; 1/r in 2D) where the stress decays
     as 1/r^3 (1/r^2): a tiltmeter or a GPS station sees it far from the fracture. On an
@@ -279,14 +279,31 @@ def displacement_at(mesh, material, dd, points, method="auto", eps=None, info=No
     displacement jumps by the DD across it); a point on an element edge (an end in 2D),
     where it is log-singular, raises InputError. ``method``, ``eps`` and ``info``: as
     :func:`hmatddm.stress_at` (``"tree"``: the build-free product of a rectangular
-    H-matrix, whose far blocks are compressed to ``eps``). A layered medium has no
-    displacement kernel: refused.
+    H-matrix, whose far blocks are compressed to ``eps``).
+
+    A :class:`hmatddm.LayeredMedium` (ref. Ch. 3): the closed form of each element's
+    layer plus its image terms (:mod:`hmatddm.layered.displacement`), summed directly
+    like the layered stress at points (``method="tree"`` is refused, ``eps`` unused); a
+    point on the free surface is in the rock, a point inside a void layer is refused.
     """
     from ..layered.medium import LayeredMedium
 
     if isinstance(material, LayeredMedium):
-        raise InputError("displacement_at takes a homogeneous hmatddm.Elastic: the layered kernels (ref. Ch. 3) "
-                         "give stresses, not displacements")
+        if method not in METHODS:
+            raise InputError(f"method must be one of {METHODS}, got {method!r}")
+        if method == "tree":
+            raise InputError("method='tree' is not available in a LayeredMedium: its displacement (like its stress "
+                             "at points) is summed directly; pass method='direct' or 'auto'")
+        if not isinstance(mesh, (Mesh2D, Mesh3D)):
+            raise InputError(f"mesh must be a Mesh2D or Mesh3D, got {type(mesh).__name__}")
+        from ..layered.displacement import displacement_at as layered_displacement_at
+
+        started = time.perf_counter()
+        values = layered_displacement_at(mesh, material, dd, points)
+        if info is not None:
+            info.update(method="direct", points=len(values), elements=mesh.n_elements,
+                        seconds=time.perf_counter() - started)
+        return values
     return induced(mesh, material, dd, points, "displacement", "none", method, eps, info)
 
 

@@ -11,6 +11,9 @@
   parts: :mod:`.potentials3d` (the potentials and the field of one image triple),
   :mod:`.image_tracer3d` (the triples through the interfaces), :mod:`.image_points3d` (the
   field of a point source), :mod:`.rectangle_quadrature` (the quadrature over a rectangle).
+* :mod:`.displacement`: the displacement at points (ref. Eqs 2.43, 2.55-2.57 with the
+  images' displacement of ref. Eq. 3.22), behind :func:`hmatddm.displacement_at`; its
+  kernels :mod:`.displacement3d` (rectangles) and :mod:`.displacement2d` (segments).
 * :func:`split_at_interfaces`: cut a mesh's elements where they cross interfaces (2D
   segments; 3D rectangles with a horizontal edge).
 """
@@ -21,7 +24,8 @@ from .medium import LayeredMedium
 
 def __getattr__(name):
     if name in ("images2d", "influence2d", "images3d", "influence3d", "image_tracer", "segment_quadrature",
-                "segments2d", "potentials3d", "image_tracer3d", "image_points3d", "rectangle_quadrature"):
+                "segments2d", "potentials3d", "image_tracer3d", "image_points3d", "rectangle_quadrature",
+                "displacement", "displacement2d", "displacement3d"):
         return importlib.import_module(f"{__name__}.{name}")
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 

@@ -220,7 +220,7 @@ The format, annotated (``=`` values are the defaults unless marked REQUIRED)::
                                    # the first); every cluster pumps this slurry
 
     [[monitor]]                    # displacement and tilt at a point after every step: DIR/monitor.csv
-    position = [0.0, 0.0, 50.0]    # and DIR/monitor.png (hmatddm.app.monitor); uniform rock only
+    position = [0.0, 0.0, 50.0]    # and DIR/monitor.png (hmatddm.app.monitor); layered rock too
 '''
 import difflib
 import tomllib

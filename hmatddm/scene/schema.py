@@ -361,8 +361,7 @@ def validate(raw, name=None):
         _check_poroelastic(scene)
     _check_leak_off_reservoir(scene)
     if "monitor" in scene and "layer" in scene:
-        raise InputError("[[monitor]] needs the displacement kernels of a uniform rock; the layered kernels "
-                         "(ref. Ch. 3) give stresses only: remove the [[monitor]] or the [[layer]] tables")
+        _check_monitors_in_rock(scene)
     if has_natural_fractures(scene) and "contact" not in raw["numerics"]:
         # a hydraulic element squeezed between natural fractures can open negatively and stall
         # the Picard iteration with contact = "natural": in a network every element closes
@@ -409,6 +408,23 @@ def _check_poroelastic(scene):
     poro, rock = scene["poroelastic"], scene["material"]
     UndrainedRock.from_poisson_ratio(rock["shear_modulus"], rock["poisson_ratio"], poro["biot"],
                                      poro["fluid_bulk_modulus"], poro["porosity"])
+
+
+def _check_monitors_in_rock(scene):
+    """A ``[[monitor]]`` above a void top layer's bottom (the free surface) or below a void
+    bottom layer's top has no rock to displace (a position on the surface is in the rock)."""
+    layers = scene["layer"]
+    axis = scene["dimension"] - 1
+    for k, monitor in enumerate(scene["monitor"]):
+        height = monitor["position"][axis] if len(monitor["position"]) > axis else None
+        if height is None:
+            continue
+        if layers[0]["shear_modulus"] == 0.0 and height > layers[0]["bottom"]:
+            raise InputError(f"monitor[{k}].position[{axis}] must be at most {show(layers[0]['bottom'])} (the free "
+                             f"surface, layer[0] is void), got {show(height)}")
+        if len(layers) > 1 and layers[-1]["shear_modulus"] == 0.0 and height < layers[-2]["bottom"]:
+            raise InputError(f"monitor[{k}].position[{axis}] must be at least {show(layers[-2]['bottom'])} (the "
+                             f"void bottom layer's top), got {show(height)}")
 
 
 def _check_layers(scene):

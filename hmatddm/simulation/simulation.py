@@ -106,6 +106,14 @@ class Simulation:
         :mod:`hmatddm.coupled.contact`): natural-fracture elements (activated or
         failed; the friction and cohesion of ``natural``), every element (hydraulic
         elements close without friction), or none (elements may interpenetrate).
+        Strong leak-off with a viscous fluid needs ``"all"``: a fresh tip element
+        loses ``2 c_l (p - p_r) dt^(1/2)`` of width in its first step (mm), more than
+        the flow brings it; without contact its opening goes negative (to -5 mm in the
+        M~ case of ``benchmarks/bench_leak_off.py``) while it still leaks, the tip
+        overlaps, its K_I is negative and the front stops for good; closed, its
+        pressure falls to the pore pressure, it stops leaking and the front goes on.
+        (Not the default with leak-off: a coarse radial start that closes whole in its
+        first step, the radial K~ case there, does not converge with it.)
     max_elements : int or None
         A step whose growth would take the mesh past it raises SizeLimitError (a
         resource limit: a run stopped by it resumes with a higher one).

@@ -79,3 +79,61 @@ def test_2d_tilt_and_refusals():
     assert np.all(np.isnan(u[1])) and np.all(np.isnan(tilt[1]))  # on the crack's end: singular, blank in the csv
     with pytest.raises(InputError, match=r"monitor\[0\]\.position must be a list of 2"):
         hs.parse_scene('name = "m"\n' + KGD_2D_HEAD + 'end_time = 1.0\n[[monitor]]\nposition = [0.0, 1.0, 2.0]\n')
+
+
+def _shallow_sill(monitors, end_time=2.0):
+    from pathlib import Path
+
+    text = (Path(hs.__file__).parent / "scenes" / "shallow-sill.toml").read_text()
+    text = text.replace("end_time = 12.0", f"end_time = {end_time}")
+    text = text.replace("[output]\nevery = 4", "[output]\nsnapshots = false\nhistory_plot = false")
+    return 'name = "shallow-sill-monitored"\n' + text + "".join(
+        f"[[monitor]]\nposition = [{x}, {y}, {z}]\n" for x, y, z in monitors)
+
+
+def test_a_layered_run_records_the_surface_uplift_and_tilt(tmp_path):
+    """The shallow sill (a free surface 4 m above it): monitors on the ground record the
+    layered displacement (hd.displacement_at in the scene's LayeredMedium) and its tilt;
+    the surface rises above the sill and tilts away from it."""
+    out = tmp_path / "run"
+    positions = np.array([[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, -6.0, -2.0]])
+    runner.run_scene(hs.parse_scene(_shallow_sill(positions)), out, quiet=True)
+    rows = _rows(out / "monitor.csv")
+    from hmatddm.app.run_folder import latest_state
+
+    mesh, fields, step, _ = latest_state(out)
+    last = {int(r["monitor"]): r for r in rows if int(r["step"]) == step}
+    medium = hd.LayeredMedium([0.0], [0.0, 10e9], [0.25, 0.25])
+    expected = hd.displacement_at(mesh, medium, fields["dd"], positions)
+    got = np.array([[float(last[k][f"u_{a}"]) for a in "xyz"] for k in range(3)])
+    np.testing.assert_allclose(got, expected, rtol=1e-8, atol=1e-15)
+    uniform = hd.displacement_at(mesh, hd.Elastic(10e9, 0.25), fields["dd"], positions)
+    assert got[0, 2] > 1.5 * uniform[0, 2] > 0  # the free surface amplifies the uplift
+    assert float(last[1]["tilt_x"]) < 0 and abs(float(last[0]["tilt_x"])) < 1e-3 * abs(float(last[1]["tilt_x"]))
+    h = 1e-2
+    du = hd.displacement_at(mesh, medium, fields["dd"], positions[1:2] + [[h, 0, 0]])[0, 2] - \
+        hd.displacement_at(mesh, medium, fields["dd"], positions[1:2] - [[h, 0, 0]])[0, 2]
+    assert float(last[1]["tilt_x"]) == pytest.approx(du / (2 * h), rel=1e-3)
+    assert (out / "monitor.png").is_file()
+
+
+def test_a_monitor_in_the_air_is_refused():
+    with pytest.raises(InputError, match=r"monitor\[1\]\.position\[2\] must be at most 0 \(the free surface"):
+        hs.parse_scene(_shallow_sill([(0.0, 0.0, 0.0), (1.0, 0.0, 0.5)]))
+
+
+def test_layered_2d_tilt_and_a_position_on_an_end():
+    """A 2D vertical section with a free surface (y = 0) over a dipping segment: the tilt
+    is the slope of hd.displacement_at's u_y along the surface; a position on the
+    segment's end is blank (NaN), as in uniform rock."""
+    medium = hd.LayeredMedium([0.0], [0.0, 10e9], [0.25, 0.25])
+    mesh = hd.mesh.line([-1.0, -2.0], [1.0, -1.5], 2)
+    dd = np.tile([1e-4, 1e-3], (2, 1))
+    positions = np.array([[0.5, 0.0], [-3.0, 0.0], [1.0, -1.5]])
+    u, tilt = displacement_and_tilt(mesh, medium, dd, positions)
+    np.testing.assert_allclose(u[:2], hd.displacement_at(mesh, medium, dd, positions[:2]), rtol=1e-12)
+    h = 1e-3
+    slope = (hd.displacement_at(mesh, medium, dd, positions[:2] + [h, 0.0])[:, 1]
+             - hd.displacement_at(mesh, medium, dd, positions[:2] - [h, 0.0])[:, 1]) / (2 * h)
+    np.testing.assert_allclose(tilt[:2, 0], slope, rtol=1e-4)
+    assert np.all(np.isnan(u[2])) and np.all(np.isnan(tilt[2]))

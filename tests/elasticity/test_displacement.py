@@ -142,6 +142,11 @@ def test_bad_points_and_media_are_refused():
         hd.displacement_at(mesh, material, np.ones((2, 2)), np.array([[0.0, 1.0], [1.0, 0.0]]))
     with pytest.raises(InputError, match="points"):
         hd.displacement_at(mesh, material, np.ones((2, 2)), np.array([[0.0, np.nan]]))
+    # a layered medium has its own kernels (tests/layered/test_layered_displacement.py): equal
+    # layers are this uniform rock, and the compressed sum is refused there
     layered = hd.LayeredMedium([0.0], [G, G], [NU, NU])
-    with pytest.raises(InputError, match="layered kernels"):
-        hd.displacement_at(mesh, layered, np.ones((2, 2)), np.array([[0.0, 1.0]]))
+    points = np.array([[0.0, 1.0], [0.3, -0.5]])
+    np.testing.assert_allclose(hd.displacement_at(mesh, layered, np.ones((2, 2)), points),
+                               hd.displacement_at(mesh, material, np.ones((2, 2)), points), rtol=1e-13, atol=0.0)
+    with pytest.raises(InputError, match="method='tree' is not available in a LayeredMedium"):
+        hd.displacement_at(mesh, layered, np.ones((2, 2)), points, method="tree")

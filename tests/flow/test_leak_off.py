@@ -61,3 +61,33 @@ def test_kgd_through_the_k_to_k_tilde_transition():
     assert np.max(np.abs(length[late] / edge[late] - 1.0)) < 0.04
     leaked = 1.0 - records[-1]["fracture_volume"] / records[-1]["injected_volume"]
     assert 0.4 < leaked < 0.6
+
+
+def _viscous_leak_off_run(end_time, **options):
+    """The M~ case of benchmarks/bench_leak_off.py (viscous, K_m 0.15, leak-off dominated)."""
+    material, s_hmin = hd.Elastic(1e9, 0.25), 20e6
+    mesh = hd.mesh.line([-0.2, 0.0], [0.2, 0.0], 4)
+    sim = hd.Simulation(mesh, material, hd.Fluid(viscosity=0.02, compressibility=0.0),
+                        [hd.Cluster((0.0, 0.0), rate=4e-3)], -np.diag([2 * s_hmin, s_hmin]), 1.0,
+                        propagation=hd.Propagation(toughness=0.1e6),
+                        leak_off=hd.LeakOff(coefficient=5e-11, pore_pressure=0.0),
+                        initial_pressure=s_hmin + 0.9 * 0.1e6 / math.sqrt(0.2 * math.pi), initial_opening=1e-5,
+                        backend="dense", **options)
+    return sim, sim.run(end_time=end_time)
+
+
+def test_viscous_leak_off_front_does_not_stall_when_tips_close():
+    """With contact "all" the leaking tip elements close: the M~ fracture keeps growing
+    towards the leak-off vertex Q t^1/2 / (pi C'), where with interpenetrating tip
+    elements (contact "natural", the default) it stops at 3.55 m from t = 10 s
+    (benchmarks/RESULTS.md, issue 36)."""
+    sim, records = _viscous_leak_off_run(16.0, contact="all")
+    t = np.array([r["time"] for r in records])
+    length = np.array([r["half_length"] for r in records])
+    net = np.array([r["wellbore_pressure"][0] for r in records]) - 20e6
+    vertex = 4e-3 * np.sqrt(t) / (math.pi * 5e-11 * (20e6 + net))
+    assert length[-1] > 4.0 and np.all(np.diff(length[t >= 8.0]) >= 0.0)
+    assert np.all(np.abs(length[t >= 8.0] / vertex[t >= 8.0] - 1.0) < 0.15)  # ~18% of the fluid is stored
+    assert min(r["min_opening"] for r in records) > -1e-9
+    stalled, records = _viscous_leak_off_run(14.0)
+    assert records[-1]["half_length"] < 3.6 and records[-1]["min_opening"] < -1e-3  # the overlap that stopped it
