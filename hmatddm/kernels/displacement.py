@@ -136,3 +136,19 @@ def rectangle_local_displacement(x1, x2, x3, a, b, poisson_ratio, out):
 
 
 __all__ = ["segment_local_displacement", "rectangle_local_displacement", "potential_gradient"]
+
+
+@njit(cache=True)
+def local_to_global(frame, local, out):
+    """The displacement at a point of unit GLOBAL DD components: ``out[q, i] = sum_k sum_p
+    F[k, q] local[k, p] F[p, i]``, with ``local[k, p]`` the displacement ``p`` (element frame)
+    of a unit DD component ``k`` (element frame) and ``F`` the element's frame (rows: the
+    element's axes in global coordinates), 2D or 3D."""
+    d = frame.shape[0]
+    for q in range(d):
+        for i in range(d):
+            acc = 0.0
+            for k in range(d):
+                for p in range(d):
+                    acc += frame[k, q] * local[k, p] * frame[p, i]
+            out[q, i] = acc

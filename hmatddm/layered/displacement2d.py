@@ -26,9 +26,9 @@ import math
 import numpy as np
 from numba import njit
 
-from ..kernels.displacement import segment_local_displacement
+from ..kernels.displacement import local_to_global, segment_local_displacement
 from .image_tracer import trace_capacity
-from .images2d import _INV_4PI, _lame, trace
+from .images2d import _INV_4PI, _lame, inverse_power_derivatives, trace
 from .segment_quadrature import composite_rule, subdivision_level, subdivisions
 
 __all__ = ["image_segment_displacement", "element_displacement", "displacement_block"]
@@ -67,16 +67,8 @@ def _pair_displacement_gradient(r1, r3, eps, coef, dcoef, delta, out, work):
                 if coef[f, j, n] != 0.0 or dcoef[f, j, n] != 0.0:
                     used = n + 1
                     break
-    w = complex(r1, r3)
-    inv = 1.0 / w
     kmax = 2 + used  # a + b <= 3 in the tables, plus D^(used - 1)
-    gk[2] = inv
-    power = inv
-    fact = 1.0
-    for k in range(3, kmax + 1):
-        power = power * inv
-        fact *= (k - 2)
-        gk[k] = fact * power if k % 2 == 0 else -fact * power
+    inverse_power_derivatives(complex(r1, r3), kmax, gk)
     grad = np.zeros(2)
     for f in range(2):
         for a in range(4):
@@ -208,13 +200,7 @@ def element_displacement(data, point, point_layer, j, local, image, center_pairs
     dy = point[1] - center[1]
     segment_local_displacement(frame[0, 0] * dx + frame[0, 1] * dy, frame[1, 0] * dx + frame[1, 1] * dy, a,
                                data.poisson_ratio[ls], local)
-    for q in range(2):
-        for i in range(2):
-            acc = 0.0
-            for k in range(2):
-                for p in range(2):
-                    acc += frame[k, q] * local[k, p] * frame[p, i]
-            out[q, i] = acc
+    local_to_global(frame, local, out)
     if data.interfaces.shape[0] > 0:
         p0 = center - a * frame[0]
         p1 = center + a * frame[0]

@@ -26,7 +26,7 @@ void layer has no displacement: :func:`hmatddm.layered.displacement.point_layers
 import numpy as np
 from numba import njit
 
-from ..kernels.displacement import rectangle_local_displacement
+from ..kernels.displacement import local_to_global, rectangle_local_displacement
 from ..kernels.rectangle3d import distance_to_rectangle, rectangle_distance
 from .image_tracer import trace_capacity
 from .image_tracer3d import trace
@@ -286,14 +286,7 @@ def element_displacement(data, point, point_layer, j, local, image, center_tripl
                                  frame[1, 0] * dx + frame[1, 1] * dy + frame[1, 2] * dz,
                                  frame[2, 0] * dx + frame[2, 1] * dy + frame[2, 2] * dz, a, b,
                                  data.poisson_ratio[ls], local)
-    # global: u_i = sum_p F[p, i] sum_k l_k local[k, p], with l_k = F[k, q] for a unit global DD q
-    for q in range(3):
-        for i in range(3):
-            acc = 0.0
-            for k in range(3):
-                for p in range(3):
-                    acc += frame[k, q] * local[k, p] * frame[p, i]
-            out[q, i] = acc
+    local_to_global(frame, local, out)  # u_i = sum_p F[p, i] sum_k F[k, q] local[k, p], unit global DD q
     if data.interfaces.shape[0] > 0:
         if frame[0, 2] == 0.0 and frame[1, 2] == 0.0:  # horizontal: every point at the centre's height
             horizontal_image_displacement(point, point_layer, center, frame, a, b, ls, data.shear_modulus,

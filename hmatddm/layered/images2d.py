@@ -116,6 +116,20 @@ def _displacement_gradient(table, da, db, scale, s, delta, out):
 
 
 @njit(cache=True)
+def inverse_power_derivatives(w, kmax, gk):
+    """``gk[k]`` = the ``(k - 2)``-th derivative of ``1/w``, ``(-1)^k (k-2)! / w^(k-1)``, for
+    ``k = 2 .. kmax`` (the image pairs' potentials and their derivatives, ref. Eq. 3.22)."""
+    inv = 1.0 / w
+    gk[2] = inv
+    power = inv
+    fact = 1.0
+    for k in range(3, kmax + 1):
+        power = power * inv
+        fact *= (k - 2)
+        gk[k] = fact * power if k % 2 == 0 else -fact * power
+
+
+@njit(cache=True)
 def pair_stress_gradient(r1, r3, eps, coef, dcoef, n_orders, delta, shear_modulus, lame, out):
     """``out[f, q, c] +=`` derivative along the source coordinate ``q`` (0: x, 1: y) of
     the stress component ``c`` (0: xx, 1: xy, 2: yy) at a receiver ``(r1, r3)`` from the
@@ -144,16 +158,8 @@ def _pair_stress_gradient(r1, r3, eps, coef, dcoef, n_orders, delta, shear_modul
                     used = n + 1
                     break
     n_orders = used
-    w = complex(r1, r3)
-    inv = 1.0 / w
     kmax = 3 + n_orders  # a + b <= 4 in the tables, plus D^(n_orders - 1)
-    gk[2] = inv
-    power = inv
-    fact = 1.0
-    for k in range(3, kmax + 1):
-        power = power * inv
-        fact *= (k - 2)
-        gk[k] = fact * power if k % 2 == 0 else -fact * power
+    inverse_power_derivatives(complex(r1, r3), kmax, gk)
     for f in range(2):
         for a in range(5):
             ib = complex(1.0, 0.0)
