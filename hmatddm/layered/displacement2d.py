@@ -27,7 +27,7 @@ import numpy as np
 from numba import njit
 
 from ..kernels.displacement import local_to_global, segment_local_displacement
-from .image_tracer import trace_capacity
+from .image_tracer import largest_trace_capacity
 from .images2d import _INV_4PI, _lame, inverse_power_derivatives, trace
 from .segment_quadrature import composite_rule, subdivision_level, subdivisions
 
@@ -111,13 +111,7 @@ def _pair_displacement_gradient(r1, r3, eps, coef, dcoef, delta, out, work):
 def _buffers(shear_modulus, n_images):
     """Room for the image pairs of one source height in any solid layer: ``(layer, z, eps,
     coef, dcoef)`` (the arguments of :func:`.images2d.trace`)."""
-    cap = 1
-    n_orders = 1
-    for source_layer in range(shear_modulus.shape[0]):
-        if shear_modulus[source_layer] > 0.0:
-            c, o = trace_capacity(source_layer, shear_modulus, n_images)
-            cap = max(cap, c)
-            n_orders = max(n_orders, o)
+    cap, n_orders = largest_trace_capacity(shear_modulus, n_images)
     return (np.empty(cap, dtype=np.int64), np.empty(cap), np.empty(cap), np.zeros((cap, 2, 2, n_orders)),
             np.zeros((cap, 2, 2, n_orders)))
 

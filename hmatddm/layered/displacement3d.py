@@ -28,10 +28,10 @@ from numba import njit
 
 from ..kernels.displacement import local_to_global, rectangle_local_displacement
 from ..kernels.rectangle3d import distance_to_rectangle, rectangle_distance
-from .image_tracer import trace_capacity
+from .image_tracer import largest_trace_capacity
 from .image_tracer3d import trace
 from .images2d import _lame
-from .potentials3d import Workspace, _original, _pair_displacement_gradient
+from .potentials3d import Workspace, _original, _pair_displacement_gradient, unit_moment
 from .rectangle_quadrature import _sub_count, far_order, square_rule
 from .segment_quadrature import subdivision_level
 
@@ -71,14 +71,7 @@ def _contract_displacement(gradient, normal, shear_modulus, lame, weight, out):
             acc = 0.0
             for p in range(3):
                 for q in range(3):
-                    m = 0.0
-                    if p == b:
-                        m += shear_modulus * normal[q]
-                    if q == b:
-                        m += shear_modulus * normal[p]
-                    if p == q:
-                        m += lame * normal[b]
-                    acc += m * gradient[p, q, i]
+                    acc += unit_moment(b, p, q, normal, shear_modulus, lame) * gradient[p, q, i]
             out[b, i] += weight * acc
 
 
@@ -86,13 +79,7 @@ def _contract_displacement(gradient, normal, shear_modulus, lame, weight, out):
 def _buffers(shear_modulus, n_images):
     """Room for the triples of one source height in any solid layer: ``(layer, z, eps,
     sigma, coef, dcoef)``."""
-    cap = 1
-    n_orders = 1
-    for source_layer in range(shear_modulus.shape[0]):
-        if shear_modulus[source_layer] > 0.0:
-            c, o = trace_capacity(source_layer, shear_modulus, n_images)
-            cap = max(cap, c)
-            n_orders = max(n_orders, o)
+    cap, n_orders = largest_trace_capacity(shear_modulus, n_images)
     return (np.empty(cap, dtype=np.int64), np.empty(cap), np.empty(cap), np.empty(cap),
             np.zeros((cap, 3, 3, n_orders)), np.zeros((cap, 3, 3, n_orders)))
 

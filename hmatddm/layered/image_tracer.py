@@ -64,6 +64,20 @@ def trace_capacity(source_layer, shear_modulus, n_images):
 
 
 @njit(cache=True)
+def largest_trace_capacity(shear_modulus, n_images):
+    """``(n_pairs, n_orders)`` enough for a source in any solid layer (:func:`trace_capacity`
+    over the layers of positive shear modulus; at least ``(1, 1)``)."""
+    cap = 1
+    n_orders = 1
+    for source_layer in range(shear_modulus.shape[0]):
+        if shear_modulus[source_layer] > 0.0:
+            c, o = trace_capacity(source_layer, shear_modulus, n_images)
+            cap = max(cap, c)
+            n_orders = max(n_orders, o)
+    return cap, n_orders
+
+
+@njit(cache=True)
 def _apply(coef, power, h, dh, src, dsrc, dst, ddst, n_orders):
     """``dst += coef h^power D^power src`` and its derivative in the source height."""
     if coef == 0.0:

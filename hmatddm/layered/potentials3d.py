@@ -364,6 +364,20 @@ def _pair_displacement_gradient(r1, r2, r3, eps, sigma, coef, dcoef, delta, out,
             out[f, 2, i] += 2.0 * delta * eps * table[f, 1, a, b, c + 1]
 
 
+@njit(cache=True, inline="always")
+def unit_moment(b, p, q, normal, shear_modulus, lame):
+    """``M_pq`` of a unit DD along global ``b`` on a plane of ``normal``: ``lame (b.n)
+    delta_pq + G (b_p n_q + b_q n_p)`` (Aki and Richards, Eq. 3.20)."""
+    m = 0.0
+    if p == b:
+        m += shear_modulus * normal[q]
+    if q == b:
+        m += shear_modulus * normal[p]
+    if p == q:
+        m += lame * normal[b]
+    return m
+
+
 @njit(cache=True)
 def _contract(gradient, normal, shear_modulus, lame, weight, out):
     """``out[b, i, k] += weight *`` stress of a unit DD density along global ``b`` on a
@@ -375,13 +389,7 @@ def _contract(gradient, normal, shear_modulus, lame, weight, out):
                 acc = 0.0
                 for p in range(3):
                     for q in range(3):
-                        m = 0.0
-                        if p == b:
-                            m += shear_modulus * normal[q]
-                        if q == b:
-                            m += shear_modulus * normal[p]
-                        if p == q:
-                            m += lame * normal[b]
+                        m = unit_moment(b, p, q, normal, shear_modulus, lame)
                         if m != 0.0:
                             acc += m * gradient[p, q, i, k]
                 out[b, i, k] += weight * acc
