@@ -28,7 +28,7 @@ from numba import njit
 
 from ..kernels.displacement import local_to_global, segment_local_displacement
 from .image_tracer import largest_trace_capacity
-from .images2d import _INV_4PI, _lame, inverse_power_derivatives, trace
+from .images2d import _INV_4PI, _lame, _potential_table, inverse_power_derivatives, potential_derivatives, trace
 from .segment_quadrature import composite_rule, subdivision_level, subdivisions
 
 __all__ = ["image_segment_displacement", "element_displacement", "displacement_block"]
@@ -71,27 +71,8 @@ def _pair_displacement_gradient(r1, r3, eps, coef, dcoef, delta, out, work):
     inverse_power_derivatives(complex(r1, r3), kmax, gk)
     grad = np.zeros(2)
     for f in range(2):
-        for a in range(4):
-            ib = complex(1.0, 0.0)
-            for b in range(kmax + 1 - a):
-                if a + b >= 2:
-                    v = ib * gk[a + b]
-                    beta[a, b] = -v.real if f == 0 else -v.imag
-                ib = ib * 1j
-        for j in range(2):
-            for a in range(4):
-                for b in range(4 - a):
-                    order = a + b
-                    if order >= 2:
-                        s = 0.0
-                        for n in range(used):
-                            s += coef[f, j, n] * beta[a, b + n]
-                        table[j, a, b] = s
-                    if 1 <= order <= 2:
-                        ds = 0.0
-                        for n in range(used):
-                            ds += dcoef[f, j, n] * beta[a, b + n]
-                        dtable[j, a, b] = ds
+        potential_derivatives(gk, kmax, 3, f, beta)
+        _potential_table(coef[f], dcoef[f], beta, used, table, dtable, 3)
         # d/dx1 of the source = -d/dr1
         grad[:] = 0.0
         _u(table, 1, 0, -1.0, r3, delta, grad)

@@ -81,24 +81,39 @@ def trace(t, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, p
 
 
 @njit(cache=True)
-def _potential_table(coef, dcoef, beta, n_orders, table, dtable):
+def _potential_table(coef, dcoef, beta, n_orders, table, dtable, top=4):
     """``table[j, a, b] = sum_n coef[j, n] beta[a, b + n]`` (derivative d1^a d3^b of
-    potential j) for ``a + b`` = 3, 4, and ``dtable`` the same with ``dcoef`` for
-    ``a + b`` = 2, 3: the entries :func:`_pair_stress_gradient` reads."""
+    potential j) for ``a + b`` = ``top - 1``, ``top``, and ``dtable`` the same with ``dcoef``
+    for ``a + b`` = ``top - 2``, ``top - 1``: the entries :func:`_pair_stress_gradient` reads
+    (``top`` 4), or the displacement gradient of :mod:`.displacement2d` (``top`` 3)."""
     for j in range(2):
-        for a in range(5):
-            for b in range(max(0, 2 - a), 5 - a):
+        for a in range(top + 1):
+            for b in range(max(0, top - 2 - a), top + 1 - a):
                 order = a + b
-                if order >= 3:
+                if order >= top - 1:
                     s = 0.0
                     for n in range(n_orders):
                         s += coef[j, n] * beta[a, b + n]
                     table[j, a, b] = s
-                if order <= 3:
+                if order <= top - 1:
                     ds = 0.0
                     for n in range(n_orders):
                         ds += dcoef[j, n] * beta[a, b + n]
                     dtable[j, a, b] = ds
+
+
+@njit(cache=True)
+def potential_derivatives(gk, kmax, top, f, beta):
+    """``beta[a, b]`` = ``-Re`` (``f`` 0) or ``-Im`` (``f`` 1) of ``i^b gk[a + b]``, the
+    derivatives d1^a d3^b of the pair's analytic function (module docstring) for
+    ``a <= top``, ``2 <= a + b <= kmax``."""
+    for a in range(top + 1):
+        ib = complex(1.0, 0.0)
+        for b in range(kmax + 1 - a):
+            if a + b >= 2:
+                v = ib * gk[a + b]
+                beta[a, b] = -v.real if f == 0 else -v.imag
+            ib = ib * 1j
 
 
 @njit(cache=True)
@@ -161,13 +176,7 @@ def _pair_stress_gradient(r1, r3, eps, coef, dcoef, n_orders, delta, shear_modul
     kmax = 3 + n_orders  # a + b <= 4 in the tables, plus D^(n_orders - 1)
     inverse_power_derivatives(complex(r1, r3), kmax, gk)
     for f in range(2):
-        for a in range(5):
-            ib = complex(1.0, 0.0)
-            for b in range(kmax + 1 - a):
-                if a + b >= 2:
-                    v = ib * gk[a + b]
-                    beta[a, b] = -v.real if f == 0 else -v.imag
-                ib = ib * 1j
+        potential_derivatives(gk, kmax, 4, f, beta)
         _potential_table(coef[f], dcoef[f], beta, n_orders, table, dtable)
         for q in range(2):
             grad[:] = 0.0
