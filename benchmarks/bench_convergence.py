@@ -94,12 +94,14 @@ def mesh_overrides(name, h):
     return sets
 
 
-def run(name, h, folder):
-    """One run in a child process: final values, errors, RMS errors over the second half."""
+def run(name, h, folder, extra=()):
+    """One run in a child process: final values, errors, RMS errors over the second half
+    (``extra``: more ``--set`` assignments, e.g. ``numerics.time_step=0.5``)."""
     out = os.path.join(folder, f"{name}-{h}.json")
     environment = dict(os.environ, PYTHONPATH=os.pathsep.join([ROOT, os.environ.get("PYTHONPATH", "")]))
     scene = VARIANTS.get(name, (name,))[0]
-    subprocess.run([sys.executable, "-c", _CHILD, scene, out, *mesh_overrides(name, h)], env=environment, check=True)
+    subprocess.run([sys.executable, "-c", _CHILD, scene, out, *mesh_overrides(name, h), *extra], env=environment,
+                   check=True)
     result = json.load(open(out))
     records, rows = result["records"], result["reference"]
     size_key = "radius" if "radius" in rows[-1] else "half_length"
@@ -151,6 +153,8 @@ def main():
                         help="skip a run whose closed-form size needs more elements than this")
     parser.add_argument("--plot", default=os.path.join(HERE, "convergence.png"))
     parser.add_argument("--json", default=None, help="also write the rows to this file")
+    parser.add_argument("--set", action="append", default=[],
+                        help="another scene assignment for every run (repeatable), e.g. numerics.time_step=0.5")
     parser.add_argument("--report", default=None,
                         help="no runs: print the tables and plot of earlier --json files (comma separated)")
     args = parser.parse_args()
@@ -175,7 +179,7 @@ def main():
                     skipped.append(f"{name} at h = {h:g} m (~{needed} elements > --max-elements {args.max_elements})")
                     print(f"skipped {skipped[-1]}", flush=True)
                     continue
-                rows.append(run(name, h, folder))
+                rows.append(run(name, h, folder, args.set))
                 print(json.dumps(rows[-1]), flush=True)
     if args.json:
         json.dump(dict(rows=rows, skipped=skipped, machine=machine()), open(args.json, "w"), indent=1)

@@ -39,6 +39,7 @@ takes a literal int argument where another call passes a variable (numba compile
 specialization per literal: ``first = np.int64(0)``).
 ``benchmarks/bench_layered3d_compile.py`` measures it.
 """
+import math
 from typing import NamedTuple
 
 import numpy as np
@@ -48,10 +49,12 @@ from ..kernels import rectangle3d
 from ..kernels.drivers import KernelKind, register_kind
 from .image_points3d import image_point_displacement, image_point_stress, kelvin_point_displacement, kelvin_point_stress
 from .image_tracer import trace_capacity
-from .images2d import zero_in_void
+from .images2d import _lame, zero_in_void
 from .image_tracer3d import _trace_range, _traced_buffer, trace, trace_points
+from .remainder_table3d import keep_near_range, rectangle_covered, remainder_rectangle_stress
 from .potentials3d import Workspace, base_derivatives, inverse_distance_derivatives
 from .rectangle_quadrature import (FAR_TOL, _cached_rules, _image_order, _integrate, far_order, image_rectangle_stress,
+                                   remainder_order,
                                    nearest_singularity, square_rule, subdivisions)
 
 __all__ = ["LayeredRectangles", "workspace", "source_state", "element_traction", "element_stress",
@@ -85,6 +88,7 @@ class LayeredRectangles(NamedTuple):
     far_tol: float = FAR_TOL  #: error allowed to :func:`far_order` (0: ``gauss_points`` everywhere)
     entry_tol: float = 0.0  #: image error allowed relative to the largest entry (:func:`entry_order`; 0: off)
     entry_scale: float = 0.0  #: the largest entry's scale (:func:`entry_scale`) over the largest shear modulus
+    table: object = None  #: the :class:`.remainder_table3d.RemainderTable` (never None once built by influence_data)
 
 
 @njit(cache=True)
@@ -108,12 +112,17 @@ def workspace(data):
 @njit(cache=True)
 def source_state(data, j, work):
     """What the receivers of source ``j`` share: room for the image triples at the points
-    of the cached rules, traced when a receiver first needs a rule."""
+    of the cached rules, traced when a receiver first needs a rule, and whether they are
+    the near triples only (the source's layer has a tabulated remainder)."""
     room = work[6]
     start = work[7][3]
     ls = data.layer[j]
-    return _traced_buffer(start[-1], max(room[ls, 0], 1), max(room[ls, 1], 1)), np.zeros(start.shape[0] - 1,
-                                                                                         dtype=np.bool_)
+    near_only = False
+    for lr in range(data.table.pair_index.shape[1]):
+        if data.table.pair_index[ls, lr] >= 0:
+            near_only = True
+    return (_traced_buffer(start[-1], max(room[ls, 0], 1), max(room[ls, 1], 1)),
+            np.zeros(start.shape[0] - 1, dtype=np.bool_), near_only)
 
 
 @njit(cache=True)
@@ -121,13 +130,16 @@ def element_traction(data, i, j, state, work, block):
     """``block`` (3, 3): traction at the centre of element ``i`` (its normal) for a unit
     global DD of rectangle ``j``: closed form of the source layer's material (with the
     closed-form kernel's singular and near-miss handling) plus images (:func:`_image_order`),
-    the source's traced triples reused across receivers."""
-    traced, is_traced = state
+    the source's traced triples reused across receivers. With a tabulated remainder
+    (:mod:`.remainder_table3d`) the quadrature takes the near triples only and the table
+    the rest; a receiver outside the table's range takes every triple by quadrature."""
+    traced, is_traced, near_only = state
     local, image, gradient, kelvin, ws1, ws, room, rules = work
     xi, eta, wt, start = rules
     g = data.shear_modulus
     nu = data.poisson_ratio
     interfaces = data.interfaces
+    table = data.table
     ls = data.layer[j]
     center = data.centers[j]
     frame = data.frames[j]
@@ -142,20 +154,43 @@ def element_traction(data, i, j, state, work, block):
                               near)
     if interfaces.shape[0] > 0:
         lr = data.layer[i]
-        n_gauss, n_sub = _image_order(point, lr, center, frame, a, b, ls, interfaces, data.gauss_points,
-                                      data.max_subdivisions, data.far_tol, data.entry_tol * data.entry_scale)
         image[:] = 0.0
-        if n_sub <= 2:
-            slot = n_gauss - 1 if n_sub == 1 else data.gauss_points
-            lo, hi = start[slot], start[slot + 1]
-            if not is_traced[slot]:
-                _trace_range(center, frame, a, b, ls, interfaces, g, nu, data.n_images, xi, eta, lo, hi, traced)
-                is_traced[slot] = True
-            _integrate(point, lr, center, frame, a, b, ls, g, nu, xi[lo:hi], eta[lo:hi], wt[lo:hi], traced, lo, image,
-                       gradient, ws, ws1, kelvin)
-        else:
+        tabulated = near_only and rectangle_covered(table, point, lr, center, frame, a, b, ls)
+        entry_tol = data.entry_tol * data.entry_scale
+        if near_only and not tabulated and table.pair_index[ls, lr] >= 0:
+            # outside the table's range: every triple by quadrature
+            n_gauss, n_sub = _image_order(point, lr, center, frame, a, b, ls, interfaces, data.gauss_points,
+                                          data.max_subdivisions, data.far_tol, entry_tol)
             image_rectangle_stress(point, lr, center, frame, a, b, ls, interfaces, g, nu, data.n_images, n_gauss,
-                                   n_sub, image)
+                                   n_sub, image, False, table.bottoms, table.tops)
+        elif not (tabulated and abs(lr - ls) >= 2):  # two layers apart, every triple is far
+            n_gauss, n_sub = _image_order(point, lr, center, frame, a, b, ls, interfaces, data.gauss_points,
+                                          data.max_subdivisions, data.far_tol, entry_tol)
+            if n_sub <= 2:
+                slot = n_gauss - 1 if n_sub == 1 else data.gauss_points
+                lo, hi = start[slot], start[slot + 1]
+                if not is_traced[slot]:
+                    _trace_range(center, frame, a, b, ls, interfaces, g, nu, data.n_images, xi, eta, lo, hi, traced)
+                    if near_only:
+                        keep_near_range(traced, lo, hi, center, frame, a, b, xi, eta, ls, table.bottoms, table.tops)
+                    is_traced[slot] = True
+                _integrate(point, lr, center, frame, a, b, ls, g, nu, xi[lo:hi], eta[lo:hi], wt[lo:hi], traced, lo,
+                           image, gradient, ws, ws1, kelvin)
+            else:
+                image_rectangle_stress(point, lr, center, frame, a, b, ls, interfaces, g, nu, data.n_images, n_gauss,
+                                       n_sub, image, near_only, table.bottoms, table.tops)
+        if tabulated:
+            # the far triples' points lie below or above the source points, at least
+            # the clearance outside the receiver's layer
+            r1 = point[0] - center[0]
+            r2 = point[1] - center[1]
+            beside = max(0.0, math.sqrt(r1 * r1 + r2 * r2) - a - b)
+            clearance = table.clearance[ls, lr]
+            n = remainder_order(math.sqrt(clearance * clearance + beside * beside), a, b, data.gauss_points,
+                                data.far_tol, entry_tol)
+            lo, hi = start[n - 1], start[n]
+            remainder_rectangle_stress(table, point, lr, center, frame, a, b, ls, g[ls], _lame(g[ls], nu[ls]),
+                                       xi[lo:hi], eta[lo:hi], wt[lo:hi], image)
         for p in range(3):
             for q in range(3):
                 block[p, q] += image[q, p, 0] * normal[0] + image[q, p, 1] * normal[1] + image[q, p, 2] * normal[2]
@@ -183,7 +218,7 @@ def element_stress(data, point, point_layer, j, work, out):
         n_gauss, n_sub = _image_order(point, point_layer, center, frame, a, b, ls, data.interfaces,
                                       data.gauss_points, data.max_subdivisions, data.far_tol, 0.0)
         image_rectangle_stress(point, point_layer, center, frame, a, b, ls, data.interfaces, g, nu, data.n_images,
-                               n_gauss, n_sub, image)
+                               n_gauss, n_sub, image, False, data.table.bottoms, data.table.tops)
         for q in range(3):
             for i in range(3):
                 for k in range(3):

@@ -8,7 +8,7 @@ import numpy as np
 from .._validation import finite_array
 from ..errors import InputError
 from ..kernels.drivers import finite_stress_sum, with_self_max
-from . import images3d
+from . import images3d, remainder_table3d
 from .influence2d import choose_images as _choose_images
 from .influence2d import layers_of_extents, with_images
 from .rectangle_quadrature import ENTRY_TOL, entry_scale
@@ -35,15 +35,65 @@ def element_layers(mesh, medium):
 
 def influence_data(mesh, medium, singular_shift, alpha, near_fraction, n_images):
     """The kernel data (:class:`images3d.LayeredRectangles`) of ``mesh`` in ``medium``
-    with ``n_images`` images; ``alpha > 0`` fills ``self_max`` for ref. Eq. 6.11."""
+    with ``n_images`` images; ``alpha > 0`` fills ``self_max`` for ref. Eq. 6.11. With
+    ``medium.method == "table"`` and far image triples (two or more interfaces), the
+    layered remainder's table (:func:`remainder_table`)."""
     layers = element_layers(mesh, medium)
     interfaces, g, nu = medium.arrays()
     scale = entry_scale(mesh.half_a, mesh.half_b, layers, g, nu) / g.max() if interfaces.shape[0] > 0 else 0.0
+    table = remainder_table3d.empty_table(g.shape[0])
+    if medium.method == "table" and n_images > 0 and interfaces.shape[0] >= 2:
+        table = remainder_table(mesh, medium, layers, int(n_images), scale * g.max())[0]
     return with_self_max(images3d.LayeredRectangles(
         mesh.centers, mesh.frames, mesh.half_a, mesh.half_b, layers, interfaces, g, nu, n_images=int(n_images),
         gauss_points=int(medium.gauss_points), max_subdivisions=int(MAX_SUBDIVISIONS),
         singular_shift=float(singular_shift), near_fraction=float(near_fraction), alpha=float(alpha),
-        self_max=np.zeros(mesh.n_elements), entry_tol=float(ENTRY_TOL), entry_scale=float(scale)))
+        self_max=np.zeros(mesh.n_elements), entry_tol=float(ENTRY_TOL), entry_scale=float(scale), table=table))
+
+
+#: Tables built in this process: ``(medium key, n_images) -> [(table, stats, cover)]``.
+_TABLES = {}
+
+
+def _table_key(medium, n_images):
+    return (medium.interfaces, medium.shear_modulus, medium.poisson_ratio, float(medium.table_tol), int(n_images))
+
+
+def _covered(table, mesh, layers):
+    """True when every rectangle of ``mesh`` and every horizontal offset between two of its
+    points lie in the table's range (a grown mesh may leave it)."""
+    corners = mesh.corners()
+    horizontal = float(np.hypot(np.ptp(corners[:, :, 0]), np.ptp(corners[:, :, 1])))
+    for k in range(table.grid.shape[0]):
+        if horizontal > table.grid[k, 0] * np.sinh(table.grid[k, 1] * (table.grid[k, 2] - 1.0)):
+            return False
+    for layer in np.unique(layers):
+        rows = np.flatnonzero(table.pair_index[layer] >= 0)
+        if rows.size == 0:
+            continue
+        grid = table.grid[table.pair_index[layer, rows[0]]]
+        z = corners[layers == layer][:, :, 2]
+        if z.min() < grid[3] - 1e-9 or z.max() > grid[3] + grid[4] * (grid[5] - 1.0) + 1e-9:
+            return False
+    return True
+
+
+def remainder_table(mesh, medium, layers, n_images, largest_entry):
+    """``(table, stats)``: the remainder table of ``medium`` at ``n_images`` covering
+    ``mesh`` (:func:`.remainder_table3d.build_table` to ``medium.table_tol`` of
+    ``largest_entry``), reused from an earlier mesh of the same medium when it covers
+    this one (a growing fracture builds it again only when it leaves the table's range)."""
+    key = _table_key(medium, n_images)
+    per_area = medium.table_tol * largest_entry / float(np.max(4.0 * mesh.half_a * mesh.half_b))
+    for table, stats, built_per_area in _TABLES.get(key, []):
+        if built_per_area <= per_area and _covered(table, mesh, layers):
+            return table, stats
+    interfaces, g, nu = medium.arrays()
+    table, stats = remainder_table3d.build_table(mesh, layers, interfaces, g, nu, n_images, medium.table_tol,
+                                                 largest_entry)
+    _TABLES.setdefault(key, []).append((table, stats, per_area))
+    del _TABLES[key][:-2]  # the two latest extents
+    return table, stats
 
 
 def choose_images(mesh, medium, data, max_samples=12, max_sources=120):

@@ -52,6 +52,14 @@ class LayeredMedium:
     gauss_points : int in [1, 32]
         Gauss points per sub-segment for the regular image terms (ref. Eqs 3.12-3.13);
         sub-segments are added where an image lies close to the receiver.
+    method : "table" or "quadrature"
+        3D constant rectangles: ``"table"`` (default) integrates the near image triples by
+        quadrature and takes the far ones (the layered remainder, which exists with two or
+        more interfaces) from a table built once per medium and mesh extent
+        (:mod:`hmatddm.layered.remainder_table3d`); ``"quadrature"`` integrates every
+        triple (the cross-check). 2D and the half-space are the same either way.
+    table_tol : float in (0, 1e-4]
+        Error of the remainder table allowed relative to the largest influence entry.
     """
 
     interfaces: tuple
@@ -62,6 +70,8 @@ class LayeredMedium:
     images: object = "auto"
     image_tol: float = LAYERED_MEDIUM["image_tol"].default
     gauss_points: int = LAYERED_MEDIUM["gauss_points"].default
+    method: str = LAYERED_MEDIUM["method"].default
+    table_tol: float = LAYERED_MEDIUM["table_tol"].default
 
     def __post_init__(self):
         d = _float_list("interfaces", self.interfaces)

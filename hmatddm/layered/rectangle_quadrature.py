@@ -19,6 +19,7 @@ from .image_tracer import trace_capacity
 from .image_tracer3d import _trace_range, _traced_buffer
 from .images2d import _lame
 from .potentials3d import Workspace, _contract
+from .remainder_table3d import keep_near_range
 from .segment_quadrature import gauss_legendre, subdivision_level
 
 
@@ -174,15 +175,19 @@ def _integrate(y, receiver_layer, center, frame, a, b, source_layer, shear_modul
 
 @njit(cache=True, inline="always")
 def image_rectangle_stress(y, receiver_layer, center, frame, a, b, source_layer, interfaces, shear_modulus,
-                           poisson_ratio, n_images, n_gauss, n_sub, out):
+                           poisson_ratio, n_images, n_gauss, n_sub, out, near_only, bottoms, tops):
     """Complementary stress ``out[b, i, k]`` at ``y`` of a unit global DD ``b`` on the
-    rectangle, by ``n_gauss^2`` points on each of ``n_sub^2`` sub-squares."""
+    rectangle, by ``n_gauss^2`` points on each of ``n_sub^2`` sub-squares; ``near_only``:
+    of the near triples only (:func:`.remainder_table3d.keep_near`, layers bounded by
+    ``bottoms``, ``tops``), the remainder being tabulated."""
     xi, eta, wt = square_rule(n_gauss, n_sub)
     cap, n_orders = trace_capacity(source_layer, shear_modulus, n_images)
     traced = _traced_buffer(xi.shape[0], cap, n_orders)
     first = np.int64(0)  # not a literal 0: the same compiled _trace_range and _integrate as element_traction's
     _trace_range(center, frame, a, b, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, xi, eta, first,
                  xi.shape[0], traced)
+    if near_only:
+        keep_near_range(traced, first, xi.shape[0], center, frame, a, b, xi, eta, source_layer, bottoms, tops)
     out[:] = 0.0
     _integrate(y, receiver_layer, center, frame, a, b, source_layer, shear_modulus, poisson_ratio, xi, eta, wt,
                traced, first, out, np.empty((3, 3, 3, 3)), Workspace(n_orders), Workspace(1),
@@ -204,6 +209,17 @@ def _image_order(y, receiver_layer, center, frame, a, b, source_layer, interface
             n = min(n, entry_order(dmin, a, b, gauss_points, entry_tol))
         return n, 1
     return gauss_points, n_sub
+
+
+@njit(cache=True)
+def remainder_order(clearance, a, b, gauss_points, far_tol, entry_tol):
+    """Gauss points per side of one square for the tabulated layered remainder
+    (:mod:`.remainder_table3d`), whose singular points stay ``clearance`` away from the
+    receiver: :func:`entry_order` when ``entry_tol > 0``, else :func:`far_order`."""
+    n = far_order(clearance / max(a, b), gauss_points, far_tol)
+    if entry_tol > 0.0:
+        n = min(n, entry_order(clearance, a, b, gauss_points, entry_tol))
+    return n
 
 
 @njit(cache=True)

@@ -30,7 +30,7 @@ def _total(y, receiver_layer, shape, source_layer, medium, n_images, dz=0.0):
                             np.empty((3, 3, 3)))
     image = np.zeros((3, 3, 3))
     images3d.image_rectangle_stress(np.asarray(y, float), receiver_layer, center, frame, a, b, source_layer,
-                                    interfaces, g, nu, n_images, 6, 4, image)
+                                    interfaces, g, nu, n_images, 6, 4, image, False, interfaces, interfaces)
     return out + image
 
 
@@ -142,7 +142,8 @@ def test_equal_layers_give_no_image_terms():
     for y, layer in (([0.3, 0.1, 0.5], 1), ([0.3, 0.1, 1.5], 0), ([0.3, 0.1, -1.5], 2)):
         image = np.zeros((3, 3, 3))
         images3d.image_rectangle_stress(np.asarray(y, float), layer, np.array([0.1, 0.2, 0.5]), _frame(e1, e2), a, b,
-                                        1, *(np.asarray(v, float) for v in medium), 3, 4, 1, image)
+                                        1, *(np.asarray(v, float) for v in medium), 3, 4, 1, image, False,
+                                        np.zeros(2), np.zeros(2))
         assert np.all(np.abs(image) < 1e-15)
 
 

@@ -1,0 +1,549 @@
+"""The layered remainder of the 3D image method, tabulated once per medium (issue 32, item 2).
+
+The image field of a point source in a plane-layered medium (ref. Secs 3.2-3.3) is the sum
+of the traced Hansen triples (:mod:`.image_tracer3d`). With two or more interfaces (a free
+surface counts as one) their number grows quickly with the number of reflections: 37
+triples for a source below a free surface and two interfaces at ``images=4``, each costing
+~2 us at every quadrature point. Only a few of them are singular where the receivers are:
+
+* **near** triples: those whose point can come to the receiver's layer (a first reflection
+  in an interface that bounds both the source's and the receiver's layer, the transmitted
+  source for a receiver in the next layer) -- with the whole-space term of the source's
+  material that :mod:`.image_points3d` subtracts in another layer, when that layer is the
+  next one;
+* **far** triples: every other one. Its point stays at least one layer thickness away
+  from the receiver's layer for every source height in the source's layer
+  (:func:`triple_gap`), so their sum -- the *layered remainder* -- is smooth there.
+
+The near triples keep the quadrature of :mod:`.rectangle_quadrature` (exact to its
+tolerance next to the interfaces). The remainder depends only on the horizontal offset
+``rho``, the source height ``t`` and the receiver height ``y3`` (the medium is
+axisymmetric about the vertical through the source), and is tabulated on uniform grids in
+the source frame rotated so that the receiver lies on its x axis (the approach of the
+layered-media Green's function tables, e.g. Wang's EDGRN/EDCMP, applied to the image sum):
+per pair of (source layer, receiver layer), the 20 components of the moment-to-stress
+response ``T[m, s]`` that the mirror symmetry ``y -> -y`` of that frame leaves non-zero
+(moment ``m`` and stress ``s`` components, each ``xx, yy, zz, xy, xz, yz``). A value is
+interpolated by 4-point Lagrange polynomials in each of the three variables (64 nodes),
+then rotated back and contracted with the element's moment tensor (Aki & Richards,
+Eq. 3.20).
+
+The table is built from the image sum itself (so it is exact at its nodes), and refined
+(the spacing halved) until its error at random points between the nodes, converted to an
+influence entry (``max |dT| (lambda + 2G) 4ab``), is below ``table_tol`` times the scale of
+the largest entry (:func:`.rectangle_quadrature.entry_scale`). A medium whose triples are
+all near (a half-space, a bi-material, one interface and a free surface at ``images=1``)
+builds no table. Sources or receivers outside a table's range (a mesh grown past it) take
+the quadrature of every triple, as without a table.
+"""
+import math
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit, prange
+
+from .image_tracer import trace_capacity
+from .image_tracer3d import trace
+from .images2d import _lame, receiver_constants
+from .potentials3d import Workspace, _original, _pair_stress_gradient
+
+#: Default error of the remainder table relative to the largest influence entry.
+TABLE_TOL = 1e-9
+#: Largest number of values a table may hold (8 bytes each) before refinement stops.
+MAX_TABLE_VALUES = 40_000_000
+#: Random points between the nodes at which a table's error is measured, per layer pair
+#: (half of them near the ends of the height ranges).
+ERROR_SAMPLES = 128
+
+# the 6 symmetric index pairs of a moment or a stress: xx, yy, zz, xy, xz, yz
+_PAIRS = np.array([[0, 0], [1, 1], [2, 2], [0, 1], [0, 2], [1, 2]], dtype=np.int64)
+
+
+def _nonzero_components():
+    """``(m, s)`` of the 20 response components that the mirror ``y -> -y`` leaves (the
+    number of ``y`` indices of the moment and the stress is even)."""
+    count = [int(p == 1) + int(q == 1) for p, q in _PAIRS]
+    return np.array([[m, s] for m in range(6) for s in range(6) if (count[m] + count[s]) % 2 == 0], dtype=np.int64)
+
+
+COMPONENTS = _nonzero_components()
+
+
+class RemainderTable(NamedTuple):
+    """The tabulated layered remainder of a medium (empty: ``pair_index`` all -1).
+
+    Layer pair ``k = pair_index[ls, lr]`` has its own grids, ``grid[k]`` =
+    ``(rho_scale, h_u, n_u, t0, h_t, n_t, y0, h_y, n_y)``: ``rho = rho_scale sinh(u)``,
+    ``u = i h_u`` (nodes denser near the source, where the remainder varies on the scale
+    of the layers, sparser far away, where it varies on the scale of ``rho``),
+    ``t = t0 + i h_t`` (source height), ``y3 = y0 + i h_y`` (receiver height); its values
+    ``values[offset[k] + ((i_u n_t + i_t) n_y + i_y) 20 + c]``. ``clearance[ls, lr]``: the
+    smallest distance of a far triple's point to the receiver's layer."""
+
+    pair_index: np.ndarray  #: (L, L) int64, -1: no table (all triples by quadrature)
+    grid: np.ndarray  #: (P, 9)
+    offset: np.ndarray  #: (P,) int64
+    values: np.ndarray  #: (sum of the pairs' sizes,)
+    clearance: np.ndarray  #: (L, L)
+    bottoms: np.ndarray  #: (L,) layer bottoms (-inf for the lowest)
+    tops: np.ndarray  #: (L,) layer tops (+inf for the highest)
+
+
+def empty_table(n_layers):
+    """A table that tabulates nothing (every pair by quadrature)."""
+    zeros = np.zeros(n_layers)
+    return RemainderTable(-np.ones((n_layers, n_layers), dtype=np.int64), np.ones((1, 9)),
+                          np.zeros(1, dtype=np.int64), np.zeros(1), np.zeros((n_layers, n_layers)), zeros - np.inf,
+                          zeros + np.inf)
+
+
+def layer_bounds(interfaces):
+    """``(bottoms, tops)`` of the layers (top down) between ``interfaces``."""
+    d = np.asarray(interfaces, dtype=np.float64)
+    tops = np.concatenate([[np.inf], d])
+    bottoms = np.concatenate([d, [-np.inf]])
+    return bottoms, tops
+
+
+@njit(cache=True)
+def triple_gap(z, eps, t, source_layer, layer, bottoms, tops):
+    """Distance between the receiver layer ``layer`` and the points a triple emanates from
+    (``z`` at the source height ``t``, moving as ``eps = dz/dt``) as the source sweeps its
+    whole layer: 0 for a near triple, at least a layer thickness for a far one."""
+    lo_t = bottoms[source_layer] - t
+    hi_t = tops[source_layer] - t
+    if eps > 0.0:
+        lo = z + eps * lo_t
+        hi = z + eps * hi_t
+    else:
+        lo = z + eps * hi_t
+        hi = z + eps * lo_t
+    if hi < bottoms[layer]:
+        return bottoms[layer] - hi
+    if lo > tops[layer]:
+        return lo - tops[layer]
+    return 0.0
+
+
+@njit(cache=True)
+def layer_gap(source_layer, layer, bottoms, tops):
+    """Distance between two layers (0 for the same or adjacent layers)."""
+    if layer == source_layer or abs(layer - source_layer) == 1:
+        return 0.0
+    if layer > source_layer:  # below
+        return bottoms[source_layer] - tops[layer]
+    return bottoms[layer] - tops[source_layer]
+
+
+@njit(cache=True)
+def is_far(z, eps, t, source_layer, layer, bottoms, tops):
+    """True for a far triple: :func:`triple_gap` above round-off of the heights."""
+    return triple_gap(z, eps, t, source_layer, layer, bottoms, tops) > 1e-9 * (1.0 + abs(z) + abs(t))
+
+
+@njit(cache=True)
+def keep_near(n, pair_layer, pair_z, pair_eps, pair_sigma, pair_coef, pair_dcoef, t, source_layer, bottoms, tops):
+    """Drop the far triples (:func:`is_far`) of a traced source point at height ``t``, in
+    place; returns the number kept."""
+    kept = 0
+    for k in range(n):
+        if is_far(pair_z[k], pair_eps[k], t, source_layer, pair_layer[k], bottoms, tops):
+            continue
+        if kept != k:
+            pair_layer[kept] = pair_layer[k]
+            pair_z[kept] = pair_z[k]
+            pair_eps[kept] = pair_eps[k]
+            pair_sigma[kept] = pair_sigma[k]
+            for f in range(pair_coef.shape[1]):
+                for j in range(pair_coef.shape[2]):
+                    for o in range(pair_coef.shape[3]):
+                        pair_coef[kept, f, j, o] = pair_coef[k, f, j, o]
+                        pair_dcoef[kept, f, j, o] = pair_dcoef[k, f, j, o]
+        kept += 1
+    return kept
+
+
+@njit(cache=True)
+def keep_near_range(traced, lo, hi, center, frame, a, b, xi, eta, source_layer, bottoms, tops):
+    """:func:`keep_near` on the traced points ``lo .. hi - 1`` of a rule on a rectangle."""
+    n_pairs, layer, z, eps, sigma, coef, dcoef = traced
+    for g in range(lo, hi):
+        t = center[2] + xi[g] * a * frame[0, 2] + eta[g] * b * frame[1, 2]
+        n_pairs[g] = keep_near(n_pairs[g], layer[g], z[g], eps[g], sigma[g], coef[g], dcoef[g], t, source_layer,
+                               bottoms, tops)
+
+
+@njit(cache=True)
+def _response(gradient, out):
+    """``out[c] = T[m, s]`` of the :data:`COMPONENTS` from ``gradient[p, q, i, k]`` (force
+    ``p``, source derivative ``q``): ``T[m, s] = G[p, q, i, k] (+ G[q, p, i, k] if p != q)``."""
+    for c in range(COMPONENTS.shape[0]):
+        m = COMPONENTS[c, 0]
+        s = COMPONENTS[c, 1]
+        p, q = _PAIRS[m, 0], _PAIRS[m, 1]
+        i, k = _PAIRS[s, 0], _PAIRS[s, 1]
+        v = gradient[p, q, i, k]
+        if p != q:
+            v += gradient[q, p, i, k]
+        out[c] = v
+
+
+@njit(cache=True, parallel=True)
+def sample_remainder(source_layer, layer, rho, heights, receiver_heights, interfaces, shear_modulus, poisson_ratio,
+                     n_images, bottoms, tops, out):
+    """``out[i, j, k, c]``: the remainder's response at horizontal offset ``rho[i]`` (along
+    x), source height ``heights[j]`` and receiver height ``receiver_heights[k]``: the far
+    triples acting in ``layer`` and, two or more layers away, minus the whole-space field of
+    the source's material (as :func:`.image_points3d._complementary_gradient` counts it)."""
+    cap, n_orders = trace_capacity(source_layer, shear_modulus, n_images)
+    g_r, delta_r, lame_r = receiver_constants(shear_modulus, poisson_ratio, layer)
+    g_s = shear_modulus[source_layer]
+    nu_s = poisson_ratio[source_layer]
+    delta_s = 1.0 / (3.0 - 4.0 * nu_s)
+    lame_s = _lame(g_s, nu_s)
+    whole_space = layer_gap(source_layer, layer, bottoms, tops) > 0.0
+    for j in prange(heights.shape[0]):
+        t = heights[j]
+        pair_layer = np.empty(cap, dtype=np.int64)
+        pair_z = np.empty(cap)
+        pair_eps = np.empty(cap)
+        pair_sigma = np.empty(cap)
+        coef = np.empty((cap, 3, 3, n_orders))
+        dcoef = np.empty((cap, 3, 3, n_orders))
+        n = trace(t, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, pair_layer, pair_z, pair_eps,
+                  pair_sigma, coef, dcoef)
+        work = Workspace(n_orders)
+        work1 = Workspace(1)
+        kelvin = np.zeros((2, 3, 3, 1))
+        _original(kelvin[0], delta_s, g_s, 1.0, -1.0)
+        kelvin_down = np.zeros((2, 3, 3, 1))
+        _original(kelvin_down[0], delta_s, g_s, -1.0, -1.0)
+        gradient = np.zeros((3, 3, 3, 3))
+        for i in range(rho.shape[0]):
+            for k in range(receiver_heights.shape[0]):
+                y3 = receiver_heights[k]
+                gradient[:] = 0.0
+                for p in range(n):
+                    if pair_layer[p] != layer:
+                        continue
+                    if not is_far(pair_z[p], pair_eps[p], t, source_layer, layer, bottoms, tops):
+                        continue
+                    _pair_stress_gradient(rho[i], 0.0, y3 - pair_z[p], pair_eps[p], pair_sigma[p], coef[p], dcoef[p],
+                                          delta_r, g_r, lame_r, gradient, work)
+                if whole_space:
+                    up = y3 >= t
+                    kc = kelvin if up else kelvin_down
+                    _pair_stress_gradient(rho[i], 0.0, y3 - t, 1.0, 1.0 if up else -1.0, kc[0], kc[1], delta_s, g_s,
+                                          lame_s, gradient, work1)
+                _response(gradient, out[i, j, k])
+
+
+#: Nodes per variable of the local Lagrange interpolation (degree ``STENCIL - 1``): the
+#: error falls like ``(h / clearance)^STENCIL``.
+STENCIL = 6
+
+
+@njit(cache=True, inline="always")
+def _lagrange(x, x0, h, n, w):
+    """First node and the :data:`STENCIL`-point Lagrange weights ``w`` at ``x`` on the grid
+    ``x0 + i h``, ``i < n`` (centred; one-sided at the ends)."""
+    u = (x - x0) / h
+    i0 = int(math.floor(u)) - (STENCIL // 2 - 1)
+    if i0 > n - STENCIL:
+        i0 = n - STENCIL
+    if i0 < 0:
+        i0 = 0
+    s = u - i0
+    for a in range(STENCIL):
+        v = 1.0
+        for b in range(STENCIL):
+            if b != a:
+                v *= (s - b) / (a - b)
+        w[a] = v
+    return i0
+
+
+@njit(cache=True)
+def covers(table, source_layer, layer, t, y3, rho):
+    """True when the table holds the pair of layers and the point lies in its range."""
+    k = table.pair_index[source_layer, layer]
+    if k < 0:
+        return False
+    grid = table.grid[k]
+    span_t = grid[4] * (grid[5] - 1.0)
+    span_y = grid[7] * (grid[8] - 1.0)
+    tol = 1e-9 * (span_t + span_y + 1.0)
+    return (math.asinh(rho / grid[0]) <= grid[1] * (grid[2] - 1.0) + 1e-12 and grid[3] - tol <= t
+            <= grid[3] + span_t + tol and grid[6] - tol <= y3 <= grid[6] + span_y + tol)
+
+
+@njit(cache=True)
+def interpolate(table, source_layer, layer, rho, t, y3, out, w):
+    """``out[c]``: the tabulated response at ``(rho, t, y3)`` (``w``: (3, 4) scratch)."""
+    k = table.pair_index[source_layer, layer]
+    grid = table.grid[k]
+    n_t = int(grid[5])
+    n_y = int(grid[8])
+    i0 = _lagrange(math.asinh(rho / grid[0]), 0.0, grid[1], int(grid[2]), w[0])
+    j0 = _lagrange(t, grid[3], grid[4], n_t, w[1])
+    k0 = _lagrange(y3, grid[6], grid[7], n_y, w[2])
+    n_c = out.shape[0]
+    values = table.values
+    base = table.offset[k]
+    for c in range(n_c):
+        out[c] = 0.0
+    for a in range(STENCIL):
+        for b in range(STENCIL):
+            wab = w[0, a] * w[1, b]
+            row = base + ((i0 + a) * n_t + j0 + b) * n_y * n_c
+            for d in range(STENCIL):
+                wt = wab * w[2, d]
+                at = row + (k0 + d) * n_c
+                for c in range(n_c):
+                    out[c] += wt * values[at + c]
+
+
+@njit(cache=True)
+def remainder_point_stress(table, y, layer, x, source_layer, normal, shear_modulus, lame, weight, out, response, w):
+    """``out[b, i, k] += weight *`` the remainder's stress at ``y`` (in ``layer``) of a unit
+    DD density along global ``b`` at ``x`` (in ``source_layer``) on a plane of ``normal``,
+    the source layer's moduli: the table in the frame rotated about z towards the receiver,
+    contracted with the rotated moment tensor and rotated back."""
+    r1 = y[0] - x[0]
+    r2 = y[1] - x[1]
+    rho = math.sqrt(r1 * r1 + r2 * r2)
+    c = 1.0
+    s = 0.0
+    if rho > 0.0:
+        c = r1 / rho
+        s = r2 / rho
+    interpolate(table, source_layer, layer, rho, x[2], y[2], response, w)
+    # rotated components of the normal: v' = (c v1 + s v2, -s v1 + c v2, v3)
+    n0 = c * normal[0] + s * normal[1]
+    n1 = -s * normal[0] + c * normal[1]
+    n2 = normal[2]
+    nr = (n0, n1, n2)
+    moment = np.empty(6)
+    local = np.zeros(6)
+    for b in range(3):
+        # the rotated unit DD along global b
+        b0 = c if b == 0 else (s if b == 1 else 0.0)
+        b1 = -s if b == 0 else (c if b == 1 else 0.0)
+        b2 = 1.0 if b == 2 else 0.0
+        br = (b0, b1, b2)
+        bn = normal[b] * lame
+        for m in range(6):
+            p, q = _PAIRS[m, 0], _PAIRS[m, 1]
+            v = shear_modulus * (br[p] * nr[q] + br[q] * nr[p])
+            if p == q:
+                v += bn
+            moment[m] = v
+        for m in range(6):
+            local[m] = 0.0
+        for comp in range(COMPONENTS.shape[0]):
+            local[COMPONENTS[comp, 1]] += moment[COMPONENTS[comp, 0]] * response[comp]
+        # back to the global frame: sigma = R^T sigma' R, R rows (c, s, 0), (-s, c, 0), (0, 0, 1)
+        sxx, syy, szz, sxy, sxz, syz = local[0], local[1], local[2], local[3], local[4], local[5]
+        gxx = c * c * sxx - 2.0 * c * s * sxy + s * s * syy
+        gyy = s * s * sxx + 2.0 * c * s * sxy + c * c * syy
+        gxy = c * s * (sxx - syy) + (c * c - s * s) * sxy
+        gxz = c * sxz - s * syz
+        gyz = s * sxz + c * syz
+        out[b, 0, 0] += weight * gxx
+        out[b, 1, 1] += weight * gyy
+        out[b, 2, 2] += weight * szz
+        out[b, 0, 1] += weight * gxy
+        out[b, 1, 0] += weight * gxy
+        out[b, 0, 2] += weight * gxz
+        out[b, 2, 0] += weight * gxz
+        out[b, 1, 2] += weight * gyz
+        out[b, 2, 1] += weight * gyz
+
+
+@njit(cache=True)
+def rectangle_covered(table, y, layer, center, frame, a, b, source_layer):
+    """True when the table covers every point of the rectangle against the receiver ``y``."""
+    if table.pair_index[source_layer, layer] < 0:
+        return False
+    dz = a * abs(frame[0, 2]) + b * abs(frame[1, 2])
+    r1 = y[0] - center[0]
+    r2 = y[1] - center[1]
+    reach = math.sqrt(r1 * r1 + r2 * r2) + a + b
+    return (covers(table, source_layer, layer, center[2] - dz, y[2], reach)
+            and covers(table, source_layer, layer, center[2] + dz, y[2], reach))
+
+
+@njit(cache=True)
+def remainder_rectangle_stress(table, y, layer, center, frame, a, b, source_layer, shear_modulus, lame, xi, eta, wt,
+                               out):
+    """``out[b, i, k] +=`` the remainder's stress at ``y`` of a unit global DD ``b`` on the
+    rectangle, by the rule ``(xi, eta, wt)`` on [-1, 1]^2."""
+    x = np.empty(3)
+    response = np.empty(COMPONENTS.shape[0])
+    w = np.empty((3, STENCIL))
+    normal = frame[2]
+    jac = a * b
+    for g in range(xi.shape[0]):
+        for c in range(3):
+            x[c] = center[c] + xi[g] * a * frame[0, c] + eta[g] * b * frame[1, c]
+        remainder_point_stress(table, y, layer, x, source_layer, normal, shear_modulus, lame, wt[g] * jac, out,
+                               response, w)
+
+
+# ---------------------------------------------------------------------------------
+# Building a table (Python: a few sampling calls per layer pair)
+# ---------------------------------------------------------------------------------
+
+def _far_pairs(interfaces, shear_modulus, poisson_ratio, n_images, ranges, bottoms, tops):
+    """``clearance[ls, lr]`` of the far triples (and the whole-space term two or more layers
+    away) of every pair of solid layers; ``inf`` where a pair has none."""
+    from .image_tracer3d import trace_points
+
+    n_layers = shear_modulus.shape[0]
+    clearance = np.full((n_layers, n_layers), np.inf)
+    for ls in range(n_layers):
+        if shear_modulus[ls] <= 0.0:
+            continue
+        t = 0.5 * (ranges[ls][0] + ranges[ls][1])
+        n_pairs, layer, z, eps, _, _, _ = trace_points(np.array([t]), ls, interfaces, shear_modulus, poisson_ratio,
+                                                       n_images)
+        for k in range(n_pairs[0]):
+            gap = triple_gap(z[0, k], eps[0, k], t, ls, layer[0, k], bottoms, tops)
+            if is_far(z[0, k], eps[0, k], t, ls, layer[0, k], bottoms, tops):
+                clearance[ls, layer[0, k]] = min(clearance[ls, layer[0, k]], gap)
+        for lr in range(n_layers):
+            if shear_modulus[lr] > 0.0:
+                gap = layer_gap(ls, lr, bottoms, tops)
+                if gap > 0.0:
+                    clearance[ls, lr] = min(clearance[ls, lr], gap)
+    return clearance
+
+
+def _layer_ranges(z_min, z_max, layers, bottoms, tops, shear_modulus):
+    """``[lo, hi]`` of each solid layer that a table covers: a finite layer whole, a
+    half-space from its interface to twice as far as the deepest (highest) element of the
+    mesh in it, and at least as far as the thinnest finite layer is thick."""
+    finite = [tops[k] - bottoms[k] for k in range(len(tops)) if np.isfinite(tops[k] - bottoms[k])]
+    thin = min(finite) if finite else 1.0
+    ranges = []
+    for k in range(len(tops)):
+        if shear_modulus[k] <= 0.0:
+            ranges.append((0.0, 0.0))
+            continue
+        lo, hi = bottoms[k], tops[k]
+        mine = layers == k
+        if not np.isfinite(lo):
+            depth = hi - float(np.min(z_min[mine])) if np.any(mine) else 0.0
+            lo = hi - max(2.0 * depth, thin)
+        if not np.isfinite(hi):
+            height = float(np.max(z_max[mine])) - lo if np.any(mine) else 0.0
+            hi = lo + max(2.0 * height, thin)
+        ranges.append((float(lo), float(hi)))
+    return ranges
+
+
+def _sample_height(rng, bounds, spacing):
+    """A random height in ``bounds``; half of them within two grid spacings of an end,
+    where the interpolation is one-sided and its error largest."""
+    lo, hi = bounds
+    if rng.uniform() < 0.5:
+        return float(rng.uniform(lo, hi))
+    width = min(2.0 * spacing, hi - lo)
+    return float(rng.uniform(lo, lo + width) if rng.uniform() < 0.5 else rng.uniform(hi - width, hi))
+
+
+def _pair_grid(d, rho_max, t_range, y_range, h):
+    """``grid`` row of a layer pair (see :class:`RemainderTable`) at spacing ``h``."""
+    h_u = h / d
+    n_u = max(STENCIL, int(math.ceil(math.asinh(rho_max / d) / h_u)) + 1)
+    row = [d, h_u, n_u]
+    for lo, hi in (t_range, y_range):
+        n = max(STENCIL, int(math.ceil((hi - lo) / h)) + 1)
+        row += [lo, (hi - lo) / (n - 1), n]
+    return np.array(row, dtype=np.float64)
+
+
+def _sample_pair(ls, lr, grid, interfaces, g, nu, n_images, bottoms, tops):
+    n_u, n_t, n_y = int(grid[2]), int(grid[5]), int(grid[8])
+    values = np.zeros((n_u, n_t, n_y, len(COMPONENTS)))
+    sample_remainder(ls, lr, grid[0] * np.sinh(grid[1] * np.arange(n_u)), grid[3] + grid[4] * np.arange(n_t),
+                     grid[6] + grid[7] * np.arange(n_y), interfaces, g, nu, n_images, bottoms, tops, values)
+    return values
+
+
+def build_table(mesh, layers, interfaces, shear_modulus, poisson_ratio, n_images, tolerance, entry_scale,
+                seed=0):
+    """The :class:`RemainderTable` of a medium for (and around) ``mesh``: each pair of
+    layers with far triples tabulated at the spacing (a quarter of its clearance, halved as
+    needed) at which the error of an entry it carries, measured at :data:`ERROR_SAMPLES`
+    random points against the image sum (``max |dT| (lambda + 2G) 4ab``, the largest
+    element), is below ``tolerance * entry_scale`` (``entry_scale``: the largest entry,
+    Pa/m). Returns ``(table, stats)``; no far triple: the empty table."""
+    import time
+
+    interfaces = np.asarray(interfaces, dtype=np.float64)
+    g = np.asarray(shear_modulus, dtype=np.float64)
+    nu = np.asarray(poisson_ratio, dtype=np.float64)
+    n_layers = g.shape[0]
+    stats = dict(table_pairs=0, table_values=0, table_error=0.0, table_build_cpu=0.0)
+    if interfaces.shape[0] < 2 or n_images < 1:
+        return empty_table(n_layers), stats
+    cpu = time.process_time()
+    bottoms, tops = layer_bounds(interfaces)
+    corners = mesh.corners()
+    z_min, z_max = corners[:, :, 2].min(axis=1), corners[:, :, 2].max(axis=1)
+    ranges = _layer_ranges(z_min, z_max, layers, bottoms, tops, g)
+    clearance = _far_pairs(interfaces, g, nu, n_images, ranges, bottoms, tops)
+    pairs = [(ls, lr) for ls in range(n_layers) for lr in range(n_layers) if np.isfinite(clearance[ls, lr])]
+    if not pairs:
+        return empty_table(n_layers), stats
+    horizontal = float(np.hypot(np.ptp(corners[:, :, 0]), np.ptp(corners[:, :, 1])))
+    areas = 4.0 * mesh.half_a * mesh.half_b
+    area = float(np.max(areas))
+    moment = np.where(g > 0.0, 2.0 * g + 2.0 * g * nu / np.maximum(1.0 - 2.0 * nu, 1e-300), 0.0)
+    allowed = tolerance * entry_scale
+    rng = np.random.default_rng(seed)
+    pair_index = -np.ones((n_layers, n_layers), dtype=np.int64)
+    grids, blocks, worst = [], [], 0.0
+    response = np.empty(len(COMPONENTS))
+    w = np.empty((3, STENCIL))
+    direct = np.empty((1, 1, 1, len(COMPONENTS)))
+    total = 0
+    for k, (ls, lr) in enumerate(pairs):
+        pair_index[ls, lr] = k
+        d = float(clearance[ls, lr])
+        rho_max = max(2.0 * horizontal, 4.0 * d)
+        h = d / 4.0
+        while True:
+            grid = _pair_grid(d, rho_max, ranges[ls], ranges[lr], h)
+            size = int(grid[2] * grid[5] * grid[8]) * len(COMPONENTS)
+            if total + size > MAX_TABLE_VALUES:
+                stats.update(table_refused=f"layer pair ({ls}, {lr}) needs more than {MAX_TABLE_VALUES} values")
+                return empty_table(n_layers), stats
+            values = _sample_pair(ls, lr, grid, interfaces, g, nu, n_images, bottoms, tops)
+            one = RemainderTable(pair_index, grid[None, :], np.zeros(1, dtype=np.int64), values.ravel(), clearance,
+                                 bottoms, tops)
+            saved = pair_index[ls, lr]
+            pair_index[ls, lr] = 0
+            error = 0.0
+            for _ in range(ERROR_SAMPLES):
+                rho = float(d * np.sinh(rng.uniform(0.0, grid[1] * (grid[2] - 1.0))))
+                t = _sample_height(rng, ranges[ls], grid[4])
+                y3 = _sample_height(rng, ranges[lr], grid[7])
+                sample_remainder(ls, lr, np.array([rho]), np.array([t]), np.array([y3]), interfaces, g, nu, n_images,
+                                 bottoms, tops, direct)
+                interpolate(one, ls, lr, rho, t, y3, response, w)
+                error = max(error, float(np.max(np.abs(response - direct[0, 0, 0]))) * moment[ls] * area)
+            pair_index[ls, lr] = saved
+            if error <= allowed:
+                break
+            h /= 2.0
+        worst = max(worst, error)
+        grids.append(grid)
+        blocks.append(values.ravel())
+        total += size
+    offset = np.cumsum([0] + [b.size for b in blocks[:-1]]).astype(np.int64)
+    table = RemainderTable(pair_index, np.array(grids), offset, np.concatenate(blocks), clearance, bottoms, tops)
+    stats.update(table_pairs=len(pairs), table_values=int(total), table_error=worst / entry_scale,
+                 table_build_cpu=time.process_time() - cpu)
+    return table, stats

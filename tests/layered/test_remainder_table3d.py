@@ -1,0 +1,199 @@
+"""The tabulated layered remainder of the 3D image method (issue 32, item 2,
+:mod:`hmatddm.layered.remainder_table3d`): the table path against the quadrature of every
+image triple (the cross-check, ``method="quadrature"``, with many points), the split into
+near and far triples, the table's convergence as it is refined, interface conditions on
+the table path, and the cases that build no table."""
+import numpy as np
+import pytest
+
+import hmatddm as hd
+from hmatddm.errors import InputError
+from hmatddm.kernels import drivers
+from hmatddm.layered import LayeredMedium
+from hmatddm.layered import remainder_table3d as rt
+from hmatddm.layered.image_points3d import _complementary_gradient, image_point_stress
+from hmatddm.layered.image_tracer3d import trace_points
+from hmatddm.layered.images2d import _lame
+from hmatddm.layered.influence3d import element_layers, influence_data
+from hmatddm.layered.potentials3d import Workspace, _contract
+
+G, NU = 1.0, 0.25
+INTERFACES = [0.0, -1.5, -3.0]
+
+
+def _medium(method="table", images=3, gauss_points=6, **options):
+    return LayeredMedium(INTERFACES, [0.0, G, 2.0 * G, G], [NU, 0.3, 0.2, NU], images=images,
+                         gauss_points=gauss_points, method=method, **options)
+
+
+def _random_mesh(seed, centers, half):
+    rng = np.random.default_rng(seed)
+    frames = np.linalg.qr(rng.normal(size=(len(centers), 3, 3)))[0]
+    half = np.broadcast_to(np.asarray(half, float), (len(centers),))
+    return hd.Mesh3D.from_rectangles(np.asarray(centers, float), frames[:, :, 0], frames[:, :, 1], half, half)
+
+
+def _matrix(data, rows=None):
+    every = np.arange(data.centers.shape[0], dtype=np.int64)
+    rows = every if rows is None else np.asarray(rows, dtype=np.int64)
+    out = np.empty((3 * rows.size, 3 * every.size))
+    drivers.traction_block(data, rows, every, out)
+    return out
+
+
+def _many_points(data):
+    """6 Gauss points per side on every (sub-)square (within 7e-11 of the largest entry next
+    to interfaces: tests/layered/test_layered_fast3d.py)."""
+    return data._replace(gauss_points=6, far_tol=0.0, entry_tol=0.0)
+
+
+# squares 0.25 m from each interface and the free surface, in all three layers
+CENTERS = [[x, y, z] for z in (-0.25, -1.25, -1.75, -2.75, -3.25, -4.0) for x, y in ((0.0, 0.0), (1.1, 0.5))]
+
+
+@pytest.fixture(scope="module")
+def mesh():
+    return _random_mesh(5, CENTERS[::2], 0.15)
+
+
+def _compare_with_the_quadrature(mesh, images):
+    data = influence_data(mesh, _medium(images=images), 0.0, 0.0, 0.0, images)
+    assert np.any(data.table.pair_index >= 0)
+    reference = _matrix(_many_points(influence_data(mesh, _medium("quadrature", images=images), 0.0, 0.0, 0.0,
+                                                    images)))
+    got = _matrix(data)
+    assert np.abs(got - reference).max() <= 1e-8 * np.abs(reference).max()
+
+
+def test_table_entries_match_the_many_point_quadrature_of_every_triple(mesh):
+    """Randomly oriented 0.3 m squares within one element size of the free surface and of
+    both interfaces, two images: every entry of the table path (default tolerance) within
+    1e-8 of the largest entry of the quadrature of every triple with 6 points per side on
+    every (sub-)square, and the table holds far triples for this medium."""
+    _compare_with_the_quadrature(mesh, 2)
+
+
+@pytest.mark.slow
+def test_table_entries_match_the_many_point_quadrature_three_images():
+    """As above, three images and twelve squares (two per depth)."""
+    _compare_with_the_quadrature(_random_mesh(5, CENTERS, 0.15), 3)
+
+
+def test_near_triples_plus_the_table_give_the_image_sum_at_points():
+    """At random source and receiver points of every pair of layers: the near triples
+    (quadrature's share) plus the table's remainder equal the sum of every triple, to the
+    table's tolerance (two layers apart, the table carries it all)."""
+    medium = _medium()
+    mesh = _random_mesh(2, CENTERS, 0.15)
+    interfaces, g, nu = medium.arrays()
+    layers = element_layers(mesh, medium)
+    table, stats = rt.build_table(mesh, layers, interfaces, g, nu, 3, 1e-6, 10.0)
+    assert stats["table_pairs"] == 9 and stats["table_error"] <= 1e-6
+    bottoms, tops = rt.layer_bounds(interfaces)
+    ranges = {1: (-1.5, 0.0), 2: (-3.0, -1.5), 3: (-4.4, -3.0)}
+    rng = np.random.default_rng(0)
+    worst = 0.0
+    for _ in range(60):
+        ls, lr = rng.integers(1, 4, size=2)
+        x = np.array([rng.uniform(-0.5, 1.5), rng.uniform(-0.5, 1.0), rng.uniform(*ranges[ls])])
+        y = np.array([rng.uniform(-0.5, 1.5), rng.uniform(-0.5, 1.0), rng.uniform(*ranges[lr])])
+        normal = rng.normal(size=3)
+        normal /= np.linalg.norm(normal)
+        full = np.zeros((3, 3, 3))
+        image_point_stress(y, lr, x, ls, normal, interfaces, g, nu, 3, full)
+        near = np.zeros((3, 3, 3))
+        if abs(lr - ls) < 2:
+            n_pairs, layer, z, eps, sigma, coef, dcoef = trace_points(np.array([x[2]]), ls, interfaces, g, nu, 3)
+            kept = rt.keep_near(n_pairs[0], layer[0], z[0], eps[0], sigma[0], coef[0], dcoef[0], x[2], ls, bottoms,
+                                tops)
+            assert kept < n_pairs[0]
+            gradient = np.empty((3, 3, 3, 3))
+            _complementary_gradient(y, lr, x, kept, ls, layer[0], z[0], eps[0], sigma[0], coef[0], dcoef[0], g, nu,
+                                    gradient, Workspace(coef.shape[-1]), Workspace(1), np.zeros((2, 3, 3, 1)))
+            _contract(gradient, normal, g[ls], _lame(g[ls], nu[ls]), 1.0, near)
+        remainder = np.zeros((3, 3, 3))
+        assert rt.covers(table, ls, lr, x[2], y[2], np.hypot(*(y - x)[:2]))
+        rt.remainder_point_stress(table, y, lr, x, ls, normal, g[ls], _lame(g[ls], nu[ls]), 1.0, remainder,
+                                  np.empty(len(rt.COMPONENTS)), np.empty((3, rt.STENCIL)))
+        worst = max(worst, np.abs(full - near - remainder).max())
+    assert worst <= 1e-6 * 10.0 / 0.09
+
+
+def test_the_table_converges_as_it_is_refined(mesh):
+    """The measured error of the table (relative to the largest entry) stays below the
+    tolerance asked, and the table grows as the tolerance falls."""
+    interfaces, g, nu = _medium().arrays()
+    layers = element_layers(mesh, _medium())
+    sizes, errors = [], []
+    for tol in (1e-4, 1e-5, 1e-6):
+        _, stats = rt.build_table(mesh, layers, interfaces, g, nu, 3, tol, 10.0)
+        assert 0.0 < stats["table_error"] <= tol
+        sizes.append(stats["table_values"])
+        errors.append(stats["table_error"])
+    assert sizes[0] < sizes[1] < sizes[2]
+    assert errors[2] < errors[0]
+
+
+@pytest.mark.slow
+def test_interface_conditions_on_the_table_path_are_those_of_the_quadrature():
+    """Horizontal receiver squares just above and below the interface z = -1.5 and just
+    below the free surface, sources of every orientation in all layers: the jump of the
+    vertical traction across the interface and the traction at the surface (the image
+    series truncated at ``images`` reflections leaves both, falling as images are added)
+    are those of the quadrature of every triple, to 1e-8 of the largest traction, and fall
+    from two images to four (~200 s: receivers 1e-6 m from a plane take 16 x 16
+    sub-squares)."""
+    rng = np.random.default_rng(9)
+    sources = np.column_stack([rng.uniform(-1.0, 1.0, 6), rng.uniform(-1.0, 1.0, 6),
+                               [-0.6, -0.9, -2.0, -2.4, -3.6, -3.9]])
+    eps = 1e-6
+    receivers = np.array([[0.2, 0.1, -1.5 + eps], [0.2, 0.1, -1.5 - eps], [0.3, -0.2, -eps]])
+    frames = np.linalg.qr(rng.normal(size=(6, 3, 3)))[0]
+    e1 = np.vstack([frames[:, :, 0], np.tile([1.0, 0.0, 0.0], (3, 1))])
+    e2 = np.vstack([frames[:, :, 1], np.tile([0.0, 1.0, 0.0], (3, 1))])
+    half = np.r_[np.full(6, 0.2), np.full(3, 0.15)]
+    mesh = hd.Mesh3D.from_rectangles(np.vstack([sources, receivers]), e1, e2, half, half)
+    mismatch = []
+    for images in (2, 4):
+        blocks = {}
+        for method in ("table", "quadrature"):
+            data = influence_data(mesh, _medium(method, images=images), 0.0, 0.0, 0.0, images)
+            blocks[method] = _matrix(data, rows=[6, 7, 8])[:, :18]
+        scale = np.abs(blocks["quadrature"]).max()
+        residuals = {m: np.r_[(b[0:3] - b[3:6]).ravel(), b[6:9].ravel()] for m, b in blocks.items()}
+        assert np.abs(residuals["table"] - residuals["quadrature"]).max() <= 1e-8 * scale
+        mismatch.append(np.abs(residuals["table"]).max() / scale)
+    assert mismatch[1] < 0.2 * mismatch[0]
+
+
+@pytest.mark.parametrize("medium", [LayeredMedium([0.0], [0.0, G], [NU, NU], images=1),
+                                    LayeredMedium([0.0], [2.0 * G, G], [NU, NU], images=3)],
+                         ids=["half-space", "bi-material"])
+def test_media_without_far_triples_build_no_table_and_equal_the_quadrature(medium, mesh):
+    """A half-space or a bi-material (one interface: every image is a first reflection or
+    the transmitted source): no far triple, so no table, and the same entries bit for bit
+    as the quadrature path."""
+    shallow = _random_mesh(5, [c for c in CENTERS if c[2] > -1.5], 0.15)
+    fields = dict(interfaces=medium.interfaces, shear_modulus=medium.shear_modulus,
+                  poisson_ratio=medium.poisson_ratio, images=medium.images)
+    table = influence_data(shallow, LayeredMedium(**fields, method="table"), 0.0, 0.0, 0.0, medium.images)
+    quadrature = influence_data(shallow, LayeredMedium(**fields, method="quadrature"), 0.0, 0.0, 0.0, medium.images)
+    assert np.all(table.table.pair_index < 0)
+    assert np.array_equal(_matrix(table), _matrix(quadrature))
+
+
+def test_equal_layers_reproduce_uniform_rock_on_the_table_path(mesh):
+    """Three equal layers (with the images forced on) give the uniform-rock entries to
+    round-off: the table holds zeros."""
+    equal = LayeredMedium([-1.5, -3.0], [G, G, G], [NU] * 3, images=3)
+    data = influence_data(mesh, equal, 0.0, 0.0, 0.0, 3)
+    uniform = hd.ElasticityOperator(mesh, hd.Elastic(G, NU), backend="dense").to_dense()
+    got = _matrix(data)
+    assert np.abs(got - uniform).max() <= 1e-12 * np.abs(uniform).max()
+
+
+@pytest.mark.parametrize("field, value", [("table_tol", 0.0), ("table_tol", 1e-3), ("table_tol", -1e-9),
+                                          ("method", "chebyshev")])
+def test_bad_table_options_are_refused_by_name(field, value):
+    with pytest.raises(InputError, match=field):
+        LayeredMedium(INTERFACES, [0.0, G, 2.0 * G, G], [NU] * 4, **{field: value})
