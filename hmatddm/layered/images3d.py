@@ -18,8 +18,12 @@ paths (:func:`.image_tracer3d.merge_coincident`: exact, 1.6-1.9x fewer triples w
 or more interfaces), and an operator's entries take the fewest Gauss points that keep
 their image error below :data:`.rectangle_quadrature.ENTRY_TOL` of the largest entry
 (:func:`.rectangle_quadrature.entry_order`; ``entry_tol = 0``: the relative rule of
-:func:`far_order` alone, the cross-check). The image terms are not integrated in closed
-form: the Hansen base functions ``F = r - sigma r3 log(r + sigma r3)`` and
+:func:`far_order` alone, the cross-check). With two or more interfaces, only the *near*
+triples (those that can reach the receiver's layer) are integrated by quadrature; the far
+ones, the smooth layered remainder, come from a table built once per medium and mesh
+extent (:mod:`.remainder_table3d`, ``LayeredMedium(method="table")``, the default;
+``method="quadrature"`` integrates every triple, the cross-check). The image terms are not
+integrated in closed form: the Hansen base functions ``F = r - sigma r3 log(r + sigma r3)`` and
 ``L = log(r + sigma r3)`` (and their horizontal derivatives) of every image, with
 coefficients polynomial in the source height, have no primitive over a rectangle of any
 orientation among the uniform-rock kernel's primitives of ``1/r`` (their integrals are
