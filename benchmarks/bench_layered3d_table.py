@@ -89,10 +89,10 @@ def operator_table(error_rows=6):
 _CHILD = """
 import json, sys, time
 import hmatddm.scene as hs
-import hmatddm.scene.build as build
+import hmatddm.layered as layered
 name, method, out = sys.argv[1:4]
-plain = build.LayeredMedium
-build.LayeredMedium = lambda *args, **options: plain(*args, method=method, **options)
+plain = layered.LayeredMedium  # the scene builds its medium through this name (hmatddm.scene.build)
+layered.LayeredMedium = lambda *args, **options: plain(*args, method=method, **options)
 scene = hs.scene_from_dict(hs.parse_scene(hs.embedded_text(name)).data, name)
 simulation = hs.build_simulation(scene.data)
 cpu, wall = time.process_time(), time.perf_counter()

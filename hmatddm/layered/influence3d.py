@@ -65,7 +65,8 @@ def _covered(table, mesh, layers):
     corners = mesh.corners()
     horizontal = float(np.hypot(np.ptp(corners[:, :, 0]), np.ptp(corners[:, :, 1])))
     for k in range(table.grid.shape[0]):
-        if horizontal > table.grid[k, 0] * np.sinh(table.grid[k, 1] * (table.grid[k, 2] - 1.0)):
+        pad = remainder_table3d.PAD
+        if horizontal > table.grid[k, 0] * np.sinh(table.grid[k, 1] * (table.grid[k, 2] - 1.0 - 2 * pad)):
             return False
     for layer in np.unique(layers):
         rows = np.flatnonzero(table.pair_index[layer] >= 0)
@@ -73,7 +74,8 @@ def _covered(table, mesh, layers):
             continue
         grid = table.grid[table.pair_index[layer, rows[0]]]
         z = corners[layers == layer][:, :, 2]
-        if z.min() < grid[3] - 1e-9 or z.max() > grid[3] + grid[4] * (grid[5] - 1.0) + 1e-9:
+        pad = remainder_table3d.PAD
+        if z.min() < grid[3] + pad * grid[4] - 1e-9 or z.max() > grid[3] + grid[4] * (grid[5] - 1.0 - pad) + 1e-9:
             return False
     return True
 

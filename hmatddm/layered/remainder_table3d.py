@@ -241,6 +241,11 @@ def sample_remainder(source_layer, layer, rho, heights, receiver_heights, interf
 #: Nodes per variable of the local Lagrange interpolation (degree ``STENCIL - 1``): the
 #: error falls like ``(h / clearance)^STENCIL``.
 STENCIL = 6
+#: Nodes each grid carries beyond either end of its range, so that every stencil in the
+#: range is centred. The remainder continues analytically past a layer's boundary; with
+#: the source and the receiver both padded, its singular points stay at least
+#: ``clearance - 2 PAD h >= clearance / 2`` away (``h <= clearance / 8``).
+PAD = STENCIL // 2 - 1
 
 
 @njit(cache=True, inline="always")
@@ -265,16 +270,20 @@ def _lagrange(x, x0, h, n, w):
 
 @njit(cache=True)
 def covers(table, source_layer, layer, t, y3, rho):
-    """True when the table holds the pair of layers and the point lies in its range."""
+    """True when the table holds the pair of layers and the point lies in its range (the
+    grids less their :data:`PAD` nodes at either end)."""
     k = table.pair_index[source_layer, layer]
     if k < 0:
         return False
     grid = table.grid[k]
-    span_t = grid[4] * (grid[5] - 1.0)
-    span_y = grid[7] * (grid[8] - 1.0)
-    tol = 1e-9 * (span_t + span_y + 1.0)
-    return (math.asinh(rho / grid[0]) <= grid[1] * (grid[2] - 1.0) + 1e-12 and grid[3] - tol <= t
-            <= grid[3] + span_t + tol and grid[6] - tol <= y3 <= grid[6] + span_y + tol)
+    t_lo = grid[3] + PAD * grid[4]
+    t_hi = grid[3] + (grid[5] - 1.0 - PAD) * grid[4]
+    y_lo = grid[6] + PAD * grid[7]
+    y_hi = grid[6] + (grid[8] - 1.0 - PAD) * grid[7]
+    tol = 1e-9 * (t_hi - t_lo + y_hi - y_lo + 1.0)
+    u_hi = (grid[2] - 1.0 - 2.0 * PAD) * grid[1]
+    return (math.asinh(rho / grid[0]) <= u_hi + 1e-12 and t_lo - tol <= t <= t_hi + tol
+            and y_lo - tol <= y3 <= y_hi + tol)
 
 
 @njit(cache=True)
@@ -284,7 +293,7 @@ def interpolate(table, source_layer, layer, rho, t, y3, out, w):
     grid = table.grid[k]
     n_t = int(grid[5])
     n_y = int(grid[8])
-    i0 = _lagrange(math.asinh(rho / grid[0]), 0.0, grid[1], int(grid[2]), w[0])
+    i0 = _lagrange(math.asinh(rho / grid[0]), -PAD * grid[1], grid[1], int(grid[2]), w[0])
     j0 = _lagrange(t, grid[3], grid[4], n_t, w[1])
     k0 = _lagrange(y3, grid[6], grid[7], n_y, w[2])
     n_c = out.shape[0]
@@ -453,20 +462,23 @@ def _sample_height(rng, bounds, spacing):
 
 
 def _pair_grid(d, rho_max, t_range, y_range, h):
-    """``grid`` row of a layer pair (see :class:`RemainderTable`) at spacing ``h``."""
+    """``grid`` row of a layer pair (see :class:`RemainderTable`) at spacing ``h``, each grid
+    padded by :data:`PAD` nodes beyond its range (``u`` below 0: the receiver on the other
+    side of the source)."""
     h_u = h / d
-    n_u = max(STENCIL, int(math.ceil(math.asinh(rho_max / d) / h_u)) + 1)
+    n_u = max(STENCIL, int(math.ceil(math.asinh(rho_max / d) / h_u)) + 1) + 2 * PAD
     row = [d, h_u, n_u]
     for lo, hi in (t_range, y_range):
         n = max(STENCIL, int(math.ceil((hi - lo) / h)) + 1)
-        row += [lo, (hi - lo) / (n - 1), n]
+        spacing = (hi - lo) / (n - 1)
+        row += [lo - PAD * spacing, spacing, n + 2 * PAD]
     return np.array(row, dtype=np.float64)
 
 
 def _sample_pair(ls, lr, grid, interfaces, g, nu, n_images, bottoms, tops):
     n_u, n_t, n_y = int(grid[2]), int(grid[5]), int(grid[8])
     values = np.zeros((n_u, n_t, n_y, len(COMPONENTS)))
-    sample_remainder(ls, lr, grid[0] * np.sinh(grid[1] * np.arange(n_u)), grid[3] + grid[4] * np.arange(n_t),
+    sample_remainder(ls, lr, grid[0] * np.sinh(grid[1] * (np.arange(n_u) - PAD)), grid[3] + grid[4] * np.arange(n_t),
                      grid[6] + grid[7] * np.arange(n_y), interfaces, g, nu, n_images, bottoms, tops, values)
     return values
 
@@ -474,7 +486,7 @@ def _sample_pair(ls, lr, grid, interfaces, g, nu, n_images, bottoms, tops):
 def build_table(mesh, layers, interfaces, shear_modulus, poisson_ratio, n_images, tolerance, entry_scale,
                 seed=0):
     """The :class:`RemainderTable` of a medium for (and around) ``mesh``: each pair of
-    layers with far triples tabulated at the spacing (a quarter of its clearance, halved as
+    layers with far triples tabulated at the spacing (an eighth of its clearance, halved as
     needed) at which the error of an entry it carries, measured at :data:`ERROR_SAMPLES`
     random points against the image sum (``max |dT| (lambda + 2G) 4ab``, the largest
     element), is below ``tolerance * entry_scale`` (``entry_scale``: the largest entry,
@@ -513,7 +525,7 @@ def build_table(mesh, layers, interfaces, shear_modulus, poisson_ratio, n_images
         pair_index[ls, lr] = k
         d = float(clearance[ls, lr])
         rho_max = max(2.0 * horizontal, 4.0 * d)
-        h = d / 4.0
+        h = d / 8.0
         while True:
             grid = _pair_grid(d, rho_max, ranges[ls], ranges[lr], h)
             size = int(grid[2] * grid[5] * grid[8]) * len(COMPONENTS)
@@ -527,7 +539,7 @@ def build_table(mesh, layers, interfaces, shear_modulus, poisson_ratio, n_images
             pair_index[ls, lr] = 0
             error = 0.0
             for _ in range(ERROR_SAMPLES):
-                rho = float(d * np.sinh(rng.uniform(0.0, grid[1] * (grid[2] - 1.0))))
+                rho = float(d * np.sinh(rng.uniform(0.0, grid[1] * (grid[2] - 1.0 - 2.0 * PAD))))
                 t = _sample_height(rng, ranges[ls], grid[4])
                 y3 = _sample_height(rng, ranges[lr], grid[7])
                 sample_remainder(ls, lr, np.array([rho]), np.array([t]), np.array([y3]), interfaces, g, nu, n_images,

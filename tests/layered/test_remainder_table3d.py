@@ -125,12 +125,12 @@ def test_the_table_converges_as_it_is_refined(mesh):
     interfaces, g, nu = _medium().arrays()
     layers = element_layers(mesh, _medium())
     sizes, errors = [], []
-    for tol in (1e-4, 1e-5, 1e-6):
+    for tol in (1e-5, 1e-6, 1e-7):
         _, stats = rt.build_table(mesh, layers, interfaces, g, nu, 3, tol, 10.0)
         assert 0.0 < stats["table_error"] <= tol
         sizes.append(stats["table_values"])
         errors.append(stats["table_error"])
-    assert sizes[0] < sizes[1] < sizes[2]
+    assert sizes[0] <= sizes[1] <= sizes[2] and sizes[0] < sizes[2]
     assert errors[2] < errors[0]
 
 
