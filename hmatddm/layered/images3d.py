@@ -121,10 +121,7 @@ def source_state(data, j, work):
     room = work[6]
     start = work[7][3]
     ls = data.layer[j]
-    near_only = False
-    for lr in range(data.table.pair_index.shape[1]):
-        if data.table.pair_index[ls, lr] >= 0:
-            near_only = True
+    near_only = data.table.pair_index[ls].max() >= 0
     return (_traced_buffer(start[-1], max(room[ls, 0], 1), max(room[ls, 1], 1)),
             np.zeros(start.shape[0] - 1, dtype=np.bool_), near_only)
 
