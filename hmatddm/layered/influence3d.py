@@ -51,50 +51,29 @@ def influence_data(mesh, medium, singular_shift, alpha, near_fraction, n_images)
         self_max=np.zeros(mesh.n_elements), entry_tol=float(ENTRY_TOL), entry_scale=float(scale), table=table))
 
 
-#: Tables built in this process: ``(medium key, n_images) -> [(table, stats, cover)]``.
+#: Tables built in this process, by medium, images, tolerance and domain (the latest few).
 _TABLES = {}
-
-
-def _table_key(medium, n_images):
-    return (medium.interfaces, medium.shear_modulus, medium.poisson_ratio, float(medium.table_tol), int(n_images))
-
-
-def _covered(table, mesh, layers):
-    """True when every rectangle of ``mesh`` and every horizontal offset between two of its
-    points lie in the table's range (a grown mesh may leave it)."""
-    corners = mesh.corners()
-    horizontal = float(np.hypot(np.ptp(corners[:, :, 0]), np.ptp(corners[:, :, 1])))
-    for k in range(table.grid.shape[0]):
-        pad = remainder_table3d.PAD
-        if horizontal > table.grid[k, 0] * np.sinh(table.grid[k, 1] * (table.grid[k, 2] - 1.0 - 2 * pad)):
-            return False
-    for layer in np.unique(layers):
-        rows = np.flatnonzero(table.pair_index[layer] >= 0)
-        if rows.size == 0:
-            continue
-        grid = table.grid[table.pair_index[layer, rows[0]]]
-        z = corners[layers == layer][:, :, 2]
-        pad = remainder_table3d.PAD
-        if z.min() < grid[3] + pad * grid[4] - 1e-9 or z.max() > grid[3] + grid[4] * (grid[5] - 1.0 - pad) + 1e-9:
-            return False
-    return True
+_KEEP_TABLES = 4
 
 
 def remainder_table(mesh, medium, layers, n_images, largest_entry):
     """``(table, stats)``: the remainder table of ``medium`` at ``n_images`` covering
     ``mesh`` (:func:`.remainder_table3d.build_table` to ``medium.table_tol`` of
-    ``largest_entry``), reused from an earlier mesh of the same medium when it covers
-    this one (a growing fracture builds it again only when it leaves the table's range)."""
-    key = _table_key(medium, n_images)
-    per_area = medium.table_tol * largest_entry / float(np.max(4.0 * mesh.half_a * mesh.half_b))
-    for table, stats, built_per_area in _TABLES.get(key, []):
-        if built_per_area <= per_area and _covered(table, mesh, layers):
-            return table, stats
+    ``largest_entry``), reused for every mesh with the same
+    :func:`.remainder_table3d.table_domain` (a growing fracture builds it again only when
+    its extent doubles; a resumed run gets the table of the run it resumes)."""
     interfaces, g, nu = medium.arrays()
-    table, stats = remainder_table3d.build_table(mesh, layers, interfaces, g, nu, n_images, medium.table_tol,
-                                                 largest_entry)
-    _TABLES.setdefault(key, []).append((table, stats, per_area))
-    del _TABLES[key][:-2]  # the two latest extents
+    domain = remainder_table3d.table_domain(mesh, layers, interfaces, g)
+    key = (medium.interfaces, medium.shear_modulus, medium.poisson_ratio, float(medium.table_tol), int(n_images),
+           domain, float(largest_entry))
+    if key in _TABLES:
+        table, stats = _TABLES.pop(key)
+    else:
+        table, stats = remainder_table3d.build_table(mesh, layers, interfaces, g, nu, n_images, medium.table_tol,
+                                                     largest_entry)
+    _TABLES[key] = (table, stats)
+    while len(_TABLES) > _KEEP_TABLES:
+        del _TABLES[next(iter(_TABLES))]
     return table, stats
 
 

@@ -428,12 +428,24 @@ def _far_pairs(interfaces, shear_modulus, poisson_ratio, n_images, ranges, botto
     return clearance
 
 
-def _layer_ranges(z_min, z_max, layers, bottoms, tops, shear_modulus):
-    """``[lo, hi]`` of each solid layer that a table covers: a finite layer whole, a
-    half-space from its interface to twice as far as the deepest (highest) element of the
-    mesh in it, and at least as far as the thinnest finite layer is thick."""
+def _doubling(length, unit):
+    """The smallest ``unit 2^k >= length`` (``k >= 0``): table ranges grow by doubling, so a
+    table is a function of the mesh's extent rounded up, not of the mesh's history."""
+    return unit * 2.0 ** max(0, math.ceil(math.log2(max(length, unit) / unit) - 1e-12))
+
+
+def table_domain(mesh, layers, interfaces, shear_modulus):
+    """What a table of ``mesh`` covers, ``(ranges, horizontal, area)``: ``ranges[k]`` the
+    heights of solid layer ``k`` (a finite layer whole; a half-space from its interface to
+    twice the farthest element of the mesh in it, rounded up by :func:`_doubling` in units
+    of the thinnest finite layer), the horizontal extent (rounded the same way) and the
+    largest element area. Meshes with the same domain get the same table (a growing mesh
+    and its resumed run alike)."""
+    bottoms, tops = layer_bounds(interfaces)
     finite = [tops[k] - bottoms[k] for k in range(len(tops)) if np.isfinite(tops[k] - bottoms[k])]
     thin = min(finite) if finite else 1.0
+    corners = mesh.corners()
+    z_min, z_max = corners[:, :, 2].min(axis=1), corners[:, :, 2].max(axis=1)
     ranges = []
     for k in range(len(tops)):
         if shear_modulus[k] <= 0.0:
@@ -443,12 +455,13 @@ def _layer_ranges(z_min, z_max, layers, bottoms, tops, shear_modulus):
         mine = layers == k
         if not np.isfinite(lo):
             depth = hi - float(np.min(z_min[mine])) if np.any(mine) else 0.0
-            lo = hi - max(2.0 * depth, thin)
+            lo = hi - _doubling(2.0 * depth, thin)
         if not np.isfinite(hi):
             height = float(np.max(z_max[mine])) - lo if np.any(mine) else 0.0
-            hi = lo + max(2.0 * height, thin)
+            hi = lo + _doubling(2.0 * height, thin)
         ranges.append((float(lo), float(hi)))
-    return ranges
+    horizontal = _doubling(float(np.hypot(np.ptp(corners[:, :, 0]), np.ptp(corners[:, :, 1]))), thin)
+    return tuple(ranges), horizontal, float(np.max(4.0 * mesh.half_a * mesh.half_b))
 
 
 def _sample_height(rng, bounds, spacing):
@@ -485,7 +498,7 @@ def _sample_pair(ls, lr, grid, interfaces, g, nu, n_images, bottoms, tops):
 
 def build_table(mesh, layers, interfaces, shear_modulus, poisson_ratio, n_images, tolerance, entry_scale,
                 seed=0):
-    """The :class:`RemainderTable` of a medium for (and around) ``mesh``: each pair of
+    """The :class:`RemainderTable` of a medium for the :func:`table_domain` of ``mesh``: each pair of
     layers with far triples tabulated at the spacing (an eighth of its clearance, halved as
     needed) at which the error of an entry it carries, measured at :data:`ERROR_SAMPLES`
     random points against the image sum (``max |dT| (lambda + 2G) 4ab``, the largest
@@ -502,16 +515,11 @@ def build_table(mesh, layers, interfaces, shear_modulus, poisson_ratio, n_images
         return empty_table(n_layers), stats
     cpu = time.process_time()
     bottoms, tops = layer_bounds(interfaces)
-    corners = mesh.corners()
-    z_min, z_max = corners[:, :, 2].min(axis=1), corners[:, :, 2].max(axis=1)
-    ranges = _layer_ranges(z_min, z_max, layers, bottoms, tops, g)
+    ranges, horizontal, area = table_domain(mesh, layers, interfaces, g)
     clearance = _far_pairs(interfaces, g, nu, n_images, ranges, bottoms, tops)
     pairs = [(ls, lr) for ls in range(n_layers) for lr in range(n_layers) if np.isfinite(clearance[ls, lr])]
     if not pairs:
         return empty_table(n_layers), stats
-    horizontal = float(np.hypot(np.ptp(corners[:, :, 0]), np.ptp(corners[:, :, 1])))
-    areas = 4.0 * mesh.half_a * mesh.half_b
-    area = float(np.max(areas))
     moment = np.where(g > 0.0, 2.0 * g + 2.0 * g * nu / np.maximum(1.0 - 2.0 * nu, 1e-300), 0.0)
     allowed = tolerance * entry_scale
     rng = np.random.default_rng(seed)
