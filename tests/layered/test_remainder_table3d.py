@@ -197,3 +197,20 @@ def test_equal_layers_reproduce_uniform_rock_on_the_table_path(mesh):
 def test_bad_table_options_are_refused_by_name(field, value):
     with pytest.raises(InputError, match=field):
         LayeredMedium(INTERFACES, [0.0, G, 2.0 * G, G], [NU] * 4, **{field: value})
+
+
+def test_a_table_depends_on_the_domain_not_on_the_history(mesh):
+    """A mesh grown by one square within the same rounded-up extent has the same
+    :func:`table_domain`, and its table built afresh equals the first mesh's value for
+    value (a resumed run interpolates the table of the run it resumes)."""
+    from hmatddm.layered import influence3d
+
+    grown = _random_mesh(5, CENTERS[::2] + [[0.4, 0.3, -2.2]], 0.15)
+    interfaces, g, _ = _medium().arrays()
+    first = rt.table_domain(mesh, element_layers(mesh, _medium()), interfaces, g)
+    assert rt.table_domain(grown, element_layers(grown, _medium()), interfaces, g) == first
+    influence3d._TABLES.clear()
+    a = influence_data(mesh, _medium(), 0.0, 0.0, 0.0, 2).table
+    influence3d._TABLES.clear()
+    b = influence_data(grown, _medium(), 0.0, 0.0, 0.0, 2).table
+    assert np.array_equal(a.values, b.values) and np.array_equal(a.grid, b.grid)
