@@ -15,6 +15,12 @@ from .rectangle_quadrature import ENTRY_TOL, entry_scale
 
 #: Largest number of sub-squares per side of a rectangle for the image quadrature.
 MAX_SUBDIVISIONS = 16
+#: Fewest elements for which ``method="table"`` builds the remainder table: below, every
+#: triple is integrated (the table's build, seconds, costs more than it saves: measured on
+#: ``layered-3d``, 73 elements, 50.3 s of CPU with the table against 44.3 s without; on the
+#: 576 squares of issue 32, 6 s to build and 22.5 s to assemble against 88.6 s;
+#: benchmarks/RESULTS.md, issue 32).
+TABLE_MIN_ELEMENTS = 400
 #: Relative tolerance (of the element size) within which a corner counts as on an interface.
 _ON_INTERFACE = 1e-9
 
@@ -42,7 +48,8 @@ def influence_data(mesh, medium, singular_shift, alpha, near_fraction, n_images)
     interfaces, g, nu = medium.arrays()
     scale = entry_scale(mesh.half_a, mesh.half_b, layers, g, nu) / g.max() if interfaces.shape[0] > 0 else 0.0
     table = remainder_table3d.empty_table(g.shape[0])
-    if medium.method == "table" and n_images > 0 and interfaces.shape[0] >= 2:
+    if (medium.method == "table" and n_images > 0 and interfaces.shape[0] >= 2
+            and mesh.n_elements >= TABLE_MIN_ELEMENTS):
         table = remainder_table(mesh, medium, layers, int(n_images), scale * g.max())[0]
     return with_self_max(images3d.LayeredRectangles(
         mesh.centers, mesh.frames, mesh.half_a, mesh.half_b, layers, interfaces, g, nu, n_images=int(n_images),

@@ -21,6 +21,14 @@ G, NU = 1.0, 0.25
 INTERFACES = [0.0, -1.5, -3.0]
 
 
+@pytest.fixture(autouse=True)
+def _tables_for_small_meshes(monkeypatch):
+    """These meshes are a few squares: let them build tables (influence3d.TABLE_MIN_ELEMENTS)."""
+    from hmatddm.layered import influence3d
+
+    monkeypatch.setattr(influence3d, "TABLE_MIN_ELEMENTS", 0)
+
+
 def _medium(method="table", images=3, gauss_points=6, **options):
     return LayeredMedium(INTERFACES, [0.0, G, 2.0 * G, G], [NU, 0.3, 0.2, NU], images=images,
                          gauss_points=gauss_points, method=method, **options)
@@ -197,6 +205,17 @@ def test_equal_layers_reproduce_uniform_rock_on_the_table_path(mesh):
 def test_bad_table_options_are_refused_by_name(field, value):
     with pytest.raises(InputError, match=field):
         LayeredMedium(INTERFACES, [0.0, G, 2.0 * G, G], [NU] * 4, **{field: value})
+
+
+def test_small_meshes_build_no_table(monkeypatch, mesh):
+    """Below TABLE_MIN_ELEMENTS the table path integrates every triple (its build would cost
+    more than it saves): no table, the quadrature's entries bit for bit."""
+    from hmatddm.layered import influence3d
+
+    monkeypatch.setattr(influence3d, "TABLE_MIN_ELEMENTS", mesh.n_elements + 1)
+    table = influence_data(mesh, _medium(), 0.0, 0.0, 0.0, 2)
+    assert np.all(table.table.pair_index < 0)
+    assert np.array_equal(_matrix(table), _matrix(influence_data(mesh, _medium("quadrature"), 0.0, 0.0, 0.0, 2)))
 
 
 def test_a_table_depends_on_the_domain_not_on_the_history(mesh):
