@@ -31,21 +31,12 @@ ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
 
 from _common import machine, markdown_table  # noqa: E402
-from bench_layered3d_kernel import issue32_mesh  # noqa: E402
+from bench_layered3d_kernel import _timed, issue32_mesh  # noqa: E402
 
 import hmatddm as hd  # noqa: E402
 from hmatddm.elasticity import operator as operators  # noqa: E402
-from hmatddm.kernels import drivers  # noqa: E402
 from hmatddm.layered import LayeredMedium  # noqa: E402
 from hmatddm.layered import influence3d  # noqa: E402
-
-
-def _timed(data, rows, cols):
-    out = np.empty((3 * len(rows), 3 * len(cols)))
-    drivers.traction_block(data, rows[:2], cols[:2], np.empty((6, 6)))
-    t0, c0 = time.perf_counter(), time.process_time()
-    drivers.traction_block(data, rows, cols, out)
-    return out, time.process_time() - c0, time.perf_counter() - t0
 
 
 def operator_table(error_rows=6):

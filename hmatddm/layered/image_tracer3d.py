@@ -48,6 +48,21 @@ def trace(t, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, p
 
 
 @njit(cache=True)
+def copy_triple(k, into, pair_layer, pair_z, pair_eps, pair_sigma, pair_coef, pair_dcoef):
+    """Copy traced triple ``k`` over triple ``into`` (element by element, not by slice
+    assignment: docs/conventions.md, §5)."""
+    pair_layer[into] = pair_layer[k]
+    pair_z[into] = pair_z[k]
+    pair_eps[into] = pair_eps[k]
+    pair_sigma[into] = pair_sigma[k]
+    for f in range(pair_coef.shape[1]):
+        for j in range(pair_coef.shape[2]):
+            for o in range(pair_coef.shape[3]):
+                pair_coef[into, f, j, o] = pair_coef[k, f, j, o]
+                pair_dcoef[into, f, j, o] = pair_dcoef[k, f, j, o]
+
+
+@njit(cache=True)
 def merge_coincident(n, pair_layer, pair_z, pair_eps, pair_sigma, pair_coef, pair_dcoef):
     """Merge the triples that differ only by their path through the interfaces: same
     layer, gauge ``sigma``, ``eps`` and point ``z`` (to round-off of the heights).
@@ -67,15 +82,7 @@ def merge_coincident(n, pair_layer, pair_z, pair_eps, pair_sigma, pair_coef, pai
         if into < 0:
             into = kept
             kept += 1
-            pair_layer[into] = pair_layer[k]
-            pair_z[into] = pair_z[k]
-            pair_eps[into] = pair_eps[k]
-            pair_sigma[into] = pair_sigma[k]
-            for f in range(pair_coef.shape[1]):
-                for j in range(pair_coef.shape[2]):
-                    for o in range(pair_coef.shape[3]):
-                        pair_coef[into, f, j, o] = pair_coef[k, f, j, o]
-                        pair_dcoef[into, f, j, o] = pair_dcoef[k, f, j, o]
+            copy_triple(k, into, pair_layer, pair_z, pair_eps, pair_sigma, pair_coef, pair_dcoef)
         else:
             for f in range(pair_coef.shape[1]):
                 for j in range(pair_coef.shape[2]):

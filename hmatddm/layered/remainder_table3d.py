@@ -43,7 +43,7 @@ import numpy as np
 from numba import njit, prange
 
 from .image_tracer import trace_capacity
-from .image_tracer3d import trace
+from .image_tracer3d import copy_triple, trace
 from .images2d import _lame, receiver_constants
 from .potentials3d import Workspace, _original, _pair_stress_gradient
 
@@ -150,15 +150,7 @@ def keep_near(n, pair_layer, pair_z, pair_eps, pair_sigma, pair_coef, pair_dcoef
         if is_far(pair_z[k], pair_eps[k], t, source_layer, pair_layer[k], bottoms, tops):
             continue
         if kept != k:
-            pair_layer[kept] = pair_layer[k]
-            pair_z[kept] = pair_z[k]
-            pair_eps[kept] = pair_eps[k]
-            pair_sigma[kept] = pair_sigma[k]
-            for f in range(pair_coef.shape[1]):
-                for j in range(pair_coef.shape[2]):
-                    for o in range(pair_coef.shape[3]):
-                        pair_coef[kept, f, j, o] = pair_coef[k, f, j, o]
-                        pair_dcoef[kept, f, j, o] = pair_dcoef[k, f, j, o]
+            copy_triple(k, kept, pair_layer, pair_z, pair_eps, pair_sigma, pair_coef, pair_dcoef)
         kept += 1
     return kept
 
