@@ -165,7 +165,9 @@ class Well:
     volume : float, m^3 >= 0: the wellbore volume that stores fluid (c_f V).
     diameter : float, m > 0, or None: inner diameter for the friction between clusters.
     friction_factor : float >= 0: Darcy friction factor f_D (0: no wellbore friction).
-    density : float, kg/m^3 > 0: the fluid's (``fluid.density``: the orifice law and the pipe friction).
+
+    The fluid's density (:attr:`hmatddm.flow.Fluid.density`) enters the orifice law and the
+    pipe friction (:meth:`system`).
     """
 
     schedule: PumpRate
@@ -174,7 +176,6 @@ class Well:
     volume: float = 0.0
     diameter: float = None
     friction_factor: float = 0.0
-    density: float = 1000.0
 
     def __post_init__(self):
         if not isinstance(self.schedule, PumpRate):
@@ -191,7 +192,6 @@ class Well:
         object.__setattr__(self, "direction", tuple(float(v) / norm for v in direction))
         for name in ("volume", "diameter", "friction_factor"):
             object.__setattr__(self, name, WELL[name].value(f"well.{name}", getattr(self, name)))
-        object.__setattr__(self, "density", FLUID["density"].value("fluid.density", self.density))
         if self.friction_factor > 0.0 and self.diameter is None:
             raise InputError("well.diameter (m, > 0) is required with well.friction_factor > 0 (the Darcy-Weisbach "
                              "loss between clusters)")
@@ -220,9 +220,10 @@ class Well:
             depths.append(max(along, 0.0))
         return np.array(depths)
 
-    def system(self, clusters):
+    def system(self, clusters, density=FLUID["density"].default):
         """The :class:`WellSystem` of ``clusters`` (:class:`hmatddm.flow.Cluster` with their
-        perforations) on this well."""
+        perforations) on this well, for a fluid of ``density`` (kg/m^3)."""
+        density = FLUID["density"].value("fluid.density", density)
         clusters = list(clusters)
         depths = self.measured_depths([c.position for c in clusters])
         coefficients = []
@@ -239,11 +240,11 @@ class Well:
                                      f"share the [well]: the perforation friction splits the rate")
                 coefficients.append(0.0)
                 continue
-            coefficients.append(perforation_coefficient(self.density, c.perforations, c.perforation_diameter,
+            coefficients.append(perforation_coefficient(density, c.perforations, c.perforation_diameter,
                                                         c.discharge_coefficient))
         friction = 0.0
         if self.friction_factor > 0.0:
-            friction = pipe_friction_coefficient(self.density, self.diameter, self.friction_factor)
+            friction = pipe_friction_coefficient(density, self.diameter, self.friction_factor)
         return WellSystem(np.array(coefficients), depths, friction, self.volume)
 
 
