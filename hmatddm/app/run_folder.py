@@ -24,6 +24,7 @@ SNAPSHOT_DIR = "snapshots"
 HISTORY = "history.png"
 MOVIE = "movie.gif"
 PROPPANT_HISTORY = "proppant_history.png"
+RATE_SPLIT = "rate_split.png"  # a run with a [well] (issue 35): hmatddm.render.well
 SUMMARY_KEYS = ("scene", "versions", "steps", "reference", "wall_seconds")
 HYDRAULIC = 0
 
@@ -367,6 +368,10 @@ def render_folder(out, movie=False):
 
             written.append(plot_proppant_history(summary["steps"], out / PROPPANT_HISTORY,
                                                  title=f"{name}: proppant mass"))
+        if any("cluster_rates" in step for step in summary["steps"]):  # a run with a [well]
+            from ..render.well import plot_rate_split
+
+            written.append(plot_rate_split(summary["steps"], out / RATE_SPLIT, title=f"{name}: rate split"))
     if movie:
         written.append(write_movie(out, profiles))
     return written
@@ -376,4 +381,4 @@ __all__ = ["SUMMARY", "SCENE_FILE", "PVD", "VTU_DIR", "CHECKPOINT_DIR", "SNAPSHO
            "versions", "write_json", "read_summary", "vtu_name", "vtu_steps", "cell_fields", "snapshot_views",
            "snapshot_title", "layer_interfaces", "write_snapshots", "write_history", "mesh_from_vtu", "latest_state",
            "read_pvd_entries", "render_folder", "saved_states", "write_profiles", "write_movie", "MOVIE",
-           "PROPPANT_HISTORY"]
+           "PROPPANT_HISTORY", "RATE_SPLIT"]

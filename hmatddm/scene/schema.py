@@ -230,6 +230,9 @@ def _check_reference(scene):
         return
     if dim != want:
         raise InputError(f"{where} is a {want}D closed form; the scene has dimension = {dim}")
+    if "well" in scene:
+        raise InputError(f"{where} compares one cluster of a fixed rate: a scene with a [well] has no closed form "
+                         "here (remove [reference] or [well])")
     if len(scene["cluster"]) != 1 or scene["cluster"][0]["rate"] <= 0.0:
         raise InputError(f"{where} needs exactly one [[cluster]] with rate > 0, got {len(scene['cluster'])} "
                          "cluster(s)")
@@ -360,6 +363,7 @@ def validate(raw, name=None):
     if "poroelastic" in scene:
         _check_poroelastic(scene)
     _check_leak_off_reservoir(scene)
+    _check_clusters_and_well(scene)
     if "monitor" in scene and "layer" in scene:
         _check_monitors_in_rock(scene)
     if has_natural_fractures(scene) and "contact" not in raw["numerics"]:
@@ -376,6 +380,46 @@ def _check_proppant(echo):
     from ..flow.pump_schedule import PumpSchedule
 
     PumpSchedule.from_rows(echo["schedule"], echo["packing_limit"])
+
+
+def _check_clusters_and_well(scene):
+    """Without a [well] every cluster has its ``rate``; with one (issue 35,
+    :mod:`hmatddm.flow.well`) none has, each has its perforations (count and diameter, both or
+    neither), lies on the well, and the pump schedule's times increase."""
+    clusters = scene["cluster"]
+    for i, cluster in enumerate(clusters):
+        given = [key for key in ("perforations", "perforation_diameter") if key in cluster]
+        if len(given) == 1:
+            other = "perforation_diameter" if given[0] == "perforations" else "perforations"
+            raise InputError(f"cluster[{i}].{other} is required with cluster[{i}].{given[0]} (the count and the "
+                             "diameter of the cluster's perforations)")
+        if "discharge_coefficient" in cluster and not given:
+            raise InputError(f"cluster[{i}].discharge_coefficient needs cluster[{i}].perforations and "
+                             f"cluster[{i}].perforation_diameter (the orifices it describes)")
+        if given and "well" not in scene:
+            raise InputError(f"cluster[{i}].{given[0]} needs a [well]: perforation friction splits a shared pump's "
+                             "rate (without a [well] each cluster injects its own rate)")
+    if "well" not in scene:
+        for i, cluster in enumerate(clusters):
+            if "rate" not in cluster:
+                raise InputError(f"cluster[{i}].rate (m^3/s) is required (or a [well] whose pump schedule the "
+                                 "clusters share)")
+        return
+    from ..flow.fluid import Cluster
+    from ..flow.well import PumpRate, Well
+
+    section = scene["well"]
+    for i, cluster in enumerate(clusters):
+        if "rate" in cluster:
+            raise InputError(f"cluster[{i}].rate must be left out with a [well]: the pump schedule well.schedule sets "
+                             "the rates, which the perforations split")
+    schedule = PumpRate.from_rows(section["schedule"], section["interpolation"])
+    well = Well(schedule, tuple(section["heel"]), tuple(section["direction"]), volume=section["volume"],
+                diameter=section.get("diameter"), friction_factor=section["friction_factor"])
+    well.system([Cluster(tuple(c["position"]), wellbore_volume=c["wellbore_volume"],
+                         perforations=c.get("perforations"), perforation_diameter=c.get("perforation_diameter"),
+                         discharge_coefficient=c.get("discharge_coefficient")) for c in clusters],
+                scene["fluid"]["density"])
 
 
 RESERVOIR_KEYS = ("permeability", "porosity", "reservoir_compressibility", "reservoir_viscosity")
