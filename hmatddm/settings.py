@@ -336,6 +336,10 @@ WELL = {
                         doc="inner diameter (needed with friction_factor > 0)"),
     "friction_factor": Setting("number", 0.0, low=0.0,
                                doc="Darcy friction factor f_D of the pipe between clusters (0: no friction)"),
+    # the perforations of every cluster that gives none of its own (one --set changes them all)
+    "perforations": CLUSTER["perforations"],
+    "perforation_diameter": CLUSTER["perforation_diameter"],
+    "discharge_coefficient": CLUSTER["discharge_coefficient"],
 }
 
 LEAK_OFF = {  # -> hmatddm.flow.fluid.LeakOff (ref. Eqs 4.25-4.26)

@@ -26,8 +26,8 @@ integral (``Qbar dt``, :meth:`PumpRate.volume`)::
 Inside the coupled step (:meth:`hmatddm.flow.LubricationModel.assemble`) the well is solved
 with the fracture pressures, not lagged: at every nonlinear iterate ``p^k``
 :meth:`WellSystem.solve` solves the well exactly for the cluster pressures ``p_c^k`` (one
-monotone scalar equation in ``p_h``, the wellbore friction converged by a fixed point
-inside), then :class:`WellLinearisation` linearises each orifice there (the tangent
+monotone scalar equation in ``p_h``; with wellbore friction the rates at each ``p_h`` are
+the minimum of a strictly convex function, :meth:`WellSystem.rates_at`), then :class:`WellLinearisation` linearises each orifice there (the tangent
 ``q_c ~ k_c Delta_c + r_c`` through the exact point) and eliminates ``p_h``, so that the
 rate into each cluster element is a linear function of the cluster pressures. Its matrix
 (:meth:`WellLinearisation.matrix_terms`) is symmetric: ``+k_c`` on the diagonal of the
@@ -292,20 +292,69 @@ class WellSystem:
         rates = np.asarray(rates, dtype=float)
         return self.coefficients * rates * np.abs(rates)
 
-    def heel_pressure(self, cluster_pressure, friction, pump_rate, storage, heel_pressure_old):
-        """The heel pressure solving ``sum_c q_c(p_h - w_c - p_c) + S (p_h - p_h^n) = Qbar`` for
-        fixed wellbore friction ``friction`` (w_c), a monotone scalar equation (bracketed, then
-        Brent's method to round-off)."""
+    def rates_at(self, heel_pressure, cluster_pressure, guess=None, max_iterations=200):
+        """The rates ``q`` (C,) of the clusters at the heel pressure ``heel_pressure`` and the
+        cluster pressures ``cluster_pressure``: ``a_c q_c |q_c| + w_c(q) = p_h - p_c`` for every
+        cluster. Without wellbore friction each is its orifice's; with it the system is the
+        gradient of the strictly convex
+        ``E(q) = sum_c a_c |q_c|^3 / 3 + sum_m b L_m |Q_m|^3 / 3 - sum_c (p_h - p_c) q_c``
+        (``Q_m`` the rate of segment ``m``), solved by Newton's method with a line search on
+        ``E`` from ``guess``; ConvergenceError if it does not converge."""
+        drive = heel_pressure - np.asarray(cluster_pressure, dtype=float)
+        alone = self.perforation_rates(drive)
+        if self.friction == 0.0:
+            return alone
+        a = self.coefficients
+        q = alone.copy() if guess is None else np.array(guess, dtype=float)
+        tolerance = 1e-13 * max(1.0, float(np.max(np.abs(drive))))
+        floor = 1e-9 * max(float(np.max(np.abs(alone))), 1e-300)
+        order = self.order
+        segment = self.friction * self.segment_lengths
+
+        def energy(rates):
+            carried = np.cumsum(rates[order][::-1])[::-1]
+            return (float(np.sum(a * np.abs(rates) ** 3)) + float(np.sum(segment * np.abs(carried) ** 3))) / 3.0 \
+                - float(drive @ rates)
+
+        for _ in range(max_iterations):
+            residual = a * q * np.abs(q) + self.wellbore_friction(q) - drive
+            if float(np.max(np.abs(residual))) <= tolerance:
+                return q
+            carried = np.cumsum(q[order][::-1])[::-1]
+            # d w_c / d q_j = sum over the segments m up to c that carry j of 2 b L_m |Q_m|
+            weights = 2.0 * segment * np.abs(carried)  # (C,) by segment, heel to toe
+            rank = np.empty(self.n_clusters, np.int64)
+            rank[order] = np.arange(self.n_clusters)
+            shared = np.minimum.outer(rank, rank)       # the last segment both clusters lie beyond
+            hessian = np.cumsum(weights)[shared] + np.diag(2.0 * a * np.maximum(np.abs(q), floor))
+            step = np.linalg.solve(hessian, -residual)
+            before, norm = energy(q), float(np.max(np.abs(residual)))
+            length = 1.0
+            while length > 1e-3:
+                trial = q + length * step
+                trial_residual = a * trial * np.abs(trial) + self.wellbore_friction(trial) - drive
+                if energy(trial) < before or float(np.max(np.abs(trial_residual))) < norm:
+                    break
+                length *= 0.5
+            q = q + length * step
+        raise ConvergenceError(f"the rates of the clusters with wellbore friction did not converge in "
+                               f"{max_iterations} Newton iterations")
+
+    def heel_pressure(self, cluster_pressure, pump_rate, storage, heel_pressure_old):
+        """``(p_h, q)``: the heel pressure solving ``sum_c q_c(p_h) + S (p_h - p_h^n) = Qbar``, a
+        monotone scalar equation (bracketed, then Brent's method to round-off), and the rates
+        there (:meth:`rates_at`)."""
         from scipy.optimize import brentq
 
-        downstream = np.asarray(cluster_pressure, dtype=float) + friction
+        cluster_pressure = np.asarray(cluster_pressure, dtype=float)
+        last = [None]
 
         def balance(p_h):
-            return float(np.sum(self.perforation_rates(p_h - downstream)) + storage * (p_h - heel_pressure_old)
-                         - pump_rate)
+            last[0] = self.rates_at(p_h, cluster_pressure, last[0])
+            return float(np.sum(last[0]) + storage * (p_h - heel_pressure_old) - pump_rate)
 
-        low, high = float(np.min(downstream)), float(np.max(downstream))
-        scale = max(float(np.max(np.abs(downstream))), abs(heel_pressure_old), 1.0)
+        low, high = float(np.min(cluster_pressure)), float(np.max(cluster_pressure))
+        scale = max(float(np.max(np.abs(cluster_pressure))), abs(heel_pressure_old), 1.0)
         width = max(high - low, float(np.max(self.coefficients)) * pump_rate**2, 1e-6 * scale)
         step = width
         while balance(low) > 0.0:
@@ -316,31 +365,20 @@ class WellSystem:
             high += step
             step *= 2.0
         if balance(low) == 0.0:
-            return low
-        if balance(high) == 0.0:
-            return high
-        return brentq(balance, low, high, xtol=1e-300, rtol=4.0 * np.finfo(float).eps, maxiter=500)
+            p_h = low
+        elif balance(high) == 0.0:
+            p_h = high
+        else:
+            p_h = brentq(balance, low, high, xtol=1e-300, rtol=4.0 * np.finfo(float).eps, maxiter=500)
+        return p_h, self.rates_at(p_h, cluster_pressure, last[0])
 
-    def solve(self, cluster_pressure, pump_rate, storage, heel_pressure_old, rates_guess=None, max_iterations=200):
+    def solve(self, cluster_pressure, pump_rate, storage, heel_pressure_old):
         """The well's exact state for the cluster pressures ``cluster_pressure`` (C,):
-        ``(p_h, q (C,), w (C,))``; the wellbore friction by a fixed point on the rates (it
-        converges while the friction between clusters is below the perforation friction, the
-        regime of limited entry; ConvergenceError otherwise)."""
+        ``(p_h, q (C,), w (C,))`` (:meth:`heel_pressure`, :meth:`rates_at`)."""
         if self.direct:
             raise ValueError("a direct well (one cluster, no perforation friction) has no orifice to solve")
-        rates = np.full(self.n_clusters, pump_rate / self.n_clusters) if rates_guess is None else rates_guess
-        friction = self.wellbore_friction(rates)
-        for _ in range(max_iterations):
-            p_h = self.heel_pressure(cluster_pressure, friction, pump_rate, storage, heel_pressure_old)
-            rates = self.perforation_rates(p_h - cluster_pressure - friction)
-            new_friction = self.wellbore_friction(rates)
-            if self.friction == 0.0 or np.max(np.abs(new_friction - friction)) <= 1e-13 * max(
-                    1.0, float(np.max(np.abs(new_friction)))):
-                return p_h, rates, new_friction
-            friction = new_friction
-        raise ConvergenceError(f"the wellbore friction between clusters did not converge in {max_iterations} "
-                               f"iterations (it exceeds the perforation friction: lower well.friction_factor or "
-                               f"raise well.diameter)")
+        p_h, rates = self.heel_pressure(cluster_pressure, pump_rate, storage, heel_pressure_old)
+        return p_h, rates, self.wellbore_friction(rates)
 
     def linearise(self, cluster_pressure, pump_rate, storage, heel_pressure_old, rate_floor):
         """The :class:`WellLinearisation` at the cluster pressures ``cluster_pressure``."""

@@ -239,6 +239,9 @@ The format, annotated (``=`` values are the defaults unless marked REQUIRED)::
     # diameter = 0.1               # m, > 0: inner diameter (required with friction_factor > 0)
     friction_factor = 0.0          # >= 0, Darcy f_D between clusters: dp = 8 f_D rho L Q^2 / (pi^2 D^5)
                                    # (fluid.density rho, default 1000 kg/m^3)
+    # perforations = 6             # the perforations of every [[cluster]] that gives none of its own
+    # perforation_diameter = 0.01  #   (count >= 1, diameter m > 0, discharge_coefficient in (0, 1],
+    # discharge_coefficient = 0.6  #   default 0.6): `--set well.perforations=1` limits the entry
 
     [[monitor]]                    # displacement and tilt at a point after every step: DIR/monitor.csv
     position = [0.0, 0.0, 50.0]    # and DIR/monitor.png (hmatddm.app.monitor); layered rock too

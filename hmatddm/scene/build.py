@@ -63,10 +63,11 @@ def fluid(scene):
 
 
 def clusters(scene):
+    """The :class:`Cluster` of each ``[[cluster]]`` (with a [well], its perforations or the well's)."""
+    from .schema import perforations
+
     return [Cluster(tuple(c["position"]), rate=c.get("rate"), wellbore_volume=c["wellbore_volume"],
-                    perforations=c.get("perforations"), perforation_diameter=c.get("perforation_diameter"),
-                    discharge_coefficient=c.get("discharge_coefficient"))
-            for c in scene["cluster"]]
+                    **perforations(scene, i)) for i, c in enumerate(scene["cluster"])]
 
 
 def well(scene):

@@ -382,11 +382,32 @@ def _check_proppant(echo):
     PumpSchedule.from_rows(echo["schedule"], echo["packing_limit"])
 
 
+PERFORATION_KEYS = ("perforations", "perforation_diameter", "discharge_coefficient")
+
+
+def perforations(scene, index):
+    """The perforation keys of ``cluster[index]``: its own, else the [well]'s (defaults for
+    every cluster)."""
+    cluster, well = scene["cluster"][index], scene.get("well", {})
+    own = {key: cluster[key] for key in PERFORATION_KEYS if key in cluster}
+    if own:
+        return own
+    return {key: well[key] for key in PERFORATION_KEYS if key in well}
+
+
 def _check_clusters_and_well(scene):
     """Without a [well] every cluster has its ``rate``; with one (issue 35,
     :mod:`hmatddm.flow.well`) none has, each has its perforations (count and diameter, both or
-    neither), lies on the well, and the pump schedule's times increase."""
+    neither; its own or the well's), lies on the well, and the pump schedule's times increase."""
     clusters = scene["cluster"]
+    well = scene.get("well", {})
+    given = [key for key in ("perforations", "perforation_diameter") if key in well]
+    if len(given) == 1:
+        other = "perforation_diameter" if given[0] == "perforations" else "perforations"
+        raise InputError(f"well.{other} is required with well.{given[0]} (the count and the diameter of the "
+                         "perforations of every cluster that gives none)")
+    if "discharge_coefficient" in well and not given:
+        raise InputError("well.discharge_coefficient needs well.perforations and well.perforation_diameter")
     for i, cluster in enumerate(clusters):
         given = [key for key in ("perforations", "perforation_diameter") if key in cluster]
         if len(given) == 1:
@@ -416,10 +437,8 @@ def _check_clusters_and_well(scene):
     schedule = PumpRate.from_rows(section["schedule"], section["interpolation"])
     well = Well(schedule, tuple(section["heel"]), tuple(section["direction"]), volume=section["volume"],
                 diameter=section.get("diameter"), friction_factor=section["friction_factor"])
-    well.system([Cluster(tuple(c["position"]), wellbore_volume=c["wellbore_volume"],
-                         perforations=c.get("perforations"), perforation_diameter=c.get("perforation_diameter"),
-                         discharge_coefficient=c.get("discharge_coefficient")) for c in clusters],
-                scene["fluid"]["density"])
+    well.system([Cluster(tuple(c["position"]), wellbore_volume=c["wellbore_volume"], **perforations(scene, i))
+                 for i, c in enumerate(clusters)], scene["fluid"]["density"])
 
 
 RESERVOIR_KEYS = ("permeability", "porosity", "reservoir_compressibility", "reservoir_viscosity")
