@@ -217,7 +217,7 @@ class SceneRun:
         """Remove the files an earlier run wrote (only ours, by name)."""
         names = [self.out / SUMMARY, self.out / PVD, self.out / HISTORY, self.out / SCENE_FILE, self.out / MOVIE,
                  self.out / PROPPANT_HISTORY, self.out / RATE_SPLIT]
-        names += [self.out / name for name in ("events.csv", "microseismic_map.png")]  # hmatddm.microseismic
+        names += [self.out / name for name in ("events.csv", "microseismic_map.png", "events.xml")]  # microseismic
         names += [self.out / name for name in ("monitor.csv", "monitor.png")]  # hmatddm.app.monitor
         folder = self.out / CHECKPOINT_DIR
         names += list(folder.glob("step-*.json")) + list(folder.glob("step-*.npz"))
