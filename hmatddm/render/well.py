@@ -87,7 +87,7 @@ def plot_side_view(mesh, opening, fracture_ids, path, well_direction, interfaces
     norm = Normalize(0.0, max(float(np.max(millimetres[chosen])), 1e-12))
     low, high = polygons[chosen].reshape(-1, 2).min(axis=0), polygons[chosen].reshape(-1, 2).max(axis=0)
     pad = 0.05 * max(high - low)
-    figure = Figure(figsize=(2.2 * len(shown) + 1.2, 4.2), dpi=110, layout="constrained")
+    figure = Figure(figsize=(2.2 * len(shown) + 1.2, 3.4), dpi=110, layout="constrained")
     FigureCanvasAgg(figure)
     axes = figure.subplots(1, len(shown), sharex=True, sharey=True, squeeze=False)[0]
     collection = None

@@ -202,3 +202,25 @@ def test_a_cluster_is_on_the_well_within_a_millimetre():
     np.testing.assert_allclose(system.depths, [0.0, 5.0])
     assert not system.direct
     assert well().system([Cluster((3.0, 0.0))]).direct
+
+
+def test_strong_wellbore_friction_and_a_stopped_cluster_match_the_full_system():
+    """Wellbore friction as large as the perforation friction, and a cluster whose fracture
+    pressure stops its flow: the exact state against scipy.optimize.fsolve on (q, p_h)."""
+    a = np.array([orifice(24, 0.008)] * 4)
+    b = pipe_b(0.02, 0.1)
+    system = WellSystem(a, np.array([40.0, 50.0, 60.0, 70.0]), b, 10.0)
+    for pressure in (np.array([37.0e6, 37.002e6, 37.0e6, 37.001e6]), np.array([37.0e6, 37.3e6, 37.0e6, 37.0e6])):
+        p_h, rates, friction = system.solve(pressure, 0.016, 4.4e-10 * 10.0 / 2.0, 37.0e6)
+
+        def residual(x):
+            q, heel = x[:4] * 1e-3, x[4] * 1e6
+            w = system.wellbore_friction(q)
+            return np.concatenate([(a * q * np.abs(q) + w + pressure - heel) / 1e3,
+                                   [(np.sum(q) + 2.2e-9 * (heel - 37.0e6) - 0.016) * 1e3]])
+
+        exact = scipy.optimize.fsolve(residual, np.array([4.0, 4.0, 4.0, 4.0, 37.1]), xtol=1e-14)
+        np.testing.assert_allclose(rates, exact[:4] * 1e-3, rtol=1e-7, atol=1e-12)
+        assert p_h == pytest.approx(exact[4] * 1e6, rel=1e-13)
+        np.testing.assert_allclose(a * rates * np.abs(rates) + friction, p_h - pressure, rtol=1e-9, atol=1e-6)
+    assert rates[1] < 0.0  # the high-pressure cluster flows back into the well

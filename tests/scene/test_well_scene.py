@@ -137,3 +137,16 @@ def test_a_run_writes_the_rate_split(tmp_path, capsys):
     assert not_blank(out / "rate_split.png")
     assert cli.main(["render", str(out)]) == cli.EXIT_OK
     assert "rate_split.png" in capsys.readouterr().out
+
+
+def test_the_well_gives_its_perforations_to_every_cluster_without_its_own():
+    shared = WELL_2D.replace("volume = 0.5\n", "volume = 0.5\nperforations = 5\nperforation_diameter = 0.012\n")
+    shared = shared.replace("perforations = 2\nperforation_diameter = 0.01\n", "", 2)
+    scene = hs.parse_scene(shared).data
+    sim = build_simulation(scene)
+    assert [c.perforations for c in sim.clusters] == [5, 5, 2]
+    assert [c.perforation_diameter for c in sim.clusters] == [0.012, 0.012, 0.01]
+    changed = build_simulation(hs.parse_scene(shared, overrides=["well.perforations=1"]).data)
+    assert [c.perforations for c in changed.clusters] == [1, 1, 2]
+    with pytest.raises(InputError, match=r"well\.perforation_diameter is required"):
+        hs.parse_scene(shared.replace("perforation_diameter = 0.012\n", ""))
