@@ -64,7 +64,7 @@ def fluid(scene):
 
 def clusters(scene):
     """The :class:`Cluster` of each ``[[cluster]]`` (with a [well], its perforations or the well's)."""
-    from .schema import perforations
+    from .well_section import perforations
 
     return [Cluster(tuple(c["position"]), rate=c.get("rate"), wellbore_volume=c["wellbore_volume"],
                     **perforations(scene, i)) for i, c in enumerate(scene["cluster"])]
