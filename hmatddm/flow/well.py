@@ -27,14 +27,19 @@ Inside the coupled step (:meth:`hmatddm.flow.LubricationModel.assemble`) the wel
 with the fracture pressures, not lagged: at every nonlinear iterate ``p^k``
 :meth:`WellSystem.solve` solves the well exactly for the cluster pressures ``p_c^k`` (one
 monotone scalar equation in ``p_h``; with wellbore friction the rates at each ``p_h`` are
-the minimum of a strictly convex function, :meth:`WellSystem.rates_at`), then :class:`WellLinearisation` linearises each orifice there (the tangent
+the minimum of a strictly convex function, :meth:`WellSystem.rates_at`), then
+:class:`WellLinearisation` linearises each orifice there (the tangent
 ``q_c ~ k_c Delta_c + r_c`` through the exact point) and eliminates ``p_h``, so that the
 rate into each cluster element is a linear function of the cluster pressures. Its matrix
 (:meth:`WellLinearisation.matrix_terms`) is symmetric: ``+k_c`` on the diagonal of the
 element of ``c`` and ``-k_c k_j / (K + S)`` between the elements of ``c`` and ``j``
 (``K = sum k``). At the fixed point ``p = p^k`` the rates and the heel pressure are the
-exact ones of the well, whatever the tangent's slope. (The wellbore friction enters each
-linearisation as the constant of its iterate: it converges with the step's iteration.)
+exact ones of the well, whatever the tangent's slope: ``k_c = 1 / (2 a_c max(|q_c|, q_0))``,
+floored at a small rate ``q_0`` so that a stopped cluster keeps a finite slope. (The wellbore
+friction enters each linearisation as the constant of its iterate: it converges with the
+step's iteration.) The rates and heel pressure a step records are the last linearisation's at
+the converged pressures (:class:`WellLink`), so the fluid budget (pumped volume = fractures +
+leak-off + the well's storage) closes to the flow solve's tolerance.
 
 A single cluster without perforation friction (no perforation data) is the reference's
 injection point (ref. Eqs 4.34-4.35): the pump rate goes straight into its element, which

@@ -28,7 +28,8 @@ def test_the_perforation_coefficient_is_the_orifice_law():
 
 def test_parallel_orifices_with_equal_downstream_pressures_split_as_their_effective_areas():
     """q_c = Q n_c d_c^2 C_c / sum_j n_j d_j^2 C_j (equal drop over every orifice)."""
-    counts, diameters, cds = np.array([3, 6, 4, 8]), np.array([0.01, 0.012, 0.009, 0.011]), np.array([0.6, 0.7, 0.8, 0.9])
+    counts, diameters = np.array([3, 6, 4, 8]), np.array([0.01, 0.012, 0.009, 0.011])
+    cds = np.array([0.6, 0.7, 0.8, 0.9])
     a = np.array([orifice(n, d, c) for n, d, c in zip(counts, diameters, cds)])
     system = WellSystem(a, np.arange(4.0), 0.0, 0.0)
     q_pump = 0.08
