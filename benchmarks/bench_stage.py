@@ -3,8 +3,9 @@ three-layer stress stack, a natural-fracture network, microseismic monitoring): 
 iterations and the rate split of the scene as embedded, its limited-entry and uniform-rock
 variants, and a larger version (>= 5x the elements).
 
-    python benchmarks/bench_stage.py              # the three variants of the scene (~10 min)
+    python benchmarks/bench_stage.py              # the three variants of the scene (~8 min)
     python benchmarks/bench_stage.py --large      # the larger version only (1 m elements)
+    python benchmarks/bench_stage.py --dense      # open and limited with the dense operator (~15 min)
     python benchmarks/bench_stage.py --end 30     # a shorter pump time
 
 Each run is a fresh process (its own peak memory, a warm numba cache). Columns: CPU and wall
@@ -18,7 +19,8 @@ Variants: `open` is the scene as embedded (24 perforations of 8 mm per cluster: 
 perforation friction); `limited` sets well.perforations = 1 (MPa: limited entry);
 `uniform` is `limited` with the bounding layers' s_hmin equal to the pay zone's (the
 containment check); `large` is `limited` with 1 m elements for the initial fractures and the
-network (4x the elements per area, twice the rows over the height) and the H-matrix operator.
+network (4x the elements per area, twice the rows over the height); `-dense` runs use the dense
+operator instead of the scene's H-matrix.
 """
 import argparse
 import json
@@ -35,9 +37,10 @@ from _common import machine, peak_rss_bytes, print_table  # noqa: E402
 
 LIMITED = ["well.perforations=1"]
 UNIFORM = LIMITED + ["layer[0].s_hmin=35.85e6", "layer[2].s_hmin=35.85e6"]
-LARGE = LIMITED + [f"initial_fracture[{k}].element_size=1.0" for k in range(5)] + [
-    "network.element_size=1.0", "numerics.backend=hmatrix"]
-VARIANTS = {"open": [], "limited": LIMITED, "uniform": UNIFORM, "large": LARGE}
+LARGE = LIMITED + [f"initial_fracture[{k}].element_size=1.0" for k in range(5)] + ["network.element_size=1.0"]
+DENSE = ["numerics.backend=dense"]
+VARIANTS = {"open": [], "limited": LIMITED, "uniform": UNIFORM, "large": LARGE, "open-dense": DENSE,
+            "limited-dense": LIMITED + DENSE}
 
 
 def _run(name, overrides, end, queue):
@@ -82,10 +85,12 @@ def run(name, end):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--large", action="store_true", help="the larger version only")
+    parser.add_argument("--dense", action="store_true", help="open and limited with the dense operator")
     parser.add_argument("--end", type=float, default=90.0, help="pump time, s (the scene's: 90)")
     args = parser.parse_args()
     print(f"Machine: {machine()}")
-    names = ["large"] if args.large else ["open", "limited", "uniform"]
+    names = ["large"] if args.large else ["open-dense", "limited-dense"] if args.dense else [
+        "open", "limited", "uniform"]
     rows = []
     for name in names:
         r = run(name, args.end)
