@@ -80,10 +80,11 @@ def test_limited_entry_feeds_the_interior_clusters_the_stress_shadow_starves(tmp
 @pytest.mark.slow
 def test_the_bounding_layers_hold_the_middle_fractures_height(tmp_path):
     """The middle cluster's fracture with limited entry in the three-layer stack, against the
-    same run with the bounding layers' stress equal to the pay zone's (uniform rock)."""
-    run(tmp_path / "layers", "numerics.end_time=30", "well.perforations=1", "output.snapshots=false")
-    run(tmp_path / "uniform", "numerics.end_time=30", "well.perforations=1", "output.snapshots=false",
-        "layer[0].s_hmin=35.85e6", "layer[2].s_hmin=35.85e6")
+    same run with the bounding layers' stress equal to the pay zone's (uniform rock), after the
+    scene's 90 s (benchmarks/RESULTS.md, issue 35: 16 m against 26 m)."""
+    run(tmp_path / "layers", "well.perforations=1", "output.snapshots=false")
+    run(tmp_path / "uniform", "well.perforations=1", "output.snapshots=false", "layer[0].s_hmin=35.85e6",
+        "layer[2].s_hmin=35.85e6")
     _, held = fracture_extent(tmp_path / "layers", 2)
     _, free = fracture_extent(tmp_path / "uniform", 2)
     assert held <= 12.0 + 4.0  # the pay zone, and at most one row of 2 m elements into each bounding layer
