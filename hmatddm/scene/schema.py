@@ -234,7 +234,7 @@ def _check_reference(scene):
     if "well" in scene:
         raise InputError(f"{where} compares one cluster of a fixed rate: a scene with a [well] has no closed form "
                          "here (remove [reference] or [well])")
-    if len(scene["cluster"]) != 1 or scene["cluster"][0]["rate"] <= 0.0:
+    if len(scene["cluster"]) != 1 or scene["cluster"][0].get("rate", 0.0) <= 0.0:
         raise InputError(f"{where} needs exactly one [[cluster]] with rate > 0, got {len(scene['cluster'])} "
                          "cluster(s)")
     if "propagation" not in scene:
@@ -357,6 +357,7 @@ def validate(raw, name=None):
         if fracture["p0"] == fracture["p1"]:
             raise InputError(f"natural_fracture[{i}].p0 and natural_fracture[{i}].p1 must differ, "
                              f"got {show(fracture['p0'])}")
+    check_clusters_and_well(scene)
     if "layer" in scene:
         _check_layers(scene)
     if "reference" in scene:
@@ -364,7 +365,6 @@ def validate(raw, name=None):
     if "poroelastic" in scene:
         _check_poroelastic(scene)
     _check_leak_off_reservoir(scene)
-    check_clusters_and_well(scene)
     if "monitor" in scene and "layer" in scene:
         _check_monitors_in_rock(scene)
     if has_natural_fractures(scene) and "contact" not in raw["numerics"]:
