@@ -281,6 +281,8 @@ FLUID = {  # -> hmatddm.flow.fluid.Fluid (ref. Eqs 4.22-4.24)
                            doc="power-law consistency index K (required when rheology = 'power-law')"),
     "flow_index": Setting("number", 1.0, low=0.0, high=1.0, low_open=True,
                           doc="power-law flow behaviour index n (1: Newtonian, < 1: shear thinning)"),
+    "density": Setting("number", 1000.0, low=0.0, low_open=True, unit="kg/m^3",
+                       doc="fluid density rho (the perforation and wellbore friction of a [well])"),
     "minimum_shear_rate": Setting("number", 1e-3, low=0.0, low_open=True, unit="1/s",
                                   doc="power-law: below this wall shear rate the fluid flows as a Newtonian "
                                       "one of the apparent viscosity there (keeps a still fluid's conductivity)"),
@@ -309,8 +311,35 @@ PROPPANT_SECTION = {
 
 CLUSTER = {  # -> hmatddm.flow.fluid.Cluster (ref. Eqs 4.34-4.35)
     "position": Setting("point", REQUIRED, length="dim", unit="m"),
-    "rate": Setting("number", REQUIRED, low=0.0, unit="m^3/s"),
+    "rate": Setting("number", ABSENT, low=0.0, unit="m^3/s",
+                    doc="fixed injection rate (required without a [well]; left out with one)"),
     "wellbore_volume": Setting("number", 0.0, low=0.0, unit="m^3"),
+    # perforations of a cluster on a shared [well] (issue 35, hmatddm.flow.well)
+    "perforations": Setting("integer", ABSENT, low=1, doc="number of perforations n (with a [well])"),
+    "perforation_diameter": Setting("number", ABSENT, low=0.0, low_open=True, unit="m",
+                                    doc="perforation diameter d (with perforations)"),
+    "discharge_coefficient": Setting("number", ABSENT, low=0.0, high=1.0, low_open=True,
+                                     doc="C_d of the orifice law, in (0, 1] (default 0.6 with perforations)"),
+}
+
+#: [well] of a scene -> hmatddm.flow.well.Well (issue 35): one pump shared by the clusters
+WELL = {
+    "schedule": Setting("rows", REQUIRED, length=2,
+                        doc="pump schedule [time (s), rate (m^3/s)] rows in increasing time (rate 0 before the "
+                            "first)"),
+    "interpolation": Setting("choice", "constant", choices=("constant", "linear"),
+                             doc="the rate between rows: held (constant) or interpolated (linear)"),
+    "heel": Setting("point", REQUIRED, length="dim", unit="m", doc="where the pump pressure (heel pressure) is"),
+    "direction": Setting("point", REQUIRED, length="dim", doc="the well's direction from the heel to the toe"),
+    "volume": Setting("number", 0.0, low=0.0, unit="m^3", doc="wellbore volume storing fluid (c_f V)"),
+    "diameter": Setting("number", ABSENT, low=0.0, low_open=True, unit="m",
+                        doc="inner diameter (needed with friction_factor > 0)"),
+    "friction_factor": Setting("number", 0.0, low=0.0,
+                               doc="Darcy friction factor f_D of the pipe between clusters (0: no friction)"),
+    # the perforations of every cluster that gives none of its own (one --set changes them all)
+    "perforations": CLUSTER["perforations"],
+    "perforation_diameter": CLUSTER["perforation_diameter"],
+    "discharge_coefficient": CLUSTER["discharge_coefficient"],
 }
 
 LEAK_OFF = {  # -> hmatddm.flow.fluid.LeakOff (ref. Eqs 4.25-4.26)

@@ -4,6 +4,9 @@ scene section) and ``hmatddm microseismic OUT_DIR`` write (ref. Sec. 7.4).
     DIR/events.csv            one row per event (columns in :data:`CSV_COLUMNS`)
     DIR/microseismic_map.png  plan view: located events coloured by Mw over the fracture
                               traces, observation wells marked (ref. Figs 7.6, 7.9-7.10)
+    DIR/events.xml            the catalogue as QuakeML (origins, Mw, moment tensors) when
+                              ObsPy imports (`pip install ".[seismology]"`,
+                              :mod:`hmatddm.app.quakeml`)
 
 Events are the failed natural-fracture elements that pass the shear filter (ref. Eq.
 7.29) in the last state of the run, with their final DD (ref. Eq. 7.14) and the time of
@@ -258,7 +261,12 @@ def write_catalogue(out, section, name=None, height=None):
     map_path = plot_event_map(out / MAP_PNG, run.plan_traces(), wells, catalogue.located,
                               events.moment_magnitude if len(events) else np.zeros(0),
                               true_positions=None if noise.is_zero else events.position, title=title)
-    return [csv_path, map_path], catalogue
+    paths = [csv_path, map_path]
+    from .quakeml import QUAKEML, obspy_available, write_quakeml
+
+    if obspy_available():  # the optional seismology extra: the catalogue as QuakeML too (issue 35)
+        paths.append(write_quakeml(out / QUAKEML, catalogue, name=name or out.name))
+    return paths, catalogue
 
 
 def catalogue_for_folder(out, scene=None):

@@ -189,7 +189,9 @@ def _run(args):
                          "not both")
     scene, out = _load_run_scene(args)
     size = check_scene(scene.data)  # values, geometry, size: every refusal before the engine loads
-    if all(cluster["rate"] == 0.0 for cluster in scene.data["cluster"]):
+    pumped = ([cluster["rate"] for cluster in scene.data["cluster"]] if "well" not in scene.data
+              else [row[1] for row in scene.data["well"]["schedule"]])
+    if all(rate == 0.0 for rate in pumped):
         print("hmatddm: warning: every cluster has rate = 0 m^3/s: nothing drives the fractures, which only relax "
               "from numerics.initial_pressure", file=sys.stderr)
     if args.check:

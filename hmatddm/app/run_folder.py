@@ -24,6 +24,7 @@ SNAPSHOT_DIR = "snapshots"
 HISTORY = "history.png"
 MOVIE = "movie.gif"
 PROPPANT_HISTORY = "proppant_history.png"
+RATE_SPLIT = "rate_split.png"  # a run with a [well] (issue 35): hmatddm.render.well
 SUMMARY_KEYS = ("scene", "versions", "steps", "reference", "wall_seconds")
 HYDRAULIC = 0
 
@@ -143,7 +144,8 @@ def layer_interfaces(scene):
 
 
 def write_snapshots(out, mesh, fields, step, time_value, title_prefix, interfaces=(), scene=None, front=None):
-    """``snapshots/step-NNNNNN_{plan,oblique}.png`` of one state; returns the paths.
+    """``snapshots/step-NNNNNN_{plan,oblique}.png`` of one state (and ``_side.png``, each
+    cluster's fracture face on, for a 3D scene with a [well]); returns the paths.
     ``interfaces``: layer interface heights, drawn across a 2D section. The plan view
     draws the tracked front (``front``: the asymptotic front's arrays ``(front_distance,
     front_velocity, front_class)``, else the element front) and the closed form's front
@@ -154,10 +156,21 @@ def write_snapshots(out, mesh, fields, step, time_value, title_prefix, interface
     title = snapshot_title(title_prefix, time_value, mesh, fields.get("state"))
     slip_vectors = _visible_slip(mesh, fields["slip"], fields["opening"])
     curves = front_curves(mesh, fields.get("state"), scene, time_value, front)
-    return [snapshot(mesh, Path(out) / SNAPSHOT_DIR / f"step-{step:06d}_{view}.png", opening=fields["opening"],
-                     state=fields.get("state"), slip=slip_vectors, view=view, title=title, interfaces=interfaces,
-                     curves=curves if view == "plan" else ())
-            for view in snapshot_views(mesh)]
+    written = [snapshot(mesh, Path(out) / SNAPSHOT_DIR / f"step-{step:06d}_{view}.png", opening=fields["opening"],
+                        state=fields.get("state"), slip=slip_vectors, view=view, title=title, interfaces=interfaces,
+                        curves=curves if view == "plan" else ())
+               for view in snapshot_views(mesh)]
+    if mesh.dim == 3 and scene is not None and "well" in scene:  # each cluster's fracture face on (issue 35)
+        from ..render.well import plot_side_view
+
+        state = fields.get("state")
+        hydraulic = np.ones(mesh.n_elements, bool) if state is None else np.asarray(state) == 0
+        ids = np.unique(mesh.fracture_id[hydraulic])
+        ids = ids[ids < len(scene["initial_fracture"])]  # the fractures of the clusters, in scene order
+        written.append(plot_side_view(mesh.subset(np.flatnonzero(hydraulic)), np.asarray(fields["opening"])[hydraulic],
+                                      ids, Path(out) / SNAPSHOT_DIR / f"step-{step:06d}_side.png",
+                                      scene["well"]["direction"], interfaces, title=title))
+    return written
 
 
 def write_history(out, records, scene):
@@ -367,6 +380,10 @@ def render_folder(out, movie=False):
 
             written.append(plot_proppant_history(summary["steps"], out / PROPPANT_HISTORY,
                                                  title=f"{name}: proppant mass"))
+        if any("cluster_rates" in step for step in summary["steps"]):  # a run with a [well]
+            from ..render.well import plot_rate_split
+
+            written.append(plot_rate_split(summary["steps"], out / RATE_SPLIT, title=f"{name}: rate split"))
     if movie:
         written.append(write_movie(out, profiles))
     return written
@@ -376,4 +393,4 @@ __all__ = ["SUMMARY", "SCENE_FILE", "PVD", "VTU_DIR", "CHECKPOINT_DIR", "SNAPSHO
            "versions", "write_json", "read_summary", "vtu_name", "vtu_steps", "cell_fields", "snapshot_views",
            "snapshot_title", "layer_interfaces", "write_snapshots", "write_history", "mesh_from_vtu", "latest_state",
            "read_pvd_entries", "render_folder", "saved_states", "write_profiles", "write_movie", "MOVIE",
-           "PROPPANT_HISTORY"]
+           "PROPPANT_HISTORY", "RATE_SPLIT"]

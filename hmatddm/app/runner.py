@@ -33,6 +33,9 @@ The folder (``--out DIR``) holds::
                         the last state on the fractures (side view of vertical 3D fractures)
     proppant_history.png  with [proppant]: proppant mass pumped and in the fractures
                         against time (summary.json's proppant_injected_mass, proppant_mass)
+    rate_split.png      with a [well]: the rate into each cluster, its share and the
+                        perforation friction against time (summary.json's cluster_rates,
+                        cluster_pressures, perforation_friction, heel_pressure)
     history.png         size, opening and wellbore pressure against time, with the
                         closed form overlaid when the scene has a [reference]; the
                         tips against the interfaces in a layered run; the fluid budget
@@ -51,7 +54,7 @@ from pathlib import Path
 from ..errors import HmatddmError, InputError, OutputError
 from ..io import atomic_output, write_pvd, write_vtu
 from ..simulation.progress import Progress
-from .run_folder import (CHECKPOINT_DIR, HISTORY, MOVIE, PROPPANT_HISTORY, PVD,  # noqa: F401  (re-exported)
+from .run_folder import (CHECKPOINT_DIR, HISTORY, MOVIE, PROPPANT_HISTORY, PVD, RATE_SPLIT,  # noqa: F401  (re-exported)
                          SCENE_FILE, SNAPSHOT_DIR, SUMMARY, SUMMARY_KEYS, VTU_DIR,
                          cell_fields, latest_state, layer_interfaces, mesh_from_vtu, read_pvd_entries,
                          read_summary, render_folder, snapshot_title, snapshot_views, versions, vtu_name,
@@ -213,8 +216,8 @@ class SceneRun:
     def _clear(self):
         """Remove the files an earlier run wrote (only ours, by name)."""
         names = [self.out / SUMMARY, self.out / PVD, self.out / HISTORY, self.out / SCENE_FILE, self.out / MOVIE,
-                 self.out / PROPPANT_HISTORY]
-        names += [self.out / name for name in ("events.csv", "microseismic_map.png")]  # hmatddm.microseismic
+                 self.out / PROPPANT_HISTORY, self.out / RATE_SPLIT]
+        names += [self.out / name for name in ("events.csv", "microseismic_map.png", "events.xml")]  # microseismic
         names += [self.out / name for name in ("monitor.csv", "monitor.png")]  # hmatddm.app.monitor
         folder = self.out / CHECKPOINT_DIR
         names += list(folder.glob("step-*.json")) + list(folder.glob("step-*.npz"))
@@ -379,6 +382,11 @@ class SceneRun:
             self.written["history"] = write_history(self.out, self.steps, self.scene.data)
             if self.simulation.proppant is not None:  # proppant mass pumped and in place
                 self.written["proppant_history"] = write_proppant_history(self.out, self.steps, self.scene.name)
+            if self.simulation.well is not None:  # the rate split of the clusters (issue 35)
+                from ..render.well import plot_rate_split
+
+                self.written["rate_split"] = plot_rate_split(self.steps, self.out / RATE_SPLIT,
+                                                             title=f"{self.scene.name}: rate split")
         if self._monitor is not None:
             self.written["monitor"] = self._monitor.plot(self.scene.name)
         if "microseismic" in self.scene.data:  # events.csv and the event map (ref. Ch. 7)

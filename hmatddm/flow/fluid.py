@@ -34,6 +34,9 @@ class Fluid:
         ``K gamma_0^(n-1)`` (a truncated power law: a still fluid keeps a finite
         conductivity, :mod:`hmatddm.flow.lubrication`). Default 1e-3 1/s, far below the
         shear rates of fracture flow (~1-1e4 1/s).
+    density : float
+        rho in kg/m^3, > 0 (default 1000): the perforation and wellbore friction of a shared
+        well (:mod:`hmatddm.flow.well`); the lubrication equation does not read it.
 
     The parallel-plate flux of a power-law fluid (Adachi and Detournay 2002, their Eq. 5)
     is ``q = -(w^(2n+1) / M')^(1/n) |dp/dx|^(1/n - 1) dp/dx`` with
@@ -47,11 +50,12 @@ class Fluid:
     consistency: float = None
     flow_index: float = 1.0
     minimum_shear_rate: float = FLUID["minimum_shear_rate"].default
+    density: float = FLUID["density"].default
 
     def __post_init__(self):
         rheology = FLUID["rheology"].value("fluid.rheology", self.rheology)
         object.__setattr__(self, "rheology", rheology)
-        for name in ("compressibility", "flow_index", "minimum_shear_rate"):
+        for name in ("compressibility", "flow_index", "minimum_shear_rate", "density"):
             object.__setattr__(self, name, FLUID[name].value(f"fluid.{name}", getattr(self, name)))
         if rheology == "newtonian":
             if self.viscosity is None:
@@ -112,31 +116,62 @@ class LeakOff:
             object.__setattr__(self, name, LEAK_OFF[name].value(f"leak_off.{name}", getattr(self, name)))
 
 
+#: C_d of a perforation when a scene gives none (a sharp-edged, unworn perforation; Lecampion
+#: and Desroches 2015 use 0.6)
+DEFAULT_DISCHARGE_COEFFICIENT = 0.6
+
+
 @dataclass(frozen=True)
 class Cluster:
     """A perforation cluster: a wellbore connected to the fracture element nearest
-    ``position`` (ref. Eqs 4.34-4.35: uniform wellbore pressure, no perforation loss).
+    ``position`` (ref. Eqs 4.34-4.35: uniform wellbore pressure, no perforation loss), or
+    a cluster of a well shared with others (issue 35, :mod:`hmatddm.flow.well`).
 
     Parameters
     ----------
     position : (d,) point, m
-    rate : float
-        Volumetric injection rate q_w in m^3/s, >= 0 (2D: into the whole flow height).
+    rate : float or None
+        Volumetric injection rate q_w in m^3/s, >= 0 (2D: into the whole flow height);
+        required without a well, None with one (the pump schedule sets the rates).
     wellbore_volume : float
-        V_w in m^3, >= 0; stores fluid through the compressibility.
+        V_w in m^3, >= 0; stores fluid through the compressibility (0 with a well, whose
+        ``volume`` stores it).
+    perforations : int >= 1 or None
+        Number of perforations n of a cluster on a well (None: no perforation friction).
+    perforation_diameter : float, m > 0, or None
+        Their diameter d (with ``perforations``).
+    discharge_coefficient : float in (0, 1] or None
+        C_d of the orifice law (default 0.6 with ``perforations``).
     """
 
     position: tuple
-    rate: float
+    rate: float = None
     wellbore_volume: float = 0.0
+    perforations: int = None
+    perforation_diameter: float = None
+    discharge_coefficient: float = None
 
     def __post_init__(self):
         position = finite_array("cluster.position", self.position)
         if position.ndim != 1 or position.size not in (2, 3):
             raise InputError(f"cluster.position must be a point with 2 or 3 coordinates, got shape {position.shape}")
         object.__setattr__(self, "position", tuple(float(v) for v in position))
-        for name in ("rate", "wellbore_volume"):
+        for name in ("rate", "wellbore_volume", "perforations", "perforation_diameter", "discharge_coefficient"):
             object.__setattr__(self, name, CLUSTER[name].value(f"cluster.{name}", getattr(self, name)))
+        perforated = [name for name in ("perforations", "perforation_diameter") if getattr(self, name) is not None]
+        if len(perforated) == 1:
+            other = "perforation_diameter" if perforated[0] == "perforations" else "perforations"
+            raise InputError(f"cluster.{other} is required with cluster.{perforated[0]} (a cluster's perforations: "
+                             f"their count and diameter)")
+        if perforated and self.discharge_coefficient is None:
+            object.__setattr__(self, "discharge_coefficient", DEFAULT_DISCHARGE_COEFFICIENT)
+        if not perforated and self.discharge_coefficient is not None:
+            raise InputError("cluster.discharge_coefficient needs cluster.perforations and "
+                             "cluster.perforation_diameter (the orifices it describes)")
+
+    @property
+    def has_perforations(self):
+        return self.perforations is not None
 
     def nearest_element(self, mesh):
         position = np.asarray(self.position)

@@ -88,6 +88,14 @@ class LubricationModel:
         "initial fracture width").
     viscosity_factor : (N,) array or None
         Slurry viscosity over the carrier fluid's per element (>= 1; None: clean fluid).
+    well : hmatddm.flow.well.WellLink or None
+        Clusters sharing one pump (issue 35, :mod:`hmatddm.flow.well`): every :meth:`assemble`
+        linearises the well at its pressure iterate and adds the injection of the clusters,
+        a linear function of their pressures with the heel pressure eliminated (a symmetric
+        block on the cluster elements), in place of ``injection_rates``; the well's storage
+        is in that block, at the heel pressure. A direct well (one cluster without
+        perforation friction) is the fixed-rate path: ``injection_rates`` holds the pump's
+        mean rate and ``wellbore_volumes`` the well's volume.
     """
 
     areas: np.ndarray
@@ -100,6 +108,7 @@ class LubricationModel:
     wellbore_volumes: np.ndarray
     minimum_width: float
     viscosity_factor: np.ndarray = None
+    well: object = None
 
     @property
     def n_elements(self):
@@ -223,4 +232,16 @@ class LubricationModel:
         if correction is not None:  # the linearised power-law flux: F_e = k_e dp_e - r_e
             np.add.at(rhs, f.first, correction)
             np.subtract.at(rhs, f.second, correction)
+        if self.well is not None and not self.well.direct:  # clusters sharing a pump (hmatddm.flow.well)
+            at = pressure_old if pressure_iterate is None else pressure_iterate
+            well_matrix, well_rhs = self.well.linearise(at).matrix_terms(self.well.elements, n)
+            matrix = (matrix + well_matrix).tocsr()
+            rhs = rhs + well_rhs
         return matrix, rhs
+
+    def cluster_rates(self, pressure):
+        """The rate into each cluster (m^3/s) at the element pressures ``pressure``: the fixed
+        rates, or those of the well (its last linearisation, :class:`hmatddm.flow.well.WellLink`)."""
+        if self.well is None:
+            return np.asarray(self.injection_rates, dtype=float).copy()
+        return self.well.state(pressure)[1]

@@ -43,6 +43,7 @@ The format, annotated (``=`` values are the defaults unless marked REQUIRED)::
     # flow_index = 0.5             # power-law: n, (0, 1] (default 1); a viscosity beside a
                                    # consistency is dropped from the echo
     # minimum_shear_rate = 1e-3    # power-law: 1/s, > 0; slower shear flows as Newtonian
+    density = 1000.0               # kg/m^3, > 0: perforation and wellbore friction of a [well]
 
     [stress]                       # compressive positive, Pa; EITHER principal values:
     s_hmin = 8e6                   #   minimum horizontal stress
@@ -54,8 +55,13 @@ The format, annotated (``=`` values are the defaults unless marked REQUIRED)::
 
     [[cluster]]                    # one table per perforation cluster (at least one)
     position = [0.0, 0.0, 0.0]     # REQUIRED, m (d coordinates); must lie on an initial fracture
-    rate = 0.01                    # REQUIRED, m^3/s, >= 0 (2D: into the whole flow height)
-    wellbore_volume = 0.005        # m^3, >= 0 (default 0)
+    rate = 0.01                    # REQUIRED without a [well], m^3/s, >= 0 (2D: into the whole flow
+                                   # height); left out with a [well] (its pump schedule sets the rates)
+    wellbore_volume = 0.005        # m^3, >= 0 (default 0; 0 with a [well], whose volume stores)
+    # perforations = 6             # with a [well]: number of perforations, integer >= 1 (required
+                                   # when several clusters share the well; none: no perforation loss)
+    # perforation_diameter = 0.01  # with perforations: m, > 0
+    # discharge_coefficient = 0.6  # with perforations: C_d in (0, 1] (default 0.6)
 
     [[initial_fracture]]           # one table per initial fracture; fracture ids 0, 1, ...
     shape = "rectangle"            # 3D: "rectangle" (default) or "penny"; 2D: "line"
@@ -218,6 +224,24 @@ The format, annotated (``=`` values are the defaults unless marked REQUIRED)::
     schedule = [[0.0, 0.0], [5.0, 0.1]]   # REQUIRED, [time (s), volume fraction in [0, packing_limit)]
                                    # stages in increasing time, each held until the next (0 before
                                    # the first); every cluster pumps this slurry
+
+    [well]                         # one pump shared by the clusters (issue 35; hmatddm.flow.well): the
+                                   # rate into each cluster follows from the heel pressure less the
+                                   # wellbore friction and the perforation friction
+                                   # dp = 8 rho q^2 / (pi^2 C_d^2 n^2 d^4), solved inside every step;
+                                   # summary.json cluster_rates, cluster_pressures, perforation_friction,
+                                   # heel_pressure; DIR/rate_split.png
+    schedule = [[0.0, 0.02]]       # REQUIRED, [time (s), rate (m^3/s, >= 0)] rows in increasing time
+    interpolation = "constant"     # "constant" (held until the next row) or "linear"; 0 before the first
+    heel = [0.0, -50.0, 0.0]       # REQUIRED, m: the pump's end of the well (heel pressure)
+    direction = [0.0, 1.0, 0.0]    # REQUIRED: from the heel to the toe; every cluster on this line
+    volume = 10.0                  # m^3, >= 0: wellbore storage c_f V at the heel pressure
+    # diameter = 0.1               # m, > 0: inner diameter (required with friction_factor > 0)
+    friction_factor = 0.0          # >= 0, Darcy f_D between clusters: dp = 8 f_D rho L Q^2 / (pi^2 D^5)
+                                   # (fluid.density rho, default 1000 kg/m^3)
+    # perforations = 6             # the perforations of every [[cluster]] that gives none of its own
+    # perforation_diameter = 0.01  #   (count >= 1, diameter m > 0, discharge_coefficient in (0, 1],
+    # discharge_coefficient = 0.6  #   default 0.6): `--set well.perforations=1` limits the entry
 
     [[monitor]]                    # displacement and tilt at a point after every step: DIR/monitor.csv
     position = [0.0, 0.0, 50.0]    # and DIR/monitor.png (hmatddm.app.monitor); layered rock too

@@ -63,8 +63,23 @@ def fluid(scene):
 
 
 def clusters(scene):
-    return [Cluster(tuple(c["position"]), rate=c["rate"], wellbore_volume=c["wellbore_volume"])
-            for c in scene["cluster"]]
+    """The :class:`Cluster` of each ``[[cluster]]`` (with a [well], its perforations or the well's)."""
+    from .well_section import perforations
+
+    return [Cluster(tuple(c["position"]), rate=c.get("rate"), wellbore_volume=c["wellbore_volume"],
+                    **perforations(scene, i)) for i, c in enumerate(scene["cluster"])]
+
+
+def well(scene):
+    """The :class:`hmatddm.flow.Well` of ``[well]`` (issue 35), or None."""
+    section = scene.get("well")
+    if section is None:
+        return None
+    from ..flow.well import PumpRate, Well
+
+    return Well(PumpRate.from_rows(section["schedule"], section["interpolation"]), tuple(section["heel"]),
+                tuple(section["direction"]), volume=section["volume"], diameter=section.get("diameter"),
+                friction_factor=section["friction_factor"])
 
 
 def propagation(scene):
@@ -133,7 +148,8 @@ def build_simulation(scene, checkpoint_dir=None):
         checkpoint_dir=checkpoint_dir, keep_checkpoints=numerics["keep_checkpoints"],
         natural_fractures=natural_mesh(scene), natural=natural_properties(scene),
         remote_failure=scene.get("network", {}).get("remote_failure", True), contact=numerics["contact"],
-        max_elements=numerics.get("max_elements"), step_control=step_control(numerics), **proppant(scene))
+        max_elements=numerics.get("max_elements"), step_control=step_control(numerics), well=well(scene),
+        **proppant(scene))
 
 
 def proppant(scene):

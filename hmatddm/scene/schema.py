@@ -27,6 +27,7 @@ from .echo import far_field_stress, has_natural_fractures, to_toml  # noqa: F401
 from .sections import (FILLED_WHEN_ABSENT, INITIAL_FRACTURE, NETWORK_GENERATOR, SCHEME_KEYS, SECTIONS,
                        SHAPE_KEYS, SHAPES, TOP)
 from .sections import LEAK_OFF_REFERENCE_KINDS
+from .well_section import check_clusters_and_well
 
 
 # ---------------------------------------------------------------------------------
@@ -230,7 +231,10 @@ def _check_reference(scene):
         return
     if dim != want:
         raise InputError(f"{where} is a {want}D closed form; the scene has dimension = {dim}")
-    if len(scene["cluster"]) != 1 or scene["cluster"][0]["rate"] <= 0.0:
+    if "well" in scene:
+        raise InputError(f"{where} compares one cluster of a fixed rate: a scene with a [well] has no closed form "
+                         "here (remove [reference] or [well])")
+    if len(scene["cluster"]) != 1 or scene["cluster"][0].get("rate", 0.0) <= 0.0:
         raise InputError(f"{where} needs exactly one [[cluster]] with rate > 0, got {len(scene['cluster'])} "
                          "cluster(s)")
     if "propagation" not in scene:
@@ -353,6 +357,7 @@ def validate(raw, name=None):
         if fracture["p0"] == fracture["p1"]:
             raise InputError(f"natural_fracture[{i}].p0 and natural_fracture[{i}].p1 must differ, "
                              f"got {show(fracture['p0'])}")
+    check_clusters_and_well(scene)
     if "layer" in scene:
         _check_layers(scene)
     if "reference" in scene:

@@ -119,5 +119,6 @@ SECTIONS = {
     "poroelastic": (settings.POROELASTIC, False, False),  # undrained rock (ref. Sec. 5.3.1): build.material
     "monitor": (settings.MONITOR, True, False),  # displacement and tilt at points: hmatddm.app.monitor
     "proppant": (settings.PROPPANT_SECTION, False, False),  # slurry and pump schedule (issue 34): build.proppant
+    "well": (settings.WELL, False, False),  # one pump shared by the clusters (issue 35): build.well
 }
 FILLED_WHEN_ABSENT = ("leak_off", "output")  # optional sections echoed with their defaults

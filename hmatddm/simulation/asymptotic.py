@@ -193,7 +193,8 @@ class AsymptoticFront:
         of the modified rows) is kept across the front iterations of one operator."""
         mesh = trial.mesh
         _, faces = mesh_topology(mesh, sim.height)
-        flow = sim.flow_model(mesh, faces, proppant_step.viscosity_factor(sim, trial, start.width))
+        flow = sim.flow_model(mesh, faces, proppant_step.viscosity_factor(sim, trial, start.width),
+                              well=sim.well_link(start, t_old, t_new))
         op = sim.operator(mesh)
         if self._solver is None or self._solver.operator is not op:
             self._solver = ElasticSolver(op, rtol=sim.settings.linear_rtol)

@@ -106,7 +106,7 @@ def advance(simulation, begin, trial, start, flow, t_old, t_new):
     # the pumped proppant: q c(t) of every cluster, its exact mean over the step
     pumped = sim.pump_schedule.integral(t_old, t_new)
     injection = np.zeros(mesh.n_elements)
-    rates = np.array([c.rate for c in sim.clusters])
+    rates = np.maximum(flow.cluster_rates(trial.pressure), 0.0)  # (a shared well's: the step's; no backflow of sand)
     np.add.at(injection, sim.injection_elements, rates * pumped / dt)
     face_flux = flow.face_flux(width_new, trial.pressure)
     volume, substeps, screened = transport(geometry, sim.proppant, trial.proppant_volume,

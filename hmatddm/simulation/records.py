@@ -107,7 +107,32 @@ def _state_record(sim, s, flow, width, tally, relaxation, seconds, previous_time
         from .proppant_step import record as proppant_record
 
         record.update(proppant_record(sim, s, flow, width))
+    if sim.well is not None:
+        record.update(well_record(sim, s, flow))
     return record
+
+
+def well_record(simulation, state, flow):
+    """A shared well's numbers (issue 35, :mod:`hmatddm.flow.well`) at ``state``, of its last
+    solve's ``flow`` model: ``heel_pressure`` (Pa), ``pump_rate`` (the schedule's mean over the
+    step, m^3/s), ``cluster_rates`` (into each cluster, m^3/s; they sum to the pump rate less
+    the well's storage rate ``c_f V dp_h/dt``), ``cluster_pressures`` (the wellbore pressure at
+    each cluster, the heel pressure less the wellbore friction, Pa), ``perforation_friction``
+    (``a_c q_c |q_c|``, Pa) and ``wellbore_friction`` (heel to cluster, Pa); the fracture
+    pressure at a cluster is ``wellbore_pressure`` (its element's)."""
+    sim, link = simulation, flow.well
+    system = sim.well_system
+    if link is None:  # the initial state: the pump's rate at t = 0, nothing flowing yet
+        n = len(sim.clusters)
+        return dict(heel_pressure=float(state.heel_pressure), pump_rate=sim.well.schedule.rate(state.time),
+                    cluster_rates=[0.0] * n, cluster_pressures=[float(state.heel_pressure)] * n,
+                    perforation_friction=[0.0] * n, wellbore_friction=[0.0] * n)
+    heel, rates = link.state(state.pressure)
+    friction = np.zeros(len(rates)) if link.direct or link.last is None else link.last.friction
+    return dict(heel_pressure=float(heel), pump_rate=float(link.pump_rate),
+                cluster_rates=[float(q) for q in rates], cluster_pressures=[float(heel - w) for w in friction],
+                perforation_friction=[float(v) for v in system.perforation_friction(rates)],
+                wellbore_friction=[float(w) for w in friction])
 
 
 def height_growth(mesh, origin, medium):
@@ -169,7 +194,7 @@ def initial_budget(simulation):
     mesh = sim.mesh0
     areas = mesh.areas * (sim.height if mesh.dim == 2 else 1.0)
     fractures = float(np.sum(areas) * sim.initial_opening)
-    wellbore = float(sum(c.wellbore_volume for c in sim.clusters))
+    wellbore = float(sum(c.wellbore_volume for c in sim.clusters)) if sim.well is None else sim.well.volume
     budget = dict(injected=0.0, initial=fractures + wellbore, fractures=fractures, wellbore=wellbore, leaked=0.0,
                   residual=0.0, compression=0.0)
     if sim.network is not None:
@@ -185,7 +210,8 @@ def fluid_budget(simulation, before, start, flow, time_old):
     * ``fractures``: the volume of the openings plus the fluid stored in them by
       compression (``compression``, accumulated step by step as the storage term of
       ref. Eq. 4.36, ``c_f S_i w_i (p_i - p_i^n)``);
-    * ``wellbore``: ``V_w (1 + c_f (p_w - p_0))`` of each cluster;
+    * ``wellbore``: ``V_w (1 + c_f (p_w - p_0))`` of each cluster (of a shared well: its
+      volume at the heel pressure, :mod:`hmatddm.flow.well`);
     * ``leaked``: Carter leak-off into the rock, ``S_i Lambda_i (p_i - p_r) dt`` per step
       (ref. Eqs 4.25-4.26);
     * ``natural`` (runs with natural fractures): the pore fluid that remotely failed
@@ -218,8 +244,11 @@ def fluid_budget(simulation, before, start, flow, time_old):
     rate = flow.leak_off_rate(s.creation_time, time_old, s.time)[fed]
     leaked = before["leaked"] + (s.time - time_old) * float(
         np.sum(areas * rate * (pressure - sim.leak_off.pore_pressure)))
-    wellbore = float(sum(c.wellbore_volume * (1.0 + c_f * (s.pressure[i] - sim.initial_pressure))
-                         for c, i in zip(sim.clusters, sim.injection_elements)))
+    if sim.well is None:
+        wellbore = float(sum(c.wellbore_volume * (1.0 + c_f * (s.pressure[i] - sim.initial_pressure))
+                             for c, i in zip(sim.clusters, sim.injection_elements)))
+    else:  # a shared well stores at its heel pressure (hmatddm.flow.well)
+        wellbore = sim.well.volume * (1.0 + c_f * (s.heel_pressure - sim.initial_pressure))
     budget = dict(injected=float(s.injected_volume), initial=before["initial"], fractures=volume + compression,
                   wellbore=wellbore, leaked=leaked, residual=0.0, compression=compression)
     sources = budget["injected"] + budget["initial"]

@@ -137,6 +137,14 @@ class Simulation:
     pump_schedule : PumpSchedule or None
         The proppant volume fraction the clusters pump against time
         (:class:`hmatddm.flow.pump_schedule.PumpSchedule`).
+    well : Well or None
+        One pump shared by the clusters through their perforations (issue 35,
+        :mod:`hmatddm.flow.well`): the clusters take no ``rate`` (the split of the pump's
+        schedule follows from the perforation and wellbore friction, solved inside every
+        step's coupled system) and no ``wellbore_volume`` (the well's ``volume`` stores fluid at
+        the heel pressure). The records add ``heel_pressure``, ``pump_rate``,
+        ``cluster_rates``, ``cluster_pressures``, ``perforation_friction`` and
+        ``wellbore_friction``. Without a well every cluster needs its ``rate``.
 
     (The settings classes are in :mod:`hmatddm.simulation.settings`.)
     """
@@ -145,7 +153,8 @@ class Simulation:
                  leak_off=None, initial_pressure=0.0, initial_opening=1e-5, minimum_width=None, height=1.0, *,
                  scheme="krylov", growing_fractures=None, natural_fractures=None, natural=None, remote_failure=True,
                  contact="natural", max_elements=None, step_control=None, operator_settings=None,
-                 rebuild_settings=None, checkpoint_settings=None, proppant=None, pump_schedule=None, **options):
+                 rebuild_settings=None, checkpoint_settings=None, proppant=None, pump_schedule=None, well=None,
+                 **options):
         if not isinstance(mesh, (Mesh2D, Mesh3D)):
             raise InputError(f"mesh must be a Mesh2D or Mesh3D, got {type(mesh).__name__}")
         check_mesh(mesh)
@@ -167,7 +176,9 @@ class Simulation:
         clusters = list(clusters)
         if not clusters or not all(isinstance(c, Cluster) for c in clusters):
             raise InputError("clusters must be a non-empty list of hmatddm.Cluster")
-        if all(c.rate == 0.0 for c in clusters):
+        self.well, self.well_system = _checked_well(well, clusters, fluid)
+        if (self.well is None and all(c.rate == 0.0 for c in clusters)) or (
+                self.well is not None and self.well.schedule.peak == 0.0):
             warnings.warn("every cluster injects at rate 0 m^3/s: nothing drives the fractures, which only relax "
                           "from their initial pressure", NoInjectionWarning, stacklevel=2)
         if propagation is not None and not isinstance(propagation, Propagation):
@@ -239,12 +250,16 @@ class Simulation:
                      time_step=self.time_step, origin=np.full(mesh.n_elements, Origin.HYDRAULIC, np.int64),
                      natural_index=-np.ones(mesh.n_elements, np.int64), intact=np.ones(n_natural, bool),
                      failed=np.zeros(n_natural, bool), extra_faces=np.zeros((0, 6)),
-                     proppant_volume=None if self.proppant is None else np.zeros(mesh.n_elements), **front)
+                     proppant_volume=None if self.proppant is None else np.zeros(mesh.n_elements),
+                     heel_pressure=None if self.well is None else self.initial_pressure, **front)
 
     def fingerprint(self):
         """SHA-256 of everything that defines the run (a resume must match it)."""
-        parts = dict(material=asdict(self.material), fluid=asdict(self.fluid),
-                     clusters=[asdict(c) for c in self.clusters], leak_off=asdict(self.leak_off),
+        fluid = asdict(self.fluid)
+        if self.well is None:  # (fields of issue 35 left out without a well: the fingerprints of other runs stay)
+            fluid.pop("density")
+        clusters = [{k: v for k, v in asdict(c).items() if v is not None} for c in self.clusters]
+        parts = dict(material=asdict(self.material), fluid=fluid, clusters=clusters, leak_off=asdict(self.leak_off),
                      propagation=None if self.propagation is None else repr(self.propagation),
                      far_field_stress=self.far_field_stress.tolist(), time_step=self.time_step,
                      step_control=None if self.step_control is None else asdict(self.step_control),
@@ -254,6 +269,8 @@ class Simulation:
                      growing=None if self.growing_fractures is None else self.growing_fractures.tolist())
         if self.proppant is not None:  # (absent without proppant: the fingerprints of other runs stay)
             parts.update(proppant=asdict(self.proppant), pump_schedule=self.pump_schedule.rows())
+        if self.well is not None:
+            parts.update(well=asdict(self.well))
         digest = hashlib.sha256(json.dumps(parts, sort_keys=True, default=str).encode())
         meshes = [self.mesh0] + ([] if self.network is None else [self.network.mesh])
         for value in [v for m in meshes for v in mesh_arrays(m).values()]:
@@ -306,15 +323,36 @@ class Simulation:
             return materials
         return layered_engine.ElementMaterials(materials.shear_modulus[elements], materials.poisson_ratio[elements])
 
-    def flow_model(self, mesh, faces, viscosity_factor=None):
+    def flow_model(self, mesh, faces, viscosity_factor=None, well=None):
         """The :class:`LubricationModel` of ``mesh`` with flow ``faces``; ``viscosity_factor``:
-        the slurry's per element (:func:`hmatddm.simulation.proppant_step.viscosity_factor`)."""
+        the slurry's per element (:func:`hmatddm.simulation.proppant_step.viscosity_factor`);
+        ``well``: the shared well over the step (:meth:`well_link`)."""
         areas = mesh.areas * (self.height if mesh.dim == 2 else 1.0)
+        if self.well is None:
+            rates = np.array([c.rate for c in self.clusters])
+            volumes = np.array([c.wellbore_volume for c in self.clusters])
+        else:  # the well's injection is its own block (hmatddm.flow.well), but a direct well's
+            direct = self.well_system.direct
+            rates = np.array([well.pump_rate if direct and well is not None else 0.0] * len(self.clusters))
+            volumes = np.array([self.well.volume if direct else 0.0] * len(self.clusters))
         return LubricationModel(areas=areas, normals=mesh.normals, faces=faces, fluid=self.fluid,
                                 leak_off=self.leak_off, injection_elements=self.injection_elements,
-                                injection_rates=np.array([c.rate for c in self.clusters]),
-                                wellbore_volumes=np.array([c.wellbore_volume for c in self.clusters]),
-                                minimum_width=self.minimum_width, viscosity_factor=viscosity_factor)
+                                injection_rates=rates, wellbore_volumes=volumes,
+                                minimum_width=self.minimum_width, viscosity_factor=viscosity_factor, well=well)
+
+    def well_link(self, start, t_old, t_new):
+        """The shared well over the step from ``t_old`` to ``t_new`` from ``start`` (a
+        :class:`StepStart`): :class:`hmatddm.flow.well.WellLink` (None without a well)."""
+        if self.well is None:
+            return None
+        from ..flow.well import WellLink
+
+        dt = t_new - t_old
+        n = len(self.clusters)
+        # the slope of an orifice is floored at this rate (only the iteration's path depends on it)
+        floor = 1e-3 * max(self.well.schedule.peak, 1e-12) / n
+        return WellLink(self.well_system, self.injection_elements, self.well.schedule.mean(t_old, t_new),
+                        self.fluid.compressibility * self.well.volume / dt, start.heel_pressure, floor)
 
     # -- one step -------------------------------------------------------------------------
     def step(self, end_time=None):
@@ -459,8 +497,14 @@ class Simulation:
             if dt < planned:  # shortened to end at a run's end time: the front's pace over the planned step
                 advance *= planned / dt
             next_step = self.step_control.next_step(max(dt, planned), advance)
+        pumped, heel = None, None
+        if self.well is None:
+            pumped = dt * sum(c.rate for c in self.clusters)
+        else:  # the schedule's exact volume; the heel pressure of the converged solve
+            pumped = self.well.schedule.volume(t_old, t_new)
+            heel = float(flow.well.state(trial.pressure)[0])
         return replace(trial, time=t_new, step=begin.step + 1, relaxation=next_relaxation, time_step=next_step,
-                       injected_volume=begin.injected_volume + dt * sum(c.rate for c in self.clusters),
+                       injected_volume=begin.injected_volume + pumped, heel_pressure=heel,
                        leaked_volume=begin.leaked_volume + float(np.sum(leak)) * dt, failed=failed,
                        **proppant_step.advance(self, begin, trial, start, flow, t_old, t_new))
 
@@ -554,6 +598,22 @@ def _checked_proppant(proppant, schedule):
         raise InputError(f"pump_schedule concentrations must be below proppant.packing_limit = "
                          f"{proppant.packing_limit:g}, got {highest:g}")
     return proppant, schedule
+
+
+def _checked_well(well, clusters, fluid):
+    """``(well, its WellSystem)`` (both None without a well); without a well every cluster
+    needs its ``rate``."""
+    from ..flow.well import Well
+
+    if well is None:
+        for i, c in enumerate(clusters):
+            if c.rate is None:
+                raise InputError(f"cluster[{i}].rate is required (m^3/s, >= 0) when the clusters do not share a well "
+                                 f"(a [well] with a pump schedule)")
+        return None, None
+    if not isinstance(well, Well):
+        raise InputError(f"well must be an hmatddm.flow.Well or None, got {type(well).__name__}")
+    return well, well.system(clusters, fluid.density)
 
 
 def _paused_margin(info):

@@ -156,6 +156,7 @@ class State:
     proppant_injected_volume: float = 0.0  # pumped by the clusters so far, m^3
     proppant_screened_volume: float = 0.0  # found a packed injection element: stays in the wellbore, m^3
     proppant_substeps: int = 0           # transport sub-steps of the last step
+    heel_pressure: float = None          # a shared well's heel pressure (issue 35); None without a well
 
     def __post_init__(self):
         n, d = self.dd.shape
@@ -219,6 +220,8 @@ class State:
         scalars = {name: getattr(self, name) for name in _SCALARS}
         if self.proppant_volume is not None:
             scalars.update({name: getattr(self, name) for name in _PROPPANT})
+        if self.heel_pressure is not None:
+            scalars["heel_pressure"] = self.heel_pressure
         return scalars
 
     @classmethod
@@ -229,6 +232,7 @@ class State:
                    float(metadata["injected_volume"]), float(metadata["leaked_volume"]),
                    time_step=None if metadata.get("time_step") is None else float(metadata["time_step"]),
                    proppant_volume=arrays.get("proppant_volume"),
+                   heel_pressure=None if metadata.get("heel_pressure") is None else float(metadata["heel_pressure"]),
                    **{name: type(getattr(cls, name))(metadata.get(name, 0)) for name in _PROPPANT},
                    **{name: arrays.get(name) for name in _ALWAYS[3:] + _FRONT})
 
@@ -238,18 +242,21 @@ class StepStart:
     """Per element, the start of the step the coupled step compares with: the opening
     ``w^n`` and pressure ``p^n`` (ref. Eq. 4.36) and the DD from which contact slip is
     measured. New elements start with zero opening, their parent's pressure and the
-    DD they start the iterations from."""
+    DD they start the iterations from. A shared well's heel pressure at the step's start
+    (:mod:`hmatddm.flow.well`) too."""
 
     width: np.ndarray     # (N,)
     pressure: np.ndarray  # (N,)
     dd: np.ndarray        # (N, d)
+    heel_pressure: float = None  # a shared well's heel pressure p_h^n (issue 35)
 
     @classmethod
     def of(cls, state):
-        return cls(np.sum(state.dd * state.mesh.normals, axis=1), state.pressure.copy(), state.dd.copy())
+        return cls(np.sum(state.dd * state.mesh.normals, axis=1), state.pressure.copy(), state.dd.copy(),
+                   state.heel_pressure)
 
     def joined(self, new, guess):
         """The start with :class:`NewElements` ``new`` (starting from DD ``guess``) appended."""
         return StepStart(np.concatenate([self.width, np.zeros(new.mesh.n_elements)]),
                          np.concatenate([self.pressure, new.from_parent(self.pressure, new.pressure)]),
-                         np.concatenate([self.dd, guess]))
+                         np.concatenate([self.dd, guess]), self.heel_pressure)

@@ -91,7 +91,8 @@ def solve(simulation, trial, start, t_old, t_new, relaxation, provisional=False)
     sim, mesh = simulation, trial.mesh
     edges, faces = mesh_topology(mesh, sim.height)
     faces = with_links(faces, trial.extra_faces)
-    flow = sim.flow_model(mesh, faces, proppant_step.viscosity_factor(sim, trial, start.width))
+    flow = sim.flow_model(mesh, faces, proppant_step.viscosity_factor(sim, trial, start.width),
+                          well=sim.well_link(start, t_old, t_new))
     elastic = ElasticSolver(sim.operator(mesh), rtol=sim.settings.linear_rtol)
     contact, fixed_pressure, pressure_guess = None, None, trial.pressure
     law = contact_law(sim, trial.origin)

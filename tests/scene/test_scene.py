@@ -181,7 +181,7 @@ def test_embedded_scenes_validate_build_and_round_trip():
     for name in names:
         scene = hs.load_scene(name)
         assert scene.name == name and scene.description
-        assert scene.has_natural_fractures == (name in ("crossing", "dfn-3cluster"))
+        assert scene.has_natural_fractures == (name in ("crossing", "dfn-3cluster", "stage"))
         sim = hs.build_simulation(scene.data)
         assert isinstance(sim, hd.Simulation) and sim.mesh0.dim == scene.dimension
         again = hs.parse_scene(scene.to_toml())  # the echo reads back to itself
