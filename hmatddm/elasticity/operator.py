@@ -136,7 +136,7 @@ class ElasticityOperator(ProductCounter, LinearOperator):
             self._matrix = None
             self._build_compressed(eps, eta, leaf_size)
         if isinstance(material, LayeredMedium):
-            self._stats["n_images"] = int(self.data.n_images)
+            self._stats["n_images"] = int(getattr(self.data, "n_images", 0))  # equal layers: 0
         self._lu = None
         self._preconditioner = None
 
@@ -294,6 +294,8 @@ def influence_data(mesh, material, singular_correction="none", alpha=None, n_ima
     influence blocks of ``mesh`` with the same options (NaN averaging of singular and
     near-singular points, Eq. 6.11 scaling) as the operator uses."""
     shift = AVERAGE_SHIFT if singular_correction == "average" else 0.0
+    if isinstance(material, LayeredMedium) and material.is_homogeneous:
+        material = material.material(0)  # equal layers: no image, the uniform-rock kernel
     if isinstance(material, LayeredMedium):  # ref. Ch. 3: closed form + image terms
         return _layered_influence_data(mesh, material, shift, alpha, n_images)
     self_max = None
