@@ -8,7 +8,7 @@ import numpy as np
 from .._validation import finite_array
 from ..errors import InputError
 from ..kernels.drivers import finite_stress_sum, with_self_max
-from . import images3d, remainder_table3d
+from . import images3d, remainder_build3d, remainder_table3d
 from .influence2d import choose_images as _choose_images
 from .influence2d import layers_of_extents, with_images
 from .rectangle_quadrature import ENTRY_TOL, entry_scale
@@ -65,18 +65,18 @@ _KEEP_TABLES = 4
 
 def remainder_table(mesh, medium, layers, n_images, largest_entry):
     """``(table, stats)``: the remainder table of ``medium`` at ``n_images`` covering
-    ``mesh`` (:func:`.remainder_table3d.build_table` to ``medium.table_tol`` of
+    ``mesh`` (:func:`.remainder_build3d.build_table` to ``medium.table_tol`` of
     ``largest_entry``), reused for every mesh with the same
-    :func:`.remainder_table3d.table_domain` (a growing fracture builds it again only when
+    :func:`.remainder_build3d.table_domain` (a growing fracture builds it again only when
     its extent doubles; a resumed run gets the table of the run it resumes)."""
     interfaces, g, nu = medium.arrays()
-    domain = remainder_table3d.table_domain(mesh, layers, interfaces, g)
+    domain = remainder_build3d.table_domain(mesh, layers, interfaces, g)
     key = (medium.interfaces, medium.shear_modulus, medium.poisson_ratio, float(medium.table_tol), int(n_images),
            domain, float(largest_entry))
     if key in _TABLES:
         table, stats = _TABLES.pop(key)
     else:
-        table, stats = remainder_table3d.build_table(mesh, layers, interfaces, g, nu, n_images, medium.table_tol,
+        table, stats = remainder_build3d.build_table(mesh, layers, interfaces, g, nu, n_images, medium.table_tol,
                                                      largest_entry)
     _TABLES[key] = (table, stats)
     while len(_TABLES) > _KEEP_TABLES:

@@ -1,5 +1,5 @@
 """The tabulated layered remainder of the 3D image method (issue 32, item 2,
-:mod:`hmatddm.layered.remainder_table3d`): the table path against the quadrature of every
+:mod:`hmatddm.layered.remainder_table3d`, built by :mod:`hmatddm.layered.remainder_build3d`): the table path against the quadrature of every
 image triple (the cross-check, ``method="quadrature"``, with many points), the split into
 near and far triples, the table's convergence as it is refined, interface conditions on
 the table path, and the cases that build no table."""
@@ -10,6 +10,7 @@ import hmatddm as hd
 from hmatddm.errors import InputError
 from hmatddm.kernels import drivers
 from hmatddm.layered import LayeredMedium
+from hmatddm.layered import remainder_build3d as build
 from hmatddm.layered import remainder_table3d as rt
 from hmatddm.layered.image_points3d import _complementary_gradient, image_point_stress
 from hmatddm.layered.image_tracer3d import trace_points
@@ -95,7 +96,7 @@ def test_near_triples_plus_the_table_give_the_image_sum_at_points():
     mesh = _random_mesh(2, CENTERS, 0.15)
     interfaces, g, nu = medium.arrays()
     layers = element_layers(mesh, medium)
-    table, stats = rt.build_table(mesh, layers, interfaces, g, nu, 3, 1e-6, 10.0)
+    table, stats = build.build_table(mesh, layers, interfaces, g, nu, 3, 1e-6, 10.0)
     assert stats["table_pairs"] == 9 and stats["table_error"] <= 1e-6
     bottoms, tops = rt.layer_bounds(interfaces)
     ranges = {1: (-1.5, 0.0), 2: (-3.0, -1.5), 3: (-4.4, -3.0)}
@@ -134,7 +135,7 @@ def test_the_table_converges_as_it_is_refined(mesh):
     layers = element_layers(mesh, _medium())
     sizes, errors = [], []
     for tol in (1e-5, 1e-6, 1e-7):
-        _, stats = rt.build_table(mesh, layers, interfaces, g, nu, 3, tol, 10.0)
+        _, stats = build.build_table(mesh, layers, interfaces, g, nu, 3, tol, 10.0)
         assert 0.0 < stats["table_error"] <= tol
         sizes.append(stats["table_values"])
         errors.append(stats["table_error"])
@@ -226,8 +227,8 @@ def test_a_table_depends_on_the_domain_not_on_the_history(mesh):
 
     grown = _random_mesh(5, CENTERS[::2] + [[0.4, 0.3, -2.2]], 0.15)
     interfaces, g, _ = _medium().arrays()
-    first = rt.table_domain(mesh, element_layers(mesh, _medium()), interfaces, g)
-    assert rt.table_domain(grown, element_layers(grown, _medium()), interfaces, g) == first
+    first = build.table_domain(mesh, element_layers(mesh, _medium()), interfaces, g)
+    assert build.table_domain(grown, element_layers(grown, _medium()), interfaces, g) == first
     influence3d._TABLES.clear()
     a = influence_data(mesh, _medium(), 0.0, 0.0, 0.0, 2).table
     influence3d._TABLES.clear()
