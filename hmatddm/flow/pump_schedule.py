@@ -13,6 +13,21 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
+from ..settings import show
+
+
+def check_time_rows(name, times, values, value_ok, value_rule, rows="rows"):
+    """Refuse a table of ``(time, value)`` rows (a pump schedule) naming the row: times
+    finite, >= 0 and strictly increasing; each finite value ``value_ok`` (else the message
+    says ``value_rule``)."""
+    for k, (t, v) in enumerate(zip(times, values)):
+        if not np.isfinite(t) or t < 0.0:
+            raise InputError(f"{name}[{k}] time must be a finite number >= 0 s, got {show(float(t))}")
+        if not np.isfinite(v) or not value_ok(v):
+            raise InputError(f"{name}[{k}] {value_rule}, got {show(float(v))}")
+        if k > 0 and not t > times[k - 1]:
+            raise InputError(f"{name}[{k}] time must be after {name}[{k - 1}]'s {show(float(times[k - 1]))} s "
+                             f"({rows} in increasing time), got {show(float(t))}")
 
 
 @dataclass(frozen=True)
@@ -44,15 +59,10 @@ class PumpSchedule:
         if times.size == 0 or times.size != values.size:
             raise InputError(f"{name} must hold at least one [time, concentration] stage, got {times.size} times "
                              f"and {values.size} concentrations")
-        for k, (t, c) in enumerate(zip(times, values)):
-            if not np.isfinite(t) or t < 0.0:
-                raise InputError(f"{name}[{k}] time must be a finite number >= 0 s, got {t:g}")
-            if not np.isfinite(c) or c < 0.0 or c >= self.packing_limit:
-                raise InputError(f"{name}[{k}] concentration must be in [0, {self.packing_limit:g}) (a volume "
-                                 f"fraction below proppant.packing_limit), got {c:g}")
-            if k > 0 and not t > times[k - 1]:
-                raise InputError(f"{name}[{k}] time must be after {name}[{k - 1}]'s {times[k - 1]:g} s (stages in "
-                                 f"increasing time), got {t:g}")
+        limit = self.packing_limit
+        check_time_rows(name, times, values, lambda c: 0.0 <= c < limit,
+                        f"concentration must be in [0, {limit:g}) (a volume fraction below proppant.packing_limit)",
+                        "stages")
         object.__setattr__(self, "times", tuple(float(t) for t in times))
         object.__setattr__(self, "concentrations", tuple(float(c) for c in values))
 

@@ -53,6 +53,7 @@ import numpy as np
 from .._validation import finite_array
 from ..errors import ConvergenceError, InputError
 from ..settings import FLUID, WELL, show
+from .pump_schedule import check_time_rows
 
 #: how far a cluster may lie from the well's line, m
 ON_WELL_TOLERANCE = 1e-3
@@ -94,14 +95,7 @@ class PumpRate:
         if times.size == 0 or times.size != rates.size:
             raise InputError(f"{name} must hold at least one [time, rate] row, got {times.size} times and "
                              f"{rates.size} rates")
-        for k, (t, q) in enumerate(zip(times, rates)):
-            if not np.isfinite(t) or t < 0.0:
-                raise InputError(f"{name}[{k}] time must be a finite number >= 0 s, got {show(float(t))}")
-            if not np.isfinite(q) or q < 0.0:
-                raise InputError(f"{name}[{k}] rate must be a finite number >= 0 m^3/s, got {show(float(q))}")
-            if k > 0 and not t > times[k - 1]:
-                raise InputError(f"{name}[{k}] time must be after {name}[{k - 1}]'s {show(float(times[k - 1]))} s "
-                                 f"(rows in increasing time), got {show(float(t))}")
+        check_time_rows(name, times, rates, lambda q: q >= 0.0, "rate must be a finite number >= 0 m^3/s")
         object.__setattr__(self, "times", tuple(float(t) for t in times))
         object.__setattr__(self, "rates", tuple(float(q) for q in rates))
 

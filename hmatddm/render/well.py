@@ -52,11 +52,7 @@ def plot_rate_split(records, path, title=""):
     heel.set_ylabel("heel pressure (MPa)")
     heel.legend(loc="best", fontsize=7)
     top.set_title(title or "rate split", fontsize=10)
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_output(path) as temporary:
-        figure.savefig(temporary, format="png")
-    return path
+    return _save(figure, path)
 
 
 def plot_side_view(mesh, opening, fracture_ids, path, well_direction, interfaces=(), title=""):
@@ -106,6 +102,11 @@ def plot_side_view(mesh, opening, fracture_ids, path, well_direction, interfaces
     axes[0].set_ylabel("z (m)")
     figure.colorbar(collection, ax=list(axes), label="opening (mm)", shrink=0.8)
     figure.suptitle(title or "side view", fontsize=10)
+    return _save(figure, path)
+
+
+def _save(figure, path):
+    """Write ``figure`` to ``path`` (PNG, atomically, its folder made); returns the path."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     with atomic_output(path) as temporary:
