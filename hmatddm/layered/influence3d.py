@@ -42,8 +42,9 @@ def element_layers(mesh, medium):
 def influence_data(mesh, medium, singular_shift, alpha, near_fraction, n_images):
     """The kernel data (:class:`images3d.LayeredRectangles`) of ``mesh`` in ``medium``
     with ``n_images`` images; ``alpha > 0`` fills ``self_max`` for ref. Eq. 6.11. With
-    ``medium.method == "table"`` and far image triples (two or more interfaces), the
-    layered remainder's table (:func:`remainder_table`)."""
+    ``medium.method == "table"``, far image triples (two or more interfaces) and at least
+    :data:`TABLE_MIN_ELEMENTS` elements, the layered remainder's table
+    (:func:`remainder_table`)."""
     layers = element_layers(mesh, medium)
     interfaces, g, nu = medium.arrays()
     scale = entry_scale(mesh.half_a, mesh.half_b, layers, g, nu) / g.max() if interfaces.shape[0] > 0 else 0.0
