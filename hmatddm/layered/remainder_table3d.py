@@ -24,17 +24,17 @@ layered-media Green's function tables, e.g. Wang's EDGRN/EDCMP, applied to the i
 per pair of (source layer, receiver layer), the 20 components of the moment-to-stress
 response ``T[m, s]`` that the mirror symmetry ``y -> -y`` of that frame leaves non-zero
 (moment ``m`` and stress ``s`` components, each ``xx, yy, zz, xy, xz, yz``). A value is
-interpolated by 4-point Lagrange polynomials in each of the three variables (64 nodes),
-then rotated back and contracted with the element's moment tensor (Aki & Richards,
-Eq. 3.20).
+interpolated by :data:`STENCIL`-point Lagrange polynomials in each of the three variables
+(the grids padded past their ranges so every stencil is centred), then rotated back and
+contracted with the element's moment tensor (Aki & Richards, Eq. 3.20).
 
-The table is built (:mod:`.remainder_build3d`) from the image sum itself (so it is exact at its nodes), and refined
-(the spacing halved) until its error at random points between the nodes, converted to an
-influence entry (``max |dT| (lambda + 2G) 4ab``), is below ``table_tol`` times the scale of
-the largest entry (:func:`.rectangle_quadrature.entry_scale`). A medium whose triples are
-all near (a half-space, a bi-material, one interface and a free surface at ``images=1``)
-builds no table. Sources or receivers outside a table's range (a mesh grown past it) take
-the quadrature of every triple, as without a table.
+The table is built (:mod:`.remainder_build3d`) from the image sum itself (so it is exact
+at its nodes), and refined (the spacing halved) until its error at random points between
+the nodes, converted to an influence entry (``max |dT| (lambda + 2G) 4ab``), is below
+``table_tol`` times the scale of the largest entry (:func:`.rectangle_quadrature.entry_scale`).
+A medium whose triples are all near (a half-space, a bi-material) builds no table, nor does
+a mesh of fewer than :data:`.influence3d.TABLE_MIN_ELEMENTS` elements. A source or receiver
+outside a table's range takes the quadrature of every triple, as without a table.
 """
 import math
 from typing import NamedTuple
@@ -47,8 +47,6 @@ from .image_tracer3d import copy_triple, trace
 from .images2d import _lame, receiver_constants
 from .potentials3d import Workspace, _original, _pair_stress_gradient
 
-#: Default error of the remainder table relative to the largest influence entry.
-TABLE_TOL = 1e-9
 #: Largest number of values a table may hold (8 bytes each) before refinement stops.
 MAX_TABLE_VALUES = 40_000_000
 #: Random points between the nodes at which a table's error is measured, per layer pair
