@@ -27,7 +27,7 @@ import numpy as np
 from numba import njit
 
 from ..kernels.displacement import local_to_global, segment_local_displacement
-from .image_tracer import largest_trace_capacity
+from .image_tracer import largest_trace_capacity, orders_used
 from .images2d import _INV_4PI, _lame, _potential_table, inverse_power_derivatives, potential_derivatives, trace
 from .segment_quadrature import composite_rule, subdivision_level, subdivisions
 
@@ -59,14 +59,7 @@ def _pair_displacement_gradient(r1, r3, eps, coef, dcoef, delta, out, work):
     of the displacement ``u_i`` at the receiver ``(r1, r3)`` (from the pair's point) of a
     unit force along ``f``; ``delta``: the receiver layer's; ``eps = dz/dt``."""
     gk, beta, table, dtable = work
-    n_orders = coef.shape[-1]
-    used = 1
-    for f in range(2):
-        for j in range(2):
-            for n in range(n_orders - 1, used - 1, -1):
-                if coef[f, j, n] != 0.0 or dcoef[f, j, n] != 0.0:
-                    used = n + 1
-                    break
+    used = orders_used(coef, dcoef)
     kmax = 2 + used  # a + b <= 3 in the tables, plus D^(used - 1)
     inverse_power_derivatives(complex(r1, r3), kmax, gk)
     grad = np.zeros(2)

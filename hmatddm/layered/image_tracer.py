@@ -78,6 +78,21 @@ def largest_trace_capacity(shear_modulus, n_images):
 
 
 @njit(cache=True)
+def orders_used(coef, dcoef):
+    """One more than the highest power of ``D`` with a non-zero coefficient in ``coef`` or
+    ``dcoef`` ``[f, j, n]`` (at least 1): most traced pairs and triples stop well below the
+    buffer's order."""
+    used = 1
+    for f in range(coef.shape[0]):
+        for j in range(coef.shape[1]):
+            for n in range(coef.shape[2] - 1, used - 1, -1):
+                if coef[f, j, n] != 0.0 or dcoef[f, j, n] != 0.0:
+                    used = n + 1
+                    break
+    return used
+
+
+@njit(cache=True)
 def _apply(coef, power, h, dh, src, dsrc, dst, ddst, n_orders):
     """``dst += coef h^power D^power src`` and its derivative in the source height."""
     if coef == 0.0:

@@ -53,7 +53,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .image_tracer import trace_capacity, trace_potentials
+from .image_tracer import orders_used, trace_capacity, trace_potentials
 
 _INV_4PI = 1.0 / (4.0 * math.pi)
 
@@ -151,7 +151,7 @@ def pair_stress_gradient(r1, r3, eps, coef, dcoef, n_orders, delta, shear_modulu
     point the pair emanates from, for a unit force along ``f``. ``delta``, shear modulus
     and Lame constant are the receiver layer's; ``eps = dz/dt``."""
     work = Workspace(n_orders)
-    _pair_stress_gradient(r1, r3, eps, coef, dcoef, n_orders, delta, shear_modulus, lame, out, work)
+    _pair_stress_gradient(r1, r3, eps, coef, dcoef, delta, shear_modulus, lame, out, work)
 
 
 @njit(cache=True)
@@ -162,17 +162,10 @@ def Workspace(n_orders):
 
 
 @njit(cache=True)
-def _pair_stress_gradient(r1, r3, eps, coef, dcoef, n_orders, delta, shear_modulus, lame, out, work):
+def _pair_stress_gradient(r1, r3, eps, coef, dcoef, delta, shear_modulus, lame, out, work):
     gk, beta, table, dtable, grad = work
     # highest order of D with a non-zero coefficient (most pairs stop well below n_orders)
-    used = 1
-    for f in range(2):
-        for j in range(2):
-            for n in range(n_orders - 1, used - 1, -1):
-                if coef[f, j, n] != 0.0 or dcoef[f, j, n] != 0.0:
-                    used = n + 1
-                    break
-    n_orders = used
+    n_orders = orders_used(coef, dcoef)
     kmax = 3 + n_orders  # a + b <= 4 in the tables, plus D^(n_orders - 1)
     inverse_power_derivatives(complex(r1, r3), kmax, gk)
     for f in range(2):
@@ -252,11 +245,10 @@ def _complementary_gradient(y1, y3, receiver_layer, x1, n_pairs, source_layer, t
     receiver from the traced pairs of a source point ``(x1, t)``; ``work``: a
     :func:`Workspace` of the pairs' order, ``work1`` one of order 1."""
     gradient[:] = 0.0
-    n_orders = pair_coef.shape[-1]
     g_r, delta_r, lame_r = receiver_constants(shear_modulus, poisson_ratio, receiver_layer)
     for k in range(n_pairs):
         if pair_layer[k] == receiver_layer:
-            _pair_stress_gradient(y1 - x1, y3 - pair_z[k], pair_eps[k], pair_coef[k], pair_dcoef[k], n_orders,
+            _pair_stress_gradient(y1 - x1, y3 - pair_z[k], pair_eps[k], pair_coef[k], pair_dcoef[k],
                                   delta_r, g_r, lame_r, gradient, work)
     if receiver_layer != source_layer:
         # minus the whole-plane field of the source's material (added in closed form)
@@ -270,7 +262,7 @@ def _complementary_gradient(y1, y3, receiver_layer, x1, n_pairs, source_layer, t
         coef[1, 0, 0] = -k_2d
         coef[1, 1, 0] = -k_2d
         dcoef = np.zeros((2, 2, 1))
-        _pair_stress_gradient(y1 - x1, y3 - t, 1.0, coef, dcoef, np.int64(1), delta_s, g_s, _lame(g_s, nu_s), gradient,
+        _pair_stress_gradient(y1 - x1, y3 - t, 1.0, coef, dcoef, delta_s, g_s, _lame(g_s, nu_s), gradient,
                               work1)
 
 

@@ -40,6 +40,8 @@ import math
 import numpy as np
 from numba import njit
 
+from .image_tracer import orders_used
+
 _INV_8PI = 1.0 / (8.0 * math.pi)
 
 
@@ -244,14 +246,7 @@ def _pair_tables(r1, r2, r3, sigma, coef, dcoef, order, work):
     the triple's point): ``coef`` at ``order`` (3 for the stress, 2 for the displacement),
     ``dcoef`` one lower."""
     sf, sl, ser, q, base, table, dtable = work
-    n_orders = coef.shape[2]
-    used = 1
-    for f in range(3):
-        for j in range(3):
-            for n in range(n_orders - 1, used - 1, -1):
-                if coef[f, j, n] != 0.0 or dcoef[f, j, n] != 0.0:
-                    used = n + 1
-                    break
+    used = orders_used(coef, dcoef)
     n_c = order + used + 1
     base_derivatives(r1, r2, sigma * r3, sf, sl, q[:, :, :n_c - 1], ser)
     _base_table(sigma, n_c, sf, sl, q, base)
