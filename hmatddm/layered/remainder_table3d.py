@@ -303,10 +303,11 @@ def interpolate(table, source_layer, layer, rho, t, y3, out, w):
 
 
 @njit(cache=True)
-def remainder_point_stress(table, y, layer, x, source_layer, normal, shear_modulus, lame, weight, out, response, w):
+def remainder_point_stress(table, y, layer, x, source_layer, normal, shear_modulus, lame, weight, out, response, w,
+                           scratch):
     """``out[b, i, k] += weight *`` the remainder's stress at ``y`` (in ``layer``) of a unit
     DD density along global ``b`` at ``x`` (in ``source_layer``) on a plane of ``normal``,
-    the source layer's moduli: the table in the frame rotated about z towards the receiver,
+    the source layer's moduli (``response``, ``w``, ``scratch`` (2, 6): scratch): the table in the frame rotated about z towards the receiver,
     contracted with the rotated moment tensor and rotated back."""
     r1 = y[0] - x[0]
     r2 = y[1] - x[1]
@@ -322,8 +323,8 @@ def remainder_point_stress(table, y, layer, x, source_layer, normal, shear_modul
     n1 = -s * normal[0] + c * normal[1]
     n2 = normal[2]
     nr = (n0, n1, n2)
-    moment = np.empty(6)
-    local = np.zeros(6)
+    moment = scratch[0]
+    local = scratch[1]
     for b in range(3):
         # the rotated unit DD along global b
         b0 = c if b == 0 else (s if b == 1 else 0.0)
@@ -380,10 +381,11 @@ def remainder_rectangle_stress(table, y, layer, center, frame, a, b, source_laye
     x = np.empty(3)
     response = np.empty(COMPONENTS.shape[0])
     w = np.empty((3, STENCIL))
+    scratch = np.empty((2, 6))
     normal = frame[2]
     jac = a * b
     for g in range(xi.shape[0]):
         for c in range(3):
             x[c] = center[c] + xi[g] * a * frame[0, c] + eta[g] * b * frame[1, c]
         remainder_point_stress(table, y, layer, x, source_layer, normal, shear_modulus, lame, wt[g] * jac, out,
-                               response, w)
+                               response, w, scratch)

@@ -123,7 +123,8 @@ def test_near_triples_plus_the_table_give_the_image_sum_at_points():
         remainder = np.zeros((3, 3, 3))
         assert rt.covers(table, ls, lr, x[2], y[2], np.hypot(*(y - x)[:2]))
         rt.remainder_point_stress(table, y, lr, x, ls, normal, g[ls], _lame(g[ls], nu[ls]), 1.0, remainder,
-                                  np.empty(len(rt.COMPONENTS)), np.empty((3, rt.STENCIL)))
+                                  np.empty(len(rt.COMPONENTS)), np.empty((3, rt.STENCIL)),
+                                  np.empty((2, 6)))
         worst = max(worst, np.abs(full - near - remainder).max())
     assert worst <= 1e-6 * 10.0 / 0.09
 
