@@ -144,12 +144,14 @@ def _mean_power_law_length(a, l_min, l_max):
     if l_max <= l_min:
         return l_min
 
-    def integral(power):  # of l^power over [l_min, l_max]
-        if abs(power + 1.0) < 1e-12:
-            return math.log(l_max / l_min)
-        return (l_max ** (power + 1.0) - l_min ** (power + 1.0)) / (power + 1.0)
+    ratio = l_max / l_min
 
-    return integral(1.0 - a) / integral(-a)
+    def integral(power):  # of (l / l_min)^power d(l / l_min) over [1, ratio]: finite for any exponent
+        if abs(power + 1.0) < 1e-12:
+            return math.log(ratio)
+        return math.expm1(min((power + 1.0) * math.log(ratio), 700.0)) / (power + 1.0)
+
+    return l_min * integral(1.0 - a) / integral(-a)
 
 
 def _natural_elements(scene):
