@@ -6,7 +6,7 @@ Each *ribbon* element ``r`` (a fully fractured element next to the front) carrie
 distance ``s_r`` from its centre to the front, found by inverting the tip asymptote
 (:mod:`.tip_asymptote`) from its opening. The signed distance ``phi`` (negative inside)
 is ``-s_r`` at the ribbon centres and solves the eikonal equation ``|grad phi| = 1``
-elsewhere (:class:`FrontField`: first-order fast marching on the cell centres, outward
+elsewhere (:class:`FrontField`: first-order fast marching on the cell centres (:mod:`.fast_marching`), outward
 through the cells that are not fully fractured and inward through those that are; the
 upwind update is exact for a straight front in any direction, so the front does not
 favour the grid axes), bilinear between the centres. A *tip* element is crossed by the
@@ -18,12 +18,11 @@ that opening: the partial element is exactly as wide, on average, as the asympto
 :class:`PlanarGrid` maps the elements of one planar fracture (3D: equal squares on a
 grid; 2D: equal segments on a line) to integer cells and back.
 """
-import heapq
-
 import numpy as np
 
 from ..errors import InputError
 from ..mesh import Mesh2D, Mesh3D
+from .fast_marching import march, nearest_circle
 
 CHANNEL, TIP, EMPTY, FILLED = 0, 1, 2, 3  # FILLED: fully fractured during the last step
 
@@ -104,73 +103,13 @@ class PlanarGrid:
                       np.full(m, template.fracture_id[0], np.int64))
 
 
-def level_set(points, centers, distances, chunk=4096):
+def level_set(points, centers, distances):
     """``min_r (|x - x_r| - s_r)`` and the arg-min ``r`` (points (M, k), in plane): the
-    distance to a union of circles (used for nearest ribbons and in tests)."""
-    points = np.asarray(points, float)
-    phi = np.empty(len(points))
-    nearest = np.empty(len(points), np.int64)
-    for start in range(0, len(points), chunk):
-        p = points[start:start + chunk]
-        value = np.linalg.norm(p[:, None, :] - centers[None, :, :], axis=2) - distances[None, :]
-        nearest[start:start + chunk] = np.argmin(value, axis=1)
-        phi[start:start + chunk] = value[np.arange(len(p)), nearest[start:start + chunk]]
-    return phi, nearest
-
-
-def _march(phi, known, allowed, h):
-    """First-order fast marching of ``|grad phi| = 1`` (increasing ``phi``) from the
-    ``known`` cells through the ``allowed`` cells of a k-dimensional array (in place)."""
-    shape = phi.shape
-    k = phi.ndim
-    done = known.copy()
-    heap = []
-
-    def update(index):
-        values = []
-        for axis in range(k):
-            best = np.inf
-            for sign in (-1, 1):
-                j = list(index)
-                j[axis] += sign
-                if 0 <= j[axis] < shape[axis] and done[tuple(j)]:
-                    best = min(best, phi[tuple(j)])
-            if np.isfinite(best):
-                values.append(best)
-        values.sort()
-        value = values[0] + h
-        for m in range(2, len(values) + 1):  # the upwind quadratic with the m smallest neighbours
-            a = np.array(values[:m])
-            b = a.sum()
-            disc = b * b - m * (np.sum(a * a) - h * h)
-            if disc < 0.0:
-                break
-            candidate = (b + np.sqrt(disc)) / m
-            if candidate < values[m - 1]:
-                break
-            value = candidate
-        return value
-
-    def push_neighbours(index):
-        for axis in range(k):
-            for sign in (-1, 1):
-                j = list(index)
-                j[axis] += sign
-                j = tuple(j)
-                if 0 <= j[axis] < shape[axis] and allowed[j] and not done[j]:
-                    value = update(j)
-                    if value < phi[j]:
-                        phi[j] = value
-                        heapq.heappush(heap, (value, j))
-
-    for index in zip(*np.nonzero(known)):
-        push_neighbours(tuple(int(i) for i in index))
-    while heap:
-        value, index = heapq.heappop(heap)
-        if done[index] or value > phi[index]:
-            continue
-        done[index] = True
-        push_neighbours(index)
+    distance to a union of circles (used for nearest ribbons and in tests; compiled,
+    :func:`.fast_marching.nearest_circle`)."""
+    points = np.ascontiguousarray(points, float).reshape(len(points), -1)
+    centers = np.ascontiguousarray(centers, float).reshape(len(centers), -1)
+    return nearest_circle(points, centers, np.ascontiguousarray(distances, float))
 
 
 class FrontField:
@@ -203,9 +142,9 @@ class FrontField:
         known[ribbon] = True
         inside[ribbon] = True
         phi[ribbon] = -self.distances
-        _march(phi, known, ~inside, self.h)              # outward, phi increasing
+        march(phi, known, ~inside, self.h)              # outward, phi increasing
         inward = np.where(known, -phi, np.inf)
-        _march(inward, known, inside & ~known, self.h)   # inward, -phi increasing
+        march(inward, known, inside & ~known, self.h)   # inward, -phi increasing
         phi[inside & ~known] = -inward[inside & ~known]
         unreached = ~np.isfinite(phi)
         phi[unreached & inside] = -np.inf
