@@ -1,6 +1,6 @@
 """The viscosity-dominated (M-vertex) similarity solutions of a plane-strain (KGD) and a
 radial (penny) hydraulic fracture, zero toughness and zero leak-off, Newtonian fluid,
-computed numerically to about 1e-6 (the published constants carry 0.2-0.6%).
+computed numerically to 1e-7 (the published constants are 0.03-1% off).
 
 Scalings (those of :func:`hmatddm.analytical.solutions._viscosity_scales`): ``mu' = 12 mu``,
 ``eps = (mu'/(E' t))^(1/3)``, ``L = (E' Q^3 t^4/mu')^(1/6)`` (KGD, ``Q`` per unit height into
@@ -19,7 +19,8 @@ Equations (derived from ``dw/dt + div q = 0``, ``q = -w^3 grad p / mu'``):
   per wing (``gamma int_-1^1 Omega = 1``) and ``rho Omega^3 Pi' -> -1/(2 pi)`` (the log
   singularity ``Pi ~ -B ln rho``, ``2 pi B Omega(0)^3 = 1``) once the volume holds;
 * elasticity as the superposition of cracks of half length (radius) ``t`` (Sneddon's
-  representation; Sneddon and Lowengrub 1969)::
+  representation; the KGD form reproduces the point-source pair ``2 - pi |xi|`` of
+  :func:`hmatddm.analytical.kgd_m_vertex_profile` exactly)::
 
       Omega(x) = c gamma int_x^1 t F(t) / sqrt(t^2 - x^2) dt,
       KGD:    c = 4/pi, F(t) = 2 int_0^1 Pi(s t) / sqrt(1 - s^2) ds
@@ -36,7 +37,9 @@ is solved by Newton's method, then ``gamma`` follows from the volume.
 
 Converged constants (module constants below; 16 points give them to 1e-6, 24 to 1e-8; the
 tip coefficient is the exact ``beta_m (V t/L)^(1/3) gamma^(2/3)``, ``beta_m = 2^(1/3) 3^(5/6)``,
-to 1e-9, although nothing imposes it; other maps ``x(tau)`` give the same digits to 5e-8)::
+to 1e-9, although nothing imposes it; other maps ``x(tau)`` give the same digits to 1e-9;
+the least-squares power-law series of :mod:`.power_law` at ``n = 1``, an independent method,
+gives gamma to 4e-7; benchmarks/bench_m_vertex.py and benchmarks/RESULTS.md, issue 39)::
 
     KGD:    gamma = 0.6154113,  Omega(0) = 1.1258346,  Pi(0) = 0.5448171
     radial: gamma = 0.6978376,  Omega(0) = 1.1932560,  B = 0.0936740
@@ -48,12 +51,12 @@ zero order) gamma -0.34%, Omega(0) +0.37%, B -1.05%; Dontsov (2016) gamma -0.49%
 
 Discretisation: ``W = (1 - x)^(2/3) w(tau)`` with ``x = 1 - (1 - tau^2)^6``, ``w`` a polynomial
 in ``tau`` interpolated at ``n`` Chebyshev points of ``[0, 1]``. The map turns the viscous tip
-``(1 - x)^(2/3)`` into ``(1 - tau^2)^4`` and the weaker terms (the tip eigenfunction
-``(1 - x)^1.58``, the source's ``x^2 ln x``) into smooth functions of ``tau``;
+``(1 - x)^(2/3)`` into ``(1 - tau^2)^4`` and the weaker terms (fractional powers of ``1 - x``
+above 2/3 at the tip, the source's ``x^2 ln x``) into smooth functions of ``tau``;
 ``-Pi' (1 - x)^(4/3)`` (times ``rho``, radial) and ``F / (1 - x)^(1/6)`` are interpolated in the
 same way (radial: ``F + B ln t``, whose log part opens a cone ``8 B / pi (sqrt(1 - rho^2) - rho
-arccos rho)``). The integrals of the kernels against
-the interpolants are done once per ``n`` by Gauss rules graded toward their singular points.
+arccos rho)``). The integrals of the kernels against the interpolants are done once per ``n``
+by Gauss rules graded toward their singular points.
 """
 import functools
 

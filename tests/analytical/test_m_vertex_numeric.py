@@ -53,6 +53,30 @@ def test_published_constants_agree_to_their_truncation(kgd, radial):
     assert radial.opening_at_source == pytest.approx(1.1901, rel=3e-3)
 
 
+def test_kgd_agrees_with_the_power_law_series_at_n_1(kgd):
+    """An independent computation: the least-squares Gegenbauer series of
+    hmatddm/analytical/power_law.py (Adachi and Detournay's basis, 8 terms) at n = 1."""
+    from hmatddm.analytical import power_law
+
+    series = power_law.solve(1.0)
+    assert series.gamma == pytest.approx(kgd.gamma, rel=1e-6)
+    opening = series.gamma * np.ravel(series.opening(np.array([0.0])))[0]
+    assert opening == pytest.approx(kgd.opening_at_source, rel=1e-5)
+    assert np.ravel(series.pressure(np.array([0.0])))[0] == pytest.approx(kgd.pressure_at_source, rel=1e-4)
+
+
+@pytest.mark.slow
+def test_radial_agrees_with_the_power_law_series_at_n_1(radial):
+    """The same for the radial series of power_law.py (its opening at the source is the less
+    accurate: 4e-4)."""
+    from hmatddm.analytical import power_law
+
+    series = power_law.solve_radial(1.0)
+    assert series.gamma == pytest.approx(radial.gamma, rel=1e-6)
+    opening = series.gamma * np.ravel(series.opening(np.array([0.0])))[0]
+    assert opening == pytest.approx(radial.opening_at_source, rel=5e-4)
+
+
 def test_volume_balance(kgd, radial):
     """gamma int_-1^1 Omega = 1 (KGD), 2 pi gamma^2 int_0^1 Omega rho d rho = 1 (radial)."""
     tip = 1.0 - 1e-13
