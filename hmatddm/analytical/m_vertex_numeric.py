@@ -125,10 +125,10 @@ def _graded(a, b, at_a, scale):
     length = b - a
     if length <= 0.0:
         return np.zeros(0), np.zeros(0)
-    edges = [0.0]
-    h = min(scale, length)
+    edges, h = [0.0], scale
     while edges[-1] < length:
-        edges.append(min(length, edges[-1] + h if len(edges) > 1 else h))
+        end = edges[-1] + h
+        edges.append(length if end > length - 0.5 * h else end)  # no sliver of a last panel
         h *= 2.0
     if at_a and b == 1.0 and _FAR_LEVELS:  # also grade toward the tip tau = 1 (the far end)
         lo, hi = edges[-2], edges[-1]
@@ -213,13 +213,9 @@ def _cone(gap):
     return (4.0 * np.arcsin(np.sqrt(0.5 * e)) * gap[:, None] * v[None, :]) @ wv
 
 
-def _pressure_gradient_scaled(w, flux, x, gap, radial):
-    """``p = -Pi' x^a (1 - x)^(4/3) = [bracket] / (gap^(2/3) w^3)`` at the points."""
-    return (flux @ w) / w**3
-
-
 def _solve_scaled(n, radial, tol=1e-13, max_iter=50):
-    """Newton on ``w = G p(w)``, ``G = opening @ force``; returns ``w`` at the points."""
+    """Newton on ``w = G p(w)``, ``G = opening @ force (+ the radial cone)``, with ``p = -Pi' x^a
+    (1 - x)^(4/3) = (flux @ w) / w^3``; returns ``w`` at the points."""
     tau, x, gap, flux, force, opening, opening_log = _operators(n, radial)
     g = opening @ force + opening_log
     w = np.full(n, 1.7 if radial else 1.8)
@@ -251,7 +247,7 @@ class MVertexSolution:
     """
 
     def __init__(self, radial, n):
-        self.radial, self.n = bool(radial), int(n)
+        self.radial, self.n = bool(radial), _checked_points(n)
         self._w = _solve_scaled(self.n, self.radial)
         self._p = (_operators(self.n, self.radial)[3] @ self._w) / self._w**3
         t, wt = _graded(0.0, 1.0, True, 0.5)
