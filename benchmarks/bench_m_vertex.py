@@ -7,7 +7,9 @@ independence of the stretching map, and the differences of the published constan
 Columns: gamma (half length or radius over L), Omega(0) (opening at the source over eps L),
 Pi(0) (KGD) or B (radial, Pi ~ -B ln rho), Pi at 0.5 and 0.9, the tip coefficient over its
 exact value beta_m (V t / L)^(1/3) gamma^(2/3) minus one, wall and CPU time of a solve
-(operators built and cached on the first call of each size).
+(operators built and cached on the first call of each size). Last table: the openings of the
+closed forms of hmatddm/analytical/solutions.py against the computed one at the same distance
+from the source (each closed form on its own radius, so the tip errors include the radius's).
 """
 import os
 import sys
@@ -17,6 +19,7 @@ sys.path.insert(0, os.path.dirname(__file__))
 from _common import machine, print_table  # noqa: E402
 
 from hmatddm.analytical import m_vertex_numeric as mv  # noqa: E402
+from hmatddm.analytical import solutions  # noqa: E402
 
 BETA_M = 2.0 ** (1.0 / 3.0) * 3.0 ** (5.0 / 6.0)
 
@@ -78,6 +81,21 @@ def main():
     print_table(["constant", "source", "published", "computed", "published / computed - 1"],
                 [[name, source, f"{value:g}", f"{computed:.7f}", f"{value / computed - 1.0:+.3%}"]
                  for name, source, value, computed in published])
+
+    # openings of the closed forms at the same distance r / L (each on its own radius)
+    fractions = (0.0, 0.25, 0.5, 0.75, 0.9, 0.97)
+    rows = []
+    for name, exact, own_gamma, shape in (
+            ("KGD, Adachi and Detournay", kgd, solutions._KGD_M_GAMMA,
+             lambda x: solutions._KGD_M_GAMMA * solutions._kgd_m_width_bar(x)),
+            ("radial, Savitski and Detournay", radial, solutions._RADIAL_M_GAMMA, solutions._radial_m_width_scaled),
+            ("radial, Dontsov", radial, 0.6944, lambda x: 1.1901 * (1.0 + x) ** 0.487 * (1.0 - x) ** (2.0 / 3.0))):
+        cells = [name]
+        for f in fractions:
+            own = f * exact.gamma / own_gamma
+            cells.append(f"{float(shape(own)) / float(exact.opening(f)) - 1.0:+.2%}" if own < 1.0 else "closed")
+        rows.append(cells)
+    print_table(["opening / computed - 1 at r = f gamma L, f ="] + [f"{f:g}" for f in fractions], rows)
 
 
 if __name__ == "__main__":
