@@ -9,6 +9,8 @@ the validation table and the scenes' ``[reference]`` blocks compare with.
   by the asymptotic front.
 * :mod:`.transition_table`: the radial K-M transition tabulated in time, for a run that
   compares with it at every step.
+* :mod:`.m_vertex_numeric`: the KGD and radial M-vertex similarity solutions computed to
+  1e-7 (the published constants above carry 0.03-1%).
 * :mod:`.leak_off`: leak-off-dominated sizes (the K~ and M~ vertices) and the plane-strain
   K-K~ edge.
 
@@ -30,8 +32,10 @@ _REGIMES = (
     "applicable_solution",
 )
 _TABLES = ("RadialTransitionTable", "radial_transition_table")
+_M_VERTEX = ("kgd_m_vertex_numeric", "radial_m_vertex_numeric")
 _EXPORTS = {**{name: ".solutions" for name in _SOLUTIONS}, **{name: ".leak_off" for name in _LEAK_OFF},
-            **{name: ".regimes" for name in _REGIMES}, **{name: ".transition_table" for name in _TABLES}}
+            **{name: ".regimes" for name in _REGIMES}, **{name: ".transition_table" for name in _TABLES},
+            **{name: ".m_vertex_numeric" for name in _M_VERTEX}}
 __getattr__, __dir__ = attach(__name__, _EXPORTS)
 
-__all__ = list(_SOLUTIONS) + list(_LEAK_OFF) + list(_REGIMES) + list(_TABLES)
+__all__ = list(_SOLUTIONS) + list(_LEAK_OFF) + list(_REGIMES) + list(_TABLES) + list(_M_VERTEX)
