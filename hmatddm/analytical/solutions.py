@@ -25,11 +25,15 @@ Comparing a discrete run with them:
 Length (over ~400 lines): a catalogue of independent closed-form solutions, each a few
 lines with its equation; tests, benchmarks and scenes look them up in one place.
 """
+import functools
+
 import numpy as np
 from scipy import special
 
 from .._validation import finite_array, finite_scalar, positive_scalar
 from ..errors import InputError
+from .m_vertex_numeric import (KGD_M_GAMMA_ACCURATE, KGD_M_OPENING_ACCURATE, KGD_M_PRESSURE_ACCURATE, MVertexSolution,
+                               RADIAL_M_GAMMA_ACCURATE, RADIAL_M_OPENING_ACCURATE)
 
 
 def griffith_opening(x, half_length, load, material):
@@ -95,15 +99,20 @@ def radial_k_vertex(t, injection_rate, fracture_toughness, material):
 
 def radial_m_vertex(t, injection_rate, viscosity, material):
     """Viscosity-dominated radial fracture, no leak-off (ref. Eqs 4.62-4.63, Savitski and
-    Detournay 2002). Returns ``(radius, max_width)``; the net pressure is log-singular at
+    Detournay 2002), with the constants computed to 1e-7 by
+    :mod:`~hmatddm.analytical.m_vertex_numeric`: ``R = 0.6978376 (E' Q^3 t^4 / mu')^(1/9)``,
+    ``w(0) = 1.1932560 (mu'^2 Q^3 t / E'^2)^(1/9)``. (Ref. Eqs 4.62-4.63 print Dontsov's
+    approximate 0.6944 and 1.1901, 0.49% and 0.26% low; Savitski and Detournay's truncated
+    series 0.6955 and 1.1977, -0.34% and +0.37%: issue 39, benchmarks/RESULTS.md.)
+    Returns ``(radius, max_width)``; the net pressure is log-singular at
     the injection point and is not a single number: see :func:`radial_m_vertex_profile` and
     :func:`radial_m_vertex_pressure` for the profiles (and the meaning of ref. Eq. 4.64)."""
     t = np.asarray(t, dtype=float)
     e_prime = material.plane_strain_modulus
     mu_prime = 12.0 * finite_scalar("viscosity", viscosity)
     q = injection_rate
-    radius = 0.6944 * (q**3 * e_prime * t**4 / mu_prime) ** (1.0 / 9.0)
-    max_width = 1.1901 * (mu_prime**2 * q**3 * t / e_prime**2) ** (1.0 / 9.0)
+    radius = RADIAL_M_GAMMA_ACCURATE * (q**3 * e_prime * t**4 / mu_prime) ** (1.0 / 9.0)
+    max_width = RADIAL_M_OPENING_ACCURATE * (mu_prime**2 * q**3 * t / e_prime**2) ** (1.0 / 9.0)
     return radius, max_width
 
 
@@ -155,9 +164,18 @@ def _open_interval(name, value, low, low_closed):
     return value
 
 
+@functools.lru_cache(maxsize=2)
+def _computed_m_vertex(radial):
+    """The M-vertex similarity solution computed once (32 points: constants to 1e-9)."""
+    return MVertexSolution(radial, 32)
+
+
+# The published zero-order series below are no longer what the profile functions return
+# (the computed solution is, issue 39); they are kept for benchmarks/bench_m_vertex.py,
+# which measures how far they are from it.
 # Savitski and Detournay (2002), Int. J. Solids Struct. 39:6311-6337, zero-toughness
 # (M-vertex) solution, Eqs for Omega_m0 and Pi_m0 with its published constants.
-_RADIAL_M_GAMMA = 0.6955
+_RADIAL_M_GAMMA = 0.6955  # (benchmarks/bench_m_vertex.py)
 _RADIAL_M_A1 = 0.3581
 _RADIAL_M_B = 0.09269
 _RADIAL_M_C1 = 0.6846
@@ -183,50 +201,31 @@ def _radial_m_width_scaled(rho):
 
 def radial_m_vertex_profile(rho, t, injection_rate, viscosity, material):
     """Opening and net pressure of a viscosity-dominated radial (penny) hydraulic fracture,
-    zero toughness and zero leak-off: the M-vertex solution of Savitski and Detournay (2002)
-    in its published zero-order form.
+    zero toughness and zero leak-off: the M-vertex similarity solution (Savitski and
+    Detournay 2002), computed to 1e-7 by :mod:`~hmatddm.analytical.m_vertex_numeric`.
 
-    ``rho = r / R`` in ``[0, 1)`` with ``R = 0.6955 L``; ``L = (E' Q^3 t^4 / mu')^(1/9)``,
+    ``rho = r / R`` in ``[0, 1)`` with ``R = 0.6978376 L``; ``L = (E' Q^3 t^4 / mu')^(1/9)``,
     ``eps = (mu' / (E' t))^(1/3)``, ``mu' = 12 mu``. Then ``w = eps L Omega(rho)`` and
-    ``p_net = eps E' Pi(rho)`` with::
+    ``p_net = eps E' Pi(rho)``. The width has the viscous tip asymptote ``(1 - rho)^(2/3)``;
+    the pressure goes to ``-inf`` as ``(1 - rho)^(-1/3)`` at the tip and to ``+inf`` as
+    ``-B ln rho`` (``B = 0.0936740``) at the injection point (a point source): at ``rho = 0``
+    the pressure returned is ``+inf``.
 
-        Pi(rho)    = A1 [omega1 - 2 / (3 (1 - rho)^(1/3))] - B [ln(rho / 2) + 1]
-        Omega(rho) = gamma { [sqrt(70)/3 C1 + 4 sqrt(5)/9 C2 (13 rho - 6)] (1 - rho)^(2/3)
-                             + 8 B / pi [sqrt(1 - rho^2) - rho arccos(rho)] }
-
-    ``gamma = 0.6955, A1 = 0.3581, B = 0.09269, C1 = 0.6846, C2 = 0.07098, omega1 = 2.479``.
-    Accuracy of this published zero-order form (measured in ``tests/analytical/test_analytical.py``):
-    ``Omega`` is the opening that elasticity gives for ``Pi`` to 0.2% for ``rho <= 0.7`` (0.8%
-    at 0.9, 2% at 0.97: the pressure series is truncated); the global volume balance
-    ``2 pi gamma^2 int Omega rho drho = 1`` holds to 1e-4, the source flux
-    ``2 pi B Omega(0)^3 = 1`` to 1e-3, and local mass conservation (lubrication) to 1.4%.
-    The width has the viscous tip asymptote ``(1 - rho)^(2/3)``; the pressure goes to
-    ``-inf`` as ``(1 - rho)^(-1/3)`` at the tip and to ``+inf`` as ``-B ln rho`` at the
-    injection point (a point source): at ``rho = 0`` the pressure returned is ``+inf``.
-
-    Relation to ref. Eqs 4.62-4.64 (Dontsov 2016, used by :func:`radial_m_vertex`): Dontsov
-    approximates the width by ``w = 1.1901 eps L (1 + rho)^0.487 (1 - rho)^(2/3)`` on a radius
-    ``0.6944 L`` (this form is in his published code, RadialVertexSolutions.m of
-    github.com/egordontsov/Radial-HF-rapid-solution; the same code gives
-    ``(1 + rho)^0.397 (1 - rho)^(5/8)`` for the leak-off M-tilde vertex). Eq. 4.64's constant
-    is ``2.4019 = 2^0.487 * 1.1901 / 0.6944`` (2.4020), i.e. ``E' w_tip / R`` in units of
-    ``eps E' = (mu' E'^2/t)^(1/3)``, with ``w_tip = 2^0.487 w(0)`` the coefficient of
-    ``(1 - rho)^(2/3)`` at the tip. We read ``F`` accordingly as the dimensionless pressure
-    that elasticity assigns to the normalised width ``((1 + rho)/2)^lambda (1 - rho)^delta``,
-    a function of ``rho`` (log-singular at ``rho = 0``, as Dontsov's width has a non-zero
-    slope there), with ``(lambda, delta) = (0.487, 2/3)`` for the M-vertex; the ``(0.397,
-    5/8)`` printed in Eq. 4.64 are the M-tilde exponents. (This reading is inferred from the
-    numbers; the 2016 paper itself was not consulted.) This function uses Savitski and
-    Detournay's closed-form pressure instead of a numerical ``F``. The two solutions agree to
-    well within their accuracy: radius ``0.6955 L`` vs ``0.6944 L`` (0.16%), opening at the
-    source ``1.1977`` vs ``1.1901`` (0.64%), both holding the injected volume to 1e-4.
+    The published forms differ from it (benchmarks/RESULTS.md, "Issue 39: the M vertices
+    computed to 1e-4"): Savitski and Detournay's zero-order series (``gamma = 0.6955``,
+    ``Omega(0) = 1.1977``; its opening is what elasticity gives for its pressure only to 0.2%
+    at ``rho <= 0.7`` and 2% at 0.97) and Dontsov's width ``1.1901 eps L (1 + rho)^0.487 (1 -
+    rho)^(2/3)`` on a radius ``0.6944 L`` (ref. Eqs 4.62-4.64; Eq. 4.64's constant ``2.4019 =
+    2^0.487 * 1.1901 / 0.6944`` is ``E' w_tip / R`` in units of ``eps E'``, and the ``(0.397,
+    5/8)`` printed there are the M-tilde exponents of his code).
 
     Returns ``(width, net_pressure)`` shaped like ``rho``; ``t`` must be a scalar > 0.
     """
     rho = _open_interval("rho", rho, 0.0, low_closed=True)
     e_prime, eps, length = _viscosity_scales(positive_scalar("t", t), injection_rate, viscosity,
                                              material, 1.0 / 9.0)
-    return eps * length * _radial_m_width_scaled(rho), eps * e_prime * _radial_m_pressure_scaled(rho)
+    solution = _computed_m_vertex(True)
+    return eps * length * solution.opening(rho), eps * e_prime * solution.pressure(rho)
 
 
 def well_element_radius(element_size):
@@ -290,34 +289,24 @@ def _kgd_m_pressure_scaled(xi):
 
 def kgd_m_vertex_profile(xi, t, injection_rate, viscosity, material):
     """Opening and net pressure of a viscosity-dominated plane-strain (KGD) hydraulic fracture,
-    zero toughness and zero leak-off (Spence and Sharp 1985; Adachi and Detournay 2002).
+    zero toughness and zero leak-off (Spence and Sharp 1985; Adachi and Detournay 2002): the
+    similarity solution computed to 1e-7 by :mod:`~hmatddm.analytical.m_vertex_numeric`.
 
     ``injection_rate`` ``Q`` is per unit height and feeds both wings (``Q/2`` each).
-    ``xi = x / l`` in ``(-1, 1)`` with ``l = gamma L``, ``L = (E' Q^3 t^4 / mu')^(1/6)``,
-    ``eps = (mu' / (E' t))^(1/3)``, ``mu' = 12 mu``; ``w = eps L gamma Omega_bar(xi)``,
-    ``p_net = eps E' Pi(xi)`` with the series of Adachi and Detournay (2002, n = 1)::
-
-        Omega_bar = sum_j A_j (1 - xi^2)^(2/3) C_(2j-2)^(1/6)(xi) + B Omega**(xi)
-        Pi        = sum_j A_j Pi*_j(xi) + B (2 - pi |xi|)
-
-    ``C_n^(1/6)`` Gegenbauer polynomials, ``Pi*_j`` their elastic pressures (hypergeometric
-    functions), ``Omega** = 4 sqrt(1 - xi^2) + 2 xi^2 ln|(1 - sqrt(1 - xi^2)) /
-    (1 + sqrt(1 - xi^2))|``; ``gamma = 0.61524, B = 0.06858, A = (1.61750, 0.39650,
-    1.00297e-2, 1.06179e-2, -2.97947e-3, -0.74268e-3, -1.34675e-3)`` (seven terms, as
-    tabulated in the EPFL Geo-Energy Lab reference implementation PyFracX). Each pair is an
-    exact elastic pair (checked to 1e-6 by quadrature in the tests); the truncated series
-    holds the injected volume to 0.3% (the balance asks for ``gamma = 0.6162``), the flux
-    ``Q/2`` at the source to 0.7% and local mass conservation to 1%.
-    The pressure is finite at the injection point (a kink, ``Pi(0) = 0.5443``) and goes to
-    ``-inf`` as ``(1 - |xi|)^(-1/3)`` at the tips.
+    ``xi = x / l`` in ``(-1, 1)`` with ``l = 0.6154113 L``, ``L = (E' Q^3 t^4 / mu')^(1/6)``,
+    ``eps = (mu' / (E' t))^(1/3)``, ``mu' = 12 mu``; ``w = eps L Omega(|xi|)``,
+    ``p_net = eps E' Pi(|xi|)``. The pressure is finite at the injection point (a kink,
+    ``Pi(0) = 0.5448171``) and goes to ``-inf`` as ``(1 - |xi|)^(-1/3)`` at the tips. Adachi
+    and Detournay's seven-term series (``gamma = 0.61524``; its volume balance asks for
+    0.6162) is 0.03% short in length and 0.23% low in opening at the source.
 
     Returns ``(width, net_pressure)`` shaped like ``xi``; ``t`` must be a scalar > 0.
     """
     xi = _open_interval("xi", xi, -1.0, low_closed=False)
     e_prime, eps, length = _viscosity_scales(positive_scalar("t", t), injection_rate, viscosity,
                                              material, 1.0 / 6.0)
-    return (eps * length * _KGD_M_GAMMA * _kgd_m_width_bar(xi),
-            eps * e_prime * _kgd_m_pressure_scaled(xi))
+    solution = _computed_m_vertex(False)
+    return eps * length * solution.opening(np.abs(xi)), eps * e_prime * solution.pressure(np.abs(xi))
 
 
 def kgd_m_vertex(t, injection_rate, viscosity, material):
@@ -328,16 +317,17 @@ def kgd_m_vertex(t, injection_rate, viscosity, material):
     opening and net pressure taken at the injection point, where the opening is largest and
     the (finite) pressure is highest::
 
-        l    = 0.61524 (E' Q^3 t^4 / mu')^(1/6)
-        w(0) = 1.1233 (mu' Q^3 t^2 / E')^(1/6)
-        p(0) = 0.5443 (mu' E'^2 / t)^(1/3)
+        l    = 0.6154113 (E' Q^3 t^4 / mu')^(1/6)
+        w(0) = 1.1258346 (mu' Q^3 t^2 / E')^(1/6)
+        p(0) = 0.5448171 (mu' E'^2 / t)^(1/3)
 
-    (prefactors of the seven-term series; ``mu' = 12 mu``).
+    (``mu' = 12 mu``; the constants computed to 1e-7 by
+    :mod:`~hmatddm.analytical.m_vertex_numeric`; the seven-term series of Adachi and
+    Detournay gives 0.61524, 1.1233 and 0.5443: -0.03%, -0.23%, -0.10%).
     """
     e_prime, eps, length = _viscosity_scales(t, injection_rate, viscosity, material, 1.0 / 6.0)
-    return (_KGD_M_GAMMA * length,
-            _KGD_M_GAMMA * _kgd_m_width_bar(0.0) * eps * length,
-            _kgd_m_pressure_scaled(0.0) * eps * e_prime)
+    return (KGD_M_GAMMA_ACCURATE * length, KGD_M_OPENING_ACCURATE * eps * length,
+            KGD_M_PRESSURE_ACCURATE * eps * e_prime)
 
 
 def radial_regime(t, injection_rate, viscosity, fracture_toughness, material):

@@ -19,9 +19,6 @@ SAMPLES = 201
 # rho = r / R of the sampled M-vertex profiles: the pressure is +inf at the well (radial)
 # and -inf at the tip, so the samples stop short of both
 _M_RHO = (0.01, 0.99)
-# R = 0.6955 L of the radial M-vertex profile of Savitski and Detournay (2002)
-# (hmatddm.analytical.radial_m_vertex_profile)
-_RADIAL_M_GAMMA = 0.6955
 
 
 def _symmetric(rho, width, pressure, radius):
@@ -93,11 +90,10 @@ def closed_form_profile(scene, time_value):
         width, pressure = analytical.kgd_m_vertex_profile(rho, t, rate / scene["height"], viscosity, rock)
         profile = _symmetric(rho, width, pressure, float(size))
     elif kind == "radial-m":
-        e_prime, mu_prime = rock.plane_strain_modulus, 12.0 * viscosity
-        radius = _RADIAL_M_GAMMA * (e_prime * rate ** 3 * t ** 4 / mu_prime) ** (1.0 / 9.0)
+        radius, _ = analytical.radial_m_vertex(t, rate, viscosity, rock)  # the profile's own radius
         rho = np.linspace(*_M_RHO, SAMPLES)
         width, pressure = analytical.radial_m_vertex_profile(rho, t, rate, viscosity, rock)
-        profile = _symmetric(rho, width, pressure, radius)
+        profile = _symmetric(rho, width, pressure, float(radius))
     elif kind == "radial-km":
         rho = np.linspace(0.0, 1.0, SAMPLES)
         table = analytical.radial_transition_table(rate, viscosity, toughness, rock)  # tabulated in time
