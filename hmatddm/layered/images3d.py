@@ -22,8 +22,11 @@ their image error below :data:`.rectangle_quadrature.ENTRY_TOL` of the largest e
 triples (those that can reach the receiver's layer) are integrated by quadrature; the far
 ones, the smooth layered remainder, come from a table built once per medium and mesh
 extent (:mod:`.remainder_table3d`, ``LayeredMedium(method="table")``, the default;
-``method="quadrature"`` integrates every triple, the cross-check). The image terms are not
-integrated in closed form: the Hansen base functions ``F = r - sigma r3 log(r + sigma r3)`` and
+``method="quadrature"`` integrates every triple, the cross-check). In a half-space (one
+solid layer under a void) the image and surface terms of a rectangle with a horizontal side
+are in closed form (:mod:`.okada3d`, Okada 1992; ``LayeredRectangles.closed_form``); a
+rectangle without one, and any medium with two solid layers, keeps the quadrature. Beyond the
+half-space the image terms are not integrated in closed form: the Hansen base functions ``F = r - sigma r3 log(r + sigma r3)`` and
 ``L = log(r + sigma r3)`` (and their horizontal derivatives) of every image, with
 coefficients polynomial in the source height, have no primitive over a rectangle of any
 orientation among the uniform-rock kernel's primitives of ``1/r`` (their integrals are
