@@ -146,7 +146,7 @@ def element_traction(data, i, j, state, work, block):
     (:mod:`.remainder_table3d`) the quadrature takes the near triples only and the table
     the rest; a receiver outside the table's range takes every triple by quadrature. In a
     half-space, a source with a horizontal side (``closed_form``) takes its image and
-    surface terms in closed form instead (:func:`.okada3d.okada_stress`, Okada 1992),
+    surface terms in closed form instead (:func:`.okada3d.okada_traction`, Okada 1992),
     whatever the number of images (the closed form is the exact half-space)."""
     traced, is_traced, near_only = state
     local, image, gradient, kelvin, ws1, ws, room, rules, okada_work = work
@@ -168,11 +168,8 @@ def element_traction(data, i, j, state, work, block):
     rectangle3d.traction_pair(point, normal, center, frame, a, b, g[ls], nu[ls], data.singular_shift, block, local,
                               near)
     if data.closed_form[j]:
-        okada3d.okada_stress(point, center, data.okada[j], data.okada_half[j, 0], data.okada_half[j, 1], data.surface,
-                             g[ls], nu[ls], False, True, okada_work, image)
-        for p in range(3):
-            for q in range(3):
-                block[p, q] += image[q, p, 0] * normal[0] + image[q, p, 1] * normal[1] + image[q, p, 2] * normal[2]
+        okada3d.okada_traction(point, normal, center, data.okada[j], data.okada_half[j, 0], data.okada_half[j, 1],
+                               data.surface, g[ls], nu[ls], False, True, okada_work, block)
     elif interfaces.shape[0] > 0:
         lr = data.layer[i]
         image[:] = 0.0

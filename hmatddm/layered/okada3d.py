@@ -60,20 +60,43 @@ def _plus(a, b, c, r):
     return (b * b + c * c) / (r - a)
 
 
-@njit(cache=True)
-def _corner(xi, eta, q, z, sd, cd, alpha, image, sign, out, t, b, w):
-    """Add ``sign`` times the derivatives of one corner to ``out[k, i, j]`` (``du_i /
+@njit(cache=True, inline="always")
+def _add_real(s, k, j, sign, cd, sd, a0, a1, a2):
+    """Real source: ``s[3, k, :, j] += sign * (-a0, -a1 cd + a2 sd, -a1 sd - a2 cd)``
+    (the fault's components turned to Okada's frame; ``sign`` carries Chinnery's sign and,
+    for ``j = 2``, the real source's ``d = depth + z``)."""
+    s[3, k, 0, j] -= sign * a0
+    s[3, k, 1, j] += sign * (a2 * sd - a1 * cd)
+    s[3, k, 2, j] -= sign * (a1 * sd + a2 * cd)
+
+
+@njit(cache=True, inline="always")
+def _add_image(s, k, j, sign, cd, sd, z, ab0, ab1, ab2, c0, c1, c2):
+    """Image source: ``A + B`` (``ab``) and ``z C`` (``c``) turned to Okada's frame (the
+    ``z C`` term flips sign in the vertical turn), added with Chinnery's ``sign``."""
+    s[3, k, 0, j] += sign * (ab0 + z * c0)
+    s[3, k, 1, j] += sign * ((ab1 + z * c1) * cd - (ab2 + z * c2) * sd)
+    s[3, k, 2, j] += sign * ((ab1 - z * c1) * sd + (ab2 - z * c2) * cd)
+
+
+@njit(cache=True, inline="always", fastmath={"contract", "arcp"})
+def _corner(xi, eta, q, z, sd, cd, alpha, image, sign, s):
+    """Add ``sign`` times the derivatives of one corner to ``s[3, k, i, j]`` (``du_i /
     dx_j`` in Okada's frame for a unit dislocation ``k``: strike, dip, tensile): part A
     (whole space) of the real source (``image`` False: ``d = depth + z`` in the caller)
     or parts A + B + z C of the image source (``image`` True: ``d = depth - z``), with the
     components turned from the fault's ``(x, y', z')`` to Okada's ``(x, y, z)`` as the
-    paper does for each source. ``t``, ``b``, ``w``: (3, 3, 3) scratch."""
+    paper does for each source. The parts' 27 derivatives are scalars (``A kij``, ``B kij``,
+    ``W kij`` for C: dislocation ``k``, component ``i`` in the fault's ``(x, y', z')``, by
+    ``x_j``); ``s`` is indexed, never sliced (a view costs two atomic reference counts)."""
     r2 = xi * xi + eta * eta + q * q
     if r2 == 0.0:
         return
     r = math.sqrt(r2)
-    r3 = r * r2
-    r5 = r3 * r2
+    ir = 1.0 / r
+    ir2 = ir * ir
+    ir3 = ir * ir2
+    ir5 = ir3 * ir2
     xi2 = xi * xi
     q2 = q * q
     y = eta * cd + q * sd  # y-tilde
@@ -84,18 +107,18 @@ def _corner(xi, eta, q, z, sd, cd, alpha, image, sign, out, t, b, w):
         x32 = 0.0
     else:
         x11 = 1.0 / (r * rx)
-        x32 = (r + rx) * x11 * x11 / r
+        x32 = (r + rx) * x11 * x11 * ir
     re = _plus(eta, xi, q, r)
     if re == 0.0:
         y11 = 0.0
         y32 = 0.0
     else:
         y11 = 1.0 / (r * re)
-        y32 = (r + re) * y11 * y11 / r
-    ey = sd / r - y * q / r3
-    ez = cd / r + d * q / r3
-    fy = d / r3 + xi2 * y32 * sd
-    fz = y / r3 + xi2 * y32 * cd
+        y32 = (r + re) * y11 * y11 * ir
+    ey = sd * ir - y * q * ir3
+    ez = cd * ir + d * q * ir3
+    fy = d * ir3 + xi2 * y32 * sd
+    fz = y * ir3 + xi2 * y32 * cd
     gy = 2.0 * x11 * sd - y * q * x32
     gz = 2.0 * x11 * cd + d * q * x32
     hy = d * q * x32 + xi * q * y32 * sd
@@ -109,185 +132,194 @@ def _corner(xi, eta, q, z, sd, cd, alpha, image, sign, out, t, b, w):
     cdcd = cd * cd
     # part A (infinite medium): rows are u_x', u_y', u_z' derivatives by x, y, z
     # strike slip
-    t[0, 0, 0] = -a1 * qy - a2 * xi2 * q * y32
-    t[0, 1, 0] = -a2 * xi * q / r3
-    t[0, 2, 0] = a1 * xy + a2 * xi * q2 * y32
-    t[0, 0, 1] = a1 * xy * sd + a2 * xi * fy + 0.5 * d * x11
-    t[0, 1, 1] = a2 * ey
-    t[0, 2, 1] = a1 * (cd / r + qy * sd) - a2 * q * fy
-    t[0, 0, 2] = a1 * xy * cd + a2 * xi * fz + 0.5 * y * x11
-    t[0, 1, 2] = a2 * ez
-    t[0, 2, 2] = -a1 * (sd / r - qy * cd) - a2 * q * fz
+    A000 = -a1 * qy - a2 * xi2 * q * y32
+    A010 = -a2 * xi * q * ir3
+    A020 = a1 * xy + a2 * xi * q2 * y32
+    A001 = a1 * xy * sd + a2 * xi * fy + 0.5 * d * x11
+    A011 = a2 * ey
+    A021 = a1 * (cd * ir + qy * sd) - a2 * q * fy
+    A002 = a1 * xy * cd + a2 * xi * fz + 0.5 * y * x11
+    A012 = a2 * ez
+    A022 = -a1 * (sd * ir - qy * cd) - a2 * q * fz
     # dip slip
-    t[1, 0, 0] = -a2 * xi * q / r3
-    t[1, 1, 0] = -0.5 * qy - a2 * eta * q / r3
-    t[1, 2, 0] = a1 / r + a2 * q2 / r3
-    t[1, 0, 1] = a2 * ey
-    t[1, 1, 1] = a1 * d * x11 + 0.5 * xy * sd + a2 * eta * gy
-    t[1, 2, 1] = a1 * y * x11 - a2 * q * gy
-    t[1, 0, 2] = a2 * ez
-    t[1, 1, 2] = a1 * y * x11 + 0.5 * xy * cd + a2 * eta * gz
-    t[1, 2, 2] = -a1 * d * x11 - a2 * q * gz
+    A100 = -a2 * xi * q * ir3
+    A110 = -0.5 * qy - a2 * eta * q * ir3
+    A120 = a1 * ir + a2 * q2 * ir3
+    A101 = a2 * ey
+    A111 = a1 * d * x11 + 0.5 * xy * sd + a2 * eta * gy
+    A121 = a1 * y * x11 - a2 * q * gy
+    A102 = a2 * ez
+    A112 = a1 * y * x11 + 0.5 * xy * cd + a2 * eta * gz
+    A122 = -a1 * d * x11 - a2 * q * gz
     # tensile
-    t[2, 0, 0] = -a1 * xy + a2 * xi * q2 * y32
-    t[2, 1, 0] = -a1 / r + a2 * q2 / r3
-    t[2, 2, 0] = -a1 * qy - a2 * q * q2 * y32
-    t[2, 0, 1] = -a1 * (cd / r + qy * sd) - a2 * q * fy
-    t[2, 1, 1] = -a1 * y * x11 - a2 * q * gy
-    t[2, 2, 1] = a1 * (d * x11 + xy * sd) + a2 * q * hy
-    t[2, 0, 2] = a1 * (sd / r - qy * cd) - a2 * q * fz
-    t[2, 1, 2] = a1 * d * x11 - a2 * q * gz
-    t[2, 2, 2] = a1 * (y * x11 + xy * cd) + a2 * q * hz
+    A200 = -a1 * xy + a2 * xi * q2 * y32
+    A210 = -a1 * ir + a2 * q2 * ir3
+    A220 = -a1 * qy - a2 * q * q2 * y32
+    A201 = -a1 * (cd * ir + qy * sd) - a2 * q * fy
+    A211 = -a1 * y * x11 - a2 * q * gy
+    A221 = a1 * (d * x11 + xy * sd) + a2 * q * hy
+    A202 = a1 * (sd * ir - qy * cd) - a2 * q * fz
+    A212 = a1 * d * x11 - a2 * q * gz
+    A222 = a1 * (y * x11 + xy * cd) + a2 * q * hz
     if not image:
-        for k in range(3):
-            for j in range(3):
-                v0 = -t[k, 0, j]
-                v1 = -t[k, 1, j] * cd + t[k, 2, j] * sd
-                v2 = -t[k, 1, j] * sd - t[k, 2, j] * cd
-                if j == 2:  # the real source's z-derivatives change sign (d = depth + z)
-                    v0, v1, v2 = -v0, -v1, -v2
-                out[k, 0, j] += sign * v0
-                out[k, 1, j] += sign * v1
-                out[k, 2, j] += sign * v2
+        _add_real(s, 0, 0, sign, cd, sd, A000, A010, A020)
+        _add_real(s, 0, 1, sign, cd, sd, A001, A011, A021)
+        _add_real(s, 0, 2, sign * -1.0, cd, sd, A002, A012, A022)
+        _add_real(s, 1, 0, sign, cd, sd, A100, A110, A120)
+        _add_real(s, 1, 1, sign, cd, sd, A101, A111, A121)
+        _add_real(s, 1, 2, sign * -1.0, cd, sd, A102, A112, A122)
+        _add_real(s, 2, 0, sign, cd, sd, A200, A210, A220)
+        _add_real(s, 2, 1, sign, cd, sd, A201, A211, A221)
+        _add_real(s, 2, 2, sign * -1.0, cd, sd, A202, A212, A222)
         return
     # part B (surface deformation terms)
     a3 = (1.0 - alpha) / alpha
     rd = r + d
-    d11 = 1.0 / (r * rd)
-    j2 = xi * y / rd * d11
-    j5 = -(d + y * y / rd) * d11
+    ird = 1.0 / rd
+    d11 = ir * ird
+    j2 = xi * y * ird * d11
+    j5 = -(d + y * y * ird) * d11
     if cd != 0.0:
-        k1 = xi * (d11 - y11 * sd) / cd
-        k3 = (q * y11 - y * d11) / cd
-        j3 = (k1 - j2 * sd) / cd
-        j6 = (k3 - j5 * sd) / cd
+        icd = 1.0 / cd
+        k1 = xi * (d11 - y11 * sd) * icd
+        k3 = (q * y11 - y * d11) * icd
+        j3 = (k1 - j2 * sd) * icd
+        j6 = (k3 - j5 * sd) * icd
     else:
-        rd2 = rd * rd
-        k1 = xi * q / rd * d11
-        k3 = sd / rd * (xi2 * d11 - 1.0)
-        j3 = -xi / rd2 * (q2 * d11 - 0.5)
-        j6 = -y / rd2 * (xi2 * d11 - 0.5)
-    k2 = 1.0 / r + k3 * sd
+        ird2 = ird * ird
+        k1 = xi * q * ird * d11
+        k3 = sd * ird * (xi2 * d11 - 1.0)
+        j3 = -xi * ird2 * (q2 * d11 - 0.5)
+        j6 = -y * ird2 * (xi2 * d11 - 0.5)
+    k2 = 1.0 * ir + k3 * sd
     k4 = xy * cd - k1 * sd
     j1 = j5 * cd - j6 * sd
     j4 = -xy - j2 * cd + j3 * sd
-    b[0, 0, 0] = xi2 * q * y32 - a3 * j1 * sd
-    b[0, 1, 0] = xi * q / r3 - a3 * j2 * sd
-    b[0, 2, 0] = -xi * q2 * y32 - a3 * j3 * sd
-    b[0, 0, 1] = -xi * fy - d * x11 + a3 * (xy + j4) * sd
-    b[0, 1, 1] = -ey + a3 * (1.0 / r + j5) * sd
-    b[0, 2, 1] = q * fy - a3 * (qy - j6) * sd
-    b[0, 0, 2] = -xi * fz - y * x11 + a3 * k1 * sd
-    b[0, 1, 2] = -ez + a3 * y * d11 * sd
-    b[0, 2, 2] = q * fz + a3 * k2 * sd
-    b[1, 0, 0] = xi * q / r3 + a3 * j4 * sdcd
-    b[1, 1, 0] = eta * q / r3 + qy + a3 * j5 * sdcd
-    b[1, 2, 0] = -q2 / r3 + a3 * j6 * sdcd
-    b[1, 0, 1] = -ey + a3 * j1 * sdcd
-    b[1, 1, 1] = -eta * gy - xy * sd + a3 * j2 * sdcd
-    b[1, 2, 1] = q * gy + a3 * j3 * sdcd
-    b[1, 0, 2] = -ez - a3 * k3 * sdcd
-    b[1, 1, 2] = -eta * gz - xy * cd - a3 * xi * d11 * sdcd
-    b[1, 2, 2] = q * gz - a3 * k4 * sdcd
-    b[2, 0, 0] = -xi * q2 * y32 - a3 * j4 * sdsd
-    b[2, 1, 0] = -q2 / r3 - a3 * j5 * sdsd
-    b[2, 2, 0] = q * q2 * y32 - a3 * j6 * sdsd
-    b[2, 0, 1] = q * fy - a3 * j1 * sdsd
-    b[2, 1, 1] = q * gy - a3 * j2 * sdsd
-    b[2, 2, 1] = -q * hy - a3 * j3 * sdsd
-    b[2, 0, 2] = q * fz + a3 * k3 * sdsd
-    b[2, 1, 2] = q * gz + a3 * xi * d11 * sdsd
-    b[2, 2, 2] = -q * hz + a3 * k4 * sdsd
+    B000 = xi2 * q * y32 - a3 * j1 * sd
+    B010 = xi * q * ir3 - a3 * j2 * sd
+    B020 = -xi * q2 * y32 - a3 * j3 * sd
+    B001 = -xi * fy - d * x11 + a3 * (xy + j4) * sd
+    B011 = -ey + a3 * (1.0 * ir + j5) * sd
+    B021 = q * fy - a3 * (qy - j6) * sd
+    B002 = -xi * fz - y * x11 + a3 * k1 * sd
+    B012 = -ez + a3 * y * d11 * sd
+    B022 = q * fz + a3 * k2 * sd
+    B100 = xi * q * ir3 + a3 * j4 * sdcd
+    B110 = eta * q * ir3 + qy + a3 * j5 * sdcd
+    B120 = -q2 * ir3 + a3 * j6 * sdcd
+    B101 = -ey + a3 * j1 * sdcd
+    B111 = -eta * gy - xy * sd + a3 * j2 * sdcd
+    B121 = q * gy + a3 * j3 * sdcd
+    B102 = -ez - a3 * k3 * sdcd
+    B112 = -eta * gz - xy * cd - a3 * xi * d11 * sdcd
+    B122 = q * gz - a3 * k4 * sdcd
+    B200 = -xi * q2 * y32 - a3 * j4 * sdsd
+    B210 = -q2 * ir3 - a3 * j5 * sdsd
+    B220 = q * q2 * y32 - a3 * j6 * sdsd
+    B201 = q * fy - a3 * j1 * sdsd
+    B211 = q * gy - a3 * j2 * sdsd
+    B221 = -q * hy - a3 * j3 * sdsd
+    B202 = q * fz + a3 * k3 * sdsd
+    B212 = q * gz + a3 * xi * d11 * sdsd
+    B222 = -q * hz + a3 * k4 * sdsd
     # part C (the terms multiplied by the depth of the observation point)
     a4 = 1.0 - alpha
     a5 = alpha
     c = d + z
     eta2 = eta * eta
-    x53 = (8.0 * r2 + 9.0 * r * xi + 3.0 * xi2) * x11 * x11 * x11 / r2
-    y53 = (8.0 * r2 + 9.0 * r * eta + 3.0 * eta2) * y11 * y11 * y11 / r2
+    x53 = (8.0 * r2 + 9.0 * r * xi + 3.0 * xi2) * x11 * x11 * x11 * ir2
+    y53 = (8.0 * r2 + 9.0 * r * eta + 3.0 * eta2) * y11 * y11 * y11 * ir2
     h = q * cd - z
-    z32 = sd / r3 - h * y32
-    z53 = 3.0 * sd / r5 - h * y53
+    z32 = sd * ir3 - h * y32
+    z53 = 3.0 * sd * ir5 - h * y53
     y0 = y11 - xi2 * y32
     z0 = z32 - xi2 * z53
-    ppy = cd / r3 + q * y32 * sd
-    ppz = sd / r3 - q * y32 * cd
+    ppy = cd * ir3 + q * y32 * sd
+    ppz = sd * ir3 - q * y32 * cd
     qq = z * y32 + z32 + z0
-    qqy = 3.0 * c * d / r5 - qq * sd
-    qqz = 3.0 * c * y / r5 - qq * cd + q * y32
-    qr = 3.0 * q / r5
-    cdr = (c + d) / r3
-    yy0 = y / r3 - y0 * cd
-    w[0, 0, 0] = a4 * y0 * cd - a5 * q * z0
-    w[0, 1, 0] = -a4 * xi * (cd / r3 + 2.0 * q * y32 * sd) + a5 * c * xi * qr
-    w[0, 2, 0] = -a4 * xi * q * y32 * cd + a5 * xi * (3.0 * c * eta / r5 - qq)
-    w[0, 0, 1] = -a4 * xi * ppy * cd - a5 * xi * qqy
-    w[0, 1, 1] = a4 * 2.0 * (d / r3 - y0 * sd) * sd - y / r3 * cd - a5 * (cdr * sd - eta / r3 - c * y * qr)
-    w[0, 2, 1] = -a4 * q / r3 + yy0 * sd + a5 * (cdr * cd + c * d * qr - (y0 * cd + q * z0) * sd)
-    w[0, 0, 2] = a4 * xi * ppz * cd - a5 * xi * qqz
-    w[0, 1, 2] = a4 * 2.0 * (y / r3 - y0 * cd) * sd + d / r3 * cd - a5 * (cdr * cd + c * d * qr)
-    w[0, 2, 2] = yy0 * cd - a5 * (cdr * sd - c * y * qr - y0 * sdsd + q * z0 * cd)
-    w[1, 0, 0] = -a4 * xi / r3 * cd + a5 * c * xi * qr + xi * q * y32 * sd
-    w[1, 1, 0] = -a4 * y / r3 + a5 * c * eta * qr
-    w[1, 2, 0] = d / r3 - y0 * sd + a5 * c / r3 * (1.0 - 3.0 * q2 / r2)
-    w[1, 0, 1] = -a4 * eta / r3 + y0 * sdsd - a5 * (cdr * sd - c * y * qr)
-    w[1, 1, 1] = a4 * (x11 - y * y * x32) - a5 * c * ((d + 2.0 * q * cd) * x32 - y * eta * q * x53)
-    w[1, 2, 1] = xi * ppy * sd + y * d * x32 + a5 * c * ((y + 2.0 * q * sd) * x32 - y * q2 * x53)
-    w[1, 0, 2] = -q / r3 + y0 * sdcd - a5 * (cdr * cd + c * d * qr)
-    w[1, 1, 2] = a4 * y * d * x32 - a5 * c * ((y - 2.0 * q * sd) * x32 + d * eta * q * x53)
-    w[1, 2, 2] = -xi * ppz * sd + x11 - d * d * x32 - a5 * c * ((d - 2.0 * q * cd) * x32 - d * q2 * x53)
-    w[2, 0, 0] = a4 * xi / r3 * sd + xi * q * y32 * cd + a5 * xi * (3.0 * c * eta / r5 - 2.0 * z32 - z0)
-    w[2, 1, 0] = a4 * 2.0 * y0 * sd - d / r3 + a5 * c / r3 * (1.0 - 3.0 * q2 / r2)
-    w[2, 2, 0] = -a4 * yy0 - a5 * (c * eta * qr - q * z0)
-    w[2, 0, 1] = a4 * (q / r3 + y0 * sdcd) + a5 * (z / r3 * cd + c * d * qr - q * z0 * sd)
-    w[2, 1, 1] = -a4 * 2.0 * xi * ppy * sd - y * d * x32 + a5 * c * ((y + 2.0 * q * sd) * x32 - y * q2 * x53)
-    w[2, 2, 1] = (-a4 * (xi * ppy * cd - x11 + y * y * x32)
-                  + a5 * (c * ((d + 2.0 * q * cd) * x32 - y * eta * q * x53) + xi * qqy))
-    w[2, 0, 2] = -eta / r3 + y0 * cdcd - a5 * (z / r3 * sd - c * y * qr - y0 * sdsd + q * z0 * cd)
-    w[2, 1, 2] = a4 * 2.0 * xi * ppz * sd - x11 + d * d * x32 - a5 * c * ((d - 2.0 * q * cd) * x32 - d * q2 * x53)
-    w[2, 2, 2] = a4 * (xi * ppz * cd + y * d * x32) + a5 * (c * ((y - 2.0 * q * sd) * x32 + d * eta * q * x53)
-                                                             + xi * qqz)
-    for k in range(3):
-        for j in range(3):
-            s0 = t[k, 0, j] + b[k, 0, j]
-            s1 = t[k, 1, j] + b[k, 1, j]
-            s2 = t[k, 2, j] + b[k, 2, j]
-            zc0 = z * w[k, 0, j]
-            zc1 = z * w[k, 1, j]
-            zc2 = z * w[k, 2, j]
-            out[k, 0, j] += sign * (s0 + zc0)
-            out[k, 1, j] += sign * ((s1 + zc1) * cd - (s2 + zc2) * sd)
-            out[k, 2, j] += sign * ((s1 - zc1) * sd + (s2 - zc2) * cd)
+    qqy = 3.0 * c * d * ir5 - qq * sd
+    qqz = 3.0 * c * y * ir5 - qq * cd + q * y32
+    qr = 3.0 * q * ir5
+    cdr = (c + d) * ir3
+    yy0 = y * ir3 - y0 * cd
+    W000 = a4 * y0 * cd - a5 * q * z0
+    W010 = -a4 * xi * (cd * ir3 + 2.0 * q * y32 * sd) + a5 * c * xi * qr
+    W020 = -a4 * xi * q * y32 * cd + a5 * xi * (3.0 * c * eta * ir5 - qq)
+    W001 = -a4 * xi * ppy * cd - a5 * xi * qqy
+    W011 = a4 * 2.0 * (d * ir3 - y0 * sd) * sd - y * ir3 * cd - a5 * (cdr * sd - eta * ir3 - c * y * qr)
+    W021 = -a4 * q * ir3 + yy0 * sd + a5 * (cdr * cd + c * d * qr - (y0 * cd + q * z0) * sd)
+    W002 = a4 * xi * ppz * cd - a5 * xi * qqz
+    W012 = a4 * 2.0 * (y * ir3 - y0 * cd) * sd + d * ir3 * cd - a5 * (cdr * cd + c * d * qr)
+    W022 = yy0 * cd - a5 * (cdr * sd - c * y * qr - y0 * sdsd + q * z0 * cd)
+    W100 = -a4 * xi * ir3 * cd + a5 * c * xi * qr + xi * q * y32 * sd
+    W110 = -a4 * y * ir3 + a5 * c * eta * qr
+    W120 = d * ir3 - y0 * sd + a5 * c * ir3 * (1.0 - 3.0 * q2 * ir2)
+    W101 = -a4 * eta * ir3 + y0 * sdsd - a5 * (cdr * sd - c * y * qr)
+    W111 = a4 * (x11 - y * y * x32) - a5 * c * ((d + 2.0 * q * cd) * x32 - y * eta * q * x53)
+    W121 = xi * ppy * sd + y * d * x32 + a5 * c * ((y + 2.0 * q * sd) * x32 - y * q2 * x53)
+    W102 = -q * ir3 + y0 * sdcd - a5 * (cdr * cd + c * d * qr)
+    W112 = a4 * y * d * x32 - a5 * c * ((y - 2.0 * q * sd) * x32 + d * eta * q * x53)
+    W122 = -xi * ppz * sd + x11 - d * d * x32 - a5 * c * ((d - 2.0 * q * cd) * x32 - d * q2 * x53)
+    W200 = a4 * xi * ir3 * sd + xi * q * y32 * cd + a5 * xi * (3.0 * c * eta * ir5 - 2.0 * z32 - z0)
+    W210 = a4 * 2.0 * y0 * sd - d * ir3 + a5 * c * ir3 * (1.0 - 3.0 * q2 * ir2)
+    W220 = -a4 * yy0 - a5 * (c * eta * qr - q * z0)
+    W201 = a4 * (q * ir3 + y0 * sdcd) + a5 * (z * ir3 * cd + c * d * qr - q * z0 * sd)
+    W211 = -a4 * 2.0 * xi * ppy * sd - y * d * x32 + a5 * c * ((y + 2.0 * q * sd) * x32 - y * q2 * x53)
+    W221 = (-a4 * (xi * ppy * cd - x11 + y * y * x32) + a5 * (c * ((d + 2.0 * q * cd) * x32 - y * eta * q * x53) + xi * qqy))
+    W202 = -eta * ir3 + y0 * cdcd - a5 * (z * ir3 * sd - c * y * qr - y0 * sdsd + q * z0 * cd)
+    W212 = a4 * 2.0 * xi * ppz * sd - x11 + d * d * x32 - a5 * c * ((d - 2.0 * q * cd) * x32 - d * q2 * x53)
+    W222 = a4 * (xi * ppz * cd + y * d * x32) + a5 * (c * ((y - 2.0 * q * sd) * x32 + d * eta * q * x53) + xi * qqz)
+    _add_image(s, 0, 0, sign, cd, sd, z, A000 + B000, A010 + B010, A020 + B020,
+               W000, W010, W020)
+    _add_image(s, 0, 1, sign, cd, sd, z, A001 + B001, A011 + B011, A021 + B021,
+               W001, W011, W021)
+    _add_image(s, 0, 2, sign, cd, sd, z, A002 + B002, A012 + B012, A022 + B022,
+               W002, W012, W022)
+    _add_image(s, 1, 0, sign, cd, sd, z, A100 + B100, A110 + B110, A120 + B120,
+               W100, W110, W120)
+    _add_image(s, 1, 1, sign, cd, sd, z, A101 + B101, A111 + B111, A121 + B121,
+               W101, W111, W121)
+    _add_image(s, 1, 2, sign, cd, sd, z, A102 + B102, A112 + B112, A122 + B122,
+               W102, W112, W122)
+    _add_image(s, 2, 0, sign, cd, sd, z, A200 + B200, A210 + B210, A220 + B220,
+               W200, W210, W220)
+    _add_image(s, 2, 1, sign, cd, sd, z, A201 + B201, A211 + B211, A221 + B221,
+               W201, W211, W221)
+    _add_image(s, 2, 2, sign, cd, sd, z, A202 + B202, A212 + B212, A222 + B222,
+               W202, W212, W222)
     # d(z C)/dz = C + z dC/dz: C's displacement joins the z-derivatives
     c0 = a4 * xy * cd - a5 * xi * q * z32
-    c1 = a4 * (cd / r + 2.0 * qy * sd) - a5 * c * q / r3
-    c2 = a4 * qy * cd - a5 * (c * eta / r3 - z * y11 + xi2 * z32)
-    out[0, 0, 2] += sign * c0
-    out[0, 1, 2] += sign * (c1 * cd - c2 * sd)
-    out[0, 2, 2] -= sign * (c1 * sd + c2 * cd)
-    c0 = a4 * cd / r - qy * sd - a5 * c * q / r3
+    c1 = a4 * (cd * ir + 2.0 * qy * sd) - a5 * c * q * ir3
+    c2 = a4 * qy * cd - a5 * (c * eta * ir3 - z * y11 + xi2 * z32)
+    s[3, 0, 0, 2] += sign * c0
+    s[3, 0, 1, 2] += sign * (c1 * cd - c2 * sd)
+    s[3, 0, 2, 2] -= sign * (c1 * sd + c2 * cd)
+    c0 = a4 * cd * ir - qy * sd - a5 * c * q * ir3
     c1 = a4 * y * x11 - a5 * c * eta * q * x32
     c2 = -d * x11 - xy * sd - a5 * c * (x11 - q2 * x32)
-    out[1, 0, 2] += sign * c0
-    out[1, 1, 2] += sign * (c1 * cd - c2 * sd)
-    out[1, 2, 2] -= sign * (c1 * sd + c2 * cd)
-    c0 = -a4 * (sd / r + qy * cd) - a5 * (z * y11 - q2 * z32)
+    s[3, 1, 0, 2] += sign * c0
+    s[3, 1, 1, 2] += sign * (c1 * cd - c2 * sd)
+    s[3, 1, 2, 2] -= sign * (c1 * sd + c2 * cd)
+    c0 = -a4 * (sd * ir + qy * cd) - a5 * (z * y11 - q2 * z32)
     c1 = a4 * 2.0 * xy * sd + d * x11 - a5 * c * (x11 - q2 * x32)
     c2 = a4 * (y * x11 + xy * cd) + a5 * q * (c * eta * x32 + xi * z32)
-    out[2, 0, 2] += sign * c0
-    out[2, 1, 2] += sign * (c1 * cd - c2 * sd)
-    out[2, 2, 2] -= sign * (c1 * sd + c2 * cd)
+    s[3, 2, 0, 2] += sign * c0
+    s[3, 2, 1, 2] += sign * (c1 * cd - c2 * sd)
+    s[3, 2, 2, 2] -= sign * (c1 * sd + c2 * cd)
 
 
-@njit(cache=True)
-def gradient(x, y, z, depth, sd, cd, al1, al2, aw1, aw2, alpha, real, image, out, scratch):
-    """``out[k, i, j] = du_i / dx_j`` at ``(x, y, z)`` (Okada's frame, ``z <= 0``) for a
+@njit(cache=True, fastmath={"contract", "arcp"})
+def gradient(x, y, z, depth, sd, cd, al1, al2, aw1, aw2, alpha, real, image, s):
+    """``s[3, k, i, j] = du_i / dx_j`` at ``(x, y, z)`` (Okada's frame, ``z <= 0``) for a
     unit dislocation ``k`` (strike, dip, tensile) on the rectangle ``al1 <= xi <= al2``,
     ``aw1 <= eta <= aw2`` whose reference point is at depth ``depth``: the real source's
     part A (the whole space) when ``real``, plus the image source's parts A + B + z C
     when ``image`` (Okada 1992, finite source; Chinnery's sum over the corners).
-    ``scratch``: (3, 3, 3, 3)."""
-    out[:] = 0.0
+    ``s``: (4, 3, 3, 3), ``s[0:3]`` scratch."""
+    for k in range(3):
+        for i in range(3):
+            for j in range(3):
+                s[3, k, i, j] = 0.0
     snap = SNAP * ((al2 - al1) + (aw2 - aw1))
     xs = (x - al1, x - al2)
     for source in range(2):
@@ -309,23 +341,11 @@ def gradient(x, y, z, depth, sd, cd, al1, al2, aw1, aw2, alpha, real, image, out
                 if abs(eta) < snap:
                     eta = 0.0
                 sign = 1.0 if jj == kk else -1.0
-                _corner(xi, eta, q, z, sd, cd, alpha, source == 1, sign, out, scratch[0], scratch[1], scratch[2])
+                _corner(xi, eta, q, z, sd, cd, alpha, source == 1, sign, s)
     for k in range(3):
         for i in range(3):
             for j in range(3):
-                out[k, i, j] *= _INV_2PI
-
-
-@njit(cache=True, inline="always")
-def _hooke(grad, shear_modulus, poisson_ratio, out):
-    """``out[k] = lambda tr(e) I + 2 mu e`` with ``e`` the symmetric part of ``grad[k]``."""
-    lam = 2.0 * shear_modulus * poisson_ratio / (1.0 - 2.0 * poisson_ratio)
-    for k in range(3):
-        tr = grad[k, 0, 0] + grad[k, 1, 1] + grad[k, 2, 2]
-        for i in range(3):
-            for j in range(3):
-                out[k, i, j] = shear_modulus * (grad[k, i, j] + grad[k, j, i])
-            out[k, i, i] += lam * tr
+                s[3, k, i, j] *= _INV_2PI
 
 
 def okada_frame(frame, half_a, half_b):
@@ -370,16 +390,10 @@ def halfspace_geometry(frames, half_a, half_b):
     return closed, okada, half
 
 
-@njit(cache=True)
-def okada_stress(point, center, okada, hs, hd, surface, shear_modulus, poisson_ratio, real, image, work, out):
-    """``out[q, i, j]``: global stress at ``point`` for a unit global DD ``q`` of the
-    rectangle (``center``, Okada rows ``okada`` = strike, up-dip, normal as
-    :func:`halfspace_geometry` gives them, half sides ``hs``, ``hd``) under the free
-    surface ``z = surface``: :func:`gradient` (``real``: the whole-space part, ``image``:
-    the image and surface terms) through Hooke's law, turned from Okada's frame (``x`` =
-    strike, ``y = z x strike``, ``z``) to the global one. ``work``: (5, 3, 3, 3) scratch."""
-    grad = work[0]
-    local = work[1]
+@njit(cache=True, inline="always")
+def _gradient(point, center, okada, hs, hd, surface, shear_modulus, poisson_ratio, real, image, work):
+    """:func:`gradient` into ``work[3]`` at a global ``point`` for the rectangle of
+    :func:`okada_stress`; returns the strike's ``(s_x, s_y)`` and Lame's lambda."""
     s0 = okada[0, 0]
     s1 = okada[0, 1]
     # Okada's horizontal axes: x = strike, y = (-s1, s0)
@@ -399,29 +413,73 @@ def okada_stress(point, center, okada, hs, hd, surface, shear_modulus, poisson_r
         sd = 1.0
     lam = 2.0 * shear_modulus * poisson_ratio / (1.0 - 2.0 * poisson_ratio)
     alpha = (lam + shear_modulus) / (lam + 2.0 * shear_modulus)
-    gradient(x, y, z, depth, sd, cd, -hs, hs, -hd, hd, alpha, real, image, grad, work[2:])
-    _hooke(grad, shear_modulus, poisson_ratio, local)
-    # rotate about z: global = R^T local R, R rows (x, y, z axes of Okada's frame)
+    gradient(x, y, z, depth, sd, cd, -hs, hs, -hd, hd, alpha, real, image, work)
+    return s0, s1, lam
+
+
+@njit(cache=True)
+def okada_stress(point, center, okada, hs, hd, surface, shear_modulus, poisson_ratio, real, image, work, out):
+    """``out[q, i, j]``: global stress at ``point`` for a unit global DD ``q`` of the
+    rectangle (``center``, Okada rows ``okada`` = strike, up-dip, normal as
+    :func:`halfspace_geometry` gives them, half sides ``hs``, ``hd``) under the free
+    surface ``z = surface``: :func:`gradient` (``real``: the whole-space part, ``image``:
+    the image and surface terms) through Hooke's law, turned from Okada's frame (``x`` =
+    strike, ``y = z x strike``, ``z``) to the global one. ``work``: (5, 3, 3, 3) scratch."""
+    s0, s1, lam = _gradient(point, center, okada, hs, hd, surface, shear_modulus, poisson_ratio, real, image, work)
+    # Hooke's law into work[4], then about z to the global frame: R^T sigma R, R rows the
+    # (x, y, z) axes of Okada's frame, each step through the other slot
     for k in range(3):
+        tr = lam * (work[3, k, 0, 0] + work[3, k, 1, 1] + work[3, k, 2, 2])
         for i in range(3):
-            # rows: sigma . R  (columns to global)
-            a0 = local[k, i, 0] * s0 - local[k, i, 1] * s1
-            a1 = local[k, i, 0] * s1 + local[k, i, 1] * s0
-            a2 = local[k, i, 2]
-            grad[k, i, 0] = a0
-            grad[k, i, 1] = a1
-            grad[k, i, 2] = a2
+            for j in range(3):
+                work[4, k, i, j] = shear_modulus * (work[3, k, i, j] + work[3, k, j, i])
+            work[4, k, i, i] += tr
+        for i in range(3):
+            a0 = work[4, k, i, 0] * s0 - work[4, k, i, 1] * s1
+            a1 = work[4, k, i, 0] * s1 + work[4, k, i, 1] * s0
+            work[3, k, i, 0] = a0
+            work[3, k, i, 1] = a1
+            work[3, k, i, 2] = work[4, k, i, 2]
         for j in range(3):
-            b0 = grad[k, 0, j] * s0 - grad[k, 1, j] * s1
-            b1 = grad[k, 0, j] * s1 + grad[k, 1, j] * s0
-            b2 = grad[k, 2, j]
-            local[k, 0, j] = b0
-            local[k, 1, j] = b1
-            local[k, 2, j] = b2
+            b0 = work[3, k, 0, j] * s0 - work[3, k, 1, j] * s1
+            b1 = work[3, k, 0, j] * s1 + work[3, k, 1, j] * s0
+            work[4, k, 0, j] = b0
+            work[4, k, 1, j] = b1
+            work[4, k, 2, j] = work[3, k, 2, j]
     for q in range(3):
         f0 = okada[0, q]
         f1 = okada[1, q]
         f2 = okada[2, q]
         for i in range(3):
             for j in range(3):
-                out[q, i, j] = f0 * local[0, i, j] + f1 * local[1, i, j] + f2 * local[2, i, j]
+                out[q, i, j] = f0 * work[4, 0, i, j] + f1 * work[4, 1, i, j] + f2 * work[4, 2, i, j]
+
+
+@njit(cache=True)
+def okada_traction(point, normal, center, okada, hs, hd, surface, shear_modulus, poisson_ratio, real, image, work,
+                   block):
+    """``block[p, q] +=`` traction ``sigma . normal`` component ``p`` (global) at ``point``
+    for a unit global DD ``q`` of the rectangle of :func:`okada_stress` (the same terms),
+    through the traction in Okada's frame: the normal turned into it once, no stress
+    tensor turned back."""
+    s0, s1, lam = _gradient(point, center, okada, hs, hd, surface, shear_modulus, poisson_ratio, real, image, work)
+    n0 = s0 * normal[0] + s1 * normal[1]
+    n1 = -s1 * normal[0] + s0 * normal[1]
+    n2 = normal[2]
+    for k in range(3):
+        tr = lam * (work[3, k, 0, 0] + work[3, k, 1, 1] + work[3, k, 2, 2])
+        t0 = (shear_modulus * (2.0 * work[3, k, 0, 0] * n0 + (work[3, k, 0, 1] + work[3, k, 1, 0]) * n1
+                               + (work[3, k, 0, 2] + work[3, k, 2, 0]) * n2) + tr * n0)
+        t1 = (shear_modulus * ((work[3, k, 1, 0] + work[3, k, 0, 1]) * n0 + 2.0 * work[3, k, 1, 1] * n1
+                               + (work[3, k, 1, 2] + work[3, k, 2, 1]) * n2) + tr * n1)
+        t2 = (shear_modulus * ((work[3, k, 2, 0] + work[3, k, 0, 2]) * n0 + (work[3, k, 2, 1] + work[3, k, 1, 2]) * n1
+                               + 2.0 * work[3, k, 2, 2] * n2) + tr * n2)
+        work[4, k, 0, 0] = t0 * s0 - t1 * s1
+        work[4, k, 0, 1] = t0 * s1 + t1 * s0
+        work[4, k, 0, 2] = t2
+    for q in range(3):
+        f0 = okada[0, q]
+        f1 = okada[1, q]
+        f2 = okada[2, q]
+        for p in range(3):
+            block[p, q] += f0 * work[4, 0, 0, p] + f1 * work[4, 1, 0, p] + f2 * work[4, 2, 0, p]
