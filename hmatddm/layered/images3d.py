@@ -118,7 +118,7 @@ def workspace(data):
                 room[layer, 0], room[layer, 1] = trace_capacity(layer, data.shear_modulus, data.n_images)
                 n_orders = max(n_orders, room[layer, 1])
     return (np.empty((3, 3, 3)), np.zeros((3, 3, 3)), np.empty((3, 3, 3, 3)), np.zeros((2, 3, 3, 1)), Workspace(1),
-            Workspace(n_orders), room, _cached_rules(data.gauss_points), np.empty((5, 3, 3, 3)))
+            Workspace(n_orders), room, _cached_rules(data.gauss_points), np.empty((5, 3, 3, 3)), np.empty((30, 4)))
 
 
 @njit(cache=True)
@@ -149,7 +149,7 @@ def element_traction(data, i, j, state, work, block):
     surface terms in closed form instead (:func:`.okada3d.okada_traction`, Okada 1992),
     whatever the number of images (the closed form is the exact half-space)."""
     traced, is_traced, near_only = state
-    local, image, gradient, kelvin, ws1, ws, room, rules, okada_work = work
+    local, image, gradient, kelvin, ws1, ws, room, rules, okada_work, corners = work
     xi, eta, wt, start = rules
     g = data.shear_modulus
     nu = data.poisson_ratio
@@ -169,7 +169,7 @@ def element_traction(data, i, j, state, work, block):
                               near)
     if data.closed_form[j]:
         okada3d.okada_traction(point, normal, center, data.okada[j], data.okada_half[j, 0], data.okada_half[j, 1],
-                               data.surface, g[ls], nu[ls], False, True, okada_work, block)
+                               data.surface, g[ls], nu[ls], False, True, okada_work, corners, block)
     elif interfaces.shape[0] > 0:
         lr = data.layer[i]
         image[:] = 0.0
@@ -235,7 +235,7 @@ def element_stress(data, point, point_layer, j, work, out):
                             data.near_fraction * min(a, b))
     if data.closed_form[j]:
         okada3d.okada_stress(point, center, data.okada[j], data.okada_half[j, 0], data.okada_half[j, 1], data.surface,
-                             g[ls], nu[ls], False, True, work[8], image)
+                             g[ls], nu[ls], False, True, work[8], work[9], image)
         for q in range(3):
             for i in range(3):
                 for k in range(3):

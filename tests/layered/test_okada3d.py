@@ -33,7 +33,7 @@ def _okada(point, center, frame, a, b, real, image, nu=NU):
     assert closed[0]
     out = np.empty((3, 3, 3))
     okada3d.okada_stress(np.asarray(point, float), np.asarray(center, float), okada[0], half[0, 0], half[0, 1], 0.0,
-                         G, nu, real, image, np.empty((5, 3, 3, 3)), out)
+                         G, nu, real, image, np.empty((5, 3, 3, 3)), np.empty((30, 4)), out)
     return out
 
 
