@@ -22,7 +22,8 @@ corners with Chinnery's signs, ``f(al1, aw1) - f(al1, aw2) - f(al2, aw1) + f(al2
 in ``(x - al, p - aw)`` (Okada 1992, the finite-source section). ``A(real)`` alone is
 the whole-space field (:func:`gradient` with ``real=True, image=False``): it equals
 :mod:`hmatddm.kernels.rectangle3d`, which the operator keeps for the real source (its
-singular and near-miss handling); :func:`image_stress` adds the rest.
+singular and near-miss handling); :func:`okada_traction` and :func:`okada_stress` with
+``real=False`` add the rest (cost: benchmarks/RESULTS.md, issue 32, Okada 1992).
 
 Only the displacement derivatives are computed (the stress needs no ``log`` and no
 ``atan``). Numerical safety, as the paper advises: ``xi``, ``eta`` and ``q`` smaller than
@@ -57,7 +58,7 @@ def _geometry(xi, eta, q, sd, cd):
     """The finite source's notation at one corner (Okada 1992): ``R`` and its inverse
     powers, ``y~``, ``d~``, ``X11``, ``X32``, ``Y11``, ``Y32`` (zero on the negative
     extension of an edge, ``R + xi = 0`` or ``R + eta = 0``, computed without cancellation
-    elsewhere), ``E``, ``F``, ``G``, ``H``. Selects, no branches (the corner loop vectorizes)."""
+    elsewhere), ``E``, ``F``, ``G``, ``H``; selects rather than branches."""
     xi2 = xi * xi
     q2 = q * q
     r2 = xi2 + eta * eta + q2
@@ -166,10 +167,11 @@ def _store(c4, m, c, sign, cd, sd, ab0, ab1, ab2, zc0, zc1, zc2):
 @njit(cache=True, fastmath={"contract", "arcp"})
 def _image_corners(q, z, sd, cd, alpha, c4):
     """Parts A + B + z C of the image source (Okada 1992, finite source) at the four
-    corners ``(c4[27, corner], c4[28, corner])`` with Chinnery's signs ``c4[29, corner]`` (0: skipped),
-    into ``c4[9 k + 3 j + i, c]`` (``du_i / dx_j``, Okada's frame, dislocation ``k``). One
-    straight loop over the corners (selects, no branches, no calls) that LLVM may
-    vectorize; the caller sums the corners."""
+    corners ``(c4[27, c], c4[28, c])`` with Chinnery's signs ``c4[29, c]`` (0: skipped),
+    into ``c4[9 k + 3 j + i, c]`` (``du_i / dx_j``, Okada's frame, dislocation ``k``); the
+    caller sums the corners. One straight loop without branches or calls, so that it could
+    be vectorized over the corners; LLVM does not (checked in the assembly: scalar
+    ``divsd``/``sqrtsd`` only), so the loop costs what four scalar corners cost."""
     a1 = 0.5 * (1.0 - alpha)
     a2 = 0.5 * alpha
     a3 = (1.0 - alpha) / alpha
@@ -195,7 +197,7 @@ def _image_corners(q, z, sd, cd, alpha, c4):
         d11 = ir * ird
         j2 = xi * y * ird * d11
         j5 = -(d + y * y * ird) * d11
-        # cos(dip) = 0 takes the vertical forms (selects, not branches: the loop vectorizes)
+        # cos(dip) = 0 takes the vertical forms
         ird2 = ird * ird
         k1 = xi * (d11 - y11 * sd) * icd if tilted else xi * q * ird * d11
         k3 = (q * y11 - y * d11) * icd if tilted else sd * ird * (xi2 * d11 - 1.0)
