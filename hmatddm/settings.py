@@ -427,7 +427,8 @@ LAYERED_MEDIUM = {  # the image-series options of hmatddm.LayeredMedium (ref. Fi
     "gauss_points": Setting("integer", 4, low=1, high=32, doc="Gauss points per sub-segment of the image terms"),
     "method": Setting("choice", "table", choices=("table", "quadrature"),
                       doc="3D: table: the far image triples from a table of the layered remainder, built once per "
-                          "medium (hmatddm.layered.remainder_table3d); quadrature: every triple by quadrature"),
+                          "medium (hmatddm.layered.remainder_table3d), and a half-space's images in closed form "
+                          "(hmatddm.layered.okada3d); quadrature: every triple by quadrature"),
     "table_tol": Setting("number", 1e-8, low=0.0, high=1e-4, low_open=True,
                          doc="error of the remainder table allowed relative to the largest influence entry"),
 }

@@ -22,8 +22,11 @@ their image error below :data:`.rectangle_quadrature.ENTRY_TOL` of the largest e
 triples (those that can reach the receiver's layer) are integrated by quadrature; the far
 ones, the smooth layered remainder, come from a table built once per medium and mesh
 extent (:mod:`.remainder_table3d`, ``LayeredMedium(method="table")``, the default;
-``method="quadrature"`` integrates every triple, the cross-check). The image terms are not
-integrated in closed form: the Hansen base functions ``F = r - sigma r3 log(r + sigma r3)`` and
+``method="quadrature"`` integrates every triple, the cross-check). In a half-space (one
+solid layer under a void) the image and surface terms of a rectangle with a horizontal side
+are in closed form (:mod:`.okada3d`, Okada 1992; ``LayeredRectangles.closed_form``); a
+rectangle without one, and any medium with two solid layers, keeps the quadrature. Beyond the
+half-space the image terms are not integrated in closed form: the Hansen base functions ``F = r - sigma r3 log(r + sigma r3)`` and
 ``L = log(r + sigma r3)`` (and their horizontal derivatives) of every image, with
 coefficients polynomial in the source height, have no primitive over a rectangle of any
 orientation among the uniform-rock kernel's primitives of ``1/r`` (their integrals are
@@ -51,6 +54,7 @@ from numba import njit
 
 from ..kernels import rectangle3d
 from ..kernels.drivers import KernelKind, register_kind
+from . import okada3d
 from .image_points3d import image_point_displacement, image_point_stress, kelvin_point_displacement, kelvin_point_stress
 from .image_tracer import trace_capacity
 from .images2d import _lame, zero_in_void
@@ -93,14 +97,18 @@ class LayeredRectangles(NamedTuple):
     entry_tol: float = 0.0  #: image error allowed relative to the largest entry (:func:`entry_order`; 0: off)
     entry_scale: float = 0.0  #: the largest entry's scale (:func:`entry_scale`) over the largest shear modulus
     table: object = None  #: the :class:`.remainder_table3d.RemainderTable` (never None once built by influence_data)
+    closed_form: np.ndarray = None  #: (N,) bool: the source's images in closed form (a half-space, :mod:`.okada3d`)
+    okada: np.ndarray = None  #: (N, 3, 3) rows strike, up-dip, normal of each closed-form element (:mod:`.okada3d`)
+    okada_half: np.ndarray = None  #: (N, 2) half sides along the strike and the dip
+    surface: float = 0.0  #: height of the free surface of a half-space (closed-form elements)
 
 
 @njit(cache=True)
 def workspace(data):
     """Scratch: local stress (3, 3, 3), image stress (3, 3, 3), gradient (3, 3, 3, 3), the
     Kelvin scratch (2, 3, 3, 1), the :func:`Workspace` of order 1 and of the largest order
-    of any source layer's triples, the tracer's room per layer ``(cap, n_orders)`` and the
-    :func:`_cached_rules`."""
+    of any source layer's triples, the tracer's room per layer ``(cap, n_orders)``, the
+    :func:`_cached_rules` and the scratch of :func:`.okada3d.okada_stress`."""
     n_layers = data.shear_modulus.shape[0]
     room = np.zeros((n_layers, 2), dtype=np.int64)
     n_orders = 1
@@ -110,18 +118,21 @@ def workspace(data):
                 room[layer, 0], room[layer, 1] = trace_capacity(layer, data.shear_modulus, data.n_images)
                 n_orders = max(n_orders, room[layer, 1])
     return (np.empty((3, 3, 3)), np.zeros((3, 3, 3)), np.empty((3, 3, 3, 3)), np.zeros((2, 3, 3, 1)), Workspace(1),
-            Workspace(n_orders), room, _cached_rules(data.gauss_points))
+            Workspace(n_orders), room, _cached_rules(data.gauss_points), np.empty((5, 3, 3, 3)), np.empty((30, 4)))
 
 
 @njit(cache=True)
 def source_state(data, j, work):
     """What the receivers of source ``j`` share: room for the image triples at the points
     of the cached rules, traced when a receiver first needs a rule, and whether they are
-    the near triples only (the source's layer has a tabulated remainder)."""
+    the near triples only (the source's layer has a tabulated remainder). A source whose
+    images are in closed form (``closed_form``) traces nothing: its room is one point."""
     room = work[6]
     start = work[7][3]
     ls = data.layer[j]
     near_only = data.table.pair_index[ls].max() >= 0
+    if data.closed_form[j]:
+        return _traced_buffer(1, 1, 1), np.zeros(start.shape[0] - 1, dtype=np.bool_), near_only
     return (_traced_buffer(start[-1], max(room[ls, 0], 1), max(room[ls, 1], 1)),
             np.zeros(start.shape[0] - 1, dtype=np.bool_), near_only)
 
@@ -133,9 +144,12 @@ def element_traction(data, i, j, state, work, block):
     closed-form kernel's singular and near-miss handling) plus images (:func:`_image_order`),
     the source's traced triples reused across receivers. With a tabulated remainder
     (:mod:`.remainder_table3d`) the quadrature takes the near triples only and the table
-    the rest; a receiver outside the table's range takes every triple by quadrature."""
+    the rest; a receiver outside the table's range takes every triple by quadrature. In a
+    half-space, a source with a horizontal side (``closed_form``) takes its image and
+    surface terms in closed form instead (:func:`.okada3d.okada_traction`, Okada 1992),
+    whatever the number of images (the closed form is the exact half-space)."""
     traced, is_traced, near_only = state
-    local, image, gradient, kelvin, ws1, ws, room, rules = work
+    local, image, gradient, kelvin, ws1, ws, room, rules, okada_work, corners = work
     xi, eta, wt, start = rules
     g = data.shear_modulus
     nu = data.poisson_ratio
@@ -153,7 +167,10 @@ def element_traction(data, i, j, state, work, block):
         near = data.near_fraction * min(data.half_a[i], data.half_b[i], a, b)
     rectangle3d.traction_pair(point, normal, center, frame, a, b, g[ls], nu[ls], data.singular_shift, block, local,
                               near)
-    if interfaces.shape[0] > 0:
+    if data.closed_form[j]:
+        okada3d.okada_traction(point, normal, center, data.okada[j], data.okada_half[j, 0], data.okada_half[j, 1],
+                               data.surface, g[ls], nu[ls], False, True, okada_work, corners, block)
+    elif interfaces.shape[0] > 0:
         lr = data.layer[i]
         image[:] = 0.0
         tabulated = near_only and rectangle_covered(table, point, lr, center, frame, a, b, ls)
@@ -202,7 +219,8 @@ def element_stress(data, point, point_layer, j, work, out):
     """``out[q, i, k]``: stress at ``point`` (in ``point_layer``; zero in a void layer)
     for a unit global DD ``q`` of rectangle ``j``, closed form plus images (the
     quadrature of :func:`element_traction`). A point within ``near_fraction`` smaller
-    half sides of an edge counts as on it."""
+    half sides of an edge counts as on it. A ``closed_form`` source: the image and surface
+    terms of :func:`.okada3d.okada_stress`."""
     local, image = work[0], work[1]
     if zero_in_void(data.shear_modulus, point_layer, out):
         return
@@ -215,7 +233,14 @@ def element_stress(data, point, point_layer, j, work, out):
     b = data.half_b[j]
     rectangle3d.stress_pair(point, center, frame, a, b, g[ls], nu[ls], data.singular_shift, out, local,
                             data.near_fraction * min(a, b))
-    if data.interfaces.shape[0] > 0:
+    if data.closed_form[j]:
+        okada3d.okada_stress(point, center, data.okada[j], data.okada_half[j, 0], data.okada_half[j, 1], data.surface,
+                             g[ls], nu[ls], False, True, work[8], work[9], image)
+        for q in range(3):
+            for i in range(3):
+                for k in range(3):
+                    out[q, i, k] += image[q, i, k]
+    elif data.interfaces.shape[0] > 0:
         n_gauss, n_sub = _image_order(point, point_layer, center, frame, a, b, ls, data.interfaces,
                                       data.gauss_points, data.max_subdivisions, data.far_tol, 0.0)
         image_rectangle_stress(point, point_layer, center, frame, a, b, ls, data.interfaces, g, nu, data.n_images,

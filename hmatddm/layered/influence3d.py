@@ -8,7 +8,7 @@ import numpy as np
 from .._validation import finite_array
 from ..errors import InputError
 from ..kernels.drivers import finite_stress_sum, with_self_max
-from . import images3d, remainder_build3d, remainder_table3d
+from . import images3d, okada3d, remainder_build3d, remainder_table3d
 from .influence2d import choose_images as _choose_images
 from .influence2d import layers_of_extents, with_images
 from .rectangle_quadrature import ENTRY_TOL, entry_scale
@@ -44,7 +44,9 @@ def influence_data(mesh, medium, singular_shift, alpha, near_fraction, n_images)
     with ``n_images`` images; ``alpha > 0`` fills ``self_max`` for ref. Eq. 6.11. With
     ``medium.method == "table"``, far image triples (two or more interfaces) and at least
     :data:`TABLE_MIN_ELEMENTS` elements, the layered remainder's table
-    (:func:`remainder_table`)."""
+    (:func:`remainder_table`). In a half-space (:func:`is_half_space`) with ``medium.method``
+    other than ``"quadrature"``, the elements with a horizontal side take their image and
+    surface terms in closed form (:mod:`.okada3d`; ``closed_form``), the others by quadrature."""
     layers = element_layers(mesh, medium)
     interfaces, g, nu = medium.arrays()
     scale = entry_scale(mesh.half_a, mesh.half_b, layers, g, nu) / g.max() if interfaces.shape[0] > 0 else 0.0
@@ -52,11 +54,22 @@ def influence_data(mesh, medium, singular_shift, alpha, near_fraction, n_images)
     if (medium.method == "table" and n_images > 0 and interfaces.shape[0] >= 2
             and mesh.n_elements >= TABLE_MIN_ELEMENTS):
         table = remainder_table(mesh, medium, layers, int(n_images), scale * g.max())[0]
+    closed, okada, half = okada3d.halfspace_geometry(mesh.frames, mesh.half_a, mesh.half_b)
+    if not is_half_space(medium) or medium.method == "quadrature":
+        closed[:] = False
     return with_self_max(images3d.LayeredRectangles(
         mesh.centers, mesh.frames, mesh.half_a, mesh.half_b, layers, interfaces, g, nu, n_images=int(n_images),
         gauss_points=int(medium.gauss_points), max_subdivisions=int(MAX_SUBDIVISIONS),
         singular_shift=float(singular_shift), near_fraction=float(near_fraction), alpha=float(alpha),
-        self_max=np.zeros(mesh.n_elements), entry_tol=float(ENTRY_TOL), entry_scale=float(scale), table=table))
+        self_max=np.zeros(mesh.n_elements), entry_tol=float(ENTRY_TOL), entry_scale=float(scale), table=table,
+        closed_form=closed, okada=okada, okada_half=half,
+        surface=float(interfaces[0]) if interfaces.shape[0] else 0.0))
+
+
+def is_half_space(medium):
+    """True when ``medium`` is a half-space: one solid layer under a void one (a free
+    surface at ``interfaces[0]``), the case :mod:`.okada3d` gives in closed form."""
+    return medium.n_layers == 2 and medium.shear_modulus[0] == 0.0 and medium.shear_modulus[1] > 0.0
 
 
 #: Tables built in this process, by medium, images, tolerance and domain (the latest few).
@@ -88,7 +101,10 @@ def remainder_table(mesh, medium, layers, n_images, largest_entry):
 def choose_images(mesh, medium, data, max_samples=12, max_sources=120):
     """The number of images (see :func:`hmatddm.layered.influence2d.choose_images`,
     same criterion, with the 3D kernels, on fewer samples: a 3D pair with many images
-    costs milliseconds)."""
+    costs milliseconds). A half-space with ``images="auto"``: 1, the exact number (one
+    reflection in the free surface), without sampling."""
+    if medium.images == "auto" and is_half_space(medium):
+        return 1
     return _choose_images(mesh, medium, data, max_samples, max_sources)
 
 

@@ -57,7 +57,11 @@ class LayeredMedium:
         quadrature and takes the far ones (the layered remainder, which exists with two or
         more interfaces) from a table built once per medium and mesh extent
         (:mod:`hmatddm.layered.remainder_table3d`); ``"quadrature"`` integrates every
-        triple (the cross-check). 2D and the half-space are the same either way.
+        triple (the cross-check). 2D is the same either way. A 3D half-space (a void layer
+        over one solid layer) takes, with ``"table"``, the image and surface terms of every
+        rectangle with a horizontal side in closed form (Okada 1992,
+        :mod:`hmatddm.layered.okada3d`), whatever ``images``; ``"quadrature"`` integrates
+        them (the cross-check).
     table_tol : float in (0, 1e-4]
         Error of the remainder table allowed relative to the largest influence entry.
     """
