@@ -76,7 +76,8 @@ from ..coupled import ElasticSolver, StepProblem, solve_step
 from ..coupled.contact import ContactRows
 from ..errors import ConvergenceError, InputError
 from ..flow import fracture_compliance
-from ..fracture.front import CHANNEL, EMPTY, FILLED, TIP, FrontField, PlanarGrid, fill, front_radii, level_set
+from ..fracture.front import (CHANNEL, EMPTY, FILLED, TIP, FrontField, PlanarGrid, fill, front_radii, level_set,
+                              sample_offsets)
 from ..analytical.power_law_tip import tip_asymptote
 from ..analytical.tip_asymptote import finite_fracture_factor
 from ..analytical.tip_leak_off import LeakOffTipAsymptote
@@ -186,10 +187,11 @@ class AsymptoticFront:
         return FrontField(cells, distance, velocity, channel, self.grid.h, margin)
 
     # -- one step ------------------------------------------------------------------------
-    def _solve(self, sim, trial, start, prescribed, width, t_old, t_new, relaxation):
+    def _solve(self, sim, trial, start, prescribed, width, t_old, t_new, relaxation, tip_leak_off=None):
         """The coupled step from ``start`` (a :class:`~hmatddm.simulation.state.StepStart`) on
         the mesh of ``trial`` with the ``prescribed`` elements' openings held at ``width``:
-        ``(trial with the solution, info, flow model)``. The elastic solver (and its inverse
+        ``(trial with the solution, info, flow model)``. ``tip_leak_off``: ``(elements, rate)``
+        replacing Carter's step rate of those elements (:meth:`_tip_leak_off_rate`). The elastic solver (and its inverse
         of the modified rows) is kept across the front iterations of one operator."""
         mesh = trial.mesh
         _, faces = mesh_topology(mesh, sim.height)
@@ -199,10 +201,12 @@ class AsymptoticFront:
         if self._solver is None or self._solver.operator is not op:
             self._solver = ElasticSolver(op, rtol=sim.settings.linear_rtol)
         rows = PrescribedOpening(prescribed, width, mesh.normals, self._solver.normal_stiffness(mesh.normals))
+        flow.tip_leak_off = tip_leak_off  # also in the step's budget (hmatddm.simulation.records)
+        leak_off_rate = flow.leak_off_rate(trial.creation_time, t_old, t_new)
         problem = StepProblem(elastic=self._solver, normals=mesh.normals, far_field=sim.far_field_traction(mesh),
                               flow=flow, compliance=fracture_compliance(mesh, sim.material), dt=t_new - t_old,
                               width_old=start.width, pressure_old=start.pressure,
-                              leak_off_rate=flow.leak_off_rate(trial.creation_time, t_old, t_new), contact=rows)
+                              leak_off_rate=leak_off_rate, contact=rows)
         guess = trial.dd.copy()
         guess[prescribed] = width[prescribed, None] * mesh.normals[prescribed]
         dd, p, info = solve_step(problem, sim.settings, guess.ravel(), trial.pressure, relaxation)
@@ -289,10 +293,15 @@ class AsymptoticFront:
             if leaking:  # an element leaks from when the front crosses its centre (module docstring)
                 trial = replace(trial, creation_time=self._crossing_times(
                     trial.creation_time, cells, channel, old, field, t_old, t_new))
+            tip_leak_off = None
+            if leaking:  # the elements the front crosses leak point by point (_tip_leak_off_rate)
+                crossing = np.flatnonzero(~channel)
+                tip_leak_off = (crossing, self._tip_leak_off_rate(cells[crossing], old, field, t_old, t_new))
             prescribed = (state == TIP) | (state == EMPTY)
             if far_ribbon:  # a filled element keeps the asymptote's opening (module docstring)
                 prescribed |= state == FILLED
-            trial, info, flow = self._solve(sim, trial, start, prescribed, width, t_old, t_new, relaxation)
+            trial, info, flow = self._solve(sim, trial, start, prescribed, width, t_old, t_new, relaxation,
+                                            tip_leak_off)
             relaxation = info["relaxation"]
             tally.add_solve(info)
             ribbon_width = np.sum(trial.dd[ribbon] * mesh.normals[ribbon], axis=1)
@@ -355,6 +364,35 @@ class AsymptoticFront:
         new = np.where((phi_old <= 0.0) & ~np.isfinite(tau[open_]), t_old, new)  # inside before, never timed
         tau[open_] = new
         return tau
+
+    def _tip_leak_off_rate(self, cells, old, field, t_old, t_new):
+        """Carter's step rate ``2 c_l (<(t_new - t_0)^(1/2)> - <(t_old - t_0)^(1/2)>) / dt`` of
+        elements the front crosses, averaged over sample points of each (``SUB_SAMPLES``) with
+        each point's own arrival time ``t_0``: linear in time between the front at ``t_old``
+        (``old``) and the trial front (``field``), a point inside the old front reached at the
+        step's speed before ``t_old`` (clipped at 0; at ``t_old`` where the front did not move, mid-step beyond the old front's
+        box), a point outside the trial front not yet.
+        A whole element leaking from its centre's crossing (:meth:`_crossing_times`) turns on
+        the leak-off of a tip element at once, with an infinite slope in the front position; at a
+        leak-off-dominated (M~) tip, where that leak-off is most of the fluid the element takes,
+        the front iterations cycled every few iterations and did not converge (issue 36)."""
+        k, h = self.grid.k, self.grid.h
+        if len(cells) == 0:
+            return np.zeros(0)
+        inner, _ = sample_offsets(k, SUB_SAMPLES[k])
+        points = (cells[:, None, :] * h + h * inner[None]).reshape(-1, k)
+        phi_old, phi_new = old(points), field(points)
+        dt = t_new - t_old
+        known = np.isfinite(phi_old) & np.isfinite(phi_new)
+        speed = np.where(known, phi_old - phi_new, 0.0) / dt
+        moving = speed > 0.0
+        arrival = np.where(moving, t_old + np.where(known, phi_old, 0.0) / np.where(moving, speed, 1.0), t_old)
+        arrival = np.where(known, arrival, t_old + 0.5 * dt)  # beyond the old front's box: mid-step
+        arrival = np.where(np.isfinite(phi_new) & (phi_new <= 0.0), np.maximum(arrival, 0.0), np.inf)
+        new = np.sqrt(np.maximum(t_new - arrival, 0.0))
+        before = np.sqrt(np.maximum(t_old - arrival, 0.0))
+        rate = 2.0 * self.leak_off.coefficient * (new - before) / dt
+        return rate.reshape(len(cells), -1).mean(axis=1)
 
     def toughness_share(self, state, length):
         """``K^ = K' s^(1/2) (1 - s/(2L))^(1/2) / (E' w)`` averaged over the ribbon of ``state``

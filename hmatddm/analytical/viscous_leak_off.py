@@ -1,0 +1,200 @@
+"""Viscous fractures with Carter leak-off: the plane-strain M~ vertex and Dontsov's (2016)
+radial solution at any toughness, viscosity and leak-off (the M, K, M~ and K~ vertices and
+the transitions between them).
+
+Notation as :mod:`.regimes`: ``E'``, ``K' = 4 (2/pi)^(1/2) K_Ic``, ``mu' = 12 mu``, Carter's
+two-face coefficient ``C' = 2 C_L`` (m/s^1/2; in this project ``C' = c_l (sigma_0 - p_r)``,
+:func:`.regimes.carter_prime`), ``Q`` the injection rate (per unit height into both wings
+for plane strain).
+
+**Plane-strain M~ vertex** (zero toughness, all the fluid leaked off; Adachi and Detournay
+2008; Detournay 2016): mass balance alone fixes ``l = Q t^(1/2) / (pi C')``
+(:func:`.leak_off.kgd_leak_off_half_length`), and the opening scales as
+``W = (mu' Q^3 t / (E' C'^2))^(1/4)`` -- the m~ tip asymptote ``w ~ (C' mu' / E')^(1/4)
+V^(1/8) s^(5/8)`` with ``V ~ l / t`` and ``s ~ l``. :func:`kgd_m_leak_off_vertex` gives the
+inlet opening ``w(0) = 0.8165 W`` and the profile ``w(xi) = w(0) (1 + xi)^0.520 (1 -
+xi)^(5/8)`` (``xi = x / l``) of Dontsov's approximate plane-strain solution (Dontsov 2017,
+Int. J. Fract. 205:221, its M~ vertex; about 1% from the similarity solution, as its
+M vertex ``w(0) = 1.1265 (mu' Q^3 t^2 / E')^(1/6)`` is 0.3% from Spence and Sharp's 1.1233).
+The approximation carries no net pressure.
+
+**Radial fracture, any regime** (:func:`radial_leak_off_transition`; Dontsov 2016, R. Soc.
+open sci. 3:160737): the opening is the universal tip asymptote with leak-off (Dontsov and
+Peirce 2015, :class:`~hmatddm.analytical.tip_leak_off.LeakOffTipAsymptote`) at the distance
+``R`` of the well from the front and the front velocity ``V = alpha R / t``, spread as
+
+    w(rho) = w_a (1 - rho)^delta ((1 + rho)/2)^lambda,
+
+with ``delta = (1 + Delta)/2``, ``Delta = beta_m^3/3 f(K^, b C^, beta_m^3/3) (1 + b C^)`` the
+local exponent of the asymptote (1/3 at m, 1/4 at m~, 0 at k; ``b = beta_c`` of
+:mod:`.tip_asymptote`), ``lambda = 0.487 (1 - K^4) eta_0 + 0.397 (1 - K^4) (1 - eta_0) + 0.5
+K^4`` (M, M~ and K vertices; ``eta_0`` the efficiency with ``lambda = 1/2``), and ``R`` from
+the global mass balance with the leak-off of a front ``R ~ t^alpha``,
+
+    Q t = 2 pi R^2 w_a int_0^1 rho (1 - rho)^delta ((1 + rho)/2)^lambda d rho
+          + 4 pi alpha B(2 alpha, 3/2) C' t^(1/2) R^2,
+
+``alpha = d ln R / d ln t`` (4/9 at M, 2/5 at K, 1/4 at M~ and K~) by a fixed point on the
+solution. Zero leak-off gives :func:`.solutions.radial_transition`; at large leak-off the
+M~ vertex ``R = 0.4502 (Q^2 t / C'^2)^(1/4)``, ``w(0) = 1.0574 (mu'^4 Q^6 t / (E'^4
+C'^2))^(1/16)`` (Dontsov 2016's vertex solutions; the radius is the exact mass balance,
+:func:`.leak_off.radial_leak_off_radius`). Dontsov quotes about 1% between the vertices.
+"""
+import numpy as np
+from scipy import special
+
+from .._validation import finite_array, positive_scalar
+from ..errors import InputError
+from .leak_off import kgd_leak_off_half_length
+from .tip_asymptote import BETA_C, BETA_M3, _f
+
+KGD_M_LEAK_OFF_OPENING = 0.8165  # w(0) / W of the plane-strain M~ vertex (Dontsov 2017)
+KGD_M_LEAK_OFF_LAMBDA = 0.520    # exponent of (1 + xi) of its profile (Dontsov 2017)
+_LAMBDA = {"M": 0.487, "M~": 0.397, "K": 0.5}  # exponents of (1 + rho), radial (Dontsov 2016)
+
+
+def _times(t):
+    t = finite_array("t", t)
+    if t.size == 0 or np.any(t <= 0.0):
+        raise InputError("t must hold times > 0 (s since the start of injection)")
+    return t
+
+
+def _carter(value):
+    return positive_scalar("carter", value)
+
+
+def kgd_m_leak_off_scale(t, injection_rate, viscosity, carter, material):
+    """``W = (mu' Q^3 t / (E' C'^2))^(1/4)``, the opening scale of the plane-strain M~ vertex
+    (m; an array like ``t``): ``Q`` per unit height, ``carter`` C' (m/s^1/2)."""
+    t = _times(t)
+    q = positive_scalar("injection_rate", injection_rate)
+    mu_prime = 12.0 * positive_scalar("viscosity", viscosity)
+    return (mu_prime * q**3 * t / (material.plane_strain_modulus * _carter(carter) ** 2)) ** 0.25
+
+
+def kgd_m_leak_off_vertex(t, injection_rate, viscosity, carter, material):
+    """Half-length and inlet opening of the plane-strain M~ vertex (module docstring):
+    ``l = Q t^(1/2) / (pi C')``, ``w(0) = 0.8165 (mu' Q^3 t / (E' C'^2))^(1/4)``. Returns
+    ``(l, w0)``, arrays like ``t``."""
+    t = _times(t)
+    scale = kgd_m_leak_off_scale(t, injection_rate, viscosity, carter, material)
+    return kgd_leak_off_half_length(t, injection_rate, carter), KGD_M_LEAK_OFF_OPENING * scale
+
+
+def kgd_m_leak_off_profile(xi, t, injection_rate, viscosity, carter, material):
+    """Opening of the plane-strain M~ vertex at ``xi = |x| / l`` in [0, 1] at one time ``t``:
+    ``w(0) (1 + xi)^0.520 (1 - xi)^(5/8)`` (Dontsov 2017). Returns ``(l, w)``."""
+    xi = finite_array("xi", xi)
+    if np.any((xi < 0.0) | (xi > 1.0)):
+        raise InputError("xi must be in [0, 1] (|x| / l)")
+    if np.size(t) != 1:
+        raise InputError("t must be a scalar > 0 for kgd_m_leak_off_profile")
+    length, w0 = (float(np.ravel(v)[0]) for v in kgd_m_leak_off_vertex(np.ravel(t), injection_rate, viscosity,
+                                                                       carter, material))
+    return length, w0 * (1.0 + xi) ** KGD_M_LEAK_OFF_LAMBDA * (1.0 - xi) ** 0.625
+
+
+# --- radial, Dontsov (2016) with leak-off -----------------------------------------------------
+
+def _exponent(k_hat, c_hat):
+    """``delta = (1 + Delta)/2``, ``Delta`` the local exponent of the asymptote with leak-off."""
+    k_hat = np.clip(k_hat, 0.0, 1.0)
+    c_hat = np.maximum(c_hat, 0.0)
+    with np.errstate(over="ignore", invalid="ignore"):
+        delta = BETA_M3 / 3.0 * _f(k_hat, BETA_C * c_hat, BETA_M3 / 3.0) * (1.0 + BETA_C * c_hat)
+    large = c_hat > 1e3  # f's series in 1/C (the k-m~ edge): the closed form loses digits there
+    if np.any(large):
+        k, c = k_hat[large], BETA_C * c_hat[large]
+        series = (1.0 - k**4) / (4.0 * c) - (1.0 - k**5) / (5.0 * c * c) + (1.0 - k**6) / (6.0 * c**3)
+        delta[large] = series * (1.0 + c)
+    return 0.5 * (1.0 + np.clip(np.nan_to_num(delta, nan=1.0 / 3.0), 1e-6, 1.0 / 3.0 - 1e-6))
+
+
+def _volume_factor(delta, lam):
+    """``int_0^1 rho (1 - rho)^delta ((1 + rho)/2)^lambda d rho`` (incomplete beta functions)."""
+    def upper(a, b):
+        return special.beta(a, b) * (1.0 - special.betainc(a, b, 0.5))
+    return 2.0 ** (1.0 + delta) * (upper(lam + 2.0, delta + 1.0) - upper(lam + 1.0, delta + 2.0))
+
+
+def _leak_factor(alpha):
+    """``4 pi alpha B(2 alpha, 3/2)``: leaked volume / (C' t^(1/2) R^2) of a front ``R ~ t^alpha``."""
+    return 4.0 * np.pi * alpha * special.beta(2.0 * alpha, 1.5)
+
+
+def _state(radius, t, alpha, q, asymptote):
+    """``(injected-volume ratio, w_a, delta, lambda, efficiency)`` of radii ``radius`` at ``t``."""
+    speed = alpha * radius / t
+    w_a = asymptote.width(radius, speed)
+    k_hat = asymptote.k_prime * np.sqrt(radius) / (asymptote.e_prime * w_a)
+    c_hat = 2.0 * asymptote.carter * np.sqrt(radius) / (np.sqrt(speed) * w_a)
+    delta = _exponent(k_hat, c_hat)
+    leaked = _leak_factor(alpha) * asymptote.carter * np.sqrt(t) * radius**2
+    stored_half = 2.0 * np.pi * radius**2 * w_a * _volume_factor(delta, 0.5)
+    eta_0 = stored_half / (stored_half + leaked)
+    k4 = np.clip(k_hat, 0.0, 1.0) ** 4
+    lam = _LAMBDA["M"] * (1.0 - k4) * eta_0 + _LAMBDA["M~"] * (1.0 - k4) * (1.0 - eta_0) + _LAMBDA["K"] * k4
+    stored = 2.0 * np.pi * radius**2 * w_a * _volume_factor(delta, lam)
+    return (stored + leaked) / (q * t), w_a, delta, lam, stored / (stored + leaked)
+
+
+def _radius(t, q, asymptote, alpha, guess, iterations=16):
+    """Radii holding ``Q t`` (stored + leaked): secant iterations in ``ln R``."""
+    def excess(log_radius):
+        return np.log(_state(np.exp(log_radius), t, alpha, q, asymptote)[0])
+    x0 = np.log(guess)
+    f0 = excess(x0)
+    x1 = x0 - f0 / 2.5
+    for _ in range(iterations):
+        f1 = excess(x1)
+        slope = np.where(np.abs(x1 - x0) > 1e-14, (f1 - f0) / np.where(x1 != x0, x1 - x0, 1.0), 2.5)
+        x0, f0, x1 = x1, f1, x1 - f1 / np.clip(slope, 1.5, 3.0)
+    return np.exp(x1)
+
+
+def radial_leak_off_transition(t, injection_rate, viscosity, fracture_toughness, carter, material):
+    """Radius, opening at the well and efficiency (stored / injected) of a radial fracture at
+    any toughness, viscosity and Carter leak-off: Dontsov (2016), module docstring.
+
+    ``carter`` C' = 2 C_L (m/s^1/2, > 0; :func:`radial_transition` is the zero-leak-off
+    case). Returns ``(radius, max_width, efficiency)``, arrays like ``t`` (s, > 0)."""
+    from .solutions import radial_k_vertex, radial_m_vertex
+    from .leak_off import radial_leak_off_radius
+    from .tip_leak_off import LeakOffTipAsymptote
+
+    t = _times(t)
+    shape, t = t.shape, t.ravel()
+    q = positive_scalar("injection_rate", injection_rate)
+    viscosity = positive_scalar("viscosity", viscosity)
+    toughness = positive_scalar("fracture_toughness", fracture_toughness)
+    asymptote = LeakOffTipAsymptote(material.plane_strain_modulus, toughness, 12.0 * viscosity, _carter(carter))
+    guess = np.minimum(np.minimum(radial_k_vertex(t, q, toughness, material)[0],
+                                  radial_m_vertex(t, q, viscosity, material)[0]),
+                       radial_leak_off_radius(t, q, carter))
+    alpha, step = np.full(t.shape, 4.0 / 9.0), 0.01
+    for _ in range(4):  # alpha from the radii a little before and after t
+        before = _radius(t * np.exp(-step), q, asymptote, alpha, guess * np.exp(-step * alpha))
+        after = _radius(t * np.exp(step), q, asymptote, alpha, guess * np.exp(step * alpha))
+        alpha = np.clip(np.log(after / before) / (2.0 * step), 0.25, 4.0 / 9.0)
+    radius = _radius(t, q, asymptote, alpha, guess)
+    _, w_a, _, lam, efficiency = _state(radius, t, alpha, q, asymptote)
+    return radius.reshape(shape), (w_a * 0.5**lam).reshape(shape), efficiency.reshape(shape)
+
+
+def radial_m_leak_off_vertex(t, injection_rate, viscosity, carter, material):
+    """The radial M~ vertex of Dontsov (2016): ``R = 0.4502 (Q^2 t / C'^2)^(1/4)`` (the exact
+    mass balance, :func:`.leak_off.radial_leak_off_radius`) and ``w(0) = 1.0574 (mu'^4 Q^6 t /
+    (E'^4 C'^2))^(1/16)``. Returns ``(R, w0)``, arrays like ``t``."""
+    from .leak_off import radial_leak_off_radius
+
+    t = _times(t)
+    q = positive_scalar("injection_rate", injection_rate)
+    mu_prime = 12.0 * positive_scalar("viscosity", viscosity)
+    e_prime = material.plane_strain_modulus
+    c = _carter(carter)
+    return radial_leak_off_radius(t, q, c), 1.0574 * (mu_prime**4 * q**6 * t / (e_prime**4 * c * c)) ** (1.0 / 16.0)
+
+
+__all__ = ["kgd_m_leak_off_scale", "kgd_m_leak_off_vertex", "kgd_m_leak_off_profile", "radial_leak_off_transition",
+           "radial_m_leak_off_vertex", "KGD_M_LEAK_OFF_OPENING"]
