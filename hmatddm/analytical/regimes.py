@@ -188,9 +188,21 @@ SOLUTIONS.update({
         "- p_r + p) / (t' - t_0(r))^(1/2) dA dt'",
         "Carter 1957; Madyarova 2003; Detournay 2016; hmatddm.analytical.radial_toughness_leak_off_edge"),
 })
-# the vertex of the toughness number whose side each leak-off edge lies on (zero viscosity:
-# the K side at any leak-off number)
-LEAK_OFF_VERTEX = {"kgd-k-leak-off": "kgd-k", "radial-k-leak-off": "radial-k"}
+# viscous closed forms with leak-off (hmatddm.analytical.viscous_leak_off)
+SOLUTIONS.update({
+    "kgd-m-leak-off": Solution(
+        "kgd-m-leak-off", "plane-strain (KGD) M~ vertex (zero toughness, all the fluid leaked off; approximate, ~1%)",
+        "l = Q t^(1/2) / (pi C'), w0 = 0.8165 (mu' Q^3 t / (E' C'^2))^(1/4), w = w0 (1 + xi)^0.520 (1 - xi)^(5/8)",
+        "Adachi and Detournay 2008; Dontsov 2017, Int. J. Fract. 205:221; hmatddm.analytical.kgd_m_leak_off_vertex"),
+    "radial-km-leak-off": Solution(
+        "radial-km-leak-off", "radial fracture at any K_m and C_m (M, K, M~, K~ and between; approximate, ~1%)",
+        "w = w_a (1 - rho)^delta ((1 + rho)/2)^lambda, w_a the tip asymptote with leak-off at s = R, "
+        "Q t = stored + 4 pi alpha B(2 alpha, 3/2) C' t^(1/2) R^2",
+        "Dontsov 2016, R. Soc. open sci. 3:160737; hmatddm.analytical.radial_leak_off_transition"),
+})
+# the vertex of the toughness number whose side each leak-off closed form lies on (a K-K~
+# edge, zero viscosity: the K side at any leak-off number; the M~ vertex: the M side)
+LEAK_OFF_VERTEX = {"kgd-k-leak-off": "kgd-k", "radial-k-leak-off": "radial-k", "kgd-m-leak-off": "kgd-m"}
 
 # what applies where a vertex does not: the transition solutions
 _TRANSITION = {
@@ -211,7 +223,7 @@ def applicable_solution(kind, toughness_numbers):
     if kind not in SOLUTIONS:
         raise InputError(f"reference kind must be one of {sorted(SOLUTIONS)}, got {kind!r}")
     geometry = "radial" if kind.startswith("radial") else "kgd"
-    if kind == "radial-km":
+    if kind in ("radial-km", "radial-km-leak-off"):
         return True, None
     kind = LEAK_OFF_VERTEX.get(kind, kind)  # a K-K~ edge: where the K-vertex's toughness number says K
     vertices = {vertex(float(k), geometry) for k in np.ravel(toughness_numbers)}

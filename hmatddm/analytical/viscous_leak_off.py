@@ -153,12 +153,13 @@ def _radius(t, q, asymptote, alpha, guess, iterations=16):
     return np.exp(x1)
 
 
-def radial_leak_off_transition(t, injection_rate, viscosity, fracture_toughness, carter, material):
+def radial_leak_off_transition(t, injection_rate, viscosity, fracture_toughness, carter, material, profile=None):
     """Radius, opening at the well and efficiency (stored / injected) of a radial fracture at
     any toughness, viscosity and Carter leak-off: Dontsov (2016), module docstring.
 
     ``carter`` C' = 2 C_L (m/s^1/2, > 0; :func:`radial_transition` is the zero-leak-off
-    case). Returns ``(radius, max_width, efficiency)``, arrays like ``t`` (s, > 0)."""
+    case). Returns ``(radius, max_width, efficiency)``, arrays like ``t`` (s, > 0); with
+    ``profile`` (``rho``, one time): ``(radius, width at rho)``, :func:`radial_leak_off_profile`."""
     from .solutions import radial_k_vertex, radial_m_vertex
     from .leak_off import radial_leak_off_radius
     from .tip_leak_off import LeakOffTipAsymptote
@@ -178,8 +179,23 @@ def radial_leak_off_transition(t, injection_rate, viscosity, fracture_toughness,
         after = _radius(t * np.exp(step), q, asymptote, alpha, guess * np.exp(step * alpha))
         alpha = np.clip(np.log(after / before) / (2.0 * step), 0.25, 4.0 / 9.0)
     radius = _radius(t, q, asymptote, alpha, guess)
-    _, w_a, _, lam, efficiency = _state(radius, t, alpha, q, asymptote)
+    _, w_a, delta, lam, efficiency = _state(radius, t, alpha, q, asymptote)
+    if profile is not None:  # radial_leak_off_profile
+        return radius, w_a * (1.0 - profile) ** delta * (0.5 * (1.0 + profile)) ** lam
     return radius.reshape(shape), (w_a * 0.5**lam).reshape(shape), efficiency.reshape(shape)
+
+
+def radial_leak_off_profile(rho, t, injection_rate, viscosity, fracture_toughness, carter, material):
+    """Opening ``w_a (1 - rho)^delta ((1 + rho)/2)^lambda`` of :func:`radial_leak_off_transition`
+    at ``rho = r / R`` in [0, 1] at one time ``t``. Returns ``(R, w)``."""
+    rho = finite_array("rho", rho)
+    if np.any((rho < 0.0) | (rho > 1.0)):
+        raise InputError("rho must be in [0, 1] (r / R)")
+    if np.size(t) != 1:
+        raise InputError("t must be a scalar > 0 for radial_leak_off_profile")
+    radius, width = radial_leak_off_transition(np.ravel(t), injection_rate, viscosity, fracture_toughness, carter,
+                                               material, profile=rho)
+    return float(radius[0]), width
 
 
 def radial_m_leak_off_vertex(t, injection_rate, viscosity, carter, material):
@@ -197,4 +213,5 @@ def radial_m_leak_off_vertex(t, injection_rate, viscosity, carter, material):
 
 
 __all__ = ["kgd_m_leak_off_scale", "kgd_m_leak_off_vertex", "kgd_m_leak_off_profile", "radial_leak_off_transition",
+           "radial_leak_off_profile",
            "radial_m_leak_off_vertex", "KGD_M_LEAK_OFF_OPENING"]

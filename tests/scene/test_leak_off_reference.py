@@ -163,3 +163,40 @@ def test_the_asymptotic_front_with_leak_off_follows_the_edge():
             assert abs(row["relative_error"]["max_opening"]) < 0.01
             assert abs(row["relative_error"]["net_pressure"]) < 0.01
         assert abs(record["budget"]["residual"]) < 1e-8 * record["injected_volume"]
+
+
+def test_the_viscous_leak_off_kinds_give_their_closed_forms():
+    # kgd-m-leak-off: the M~ vertex with C' = c_l (sigma_0 - p_r); radial-km-leak-off: Dontsov 2016
+    from hmatddm.analytical.viscous_leak_off import kgd_m_leak_off_vertex, radial_leak_off_transition
+    from hmatddm.app.profiles import closed_form_profile
+
+    data = scene(**{"fluid.viscosity": 1e-3, "reference.kind": "kgd-m-leak-off"})
+    t = np.array([5.0, 20.0])
+    curves = _closed_form(data, t)
+    length, w0 = kgd_m_leak_off_vertex(t, 1e-3, 1e-3, 1e-11 * 20e6, data_material(data))
+    np.testing.assert_allclose(curves["half_length"], length, rtol=1e-12)
+    np.testing.assert_allclose(curves["max_opening"], w0, rtol=1e-12)
+    assert "net_pressure" not in curves and np.all(curves["leak_off_number"] > 0.0)
+    profile = closed_form_profile(data, 20.0)
+    assert max(profile["opening"]) == pytest.approx(w0[1], rel=1e-9) and "M~" in profile["label"]
+    raw = hs.parse_scene(hs.embedded_text("radial-k")).data
+    raw["leak_off"] = {"coefficient": 1e-11}
+    raw["propagation"]["front"] = "element"
+    raw["reference"]["kind"] = "radial-km-leak-off"
+    radial = hs.scene_from_dict(raw, "radial-viscous-leak-off").data
+    curves = _closed_form(radial, t)
+    excess = 1e-11 * (hs.build.confining_stress(radial) - radial["leak_off"]["pore_pressure"])
+    radius, width, _ = radial_leak_off_transition(t, radial["cluster"][0]["rate"], radial["fluid"]["viscosity"],
+                                                  radial["propagation"]["toughness"], excess, data_material(radial))
+    np.testing.assert_allclose(curves["radius"], radius, rtol=1e-12)
+    np.testing.assert_allclose(curves["max_opening"], width, rtol=1e-12)
+    assert max(closed_form_profile(radial, 20.0)["opening"]) == pytest.approx(width[1], rel=1e-6)
+    raw["reference"]["kind"] = "radial-k"
+    with pytest.raises(InputError, match="'radial-km-leak-off' \\(viscous\\)"):
+        hs.scene_from_dict(raw, "radial-viscous-leak-off")
+
+
+def data_material(data):
+    from hmatddm.scene.build import material
+
+    return material(data)
