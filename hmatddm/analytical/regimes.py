@@ -194,6 +194,12 @@ SOLUTIONS.update({
         "kgd-m-leak-off", "plane-strain (KGD) M~ vertex (zero toughness, all the fluid leaked off; approximate, ~1%)",
         "l = Q t^(1/2) / (pi C'), w0 = 0.8165 (mu' Q^3 t / (E' C'^2))^(1/4), w = w0 (1 + xi)^0.520 (1 - xi)^(5/8)",
         "Adachi and Detournay 2008; Dontsov 2017, Int. J. Fract. 205:221; hmatddm.analytical.kgd_m_leak_off_vertex"),
+    "kgd-km-leak-off": Solution(
+        "kgd-km-leak-off", "plane-strain (KGD) fracture at any K_m and C_m (M, K, M~, K~ and between; approximate, "
+        "~1%)",
+        "w = w_a (1 - xi)^delta ((1 + xi)/2)^lambda, w_a the tip asymptote with leak-off at s = l, "
+        "Q t = stored + 4 alpha B(alpha, 3/2) C' t^(1/2) l",
+        "Dontsov 2017, Int. J. Fract. 205:221; hmatddm.analytical.viscous_leak_off.kgd_leak_off_transition"),
     "radial-km-leak-off": Solution(
         "radial-km-leak-off", "radial fracture at any K_m and C_m (M, K, M~, K~ and between; approximate, ~1%)",
         "w = w_a (1 - rho)^delta ((1 + rho)/2)^lambda, w_a the tip asymptote with leak-off at s = R, "
@@ -223,7 +229,7 @@ def applicable_solution(kind, toughness_numbers):
     if kind not in SOLUTIONS:
         raise InputError(f"reference kind must be one of {sorted(SOLUTIONS)}, got {kind!r}")
     geometry = "radial" if kind.startswith("radial") else "kgd"
-    if kind in ("radial-km", "radial-km-leak-off"):
+    if kind in ("radial-km", "radial-km-leak-off", "kgd-km-leak-off"):
         return True, None
     kind = LEAK_OFF_VERTEX.get(kind, kind)  # a K-K~ edge: where the K-vertex's toughness number says K
     vertices = {vertex(float(k), geometry) for k in np.ravel(toughness_numbers)}

@@ -95,7 +95,7 @@ def kgd_m_leak_off_profile(xi, t, injection_rate, viscosity, carter, material):
     return length, w0 * (1.0 + xi) ** KGD_M_LEAK_OFF_LAMBDA * (1.0 - xi) ** 0.625
 
 
-# --- radial, Dontsov (2016) with leak-off -----------------------------------------------------
+# --- Dontsov (2016, radial; 2017, plane strain) with leak-off -----------------------------------
 
 def _exponent(k_hat, c_hat):
     """``delta = (1 + Delta)/2``, ``Delta`` the local exponent of the asymptote with leak-off."""
@@ -111,46 +111,95 @@ def _exponent(k_hat, c_hat):
     return 0.5 * (1.0 + np.clip(np.nan_to_num(delta, nan=1.0 / 3.0), 1e-6, 1.0 / 3.0 - 1e-6))
 
 
-def _volume_factor(delta, lam):
-    """``int_0^1 rho (1 - rho)^delta ((1 + rho)/2)^lambda d rho`` (incomplete beta functions)."""
-    def upper(a, b):
-        return special.beta(a, b) * (1.0 - special.betainc(a, b, 0.5))
-    return 2.0 ** (1.0 + delta) * (upper(lam + 2.0, delta + 1.0) - upper(lam + 1.0, delta + 2.0))
+def _upper(a, b):
+    """``B_(1/2)(a, b) = int_(1/2)^1 u^(a-1) (1 - u)^(b-1) du``."""
+    return special.beta(a, b) * (1.0 - special.betainc(a, b, 0.5))
 
 
-def _leak_factor(alpha):
-    """``4 pi alpha B(2 alpha, 3/2)``: leaked volume / (C' t^(1/2) R^2) of a front ``R ~ t^alpha``."""
-    return 4.0 * np.pi * alpha * special.beta(2.0 * alpha, 1.5)
+class _Geometry:
+    """What differs between Dontsov's radial (2016) and plane-strain (2017) solutions: the
+    stored volume per ``w_a``, the leaked volume per ``C' t^(1/2)``, the exponents ``lambda``
+    of the M, M~ and K vertices and the power of ``K^`` that weighs them, the range of
+    ``alpha``."""
+
+    def __init__(self, radial):
+        self.radial = radial
+        self.lambdas = (0.487, 0.397, 0.5) if radial else (0.588, 0.520, 0.5)
+        self.k_power = 4 if radial else 3
+        self.alpha_range = (0.25, 4.0 / 9.0) if radial else (0.5, 2.0 / 3.0)
+
+    def stored(self, size, w_a, delta, lam):
+        """Radial: ``2 pi R^2 w_a int_0^1 rho (1 - rho)^delta ((1 + rho)/2)^lambda d rho``;
+        plane strain (both wings, per unit height): ``2 l w_a int_0^1 (1 - xi)^delta ((1 +
+        xi)/2)^lambda d xi`` (incomplete beta functions, ``u = (1 + rho)/2``)."""
+        if self.radial:
+            factor = 2.0 ** (1.0 + delta) * (_upper(lam + 2.0, delta + 1.0) - _upper(lam + 1.0, delta + 2.0))
+            return 2.0 * np.pi * size**2 * w_a * factor
+        return 2.0 * size * w_a * 2.0 ** (1.0 + delta) * _upper(lam + 1.0, delta + 1.0)
+
+    def leaked(self, size, alpha, carter, t):
+        """Carter's leak-off of a front ``L ~ t^alpha`` (arrival ``t (r/L)^(1/alpha)``):
+        radial ``4 pi alpha B(2 alpha, 3/2) C' t^(1/2) R^2``, plane strain ``4 alpha B(alpha,
+        3/2) C' t^(1/2) l``."""
+        if self.radial:
+            return 4.0 * np.pi * alpha * special.beta(2.0 * alpha, 1.5) * carter * np.sqrt(t) * size**2
+        return 4.0 * alpha * special.beta(alpha, 1.5) * carter * np.sqrt(t) * size
 
 
-def _state(radius, t, alpha, q, asymptote):
-    """``(injected-volume ratio, w_a, delta, lambda, efficiency)`` of radii ``radius`` at ``t``."""
-    speed = alpha * radius / t
-    w_a = asymptote.width(radius, speed)
-    k_hat = asymptote.k_prime * np.sqrt(radius) / (asymptote.e_prime * w_a)
-    c_hat = 2.0 * asymptote.carter * np.sqrt(radius) / (np.sqrt(speed) * w_a)
+def _state(size, t, alpha, q, asymptote, geometry):
+    """``(injected-volume ratio, w_a, delta, lambda, efficiency)`` of sizes ``size`` at ``t``."""
+    speed = alpha * size / t
+    w_a = asymptote.width(size, speed)
+    k_hat = asymptote.k_prime * np.sqrt(size) / (asymptote.e_prime * w_a)
+    c_hat = 2.0 * asymptote.carter * np.sqrt(size) / (np.sqrt(speed) * w_a)
     delta = _exponent(k_hat, c_hat)
-    leaked = _leak_factor(alpha) * asymptote.carter * np.sqrt(t) * radius**2
-    stored_half = 2.0 * np.pi * radius**2 * w_a * _volume_factor(delta, 0.5)
+    leaked = geometry.leaked(size, alpha, asymptote.carter, t)
+    stored_half = geometry.stored(size, w_a, delta, 0.5)
     eta_0 = stored_half / (stored_half + leaked)
-    k4 = np.clip(k_hat, 0.0, 1.0) ** 4
-    lam = _LAMBDA["M"] * (1.0 - k4) * eta_0 + _LAMBDA["M~"] * (1.0 - k4) * (1.0 - eta_0) + _LAMBDA["K"] * k4
-    stored = 2.0 * np.pi * radius**2 * w_a * _volume_factor(delta, lam)
+    weight = np.clip(k_hat, 0.0, 1.0) ** geometry.k_power
+    lam_m, lam_mt, lam_k = geometry.lambdas
+    lam = lam_m * (1.0 - weight) * eta_0 + lam_mt * (1.0 - weight) * (1.0 - eta_0) + lam_k * weight
+    stored = geometry.stored(size, w_a, delta, lam)
     return (stored + leaked) / (q * t), w_a, delta, lam, stored / (stored + leaked)
 
 
-def _radius(t, q, asymptote, alpha, guess, iterations=16):
-    """Radii holding ``Q t`` (stored + leaked): secant iterations in ``ln R``."""
-    def excess(log_radius):
-        return np.log(_state(np.exp(log_radius), t, alpha, q, asymptote)[0])
+def _size(t, q, asymptote, geometry, alpha, guess, iterations=16):
+    """Sizes holding ``Q t`` (stored + leaked): secant iterations in ``ln L``."""
+    def excess(log_size):
+        return np.log(_state(np.exp(log_size), t, alpha, q, asymptote, geometry)[0])
     x0 = np.log(guess)
     f0 = excess(x0)
-    x1 = x0 - f0 / 2.5
+    x1 = x0 - f0 / 2.0
     for _ in range(iterations):
         f1 = excess(x1)
-        slope = np.where(np.abs(x1 - x0) > 1e-14, (f1 - f0) / np.where(x1 != x0, x1 - x0, 1.0), 2.5)
-        x0, f0, x1 = x1, f1, x1 - f1 / np.clip(slope, 1.5, 3.0)
+        slope = np.where(np.abs(x1 - x0) > 1e-14, (f1 - f0) / np.where(x1 != x0, x1 - x0, 1.0), 2.0)
+        x0, f0, x1 = x1, f1, x1 - f1 / np.clip(slope, 1.0, 3.0)
     return np.exp(x1)
+
+
+def _solution(t, q, viscosity, toughness, carter, material, geometry, guess, profile=None):
+    """Dontsov's solution on ``geometry``: ``(size, opening at the well, efficiency)``, or with
+    ``profile`` (``rho``, one time) ``(size, opening at rho)``."""
+    from .tip_leak_off import LeakOffTipAsymptote
+
+    asymptote = LeakOffTipAsymptote(material.plane_strain_modulus, toughness, 12.0 * viscosity, carter)
+    low, high = geometry.alpha_range
+    alpha, step = np.full(t.shape, high), 0.01
+    for _ in range(4):  # alpha from the sizes a little before and after t
+        before = _size(t * np.exp(-step), q, asymptote, geometry, alpha, guess * np.exp(-step * alpha))
+        after = _size(t * np.exp(step), q, asymptote, geometry, alpha, guess * np.exp(step * alpha))
+        alpha = np.clip(np.log(after / before) / (2.0 * step), low, high)
+    size = _size(t, q, asymptote, geometry, alpha, guess)
+    _, w_a, delta, lam, efficiency = _state(size, t, alpha, q, asymptote, geometry)
+    if profile is not None:
+        return size, w_a * (1.0 - profile) ** delta * (0.5 * (1.0 + profile)) ** lam
+    return size, w_a * 0.5**lam, efficiency
+
+
+def _inputs(t, injection_rate, viscosity, fracture_toughness, carter):
+    t = _times(t)
+    return (t, positive_scalar("injection_rate", injection_rate), positive_scalar("viscosity", viscosity),
+            positive_scalar("fracture_toughness", fracture_toughness), _carter(carter))
 
 
 def radial_leak_off_transition(t, injection_rate, viscosity, fracture_toughness, carter, material, profile=None):
@@ -162,27 +211,33 @@ def radial_leak_off_transition(t, injection_rate, viscosity, fracture_toughness,
     ``profile`` (``rho``, one time): ``(radius, width at rho)``, :func:`radial_leak_off_profile`."""
     from .solutions import radial_k_vertex, radial_m_vertex
     from .leak_off import radial_leak_off_radius
-    from .tip_leak_off import LeakOffTipAsymptote
 
-    t = _times(t)
+    t, q, viscosity, toughness, carter = _inputs(t, injection_rate, viscosity, fracture_toughness, carter)
     shape, t = t.shape, t.ravel()
-    q = positive_scalar("injection_rate", injection_rate)
-    viscosity = positive_scalar("viscosity", viscosity)
-    toughness = positive_scalar("fracture_toughness", fracture_toughness)
-    asymptote = LeakOffTipAsymptote(material.plane_strain_modulus, toughness, 12.0 * viscosity, _carter(carter))
     guess = np.minimum(np.minimum(radial_k_vertex(t, q, toughness, material)[0],
                                   radial_m_vertex(t, q, viscosity, material)[0]),
                        radial_leak_off_radius(t, q, carter))
-    alpha, step = np.full(t.shape, 4.0 / 9.0), 0.01
-    for _ in range(4):  # alpha from the radii a little before and after t
-        before = _radius(t * np.exp(-step), q, asymptote, alpha, guess * np.exp(-step * alpha))
-        after = _radius(t * np.exp(step), q, asymptote, alpha, guess * np.exp(step * alpha))
-        alpha = np.clip(np.log(after / before) / (2.0 * step), 0.25, 4.0 / 9.0)
-    radius = _radius(t, q, asymptote, alpha, guess)
-    _, w_a, delta, lam, efficiency = _state(radius, t, alpha, q, asymptote)
-    if profile is not None:  # radial_leak_off_profile
-        return radius, w_a * (1.0 - profile) ** delta * (0.5 * (1.0 + profile)) ** lam
-    return radius.reshape(shape), (w_a * 0.5**lam).reshape(shape), efficiency.reshape(shape)
+    out = _solution(t, q, viscosity, toughness, carter, material, _Geometry(True), guess, profile)
+    return out if profile is not None else tuple(v.reshape(shape) for v in out)
+
+
+def kgd_leak_off_transition(t, injection_rate, viscosity, fracture_toughness, carter, material, profile=None):
+    """Half-length, inlet opening and efficiency of a plane-strain fracture at any toughness,
+    viscosity and Carter leak-off: Dontsov (2017, Int. J. Fract. 205:221), the plane-strain
+    form of the module's radial solution -- ``Q t = 2 l w_a int_0^1 (1 - xi)^delta ((1 +
+    xi)/2)^lambda d xi + 4 alpha B(alpha, 3/2) C' t^(1/2) l`` (``Q`` per unit height into both
+    wings), ``lambda`` 0.588, 0.520 and 0.5 at the M, M~ and K vertices weighed by ``K^3``,
+    ``alpha`` between 1/2 and 2/3. Returns ``(l, w0, efficiency)``, arrays like ``t``; with
+    ``profile`` (``xi``, one time) ``(l, width at xi)``."""
+    from .solutions import kgd_k_vertex, kgd_m_vertex
+
+    t, q, viscosity, toughness, carter = _inputs(t, injection_rate, viscosity, fracture_toughness, carter)
+    shape, t = t.shape, t.ravel()
+    guess = np.minimum(np.minimum(kgd_k_vertex(t, q, toughness, material)[0],
+                                  kgd_m_vertex(t, q, viscosity, material)[0]),
+                       kgd_leak_off_half_length(t, q, carter))
+    out = _solution(t, q, viscosity, toughness, carter, material, _Geometry(False), guess, profile)
+    return out if profile is not None else tuple(v.reshape(shape) for v in out)
 
 
 def radial_leak_off_profile(rho, t, injection_rate, viscosity, fracture_toughness, carter, material):
@@ -213,5 +268,6 @@ def radial_m_leak_off_vertex(t, injection_rate, viscosity, carter, material):
 
 
 __all__ = ["kgd_m_leak_off_scale", "kgd_m_leak_off_vertex", "kgd_m_leak_off_profile", "radial_leak_off_transition",
+           "kgd_leak_off_transition",
            "radial_leak_off_profile",
            "radial_m_leak_off_vertex", "KGD_M_LEAK_OFF_OPENING"]

@@ -291,7 +291,7 @@ def _leak_off_closed_form(scene, times, kind, curves):
     c_l = leak_off(scene).coefficient
     excess = confining_stress(scene) - scene["leak_off"]["pore_pressure"]
     c_prime = regimes.carter_prime(c_l, excess)
-    if kind in ("kgd-m-leak-off", "radial-km-leak-off"):  # viscous (hmatddm.analytical.viscous_leak_off): no
+    if kind in ("kgd-m-leak-off", "kgd-km-leak-off", "radial-km-leak-off"):  # viscous (hmatddm.analytical.viscous_leak_off): no
         from ..analytical import viscous_leak_off  # net pressure in these approximations
 
         if kind == "radial-km-leak-off":
@@ -301,8 +301,12 @@ def _leak_off_closed_form(scene, times, kind, curves):
             curves["leak_off_number"] = regimes.radial_leak_off_number(times, rate, viscosity, c_prime, mat)
         else:
             rate = rate / scene["height"]
-            curves["half_length"], curves["max_opening"] = viscous_leak_off.kgd_m_leak_off_vertex(
-                times, rate, viscosity, c_prime, mat)
+            if kind == "kgd-m-leak-off":
+                curves["half_length"], curves["max_opening"] = viscous_leak_off.kgd_m_leak_off_vertex(
+                    times, rate, viscosity, c_prime, mat)
+            else:
+                curves["half_length"], curves["max_opening"], _ = viscous_leak_off.kgd_leak_off_transition(
+                    times, rate, viscosity, toughness, c_prime, mat)
             curves["dimensionless_toughness"] = np.full(times.shape, analytical.kgd_regime(rate, viscosity,
                                                                                             toughness, mat))
             curves["leak_off_number"] = regimes.kgd_leak_off_number(times, rate, viscosity, c_prime, mat)

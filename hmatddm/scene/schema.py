@@ -256,7 +256,7 @@ def _check_reference(scene):
         raise InputError(f"{where} assumes no leak-off: leak_off.coefficient must be 0, got "
                          f"{show(scene['leak_off']['coefficient'])}; with leak-off use kind = "
                          f"{kind.split('-')[0] + '-k-leak-off'!r} (the K-K~ edge) or "
-                         f"{('radial-km-leak-off' if kind.startswith('radial') else 'kgd-m-leak-off')!r} (viscous)")
+                         f"{kind.split('-')[0] + '-km-leak-off'!r} (viscous)")
 
 
 # ---------------------------------------------------------------------------------

@@ -92,6 +92,9 @@ logger = logging.getLogger(__name__)
 # (2D: a segment, fine and cheap; 3D: 8 x 8, the fraction of the front's many tip elements
 # averages out)
 SUB_SAMPLES = {1: 256, 2: 8}
+# failed coupled solves in a row after which a step with leak-off gives up (each halves the
+# trial front's advance)
+MAX_RETREATS = 6
 
 
 class PrescribedOpening:
@@ -268,7 +271,9 @@ class AsymptoticFront:
         last_update = np.zeros(len(ribbon))
         mixing = AndersonMixing()  # hmatddm.simulation.front_acceleration
         filled = np.zeros(mesh.n_elements, bool)  # filled once in this step: stays filled (no tip/filled cycling)
+        retreats = 0  # failed coupled solves in a row (leak-off: the trial front's advance halved each time)
         for iterations in range(1, prop.front_iterations + 1):
+            filled_before = filled.copy()
             field = self.field(cells[ribbon], distance, velocity, cells[channel])
             candidates = self._candidates(cells, channel, field)
             fraction, mean_width, full = fill(candidates, field, self.asymptote, SUB_SAMPLES[self.grid.k], length)
@@ -291,8 +296,11 @@ class AsymptoticFront:
             state[channel] = CHANNEL
             width[where[kept]] = mean_width[kept]
             if leaking:  # an element leaks from when the front crosses its centre (module docstring)
-                trial = replace(trial, creation_time=self._crossing_times(
-                    trial.creation_time, cells, channel, old, field, t_old, t_new))
+                tau = self._crossing_times(trial.creation_time, cells, channel, old, field, t_old, t_new)
+                # filled in an earlier iteration of the step (it stays filled) but behind this
+                # trial front's centre line: it joins the channel next step, leaking from t_new
+                tau[(state == FILLED) & ~np.isfinite(tau)] = t_new
+                trial = replace(trial, creation_time=tau)
             tip_leak_off = None
             if leaking:  # the elements the front crosses leak point by point (_tip_leak_off_rate)
                 crossing = np.flatnonzero(~channel)
@@ -300,8 +308,24 @@ class AsymptoticFront:
             prescribed = (state == TIP) | (state == EMPTY)
             if far_ribbon:  # a filled element keeps the asymptote's opening (module docstring)
                 prescribed |= state == FILLED
-            trial, info, flow = self._solve(sim, trial, start, prescribed, width, t_old, t_new, relaxation,
-                                            tip_leak_off)
+            try:
+                trial, info, flow = self._solve(sim, trial, start, prescribed, width, t_old, t_new, relaxation,
+                                                tip_leak_off)
+            except ConvergenceError:
+                # a trial front far ahead of the fluid can starve the elements behind it (at an M~
+                # tip their leak-off takes more than the flow brings): halve its advance and retry
+                retreats += 1
+                if retreats > MAX_RETREATS or leaking is False:
+                    raise
+                logger.debug("front iteration %d: the coupled solve failed; the trial front's advance halved",
+                             iterations)
+                filled = np.concatenate([filled_before, np.zeros(len(filled) - len(filled_before), bool)])
+                distance = distance_old + 0.5 * (distance - distance_old)
+                velocity = (distance - distance_old) / dt
+                length = length_old + float(np.mean(distance - distance_old))
+                last_update = np.zeros(len(ribbon))
+                continue
+            retreats = 0
             relaxation = info["relaxation"]
             tally.add_solve(info)
             ribbon_width = np.sum(trial.dd[ribbon] * mesh.normals[ribbon], axis=1)

@@ -79,3 +79,31 @@ def test_the_radial_solution_between_the_vertices_stays_between_them():
     assert np.all(radius < np.minimum(r_m, r_c)) and np.all((efficiency > 0.05) & (efficiency < 0.9))
     with pytest.raises(InputError, match="carter"):
         radial_leak_off_transition(t, 1e-3, 0.01, 1e2, -1.0, ROCK)
+
+
+def test_the_plane_strain_solution_spans_the_m_k_and_m_tilde_vertices():
+    # Dontsov (2017): zero leak-off -> Spence and Sharp's M vertex (Dontsov quotes 0.3% in w0) and the
+    # exact K vertex; much leak-off -> the M~ vertex with l from mass balance
+    from hmatddm.analytical import kgd_k_vertex, kgd_m_vertex
+    from hmatddm.analytical.viscous_leak_off import kgd_leak_off_transition
+
+    t = np.array([1.0, 100.0])
+    length, width, efficiency = kgd_leak_off_transition(t, 1e-3, 0.01, 1e2, 1e-12, ROCK)
+    m_length, m_width, _ = kgd_m_vertex(t, 1e-3, 0.01, ROCK)
+    np.testing.assert_allclose(length, m_length, rtol=2e-3)
+    np.testing.assert_allclose(width, m_width, rtol=4e-3)
+    assert np.all(efficiency > 0.9999)
+    length, width, _ = kgd_leak_off_transition(t, 1e-3, 1e-6, 3e6, 1e-12, ROCK)
+    k_length, k_width, _ = kgd_k_vertex(t, 1e-3, 3e6, ROCK)
+    np.testing.assert_allclose(length, k_length, rtol=1e-3)
+    np.testing.assert_allclose(width, k_width, rtol=1e-3)
+    t = np.array([10.0, 1000.0])
+    length, width, efficiency = kgd_leak_off_transition(t, 1e-3, 0.01, 1e2, 1e-3, ROCK)
+    v_length, v_width = kgd_m_leak_off_vertex(t, 1e-3, 0.01, 1e-3, ROCK)
+    assert np.all(np.diff(efficiency) < 0.0) and efficiency[-1] < 0.02
+    assert np.all(np.abs(length / v_length - 1.0) < 3.0 * efficiency)
+    assert abs(width[-1] / v_width[-1] - 1.0) < 0.01
+    # in between (M to M~): below both sizes
+    length, _, efficiency = kgd_leak_off_transition([10.0], 1e-3, 0.01, 1e2, 1e-4, ROCK)
+    assert length[0] < min(kgd_m_vertex([10.0], 1e-3, 0.01, ROCK)[0][0], 10.0 * v_length[0])  # C' ten times smaller: l ten times longer
+    assert 0.3 < efficiency[0] < 0.8
