@@ -272,6 +272,7 @@ class AsymptoticFront:
         mixing = AndersonMixing()  # hmatddm.simulation.front_acceleration
         filled = np.zeros(mesh.n_elements, bool)  # filled once in this step: stays filled (no tip/filled cycling)
         retreats = 0  # failed coupled solves in a row (leak-off: the trial front's advance halved each time)
+        ceiling = np.full(len(ribbon), np.inf)  # the nearest trial front whose coupled solve failed
         for iterations in range(1, prop.front_iterations + 1):
             filled_before = filled.copy()
             field = self.field(cells[ribbon], distance, velocity, cells[channel])
@@ -320,6 +321,7 @@ class AsymptoticFront:
                 logger.debug("front iteration %d: the coupled solve failed; the trial front's advance halved",
                              iterations)
                 filled = np.concatenate([filled_before, np.zeros(len(filled) - len(filled_before), bool)])
+                ceiling = np.minimum(ceiling, distance)  # no later trial front goes this far again
                 distance = distance_old + 0.5 * (distance - distance_old)
                 velocity = (distance - distance_old) / dt
                 length = length_old + float(np.mean(distance - distance_old))
@@ -333,6 +335,8 @@ class AsymptoticFront:
             # at most one element per iteration: far from the fixed point the ribbon takes the
             # volume the trial front leaves out, and the asymptote answers with a far front
             new_distance = np.maximum(np.clip(new_distance, distance - h, distance + h), distance_old)
+            # below a trial front whose solve failed: halfway to it at most (bisection)
+            new_distance = np.minimum(new_distance, np.where(np.isfinite(ceiling), 0.5 * (distance + ceiling), np.inf))
             update = new_distance - distance
             change = float(np.max(np.abs(update))) / h
             # relax an iteration that oscillates (the update turned back), speed up one
