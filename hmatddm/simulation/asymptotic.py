@@ -272,7 +272,8 @@ class AsymptoticFront:
         mixing = AndersonMixing()  # hmatddm.simulation.front_acceleration
         filled = np.zeros(mesh.n_elements, bool)  # filled once in this step: stays filled (no tip/filled cycling)
         retreats = 0  # failed coupled solves in a row (leak-off: the trial front's advance halved each time)
-        ceiling = np.full(len(ribbon), np.inf)  # the nearest trial front whose coupled solve failed
+        ceiling = np.full(len(ribbon), np.inf)  # leak-off: the nearest trial front too far (solve failed or
+        floor = distance_old.copy()  # the inversion asked for less), the farthest too near
         for iterations in range(1, prop.front_iterations + 1):
             filled_before = filled.copy()
             field = self.field(cells[ribbon], distance, velocity, cells[channel])
@@ -345,9 +346,20 @@ class AsymptoticFront:
             last_update = update
             accelerated = mixing.step(distance, update) if self.accelerate and grid.k == 2 else None
             if accelerated is None:
-                distance = distance + weight * update
+                proposal = distance + weight * update
             else:  # Anderson's step, held to an element and behind no old front like the plain one
-                distance = np.maximum(distance + np.clip(accelerated, -h, h), distance_old)
+                proposal = np.maximum(distance + np.clip(accelerated, -h, h), distance_old)
+            if leaking:
+                # bracket each ribbon's front (the inversion asks for more below it, less above):
+                # at a leak-off-dominated tip the advance goes as a high power of the ribbon's
+                # opening (w ~ V^(1/8) s^(5/8) at m~), the plain iteration cycled by whole elements
+                floor = np.where(update > 0.0, np.maximum(floor, distance), floor)
+                ceiling = np.where(update < 0.0, np.minimum(ceiling, distance), ceiling)
+                outside = np.isfinite(ceiling) & ((proposal <= floor) | (proposal >= ceiling))
+                proposal = np.where(outside, 0.5 * (floor + ceiling), proposal)
+                if np.all(np.isfinite(ceiling)):  # located to the bracket's width
+                    change = min(change, float(np.max(ceiling - floor)) / h)
+            distance = proposal
             velocity = (distance - distance_old) / dt
             length = length_old + float(np.mean(distance - distance_old))  # the trial front's size
             logger.debug("front iteration %d: %d elements, %d ribbon, %d tip, %d empty, change %.3g elements",
