@@ -103,11 +103,6 @@ def _exponent(k_hat, c_hat):
     c_hat = np.maximum(c_hat, 0.0)
     with np.errstate(over="ignore", invalid="ignore"):
         delta = BETA_M3 / 3.0 * _f(k_hat, BETA_C * c_hat, BETA_M3 / 3.0) * (1.0 + BETA_C * c_hat)
-    large = c_hat > 1e3  # f's series in 1/C (the k-m~ edge): the closed form loses digits there
-    if np.any(large):
-        k, c = k_hat[large], BETA_C * c_hat[large]
-        series = (1.0 - k**4) / (4.0 * c) - (1.0 - k**5) / (5.0 * c * c) + (1.0 - k**6) / (6.0 * c**3)
-        delta[large] = series * (1.0 + c)
     return 0.5 * (1.0 + np.clip(np.nan_to_num(delta, nan=1.0 / 3.0), 1e-6, 1.0 / 3.0 - 1e-6))
 
 

@@ -107,3 +107,21 @@ def test_the_plane_strain_solution_spans_the_m_k_and_m_tilde_vertices():
     length, _, efficiency = kgd_leak_off_transition([10.0], 1e-3, 0.01, 1e2, 1e-4, ROCK)
     assert length[0] < min(kgd_m_vertex([10.0], 1e-3, 0.01, ROCK)[0][0], 10.0 * v_length[0])  # C' ten times smaller: l ten times longer
     assert 0.3 < efficiency[0] < 0.8
+
+
+def test_deep_in_the_m_tilde_vertex_dontsovs_solutions_give_his_vertex_constants():
+    # C^ > 1e3 at the well: the tip asymptote's series branch (the closed form cancels there;
+    # before it, the radial opening came out at 9% of the vertex at 100 s)
+    from hmatddm.analytical.viscous_leak_off import kgd_leak_off_transition
+
+    t = np.array([100.0, 1000.0])
+    radius, width, efficiency = radial_leak_off_transition(t, 1e-3, 0.01, 1e2, 1e-2, ROCK)
+    r_v, w_v = radial_m_leak_off_vertex(t, 1e-3, 0.01, 1e-2, ROCK)
+    assert np.all(efficiency < 1e-3)
+    np.testing.assert_allclose(radius, r_v, rtol=1e-3)
+    np.testing.assert_allclose(width, w_v, rtol=1e-3)  # 1.0574 (Dontsov 2016)
+    length, width, efficiency = kgd_leak_off_transition(t, 1e-3, 0.01, 1e2, 1e-2, ROCK)
+    l_v, w_v = kgd_m_leak_off_vertex(t, 1e-3, 0.01, 1e-2, ROCK)
+    assert np.all(efficiency < 1e-3)
+    np.testing.assert_allclose(length, l_v, rtol=1e-3)
+    np.testing.assert_allclose(width, w_v, rtol=1e-3)  # 0.8165 (Dontsov 2017)
