@@ -52,19 +52,9 @@ at a viscous tip a far ribbon measured worse -- the KGD M-vertex (K_m 0.2, 1 m, 
 +1.9% instead of +0.6%, the power-law M-vertex runs' past +2%. 3D keeps ``s_r >= h/2`` (the
 radial runs converge with it, issue 39; not re-measured with this rule).
 
-**Carter leak-off** (a Newtonian fluid): the tip asymptote is the one with leak-off
-(:class:`~hmatddm.analytical.tip_leak_off.LeakOffTipAsymptote`, ``C' = c_l (p - p_r)`` at
-the ribbon's mean pressure at the start of the step), and an element leaks (Carter's
-``tau_i``, the state's ``creation_time``) from the time the front crosses its centre --
-linear between the front at the start of the step and the trial front -- not from when it
-joined the mesh: a tip element's filled part leaks, roughly, and one the front has barely
-touched does not (:meth:`AsymptoticFront._crossing_times`; +inf while the centre is outside).
-Leaking the whole element from the first touch made the solve fail or the front stall
-(issue 36). Measured against the K-K~ edge (benchmarks/RESULTS.md, issue 39): KGD from K to
-K~ (0.1 m elements, 1 s steps, 52% leaked by 20 s) within 0.15% in half-length and 0.6% in
-net pressure from 5 s on; K~ (85% leaked by 40 s) within 0.5% with 0.25 s steps (1 s steps
-do not converge in the first step, which grows the fracture by seven elements -- without
-leak-off too); radial K to K~ -1.1% in radius.
+**Carter leak-off** (a Newtonian fluid): the tip asymptote with leak-off, the elements the
+front crosses leaking point by point, and the front iteration bracketed --
+:mod:`hmatddm.simulation.front_leak_off`, where the measurements are.
 """
 import logging
 import time
@@ -76,13 +66,13 @@ from ..coupled import ElasticSolver, StepProblem, solve_step
 from ..coupled.contact import ContactRows
 from ..errors import ConvergenceError, InputError
 from ..flow import fracture_compliance
-from ..fracture.front import (CHANNEL, EMPTY, FILLED, TIP, FrontField, PlanarGrid, fill, front_radii, level_set,
-                              sample_offsets)
+from ..fracture.front import CHANNEL, EMPTY, FILLED, TIP, FrontField, PlanarGrid, fill, front_radii, level_set
 from ..analytical.power_law_tip import tip_asymptote
 from ..analytical.tip_asymptote import finite_fracture_factor
 from ..analytical.tip_leak_off import LeakOffTipAsymptote
 from . import proppant_step
 from .front_acceleration import AndersonMixing
+from .front_leak_off import MAX_RETREATS, crossing_times, tip_leak_off_rate
 from .records import StepTally, step_record
 from .step_solve import mesh_topology
 from .state import NewElements, StepStart
@@ -92,9 +82,6 @@ logger = logging.getLogger(__name__)
 # (2D: a segment, fine and cheap; 3D: 8 x 8, the fraction of the front's many tip elements
 # averages out)
 SUB_SAMPLES = {1: 256, 2: 8}
-# failed coupled solves in a row after which a step with leak-off gives up (each halves the
-# trial front's advance)
-MAX_RETREATS = 6
 
 
 class PrescribedOpening:
@@ -194,7 +181,7 @@ class AsymptoticFront:
         """The coupled step from ``start`` (a :class:`~hmatddm.simulation.state.StepStart`) on
         the mesh of ``trial`` with the ``prescribed`` elements' openings held at ``width``:
         ``(trial with the solution, info, flow model)``. ``tip_leak_off``: ``(elements, rate)``
-        replacing Carter's step rate of those elements (:meth:`_tip_leak_off_rate`). The elastic solver (and its inverse
+        replacing Carter's step rate of those elements (:func:`~.front_leak_off.tip_leak_off_rate`). The elastic solver (and its inverse
         of the modified rows) is kept across the front iterations of one operator."""
         mesh = trial.mesh
         _, faces = mesh_topology(mesh, sim.height)
@@ -298,15 +285,16 @@ class AsymptoticFront:
             state[channel] = CHANNEL
             width[where[kept]] = mean_width[kept]
             if leaking:  # an element leaks from when the front crosses its centre (module docstring)
-                tau = self._crossing_times(trial.creation_time, cells, channel, old, field, t_old, t_new)
+                tau = crossing_times(trial.creation_time, cells, channel, old, field, t_old, t_new)
                 # filled in an earlier iteration of the step (it stays filled) but behind this
                 # trial front's centre line: it joins the channel next step, leaking from t_new
                 tau[(state == FILLED) & ~np.isfinite(tau)] = t_new
                 trial = replace(trial, creation_time=tau)
             tip_leak_off = None
-            if leaking:  # the elements the front crosses leak point by point (_tip_leak_off_rate)
+            if leaking:  # the elements the front crosses leak point by point (front_leak_off)
                 crossing = np.flatnonzero(~channel)
-                tip_leak_off = (crossing, self._tip_leak_off_rate(cells[crossing], old, field, t_old, t_new))
+                tip_leak_off = (crossing, tip_leak_off_rate(self.grid, self.leak_off.coefficient, cells[crossing],
+                                                              old, field, t_old, t_new))
             prescribed = (state == TIP) | (state == EMPTY)
             if far_ribbon:  # a filled element keeps the asymptote's opening (module docstring)
                 prescribed |= state == FILLED
@@ -385,54 +373,6 @@ class AsymptoticFront:
         record["front_iterations"] = int(iterations)
         sim.records.append(record)
         return record
-
-    @staticmethod
-    def _crossing_times(creation_time, cells, channel, old, field, t_old, t_new):
-        """Carter's ``tau`` of the elements that are not channel: the time the front crosses
-        the element's centre, linear between the front at ``t_old`` (``old``) and the trial
-        front at ``t_new`` (``field``); +inf (no leak-off yet) while the centre is outside.
-        Elements whose centre was inside at ``t_old`` keep theirs."""
-        tau = creation_time.copy()
-        open_ = ~channel
-        phi_old = old.at_cells(cells[open_])
-        phi_new = field.at_cells(cells[open_])
-        crossed = (phi_old > 0.0) & (phi_new <= 0.0)
-        far = crossed & ~np.isfinite(phi_old)  # beyond the old front's box: crossed mid-step
-        ratio = np.where(crossed & ~far, phi_old / np.where(crossed & ~far, phi_old - phi_new, 1.0), 0.5)
-        fraction = np.clip(ratio, 0.0, 1.0)
-        new = np.where(phi_new > 0.0, np.inf, np.where(crossed, t_old + fraction * (t_new - t_old), tau[open_]))
-        new = np.where((phi_old <= 0.0) & ~np.isfinite(tau[open_]), t_old, new)  # inside before, never timed
-        tau[open_] = new
-        return tau
-
-    def _tip_leak_off_rate(self, cells, old, field, t_old, t_new):
-        """Carter's step rate ``2 c_l (<(t_new - t_0)^(1/2)> - <(t_old - t_0)^(1/2)>) / dt`` of
-        elements the front crosses, averaged over sample points of each (``SUB_SAMPLES``) with
-        each point's own arrival time ``t_0``: linear in time between the front at ``t_old``
-        (``old``) and the trial front (``field``), a point inside the old front reached at the
-        step's speed before ``t_old`` (clipped at 0; at ``t_old`` where the front did not move, mid-step beyond the old front's
-        box), a point outside the trial front not yet.
-        A whole element leaking from its centre's crossing (:meth:`_crossing_times`) turns on
-        the leak-off of a tip element at once, with an infinite slope in the front position; at a
-        leak-off-dominated (M~) tip, where that leak-off is most of the fluid the element takes,
-        the front iterations cycled every few iterations and did not converge (issue 36)."""
-        k, h = self.grid.k, self.grid.h
-        if len(cells) == 0:
-            return np.zeros(0)
-        inner, _ = sample_offsets(k, SUB_SAMPLES[k])
-        points = (cells[:, None, :] * h + h * inner[None]).reshape(-1, k)
-        phi_old, phi_new = old(points), field(points)
-        dt = t_new - t_old
-        known = np.isfinite(phi_old) & np.isfinite(phi_new)
-        speed = np.where(known, phi_old - phi_new, 0.0) / dt
-        moving = speed > 0.0
-        arrival = np.where(moving, t_old + np.where(known, phi_old, 0.0) / np.where(moving, speed, 1.0), t_old)
-        arrival = np.where(known, arrival, t_old + 0.5 * dt)  # beyond the old front's box: mid-step
-        arrival = np.where(np.isfinite(phi_new) & (phi_new <= 0.0), np.maximum(arrival, 0.0), np.inf)
-        new = np.sqrt(np.maximum(t_new - arrival, 0.0))
-        before = np.sqrt(np.maximum(t_old - arrival, 0.0))
-        rate = 2.0 * self.leak_off.coefficient * (new - before) / dt
-        return rate.reshape(len(cells), -1).mean(axis=1)
 
     def toughness_share(self, state, length):
         """``K^ = K' s^(1/2) (1 - s/(2L))^(1/2) / (E' w)`` averaged over the ribbon of ``state``
