@@ -11,6 +11,8 @@ the validation table and the scenes' ``[reference]`` blocks compare with.
   compares with it at every step.
 * :mod:`.leak_off`: leak-off-dominated sizes (the K~ and M~ vertices) and the plane-strain
   K-K~ edge.
+* :mod:`.viscous_leak_off`: the plane-strain M~ vertex and Dontsov's (2016, 2017) radial and
+  plane-strain solutions at any toughness, viscosity and leak-off.
 
 Names of :mod:`.solutions` are exported here (``hd.analytical.radial_k_vertex``), loaded
 on first use (scipy.special is not imported with the package).
@@ -30,8 +32,11 @@ _REGIMES = (
     "applicable_solution",
 )
 _TABLES = ("RadialTransitionTable", "radial_transition_table")
+_VISCOUS_LEAK_OFF = ("kgd_m_leak_off_vertex", "kgd_m_leak_off_profile", "kgd_leak_off_transition",
+                     "radial_leak_off_transition", "radial_leak_off_profile", "radial_m_leak_off_vertex")
 _EXPORTS = {**{name: ".solutions" for name in _SOLUTIONS}, **{name: ".leak_off" for name in _LEAK_OFF},
-            **{name: ".regimes" for name in _REGIMES}, **{name: ".transition_table" for name in _TABLES}}
+            **{name: ".regimes" for name in _REGIMES}, **{name: ".transition_table" for name in _TABLES},
+            **{name: ".viscous_leak_off" for name in _VISCOUS_LEAK_OFF}}
 __getattr__, __dir__ = attach(__name__, _EXPORTS)
 
-__all__ = list(_SOLUTIONS) + list(_LEAK_OFF) + list(_REGIMES) + list(_TABLES)
+__all__ = list(_SOLUTIONS) + list(_LEAK_OFF) + list(_REGIMES) + list(_TABLES) + list(_VISCOUS_LEAK_OFF)

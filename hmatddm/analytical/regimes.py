@@ -33,8 +33,12 @@ solution, so a scene's ``[reference]`` with them refuses leak-off (:mod:`hmatddm
 the leak-off numbers say how far a scene with leak-off is from them. A scene with leak-off
 is judged by a K-K~ edge (``kgd-k-leak-off``, ``radial-k-leak-off``; :mod:`.leak_off`,
 zero viscosity at any leak-off number): it applies where the toughness number says K (the
-viscosity is negligible; :data:`LEAK_OFF_VERTEX`), and its reference block records ``C_m``
-beside ``K_m``, with ``C' = c_l (sigma_0 - p_r)`` (:func:`carter_prime`).
+viscosity is negligible; :data:`LEAK_OFF_VERTEX`); by the plane-strain M~ vertex
+(``kgd-m-leak-off``, where the toughness number says M; it assumes all the fluid leaked:
+``C_m`` large, the stored share about ``C_m^(-3/2)``); or by Dontsov's solutions at any
+``K_m`` and ``C_m`` (``kgd-km-leak-off``, ``radial-km-leak-off``; :mod:`.viscous_leak_off`).
+Its reference block records ``C_m`` beside ``K_m``, with ``C' = c_l (sigma_0 - p_r)``
+(:func:`carter_prime`).
 """
 from dataclasses import dataclass
 

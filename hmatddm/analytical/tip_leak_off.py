@@ -12,10 +12,8 @@ rest (``V = 0``) opens as the toughness asymptote (``K^ = 1`` makes ``g_delta`` 
 any ``C^``). :class:`LeakOffTipAsymptote` takes one ``C'`` for every point of a call.
 
 Used by the asymptotic front (:mod:`hmatddm.simulation.asymptotic`) with one ``C'`` per
-step at the ribbon's mean pressure. A first try (issue 36) failed -- the coupled solve of a
-KGD step did not converge (M~ case of benchmarks/bench_leak_off.py) or the front stalled
-(K~) -- because a tip element leaked ``c_l (p - p_r)`` through its whole area from the time
-the front first touched it; it now leaks from the time the front crosses its centre.
+step at the ribbon's mean pressure; how the elements the front crosses leak, and why, is in
+:mod:`hmatddm.simulation.front_leak_off`.
 """
 import numpy as np
 
