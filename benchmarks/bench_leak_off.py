@@ -28,8 +28,9 @@ stored at the end) at three element sizes, against the M~ vertex
 (:func:`hmatddm.analytical.viscous_leak_off.kgd_m_leak_off_vertex`) and Dontsov's (2017)
 solution at the run's K_m and C_m (:func:`~hmatddm.analytical.viscous_leak_off.kgd_leak_off_transition`),
 and a transition case (mu 0.02 Pa s, C_m 2.7-4.8) against Dontsov's solution; the net pressure
-as ``Pi = p / (E'^3 mu' C'^2 / (Q t))^(1/4)``, the M~ scaling (constant at the vertex; neither
-closed form gives it).
+as ``Pi = p / (E'^3 mu' C'^2 / (Q t))^(1/4)``, the M~ scaling, against the vertex's 0.7515 (its
+similarity solution, :func:`~hmatddm.analytical.viscous_leak_off.kgd_m_leak_off_similarity`;
+Dontsov's solution gives no pressure).
 
 Also the leak-off coefficient from the reservoir (ref. Eq. 4.26,
 :func:`hmatddm.flow.carter_coefficient`) for the reference's Table 5.2 / 6.2 rock (shown,
@@ -230,6 +231,8 @@ def run_viscous(name, viscosity, h, n_initial, first_step, max_step, end_time):
 
 
 def print_viscous(results):
+    from hmatddm.analytical.viscous_leak_off import KGD_M_LEAK_OFF_PRESSURE
+
     for r in results:
         pick = np.unique(np.clip(np.searchsorted(r["t"], [2, 4, 8, 16]), 0, len(r["t"]) - 1))
         rows = [[f"{r['t'][i]:.3g}", f"{r['c_m'][i]:.2f}", f"{100 * r['stored'][i]:.1f}% / "
@@ -237,12 +240,13 @@ def print_viscous(results):
                  f"{100 * (r['length'][i] / r['vertex_l'][i] - 1):+.1f}%",
                  f"{100 * (r['length'][i] / r['dontsov_l'][i] - 1):+.1f}%", f"{1e3 * r['w0'][i]:.4f}",
                  f"{100 * (r['w0'][i] / r['vertex_w'][i] - 1):+.1f}%",
-                 f"{100 * (r['w0'][i] / r['dontsov_w'][i] - 1):+.1f}%", f"{r['pi'][i]:.3f}"] for i in pick]
+                 f"{100 * (r['w0'][i] / r['dontsov_w'][i] - 1):+.1f}%", f"{r['pi'][i]:.3f}",
+                 f"{100 * (r['pi'][i] / KGD_M_LEAK_OFF_PRESSURE - 1):+.1f}%"] for i in pick]
         print(f"\n{r['name']}: {r['elements']} elements at the end; CPU {r['cpu']:.1f} s, wall {r['wall']:.1f} s; "
               f"largest budget residual {r['residual']:.1e} of the injected volume"
               + (f"; FAILED: {r['failure']}" if r["failure"] else ""))
         print_table(["t (s)", "C_m", "stored DDM / Dontsov", "l DDM (m)", "l vs M~", "l vs Dontsov",
-                     "w0 DDM (mm)", "w0 vs M~", "w0 vs Dontsov", "Pi = p/P_m~"], rows)
+                     "w0 DDM (mm)", "w0 vs M~", "w0 vs Dontsov", "Pi = p/P_m~", "p vs M~"], rows)
 
 
 def plot(results, path):

@@ -195,9 +195,11 @@ SOLUTIONS.update({
 # viscous closed forms with leak-off (hmatddm.analytical.viscous_leak_off)
 SOLUTIONS.update({
     "kgd-m-leak-off": Solution(
-        "kgd-m-leak-off", "plane-strain (KGD) M~ vertex (zero toughness, all the fluid leaked off; approximate, ~1%)",
-        "l = Q t^(1/2) / (pi C'), w0 = 0.8165 (mu' Q^3 t / (E' C'^2))^(1/4), w = w0 (1 + xi)^0.520 (1 - xi)^(5/8)",
-        "Adachi and Detournay 2008; Dontsov 2017, Int. J. Fract. 205:221; hmatddm.analytical.kgd_m_leak_off_vertex"),
+        "kgd-m-leak-off", "plane-strain (KGD) M~ vertex (zero toughness, all the fluid leaked off)",
+        "l = Q t^(1/2) / (pi C'), w0 = 0.8165 (mu' Q^3 t / (E' C'^2))^(1/4), w = w0 (1 + xi)^0.520 (1 - xi)^(5/8), "
+        "p(0) = 0.7515 (E'^3 mu' C'^2 / (Q t))^(1/4)",
+        "Adachi and Detournay 2008; Dontsov 2017, Int. J. Fract. 205:221; the similarity solution "
+        "(hmatddm.analytical.viscous_leak_off.kgd_m_leak_off_similarity)"),
     "kgd-km-leak-off": Solution(
         "kgd-km-leak-off", "plane-strain (KGD) fracture at any K_m and C_m (M, K, M~, K~ and between; approximate, "
         "~1%)",

@@ -291,8 +291,8 @@ def _leak_off_closed_form(scene, times, kind, curves):
     c_l = leak_off(scene).coefficient
     excess = confining_stress(scene) - scene["leak_off"]["pore_pressure"]
     c_prime = regimes.carter_prime(c_l, excess)
-    if kind in ("kgd-m-leak-off", "kgd-km-leak-off", "radial-km-leak-off"):  # viscous (hmatddm.analytical.viscous_leak_off): no
-        from ..analytical import viscous_leak_off  # net pressure in these approximations
+    if kind in ("kgd-m-leak-off", "kgd-km-leak-off", "radial-km-leak-off"):  # viscous: Dontsov's solutions have
+        from ..analytical import viscous_leak_off  # no net pressure (hmatddm.analytical.viscous_leak_off)
 
         if kind == "radial-km-leak-off":
             curves["radius"], curves["max_opening"], _ = viscous_leak_off.radial_leak_off_transition(
@@ -301,9 +301,9 @@ def _leak_off_closed_form(scene, times, kind, curves):
             curves["leak_off_number"] = regimes.radial_leak_off_number(times, rate, viscosity, c_prime, mat)
         else:
             rate = rate / scene["height"]
-            if kind == "kgd-m-leak-off":
-                curves["half_length"], curves["max_opening"] = viscous_leak_off.kgd_m_leak_off_vertex(
-                    times, rate, viscosity, c_prime, mat)
+            if kind == "kgd-m-leak-off":  # with the inlet net pressure of the similarity solution
+                curves["half_length"], curves["max_opening"], curves["net_pressure"] = \
+                    viscous_leak_off.kgd_m_leak_off_vertex(times, rate, viscosity, c_prime, mat, pressure=True)
             else:
                 curves["half_length"], curves["max_opening"], _ = viscous_leak_off.kgd_leak_off_transition(
                     times, rate, viscosity, toughness, c_prime, mat)

@@ -125,3 +125,19 @@ def test_deep_in_the_m_tilde_vertex_dontsovs_solutions_give_his_vertex_constants
     assert np.all(efficiency < 1e-3)
     np.testing.assert_allclose(length, l_v, rtol=1e-3)
     np.testing.assert_allclose(width, w_v, rtol=1e-3)  # 0.8165 (Dontsov 2017)
+
+
+def test_the_m_tilde_similarity_solution_gives_dontsovs_opening_and_the_pressure_constant():
+    # an independent solution of the vertex (known flux, Poiseuille, elasticity, zero toughness):
+    # Dontsov's (2017) 0.8165 to 0.01%, and the constant of the net pressure used by the vertex
+    from hmatddm.analytical.viscous_leak_off import KGD_M_LEAK_OFF_PRESSURE, kgd_m_leak_off_similarity
+
+    opening, pressure = kgd_m_leak_off_similarity()
+    assert opening == pytest.approx(0.8165, rel=2e-4)
+    assert pressure == pytest.approx(KGD_M_LEAK_OFF_PRESSURE, rel=1e-4)
+    coarse = kgd_m_leak_off_similarity(terms=6)  # converged in the number of terms
+    assert coarse[0] == pytest.approx(opening, rel=3e-5) and coarse[1] == pytest.approx(pressure, rel=3e-5)
+    t, q, mu, c = np.array([4.0]), 1e-3, 0.01, 1e-4
+    _, _, p0 = kgd_m_leak_off_vertex(t, q, mu, c, ROCK, pressure=True)
+    e_prime = ROCK.plane_strain_modulus
+    assert p0[0] == pytest.approx(pressure * (e_prime**3 * 12 * mu * c * c / (q * t[0])) ** 0.25, rel=1e-4)
