@@ -230,6 +230,76 @@ def run_viscous(name, viscosity, h, n_initial, first_step, max_step, end_time):
             "cpu": cpu, "wall": wall, "elements": records[-1]["n_elements"] if records else 0, "failure": failure}
 
 
+def run_radial_viscous(end_time=8.0, h=0.2):
+    """A radial fracture from M towards M~ (Q 1e-2 m^3/s, mu 1e-3 Pa s, K_Ic 10 kPa m^1/2, c_l
+    1e-10 at s_v - p_r = 20 MPa: C' = 2e-3 m/s^1/2; 3 x 3 initial elements of ``h``; steps of 0.3
+    elements, the first 0.05 s) against Dontsov's (2016) solution with leak-off
+    (``radial-km-leak-off``) and the radial M~ vertex."""
+    import hmatddm.scene as hs
+    from hmatddm.analytical.viscous_leak_off import radial_m_leak_off_vertex
+
+    text = f"""
+dimension = 3
+[material]
+shear_modulus = 1e9
+poisson_ratio = 0.25
+[fluid]
+viscosity = 1e-3
+compressibility = 0.0
+[stress]
+s_hmin = 40e6
+s_hmax = 40e6
+s_v = 20e6
+[[cluster]]
+position = [0.0, 0.0, 0.0]
+rate = 1e-2
+[[initial_fracture]]
+shape = "rectangle"
+center = [0.0, 0.0, 0.0]
+e1 = [1.0, 0.0, 0.0]
+e2 = [0.0, 1.0, 0.0]
+length = {3 * h}
+height = {3 * h}
+element_size = {h}
+[propagation]
+toughness = 1e4
+front = "asymptotic"
+[leak_off]
+coefficient = 1e-10
+pore_pressure = 0.0
+[numerics]
+time_step = "auto"
+first_time_step = 0.05
+max_time_step = 0.5
+step_advance = 0.3
+end_time = {end_time}
+backend = "dense"
+initial_pressure = 20e6
+initial_opening = 1e-6
+[reference]
+kind = "radial-km-leak-off"
+"""
+    data = hs.scene_from_dict(hs.parse_scene(text).data, "radial-viscous-leak-off").data
+    simulation = hs.build_simulation(data)
+    wall, cpu = time.perf_counter(), time.process_time()
+    records = simulation.run(end_time)
+    wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
+    rows = hs.reference_values(data, records)
+    t = np.array([r["time"] for r in records])
+    vertex_r, vertex_w = radial_m_leak_off_vertex(t, 1e-2, 1e-3, 2e-3, MATERIAL)
+    pick = np.unique(np.clip(np.searchsorted(t, [0.5, 1, 2, 4, 8]), 0, len(t) - 1))
+    table = [[f"{t[i]:.3g}", f"{rows[i]['regime']['leak_off']['value']:.2f}",
+              f"{100 * records[i]['fracture_volume'] / records[i]['injected_volume']:.1f}%",
+              f"{records[i]['radius']:.3f}", f"{100 * rows[i]['relative_error']['radius']:+.1f}%",
+              f"{100 * (records[i]['radius'] / vertex_r[i] - 1):+.1f}%", f"{1e3 * records[i]['max_opening']:.4f}",
+              f"{100 * rows[i]['relative_error']['max_opening']:+.1f}%",
+              f"{100 * (records[i]['max_opening'] / vertex_w[i] - 1):+.1f}%"] for i in pick]
+    print(f"\nradial M to M~ (Q 1e-2, mu 1e-3, C' 2e-3), {h} m: {records[-1]['n_elements']} elements at the end; "
+          f"CPU {cpu:.1f} s, wall {wall:.1f} s; front circularity {records[-1]['front_circularity']:.3f}")
+    print_table(["t (s)", "C_m", "stored", "R DDM (m)", "R vs Dontsov", "R vs M~", "w0 DDM (mm)", "w0 vs Dontsov",
+                 "w0 vs M~"], table)
+
+
 def print_viscous(results):
     from hmatddm.analytical.viscous_leak_off import KGD_M_LEAK_OFF_PRESSURE
 
@@ -284,6 +354,7 @@ def main(argv=None):
     if args.viscous:
         print_viscous([run_viscous(*case, end_time=4.0 if args.quick else VISCOUS["end_time"])
                        for case in VISCOUS_CASES])
+        run_radial_viscous(end_time=2.0 if args.quick else 8.0)
         return
     # ref. Eq. 4.26 for a shale and a tight sand (reservoir fluid: oil 1 cP; c_t 1e-9 1/Pa)
     md = 9.869233e-16

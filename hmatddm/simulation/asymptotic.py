@@ -72,7 +72,7 @@ from ..analytical.tip_asymptote import finite_fracture_factor
 from ..analytical.tip_leak_off import LeakOffTipAsymptote
 from . import proppant_step
 from .front_acceleration import AndersonMixing
-from .front_leak_off import MAX_RETREATS, crossing_times, tip_leak_off_rate
+from .front_leak_off import MAX_RETREATS, crossing_times, starved, tip_leak_off_rate
 from .records import StepTally, step_record
 from .step_solve import mesh_topology
 from .state import NewElements, StepStart
@@ -299,8 +299,11 @@ class AsymptoticFront:
             if far_ribbon:  # a filled element keeps the asymptote's opening (module docstring)
                 prescribed |= state == FILLED
             try:
-                trial, info, flow = self._solve(sim, trial, start, prescribed, width, t_old, t_new, relaxation,
-                                                tip_leak_off)
+                solved, info, flow = self._solve(sim, trial, start, prescribed, width, t_old, t_new, relaxation,
+                                                 tip_leak_off)
+                if leaking and starved(solved, prescribed):
+                    raise ConvergenceError("elements behind the trial front starved")
+                trial = solved
             except ConvergenceError:
                 # a trial front far ahead of the fluid can starve the elements behind it (at an M~
                 # tip their leak-off takes more than the flow brings): halve its advance and retry
