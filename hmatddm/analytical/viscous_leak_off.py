@@ -112,6 +112,12 @@ def kgd_m_leak_off_similarity(terms=8, points=31):
     0.75147``. About 1 s."""
     from scipy import integrate, optimize
 
+    if int(terms) != terms or not 2 <= terms <= 16:
+        raise InputError(f"terms must be an integer in [2, 16], got {terms!r}")
+    if int(points) != points or not terms + 4 <= points <= 400:
+        raise InputError(f"points must be an integer in [terms + 4, 400], got {points!r}")
+    terms, points = int(terms), int(points)
+
     def kernel(x, s):
         a, b = np.sqrt(1.0 - x * x), np.sqrt(1.0 - s * s)
         return np.log(abs((a + b) / (a - b))) if a != b else 0.0

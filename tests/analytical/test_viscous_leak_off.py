@@ -136,6 +136,10 @@ def test_the_m_tilde_similarity_solution_gives_dontsovs_opening_and_the_pressure
     assert opening == pytest.approx(0.8165, rel=2e-4)
     assert pressure == pytest.approx(KGD_M_LEAK_OFF_PRESSURE, rel=1e-4)
     coarse = kgd_m_leak_off_similarity(terms=6)  # converged in the number of terms
+    with pytest.raises(InputError, match="terms"):
+        kgd_m_leak_off_similarity(terms=1.5)
+    with pytest.raises(InputError, match="points"):
+        kgd_m_leak_off_similarity(points=5)
     assert coarse[0] == pytest.approx(opening, rel=3e-5) and coarse[1] == pytest.approx(pressure, rel=3e-5)
     t, q, mu, c = np.array([4.0]), 1e-3, 0.01, 1e-4
     _, _, p0 = kgd_m_leak_off_vertex(t, q, mu, c, ROCK, pressure=True)
