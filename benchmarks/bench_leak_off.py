@@ -21,6 +21,17 @@ percent only), compared at every step with:
 And radial fractures (3D, 0.25 m elements, 20 s) against the radial K vertex and the
 radial K-K~ edge (:func:`hmatddm.analytical.radial_toughness_leak_off_edge`).
 
+``--viscous`` runs only the viscous leak-off rows (issue 36): a KGD fracture on the
+asymptotic front with mu 1e-3 Pa s, K_Ic 1 kPa m^1/2 (K_m 0.011), c_l 1e-10 (C' = 2e-3 m/s^1/2 at
+sigma_0 - p_r = 20 MPa), Q 1e-3 m^2/s, G 1 GPa, nu 0.25, 16 s (C_m 4.4 to 7.8: 1.7% of the fluid
+stored at the end) at three element sizes, against the M~ vertex
+(:func:`hmatddm.analytical.viscous_leak_off.kgd_m_leak_off_vertex`) and Dontsov's (2017)
+solution at the run's K_m and C_m (:func:`~hmatddm.analytical.viscous_leak_off.kgd_leak_off_transition`),
+and a transition case (mu 0.02 Pa s, C_m 2.7-4.8) against Dontsov's solution; the net pressure
+as ``Pi = p / (E'^3 mu' C'^2 / (Q t))^(1/4)``, the M~ scaling, against the vertex's 0.7515 (its
+similarity solution, :func:`~hmatddm.analytical.viscous_leak_off.kgd_m_leak_off_similarity`;
+Dontsov's solution gives no pressure).
+
 Also the leak-off coefficient from the reservoir (ref. Eq. 4.26,
 :func:`hmatddm.flow.carter_coefficient`) for the reference's Table 5.2 / 6.2 rock (shown,
 not run: with ``k_r = 0`` it is zero).
@@ -48,6 +59,7 @@ import hmatddm as hd  # noqa: E402
 from hmatddm.analytical import (kgd_k_vertex, kgd_leak_off_half_length, kgd_regime,  # noqa: E402
                                 kgd_toughness_leak_off_edge, radial_k_vertex, radial_leak_off_radius,
                                 radial_toughness_leak_off_edge)
+from hmatddm.errors import ConvergenceError  # noqa: E402
 from hmatddm.flow import carter_coefficient  # noqa: E402
 
 MATERIAL = hd.Elastic(1e9, 0.25)
@@ -130,6 +142,184 @@ def run_radial(name, rate, c_l, end_time=20.0, toughness=1e6):
             "cpu": cpu, "wall": wall, "elements": records[-1]["n_elements"], "c_l": c_l}
 
 
+#: viscous leak-off (issue 36): name, viscosity (Pa s), element size (m), initial elements,
+#: first step (s), longest step (s)
+VISCOUS_CASES = (
+    ("M~, 0.1 m", 1e-3, 0.1, 3, 2.0, 2.0),
+    ("M~, 0.05 m", 1e-3, 0.05, 3, 0.5, 0.5),
+    ("M~, 0.025 m", 1e-3, 0.025, 5, 0.5, 0.5),
+    ("M to M~ (mu 0.02), 0.05 m", 0.02, 0.05, 3, 0.5, 0.5),
+    ("deep M~ (mu 2.5e-5), 0.05 m", 2.5e-5, 0.05, 3, 0.5, 0.5),
+)
+VISCOUS = dict(rate=1e-3, c_l=1e-10, toughness=1e3, end_time=16.0)
+
+
+def viscous_scene(viscosity, h, n_initial, first_step, max_step, end_time):
+    """The scene of a viscous leak-off row (VISCOUS_CASES): KGD, the asymptotic front, steps
+    that move the front 0.3 elements (the first long enough that the initial elements,
+    leaking from t = 0, do not take all the fluid)."""
+    import hmatddm.scene as hs
+
+    half = 0.5 * n_initial * h
+    text = f"""
+dimension = 2
+[material]
+shear_modulus = 1e9
+poisson_ratio = 0.25
+[fluid]
+viscosity = {viscosity}
+compressibility = 0.0
+[stress]
+s_hmin = 20e6
+s_hmax = 40e6
+[[cluster]]
+position = [0.0, 0.0]
+rate = {VISCOUS['rate']}
+[[initial_fracture]]
+shape = "line"
+p0 = [{-half}, 0.0]
+p1 = [{half}, 0.0]
+element_size = {h}
+[propagation]
+toughness = {VISCOUS['toughness']}
+front = "asymptotic"
+[leak_off]
+coefficient = {VISCOUS['c_l']}
+pore_pressure = 0.0
+[numerics]
+time_step = "auto"
+first_time_step = {first_step}
+max_time_step = {max_step}
+step_advance = 0.3
+end_time = {end_time}
+backend = "dense"
+initial_pressure = 20e6
+initial_opening = 1e-6
+[reference]
+kind = "kgd-km-leak-off"
+"""
+    return hs.scene_from_dict(hs.parse_scene(text).data, "viscous-leak-off").data
+
+
+def run_viscous(name, viscosity, h, n_initial, first_step, max_step, end_time):
+    import hmatddm.scene as hs
+    from hmatddm.analytical.viscous_leak_off import kgd_leak_off_transition, kgd_m_leak_off_vertex
+
+    data = viscous_scene(viscosity, h, n_initial, first_step, max_step, end_time)
+    simulation = hs.build_simulation(data)
+    wall, cpu = time.perf_counter(), time.process_time()
+    failure = None
+    try:
+        records = simulation.run(end_time)
+    except ConvergenceError as error:  # shown in the table, not hidden
+        records, failure = simulation.records, str(error)
+    wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
+    t = np.array([r["time"] for r in records])
+    c_prime = VISCOUS["c_l"] * (S_HMIN - PORE)
+    e_prime, mu_prime = MATERIAL.plane_strain_modulus, 12.0 * viscosity
+    vertex_l, vertex_w = kgd_m_leak_off_vertex(t, VISCOUS["rate"], viscosity, c_prime, MATERIAL)
+    dontsov_l, dontsov_w, efficiency = kgd_leak_off_transition(t, VISCOUS["rate"], viscosity, VISCOUS["toughness"],
+                                                               c_prime, MATERIAL)
+    scale = (e_prime**3 * mu_prime * c_prime**2 / (VISCOUS["rate"] * t)) ** 0.25
+    return {"name": name, "t": t, "length": np.array([r["half_length"] for r in records]),
+            "w0": np.array([r["max_opening"] for r in records]), "vertex_l": vertex_l, "vertex_w": vertex_w,
+            "dontsov_l": dontsov_l, "dontsov_w": dontsov_w, "dontsov_stored": efficiency,
+            "pi": (np.array([r["wellbore_pressure"][0] for r in records]) - S_HMIN) / scale,
+            "stored": np.array([r["fracture_volume"] / r["injected_volume"] for r in records]),
+            "c_m": (c_prime**6 * e_prime * t / (mu_prime * VISCOUS["rate"] ** 3)) ** (1.0 / 6.0),
+            "residual": max(abs(r["budget"]["residual"]) / r["injected_volume"] for r in records),
+            "cpu": cpu, "wall": wall, "elements": records[-1]["n_elements"] if records else 0, "failure": failure}
+
+
+def run_radial_viscous(end_time=8.0, h=0.2):
+    """A radial fracture from M towards M~ (Q 1e-2 m^3/s, mu 1e-3 Pa s, K_Ic 10 kPa m^1/2, c_l
+    1e-10 at s_v - p_r = 20 MPa: C' = 2e-3 m/s^1/2; 3 x 3 initial elements of ``h``; steps of 0.3
+    elements, the first 0.05 s) against Dontsov's (2016) solution with leak-off
+    (``radial-km-leak-off``) and the radial M~ vertex."""
+    import hmatddm.scene as hs
+    from hmatddm.analytical.viscous_leak_off import radial_m_leak_off_vertex
+
+    text = f"""
+dimension = 3
+[material]
+shear_modulus = 1e9
+poisson_ratio = 0.25
+[fluid]
+viscosity = 1e-3
+compressibility = 0.0
+[stress]
+s_hmin = 40e6
+s_hmax = 40e6
+s_v = 20e6
+[[cluster]]
+position = [0.0, 0.0, 0.0]
+rate = 1e-2
+[[initial_fracture]]
+shape = "rectangle"
+center = [0.0, 0.0, 0.0]
+e1 = [1.0, 0.0, 0.0]
+e2 = [0.0, 1.0, 0.0]
+length = {3 * h}
+height = {3 * h}
+element_size = {h}
+[propagation]
+toughness = 1e4
+front = "asymptotic"
+[leak_off]
+coefficient = 1e-10
+pore_pressure = 0.0
+[numerics]
+time_step = "auto"
+first_time_step = 0.05
+max_time_step = 0.5
+step_advance = 0.3
+end_time = {end_time}
+backend = "dense"
+initial_pressure = 20e6
+initial_opening = 1e-6
+[reference]
+kind = "radial-km-leak-off"
+"""
+    data = hs.scene_from_dict(hs.parse_scene(text).data, "radial-viscous-leak-off").data
+    simulation = hs.build_simulation(data)
+    wall, cpu = time.perf_counter(), time.process_time()
+    records = simulation.run(end_time)
+    wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
+    rows = hs.reference_values(data, records)
+    t = np.array([r["time"] for r in records])
+    vertex_r, vertex_w = radial_m_leak_off_vertex(t, 1e-2, 1e-3, 2e-3, MATERIAL)
+    pick = np.unique(np.clip(np.searchsorted(t, [0.5, 1, 2, 4, 8]), 0, len(t) - 1))
+    table = [[f"{t[i]:.3g}", f"{rows[i]['regime']['leak_off']['value']:.2f}",
+              f"{100 * records[i]['fracture_volume'] / records[i]['injected_volume']:.1f}%",
+              f"{records[i]['radius']:.3f}", f"{100 * rows[i]['relative_error']['radius']:+.1f}%",
+              f"{100 * (records[i]['radius'] / vertex_r[i] - 1):+.1f}%", f"{1e3 * records[i]['max_opening']:.4f}",
+              f"{100 * rows[i]['relative_error']['max_opening']:+.1f}%",
+              f"{100 * (records[i]['max_opening'] / vertex_w[i] - 1):+.1f}%"] for i in pick]
+    print(f"\nradial M to M~ (Q 1e-2, mu 1e-3, C' 2e-3), {h} m: {records[-1]['n_elements']} elements at the end; "
+          f"CPU {cpu:.1f} s, wall {wall:.1f} s; front circularity {records[-1]['front_circularity']:.3f}")
+    print_table(["t (s)", "C_m", "stored", "R DDM (m)", "R vs Dontsov", "R vs M~", "w0 DDM (mm)", "w0 vs Dontsov",
+                 "w0 vs M~"], table)
+
+
+def print_viscous(results):
+    from hmatddm.analytical.viscous_leak_off import KGD_M_LEAK_OFF_PRESSURE
+
+    for r in results:
+        pick = np.unique(np.clip(np.searchsorted(r["t"], [2, 4, 8, 16]), 0, len(r["t"]) - 1))
+        rows = [[f"{r['t'][i]:.3g}", f"{r['c_m'][i]:.2f}", f"{100 * r['stored'][i]:.1f}% / "
+                 f"{100 * r['dontsov_stored'][i]:.1f}%", f"{r['length'][i]:.4f}",
+                 f"{100 * (r['length'][i] / r['vertex_l'][i] - 1):+.1f}%",
+                 f"{100 * (r['length'][i] / r['dontsov_l'][i] - 1):+.1f}%", f"{1e3 * r['w0'][i]:.4f}",
+                 f"{100 * (r['w0'][i] / r['vertex_w'][i] - 1):+.1f}%",
+                 f"{100 * (r['w0'][i] / r['dontsov_w'][i] - 1):+.1f}%", f"{r['pi'][i]:.3f}",
+                 f"{100 * (r['pi'][i] / KGD_M_LEAK_OFF_PRESSURE - 1):+.1f}%"] for i in pick]
+        print(f"\n{r['name']}: {r['elements']} elements at the end; CPU {r['cpu']:.1f} s, wall {r['wall']:.1f} s; "
+              f"largest budget residual {r['residual']:.1e} of the injected volume"
+              + (f"; FAILED: {r['failure']}" if r["failure"] else ""))
+        print_table(["t (s)", "C_m", "stored DDM / Dontsov", "l DDM (m)", "l vs M~", "l vs Dontsov",
+                     "w0 DDM (mm)", "w0 vs M~", "w0 vs Dontsov", "Pi = p/P_m~", "p vs M~"], rows)
+
+
 def plot(results, path):
     import matplotlib
 
@@ -159,8 +349,14 @@ def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--quick", action="store_true", help="10 s runs")
     parser.add_argument("--plot", default=os.path.join(HERE, "leak_off_kgd.png"))
+    parser.add_argument("--viscous", action="store_true", help="only the viscous leak-off (M~) rows")
     args = parser.parse_args(argv)
     print(f"Machine: {machine()}")
+    if args.viscous:
+        print_viscous([run_viscous(*case, end_time=4.0 if args.quick else VISCOUS["end_time"])
+                       for case in VISCOUS_CASES])
+        run_radial_viscous(end_time=2.0 if args.quick else 8.0)
+        return
     # ref. Eq. 4.26 for a shale and a tight sand (reservoir fluid: oil 1 cP; c_t 1e-9 1/Pa)
     md = 9.869233e-16
     for label, k_r in (("shale, 1e-4 mD", 1e-4), ("tight sand, 0.1 mD", 0.1)):

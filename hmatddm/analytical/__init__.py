@@ -13,6 +13,8 @@ the validation table and the scenes' ``[reference]`` blocks compare with.
   1e-7 (the published constants above carry 0.03-1%).
 * :mod:`.leak_off`: leak-off-dominated sizes (the K~ and M~ vertices) and the plane-strain
   K-K~ edge.
+* :mod:`.viscous_leak_off`: the plane-strain M~ vertex and Dontsov's (2016, 2017) radial and
+  plane-strain solutions at any toughness, viscosity and leak-off.
 
 Names of :mod:`.solutions` are exported here (``hd.analytical.radial_k_vertex``), loaded
 on first use (scipy.special is not imported with the package).
@@ -33,9 +35,13 @@ _REGIMES = (
 )
 _TABLES = ("RadialTransitionTable", "radial_transition_table")
 _M_VERTEX = ("kgd_m_vertex_numeric", "radial_m_vertex_numeric")
+_VISCOUS_LEAK_OFF = ("kgd_m_leak_off_vertex", "kgd_m_leak_off_profile", "kgd_leak_off_transition",
+                     "radial_leak_off_transition", "radial_leak_off_profile", "radial_m_leak_off_vertex")
 _EXPORTS = {**{name: ".solutions" for name in _SOLUTIONS}, **{name: ".leak_off" for name in _LEAK_OFF},
             **{name: ".regimes" for name in _REGIMES}, **{name: ".transition_table" for name in _TABLES},
-            **{name: ".m_vertex_numeric" for name in _M_VERTEX}}
+            **{name: ".m_vertex_numeric" for name in _M_VERTEX},
+            **{name: ".viscous_leak_off" for name in _VISCOUS_LEAK_OFF}}
 __getattr__, __dir__ = attach(__name__, _EXPORTS)
 
-__all__ = list(_SOLUTIONS) + list(_LEAK_OFF) + list(_REGIMES) + list(_TABLES) + list(_M_VERTEX)
+__all__ = (list(_SOLUTIONS) + list(_LEAK_OFF) + list(_REGIMES) + list(_TABLES) + list(_M_VERTEX)
+           + list(_VISCOUS_LEAK_OFF))

@@ -33,8 +33,12 @@ solution, so a scene's ``[reference]`` with them refuses leak-off (:mod:`hmatddm
 the leak-off numbers say how far a scene with leak-off is from them. A scene with leak-off
 is judged by a K-K~ edge (``kgd-k-leak-off``, ``radial-k-leak-off``; :mod:`.leak_off`,
 zero viscosity at any leak-off number): it applies where the toughness number says K (the
-viscosity is negligible; :data:`LEAK_OFF_VERTEX`), and its reference block records ``C_m``
-beside ``K_m``, with ``C' = c_l (sigma_0 - p_r)`` (:func:`carter_prime`).
+viscosity is negligible; :data:`LEAK_OFF_VERTEX`); by the plane-strain M~ vertex
+(``kgd-m-leak-off``, where the toughness number says M; it assumes all the fluid leaked:
+``C_m`` large, the stored share about ``C_m^(-3/2)``); or by Dontsov's solutions at any
+``K_m`` and ``C_m`` (``kgd-km-leak-off``, ``radial-km-leak-off``; :mod:`.viscous_leak_off`).
+Its reference block records ``C_m`` beside ``K_m``, with ``C' = c_l (sigma_0 - p_r)``
+(:func:`carter_prime`).
 """
 from dataclasses import dataclass
 
@@ -188,9 +192,29 @@ SOLUTIONS.update({
         "- p_r + p) / (t' - t_0(r))^(1/2) dA dt'",
         "Carter 1957; Madyarova 2003; Detournay 2016; hmatddm.analytical.radial_toughness_leak_off_edge"),
 })
-# the vertex of the toughness number whose side each leak-off edge lies on (zero viscosity:
-# the K side at any leak-off number)
-LEAK_OFF_VERTEX = {"kgd-k-leak-off": "kgd-k", "radial-k-leak-off": "radial-k"}
+# viscous closed forms with leak-off (hmatddm.analytical.viscous_leak_off)
+SOLUTIONS.update({
+    "kgd-m-leak-off": Solution(
+        "kgd-m-leak-off", "plane-strain (KGD) M~ vertex (zero toughness, all the fluid leaked off)",
+        "l = Q t^(1/2) / (pi C'), w0 = 0.8165 (mu' Q^3 t / (E' C'^2))^(1/4), w = w0 (1 + xi)^0.520 (1 - xi)^(5/8), "
+        "p(0) = 0.7515 (E'^3 mu' C'^2 / (Q t))^(1/4)",
+        "Adachi and Detournay 2008; Dontsov 2017, Int. J. Fract. 205:221; the similarity solution "
+        "(hmatddm.analytical.viscous_leak_off.kgd_m_leak_off_similarity)"),
+    "kgd-km-leak-off": Solution(
+        "kgd-km-leak-off", "plane-strain (KGD) fracture at any K_m and C_m (M, K, M~, K~ and between; approximate, "
+        "~1%)",
+        "w = w_a (1 - xi)^delta ((1 + xi)/2)^lambda, w_a the tip asymptote with leak-off at s = l, "
+        "Q t = stored + 4 alpha B(alpha, 3/2) C' t^(1/2) l",
+        "Dontsov 2017, Int. J. Fract. 205:221; hmatddm.analytical.viscous_leak_off.kgd_leak_off_transition"),
+    "radial-km-leak-off": Solution(
+        "radial-km-leak-off", "radial fracture at any K_m and C_m (M, K, M~, K~ and between; approximate, ~1%)",
+        "w = w_a (1 - rho)^delta ((1 + rho)/2)^lambda, w_a the tip asymptote with leak-off at s = R, "
+        "Q t = stored + 4 pi alpha B(2 alpha, 3/2) C' t^(1/2) R^2",
+        "Dontsov 2016, R. Soc. open sci. 3:160737; hmatddm.analytical.radial_leak_off_transition"),
+})
+# the vertex of the toughness number whose side each leak-off closed form lies on (a K-K~
+# edge, zero viscosity: the K side at any leak-off number; the M~ vertex: the M side)
+LEAK_OFF_VERTEX = {"kgd-k-leak-off": "kgd-k", "radial-k-leak-off": "radial-k", "kgd-m-leak-off": "kgd-m"}
 
 # what applies where a vertex does not: the transition solutions
 _TRANSITION = {
@@ -211,7 +235,7 @@ def applicable_solution(kind, toughness_numbers):
     if kind not in SOLUTIONS:
         raise InputError(f"reference kind must be one of {sorted(SOLUTIONS)}, got {kind!r}")
     geometry = "radial" if kind.startswith("radial") else "kgd"
-    if kind == "radial-km":
+    if kind in ("radial-km", "radial-km-leak-off", "kgd-km-leak-off"):
         return True, None
     kind = LEAK_OFF_VERTEX.get(kind, kind)  # a K-K~ edge: where the K-vertex's toughness number says K
     vertices = {vertex(float(k), geometry) for k in np.ravel(toughness_numbers)}

@@ -57,11 +57,17 @@ def toughness_prime(toughness):
 
 
 def _f(k_hat, c_hat, c_1):
+    """Dontsov and Peirce's ``f(K, C, C_1)``; for ``C > 1e3`` (the k-m~ edge, where the closed
+    form cancels to round-off) its series ``[(1 - K^4)/(4 C) - (1 - K^5)/(5 C^2) + (1 - K^6)/(6
+    C^3)] / C_1`` (the expansion of the logarithm; Dontsov 2016's code does the same)."""
     k = np.minimum(k_hat, 1.0)
     c = c_hat
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         log_term = np.where(c > 0.0, c**3 * np.log((c + 1.0) / (c + k)), 0.0)
-    return (1.0 - k**3 - 1.5 * c * (1.0 - k * k) + 3.0 * c * c * (1.0 - k) - 3.0 * log_term) / (3.0 * c_1)
+        closed = (1.0 - k**3 - 1.5 * c * (1.0 - k * k) + 3.0 * c * c * (1.0 - k) - 3.0 * log_term) / (3.0 * c_1)
+        big = np.where(c > 1e3, c, 1e3)
+        series = ((1.0 - k**4) / (4.0 * big) - (1.0 - k**5) / (5.0 * big**2) + (1.0 - k**6) / (6.0 * big**3)) / c_1
+    return np.where(c > 1e3, series, closed)
 
 
 def g_delta(k_hat, c_hat):

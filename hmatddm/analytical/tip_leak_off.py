@@ -12,10 +12,8 @@ rest (``V = 0``) opens as the toughness asymptote (``K^ = 1`` makes ``g_delta`` 
 any ``C^``). :class:`LeakOffTipAsymptote` takes one ``C'`` for every point of a call.
 
 Used by the asymptotic front (:mod:`hmatddm.simulation.asymptotic`) with one ``C'`` per
-step at the ribbon's mean pressure. A first try (issue 36) failed -- the coupled solve of a
-KGD step did not converge (M~ case of benchmarks/bench_leak_off.py) or the front stalled
-(K~) -- because a tip element leaked ``c_l (p - p_r)`` through its whole area from the time
-the front first touched it; it now leaks from the time the front crosses its centre.
+step at the ribbon's mean pressure; how the elements the front crosses leak, and why, is in
+:mod:`hmatddm.simulation.front_leak_off`.
 """
 import numpy as np
 
@@ -39,11 +37,13 @@ class LeakOffTipAsymptote(TipAsymptote):
         """``s^ - g_delta(K^, C^)`` (negative when ``w`` is wider than the asymptote)."""
         s, velocity, w = np.broadcast_arrays(np.asarray(s, float), np.asarray(velocity, float), np.asarray(w, float))
         v = np.maximum(velocity, 0.0)
-        k_hat = self.k_prime * np.sqrt(s) / (self.e_prime * w)
-        s_hat = self.mu_prime * v * s * s / (self.e_prime * w**3)
         moving = v > 0.0
-        c_hat = np.where(moving, 2.0 * self.carter * np.sqrt(s) / (np.sqrt(np.where(moving, v, 1.0)) * w), 0.0)
-        return s_hat - g_delta(k_hat, c_hat)
+        # a front at rest: s^ = 0 (also where w^3 underflows, which made 0/0 warnings and NaN)
+        with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+            k_hat = self.k_prime * np.sqrt(s) / (self.e_prime * w)
+            s_hat = np.where(moving, self.mu_prime * v * s * s / (self.e_prime * w**3), 0.0)
+            c_hat = np.where(moving, 2.0 * self.carter * np.sqrt(s) / (np.sqrt(np.where(moving, v, 1.0)) * w), 0.0)
+            return s_hat - g_delta(k_hat, c_hat)
 
     def width(self, s, velocity, iterations=36, length=np.inf):
         """Opening ``w(s)`` behind a front moving at ``velocity`` (the parent's bisection in

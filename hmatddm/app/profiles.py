@@ -84,6 +84,27 @@ def closed_form_profile(scene, time_value):
                              np.full(SAMPLES, float(curves["net_pressure"][0])), size)
         profile["label"] = f"{kind.split('-')[0]} K-K~ edge (leak-off)"
         return profile
+    if kind in ("kgd-m-leak-off", "kgd-km-leak-off", "radial-km-leak-off"):  # viscous with leak-off: no net pressure
+        from ..analytical import viscous_leak_off
+        from ..scene.build import _closed_form, confining_stress, leak_off
+
+        rho = np.linspace(0.0, 1.0, SAMPLES)
+        c_prime = leak_off(scene).coefficient * (confining_stress(scene) - scene["leak_off"]["pore_pressure"])
+        if kind == "kgd-m-leak-off":
+            size, width = viscous_leak_off.kgd_m_leak_off_profile(rho, t, rate / scene["height"], viscosity,
+                                                                  c_prime, rock)
+            profile = _symmetric(rho, width, None, size)
+            profile["label"] = "kgd M~ vertex (Dontsov 2017)"
+        elif kind == "kgd-km-leak-off":
+            size, width = viscous_leak_off.kgd_leak_off_transition(t, rate / scene["height"], viscosity, toughness,
+                                                                   c_prime, rock, profile=rho)
+            profile = _symmetric(rho, width, None, float(size[0]))
+            profile["label"] = "kgd with leak-off (Dontsov 2017)"
+        else:
+            size, width = viscous_leak_off.radial_leak_off_profile(rho, t, rate, viscosity, toughness, c_prime, rock)
+            profile = _symmetric(rho, width, None, size)
+            profile["label"] = "radial with leak-off (Dontsov 2016)"
+        return profile
     if kind == "kgd-m":
         size, _, _ = analytical.kgd_m_vertex(t, rate / scene["height"], viscosity, rock)
         rho = np.linspace(0.0, _M_RHO[1], SAMPLES)

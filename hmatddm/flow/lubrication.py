@@ -171,15 +171,23 @@ class LubricationModel:
         conductance, correction = self.power_law_conductance(width, pressure)
         return conductance * difference - correction
 
+    #: ``(elements, Lambda)`` that replace :meth:`leak_off_rate` of those elements (the
+    #: asymptotic front's tip elements, leaking point by point; None: none)
+    tip_leak_off = None
+
     def leak_off_rate(self, creation_time, time_old, time_new):
-        """Lambda_i, the step-averaged Carter coefficient (1/s per Pa scale: m/(s Pa))."""
+        """Lambda_i, the step-averaged Carter coefficient (1/s per Pa scale: m/(s Pa)), with
+        :attr:`tip_leak_off` in place where given."""
         c = self.leak_off.coefficient
         if c == 0.0:
             return np.zeros(self.n_elements)
         dt = time_new - time_old
         new = np.sqrt(np.maximum(time_new - creation_time, 0.0))
         old = np.sqrt(np.maximum(time_old - creation_time, 0.0))
-        return 2.0 * c * (new - old) / dt
+        rate = 2.0 * c * (new - old) / dt
+        if self.tip_leak_off is not None:
+            rate[self.tip_leak_off[0]] = self.tip_leak_off[1]
+        return rate
 
     def wellbore_storage(self):
         """V_w per element (summed when clusters share an element)."""

@@ -145,7 +145,10 @@ The format, annotated (``=`` values are the defaults unless marked REQUIRED)::
                                    # Dontsov 2016), "kgd-k", "kgd-m" (2D);
                                    # needs one cluster, [propagation] and no leak-off;
                                    # with leak-off: "kgd-k-leak-off", "radial-k-leak-off"
-                                   # (the K-K~ edge, Carter leak-off; records C_m too);
+                                   # (the K-K~ edge, Carter leak-off; records C_m too),
+                                   # "kgd-m-leak-off" (M~ vertex), "kgd-km-leak-off",
+                                   # "radial-km-leak-off" (Dontsov 2017 / 2016 at any
+                                   # K_m, C_m; no net pressure);
                                    # or "three-layer-height" (2D, three [[layer]]s: the
                                    # equilibrium height of a symmetric stack under a
                                    # stress contrast, Simonson et al. 1978)

@@ -291,6 +291,26 @@ def _leak_off_closed_form(scene, times, kind, curves):
     c_l = leak_off(scene).coefficient
     excess = confining_stress(scene) - scene["leak_off"]["pore_pressure"]
     c_prime = regimes.carter_prime(c_l, excess)
+    if kind in ("kgd-m-leak-off", "kgd-km-leak-off", "radial-km-leak-off"):  # viscous: Dontsov's solutions have
+        from ..analytical import viscous_leak_off  # no net pressure (hmatddm.analytical.viscous_leak_off)
+
+        if kind == "radial-km-leak-off":
+            curves["radius"], curves["max_opening"], _ = viscous_leak_off.radial_leak_off_transition(
+                times, rate, viscosity, toughness, c_prime, mat)
+            curves["dimensionless_toughness"] = analytical.radial_regime(times, rate, viscosity, toughness, mat)
+            curves["leak_off_number"] = regimes.radial_leak_off_number(times, rate, viscosity, c_prime, mat)
+        else:
+            rate = rate / scene["height"]
+            if kind == "kgd-m-leak-off":  # with the inlet net pressure of the similarity solution
+                curves["half_length"], curves["max_opening"], curves["net_pressure"] = \
+                    viscous_leak_off.kgd_m_leak_off_vertex(times, rate, viscosity, c_prime, mat, pressure=True)
+            else:
+                curves["half_length"], curves["max_opening"], _ = viscous_leak_off.kgd_leak_off_transition(
+                    times, rate, viscosity, toughness, c_prime, mat)
+            curves["dimensionless_toughness"] = np.full(times.shape, analytical.kgd_regime(rate, viscosity,
+                                                                                            toughness, mat))
+            curves["leak_off_number"] = regimes.kgd_leak_off_number(times, rate, viscosity, c_prime, mat)
+        return curves
     if kind == "radial-k-leak-off":
         radius, net = analytical.radial_toughness_leak_off_edge(times, rate, c_l, excess, toughness, e_prime)
         curves.update(radius=radius, max_opening=8.0 * net * radius / (np.pi * e_prime), net_pressure=net)
@@ -405,7 +425,7 @@ def reference_values(scene, records):
     rows = []
     for index, record in enumerate(records):
         row = {key: float(values[index]) for key, values in curves.items()}
-        uniform = kind.endswith("-k") or kind in LEAK_OFF_REFERENCE_KINDS  # a K vertex or a K-K~ edge
+        uniform = kind.endswith("-k") or kind.endswith("-k-leak-off")  # a K vertex or a K-K~ edge
         simulated = _simulated(record, size_key, confining, uniform_pressure=uniform)
         row["relative_error"] = _relative(simulated, row)
         row["regime"] = {"number": regime["number"], "value": row["dimensionless_toughness"],

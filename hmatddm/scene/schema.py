@@ -255,7 +255,8 @@ def _check_reference(scene):
     elif scene["leak_off"]["coefficient"] != 0.0:
         raise InputError(f"{where} assumes no leak-off: leak_off.coefficient must be 0, got "
                          f"{show(scene['leak_off']['coefficient'])}; with leak-off use kind = "
-                         f"{kind.split('-')[0] + '-k-leak-off'!r} (the K-K~ edge)")
+                         f"{kind.split('-')[0] + '-k-leak-off'!r} (the K-K~ edge) or "
+                         f"{kind.split('-')[0] + '-km-leak-off'!r} (viscous)")
 
 
 # ---------------------------------------------------------------------------------

@@ -163,3 +163,85 @@ def test_the_asymptotic_front_with_leak_off_follows_the_edge():
             assert abs(row["relative_error"]["max_opening"]) < 0.01
             assert abs(row["relative_error"]["net_pressure"]) < 0.01
         assert abs(record["budget"]["residual"]) < 1e-8 * record["injected_volume"]
+
+
+def test_the_viscous_leak_off_kinds_give_their_closed_forms():
+    # kgd-m-leak-off: the M~ vertex with C' = c_l (sigma_0 - p_r); radial-km-leak-off: Dontsov 2016
+    from hmatddm.analytical.viscous_leak_off import kgd_m_leak_off_vertex, radial_leak_off_transition
+    from hmatddm.app.profiles import closed_form_profile
+
+    data = scene(**{"fluid.viscosity": 1e-3, "reference.kind": "kgd-m-leak-off"})
+    t = np.array([5.0, 20.0])
+    curves = _closed_form(data, t)
+    length, w0 = kgd_m_leak_off_vertex(t, 1e-3, 1e-3, 1e-11 * 20e6, data_material(data))
+    np.testing.assert_allclose(curves["half_length"], length, rtol=1e-12)
+    np.testing.assert_allclose(curves["max_opening"], w0, rtol=1e-12)
+    assert np.all(curves["leak_off_number"] > 0.0)
+    # p(0) = 0.7515 (E'^3 mu' C'^2 / (Q t))^(1/4), the similarity solution's
+    e_prime = 2.0 * 1e9 / (1.0 - 0.25)
+    np.testing.assert_allclose(curves["net_pressure"], 0.7515 * (e_prime**3 * 12e-3 * (2e-4) ** 2 / (1e-3 * t)) ** 0.25,
+                               rtol=1e-12)
+    profile = closed_form_profile(data, 20.0)
+    assert max(profile["opening"]) == pytest.approx(w0[1], rel=1e-9) and "M~" in profile["label"]
+    raw = hs.parse_scene(hs.embedded_text("radial-k")).data
+    raw["leak_off"] = {"coefficient": 1e-11}
+    raw["propagation"]["front"] = "element"
+    raw["reference"]["kind"] = "radial-km-leak-off"
+    radial = hs.scene_from_dict(raw, "radial-viscous-leak-off").data
+    curves = _closed_form(radial, t)
+    excess = 1e-11 * (hs.build.confining_stress(radial) - radial["leak_off"]["pore_pressure"])
+    radius, width, _ = radial_leak_off_transition(t, radial["cluster"][0]["rate"], radial["fluid"]["viscosity"],
+                                                  radial["propagation"]["toughness"], excess, data_material(radial))
+    np.testing.assert_allclose(curves["radius"], radius, rtol=1e-12)
+    np.testing.assert_allclose(curves["max_opening"], width, rtol=1e-12)
+    assert max(closed_form_profile(radial, 20.0)["opening"]) == pytest.approx(width[1], rel=1e-6)
+    raw["reference"]["kind"] = "radial-k"
+    with pytest.raises(InputError, match="'radial-km-leak-off' \\(viscous\\)"):
+        hs.scene_from_dict(raw, "radial-viscous-leak-off")
+
+
+def data_material(data):
+    from hmatddm.scene.build import material
+
+    return material(data)
+
+
+# A viscous, leak-off-dominated KGD fracture (issue 36): mu 1e-3 Pa s, K_Ic 1 kPa m^1/2 (K_m 0.011),
+# c_l 1e-10 m/(s^1/2 Pa) (C' = 2e-3 m/s^1/2), Q 1e-3 m^2/s: C_m 4.4 to 6.2 over 0.5-4 s, 2.4-3.9%
+# of the fluid stored (the M~ vertex stores none), on 0.05 m elements of the asymptotic front; the
+# first step (0.5 s) is long enough that the 3 initial elements, leaking from t = 0, do not take
+# all the fluid; steps that move the front 0.3 elements
+KGD_M_LEAK_OFF = KGD_LEAK_OFF.replace("viscosity = 1e-5", "viscosity = 1e-3").replace(
+    "coefficient = 1e-11", "coefficient = 1e-10").replace("toughness = 1e6", "toughness = 1e3").replace(
+    'front = "element"', 'front = "asymptotic"').replace("p0 = [-0.2, 0.0]", "p0 = [-0.075, 0.0]").replace(
+    "p1 = [0.2, 0.0]", "p1 = [0.075, 0.0]").replace("element_size = 0.1", "element_size = 0.05").replace(
+    "time_step = 1.0", 'time_step = "auto"\nfirst_time_step = 0.5\nmax_time_step = 0.5\nstep_advance = 0.3').replace(
+    "end_time = 20.0", "end_time = 4.0").replace("initial_pressure = 21.28e6", "initial_pressure = 20e6").replace(
+    "initial_opening = 1e-5", "initial_opening = 1e-6").replace('kind = "kgd-k-leak-off"', 'kind = "kgd-km-leak-off"')
+
+
+def test_a_viscous_leak_off_run_follows_dontsovs_solution_towards_the_m_tilde_vertex():
+    # measured (0.05 m) from 2 s on: half-length -2.2..-0.5% and inlet opening -3.2..-0.4% from
+    # Dontsov 2017 (kgd-km-leak-off); from the M~ vertex -4.6..-2.7% and -4.2..-1.5% (the 2.4% of
+    # the fluid still stored: Dontsov's own solution sits -2.3% / -1.2% from the vertex); the
+    # budget's residual below 1e-7 of the injected volume; the wellbore net pressure -3.0..+2.3%
+    # from the vertex's (its similarity solution's 0.7515 P); 4-8 s CPU
+    from hmatddm.analytical.viscous_leak_off import kgd_m_leak_off_vertex
+
+    data = hs.scene_from_dict(hs.parse_scene(KGD_M_LEAK_OFF).data, "m-leak-off").data
+    records = hs.build_simulation(data).run(4.0)
+    rows = hs.reference_values(data, records)
+    late = [(record, row) for record, row in zip(records, rows) if record["time"] >= 2.0]
+    assert len(late) >= 4 and records[-1]["leaked_volume"] > 0.97 * records[-1]["injected_volume"]
+    for record, row in late:
+        assert row["regime"]["leak_off"]["value"] > 5.5
+        assert abs(row["relative_error"]["half_length"]) < 0.03
+        assert abs(row["relative_error"]["max_opening"]) < 0.04
+        assert abs(record["budget"]["residual"]) < 1e-6 * record["injected_volume"]
+    t = np.array([record["time"] for record, _ in late])
+    length, w0 = kgd_m_leak_off_vertex(t, 1e-3, 1e-3, 2e-3, data_material(data))
+    assert np.all(np.abs(np.array([record["half_length"] for record, _ in late]) / length - 1.0) < 0.05)
+    assert np.all(np.abs(np.array([record["max_opening"] for record, _ in late]) / w0 - 1.0) < 0.05)
+    net = np.array([record["wellbore_pressure"][0] - 20e6 for record, _ in late])
+    assert np.all(np.abs(net / kgd_m_leak_off_vertex(t, 1e-3, 1e-3, 2e-3, data_material(data), pressure=True)[2] - 1.0)
+                  < 0.04)
