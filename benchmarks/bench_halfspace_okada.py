@@ -27,10 +27,10 @@ from hmatddm.layered import LayeredMedium
 
 try:
     from _common import machine, markdown_table
-    from bench_layered3d_kernel import issue32_mesh
+    from bench_layered3d_kernel import block, issue32_mesh
 except ImportError:  # run from the repository root
     from benchmarks._common import machine, markdown_table
-    from benchmarks.bench_layered3d_kernel import issue32_mesh
+    from benchmarks.bench_layered3d_kernel import block, issue32_mesh
 
 G, NU = 1.0, 0.25
 
@@ -52,25 +52,13 @@ def strike_dip_mesh(seed=0):
     return hd.Mesh3D.from_rectangles(grid.centers, e1, up, grid.half_a, grid.half_b)
 
 
-def _timed(data, rows, cols, repeats=3):
-    """(block, best CPU s, its wall s) of ``traction_block`` (compiled first)."""
-    out = np.empty((3 * len(rows), 3 * len(cols)))
-    drivers.traction_block(data, rows[:2], cols[:2], np.empty((6, 6)))
-    best = (np.inf, np.inf)
-    for _ in range(repeats):
-        t0, c0 = time.perf_counter(), time.process_time()
-        drivers.traction_block(data, rows, cols, out)
-        best = min(best, (time.process_time() - c0, time.perf_counter() - t0))
-    return out, best[0], best[1]
-
-
 def per_pair(args):
     table = []
     for mesh_name, grid in (("strike and dip", strike_dip_mesh()), ("issue 32 (random frames)", issue32_mesh())):
         every = np.arange(grid.n_elements, dtype=np.int64)
         some = every[::len(every) // args.rows][:args.rows]
         err_rows = every[::len(every) // args.error_rows][:args.error_rows]
-        reference = _timed(operators.influence_data(grid, half_space(method="quadrature"))._replace(
+        reference = block(operators.influence_data(grid, half_space(method="quadrature"))._replace(
             gauss_points=8, far_tol=0.0, entry_tol=0.0), err_rows, every, repeats=1)[0]
         base = None
         for name, medium, rows in (("uniform rock", hd.Elastic(G, NU), every),
@@ -78,12 +66,12 @@ def per_pair(args):
                                    ("half-space, quadrature (old path)", half_space(method="quadrature"), some)):
             data = operators.influence_data(grid, medium)
             closed = int(data.closed_form.sum()) if hasattr(data, "closed_form") else "-"
-            _, cpu, wall = _timed(data, rows, every)
+            _, cpu, wall = block(data, rows, every, repeats=3)
             per = cpu / (len(rows) * len(every)) * 1e6
             base = base or per
             error = "-"
             if isinstance(medium, LayeredMedium):
-                got = _timed(data, err_rows, every, repeats=1)[0]
+                got = block(data, err_rows, every, repeats=1)[0]
                 error = f"{np.abs(got - reference).max() / np.abs(reference).max():.1e}"
             table.append([mesh_name, name, closed, f"{len(rows)} x {len(every)}", f"{cpu:.3f}", f"{wall:.3f}",
                           f"{per:.2f}", f"{per / base:.1f}", error])
