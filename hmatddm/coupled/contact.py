@@ -140,10 +140,12 @@ class ContactRows:
         return out
 
     def modify_rows(self, matrix, first_row):
-        """``S M`` for an off-diagonal dense block (rows of elements ``first_row..``)."""
+        """``S M`` for an off-diagonal block, dense or sparse (rows of elements ``first_row..``)."""
         d = self.d
         rows = matrix.shape[0] // d
         select = self.select[first_row:first_row + rows]
+        if sp.issparse(matrix):
+            return (self.subset(first_row, first_row + rows)._sparse(select) @ matrix).tocsr()
         return np.einsum("eij,ejc->eic", select, matrix.reshape(rows, d, -1)).reshape(matrix.shape)
 
     def subset(self, start, stop):

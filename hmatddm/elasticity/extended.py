@@ -337,10 +337,12 @@ class ExtendedElasticityOperator(ProductCounter, LinearOperator):
 
     def modified_inverse(self, rows):
         """Approximate inverse (a callable) of ``S A + D`` for row operators ``rows``: the
-        block-triangular solve with the base's modified inverse and modified blocks."""
+        block-triangular solve with the base's modified inverse and modified blocks (the
+        border rows' near field, as :meth:`approximate_inverse` takes it: a dense ``A_no``
+        of a compressed border would cost its whole size at every new set of rows)."""
         n0 = self.n_base
         base_inverse = self.base.modified_inverse(rows.subset(0, n0))
-        no_rows = rows.modify_rows(self.no, n0)
+        no_rows = rows.modify_rows(sp.vstack([chunk.near for chunk in self.chunks], format="csr"), n0)
         nn_lu = scipy.linalg.lu_factor(rows.subset(n0, rows.n).modify_dense(self.nn), check_finite=False)
         return lambda r: self._block_triangular(r, base_inverse, no_rows, nn_lu)
 

@@ -48,6 +48,11 @@ PLANAR_TOLERANCE = 1e-12
 #: round-off of the projection (see the module docstring) and is not multiplied.
 SHEAR_ROUND_OFF = 1e-13
 
+#: Contact rows keep the modes apart (:func:`split_rows`) when, in each element's frame,
+#: their opening-shear entries are below this fraction of the element's largest entry
+#: (round-off of rotating ``k I`` or ``I`` into the frame).
+SPLIT_ROUND_OFF = 1e-12
+
 
 def is_planar(mesh, tolerance=PLANAR_TOLERANCE):
     """True when ``mesh`` (3D) lies in one plane: centres and normals (to ``tolerance``)."""
@@ -106,6 +111,52 @@ def split_modes(x, normals, axes):
     if not np.any(np.abs(shear) > SHEAR_ROUND_OFF * np.abs(vectors).max(initial=0.0)):
         shear = None
     return opening, shear
+
+
+def split_rows(rows, frames):
+    """(opening rows, shear rows) of contact rows ``rows`` (``S``, ``D`` (N, 3, 3) in global
+    components) in the elements' frames ``frames`` (N, 3, 3), as :class:`~hmatddm.coupled.
+    contact.ContactRows` of 1 and 2 unknowns per element; None when some element's ``S`` or
+    ``D`` couples its opening with its shear (a slipping element's friction row), which
+    only the 3 x 3 operator can take.
+
+    Rows that keep the modes apart (open: ``S = I``, ``D = 0``; stuck or prescribed:
+    ``S = 0``, ``D = k I``; the asymptotic front's tip rows ``DD_i = w_i n_i``) turn
+    ``S A + D`` of a planar crack into ``S_n A_nn + D_n`` and ``S_s A_ss + D_s`` (module
+    docstring), so each part's modified inverse is that of its own operator."""
+    from ..coupled.contact import ContactRows
+
+    select = np.einsum("eip,epq,ejq->eij", frames, rows.select, frames)
+    direct = np.einsum("eip,epq,ejq->eij", frames, rows.direct, frames)
+    for blocks in (select, direct):
+        scale = np.abs(blocks).max(axis=(1, 2))
+        coupling = np.maximum(np.abs(blocks[:, 2, :2]).max(axis=1), np.abs(blocks[:, :2, 2]).max(axis=1))
+        if np.any(coupling > SPLIT_ROUND_OFF * scale):
+            return None
+    n = rows.n
+    normal = ContactRows(np.ascontiguousarray(select[:, 2:, 2:]), np.ascontiguousarray(direct[:, 2:, 2:]),
+                         np.zeros((n, 1)), (rows.key, "normal"))
+    shear = ContactRows(np.ascontiguousarray(select[:, :2, :2]), np.ascontiguousarray(direct[:, :2, :2]),
+                        np.zeros((n, 2)), (rows.key, "shear"))
+    return normal, shear
+
+
+def split_modified_inverse(normal_inverse, shear_inverse, normals, axes):
+    """The approximate inverse (a callable) of a planar crack's ``S A + D`` from its parts'
+    (:func:`split_rows`): ``normal_inverse`` a callable, ``shear_inverse`` a function that
+    builds the shear part's on first call -- only a right-hand side with a shear part
+    needs it (the asymptotic front's tip rows never do)."""
+    built = []
+
+    def inverse(r):
+        opening, shear = split_modes(r, normals, axes)
+        if shear is not None:
+            if not built:
+                built.append(shear_inverse())
+            shear = built[0](shear)
+        return join_modes(normal_inverse(opening), shear, normals, axes)
+
+    return inverse
 
 
 def join_modes(opening, shear, normals, axes):
@@ -263,8 +314,16 @@ class PlanarElasticityOperator(ElasticityOperator):
         return self._join(self._part_preconditioner("normal") @ opening, shear)
 
     def modified_inverse(self, rows):
-        """The approximate inverse of ``S A + D`` (contact rows) of the 3 x 3 operator of
-        the same mesh, built on first use: contact rows mix the components of an element."""
+        """The approximate inverse of ``S A + D`` (contact rows): each part's modified
+        near-field ILU when the rows keep the modes apart (:func:`split_rows`; the shear
+        part's on first use), else that of the 3 x 3 operator of the same mesh, built on
+        first use (a slipping element's friction row mixes the components of an element)."""
+        parts = split_rows(rows, self.data.frames)
+        if parts is not None:
+            normal_rows, shear_rows = parts
+            return split_modified_inverse(self.part("normal").modified_inverse(normal_rows),
+                                          lambda: self.part("shear").modified_inverse(shear_rows),
+                                          self._normals, self._axes)
         if self._full is None:
             self._full = ElasticityOperator(self.mesh, self.material, backend="hmatrix",
                                             singular_correction=self.singular_correction, alpha=self.alpha,
@@ -299,8 +358,21 @@ class OperatorPart:
     def element_diagonal_blocks(self):
         return self.hmatrix.element_diagonal_blocks()
 
+    @property
+    def shape(self):
+        n = self.mesh.n_elements * self.dof
+        return (n, n)
+
     def modified_inverse(self, rows):
-        raise InputError("contact rows act on whole elements: use the PlanarExtendedOperator's modified_inverse")
+        """The ILU of the part's modified near field ``S A_near + D`` (``rows`` of
+        :attr:`dof` unknowns per element, from :func:`split_rows`) as a callable."""
+        from .inverse import modified_near_field_inverse
+
+        if rows.d != self.dof or rows.n != self.mesh.n_elements:
+            raise InputError(f"rows must have {self.dof} unknown(s) per element for the {self.name} part and "
+                             f"{self.mesh.n_elements} elements, got {rows.d} and {rows.n}")
+        inverse = modified_near_field_inverse(self, rows)
+        return lambda r: inverse @ np.asarray(r, dtype=np.float64).ravel()
 
 
 class PlanarExtendedOperator(ProductCounter, LinearOperator):
@@ -378,8 +450,16 @@ class PlanarExtendedOperator(ProductCounter, LinearOperator):
                                self_blocks(self._normal._data, self.n_base, self.mesh.n_elements)])
 
     def modified_inverse(self, rows):
-        """The whole-tensor extension's (built on first use): contact rows mix an
+        """Each part's block-triangular modified inverse when the rows keep the modes
+        apart (:func:`split_rows`; the shear part's on first use), else the whole-tensor
+        extension's (built on first use): a slipping element's friction row mixes an
         element's components."""
+        parts = split_rows(rows, self._normal._data.frames)
+        if parts is not None:
+            normal_rows, shear_rows = parts
+            return split_modified_inverse(self._normal.modified_inverse(normal_rows),
+                                          lambda: self._shear_operator().modified_inverse(shear_rows),
+                                          self._normals, self._axes)
         if self._full is None:
             from .extended import ExtendedElasticityOperator
 

@@ -77,18 +77,60 @@ def test_every_product_and_solve_matches_the_dense_operator(pair):
     assert np.linalg.norm(solution - x) <= 1e-5 * np.linalg.norm(x)
 
 
-def test_contact_rows_use_the_whole_tensor_operator():
-    mesh = _mesh("horizontal", n=8)
-    op = PlanarElasticityOperator(mesh, MATERIAL, eps=1e-6)
-    full = hd.ElasticityOperator(mesh, MATERIAL, backend="hmatrix", eps=1e-6)
+def _closed_rows(mesh, every, mixed=False):
+    """Contact rows (global components) closing every ``every``-th element: its normal row
+    replaced by ``k n.DD``; ``mixed``: also a friction-like row that couples its opening and
+    shear (a slipping element's ``(m + mu n).c``), which does not split."""
+    n = mesh.n_elements
+    frames = mesh.frames
+    select_frame = np.tile(np.eye(3), (n, 1, 1))
+    direct_frame = np.zeros((n, 3, 3))
+    select_frame[::every] = np.diag([1.0, 1.0, 0.0])
+    direct_frame[::every, 2, 2] = 1e12
+    if mixed:
+        select_frame[1::every, 0] = [1.0, 0.0, 0.6]
+    # frame -> global: S = F^T S_f F
+    select = np.einsum("epi,epq,eqj->eij", frames, select_frame, frames)
+    direct = np.einsum("epi,epq,eqj->eij", frames, direct_frame, frames)
+    return ContactRows(select, direct, np.zeros((n, 3)), ("closed", every, mixed))
+
+
+def _modified_dense(rows, dense):
+    return rows.modify_dense(dense)
+
+
+@pytest.mark.parametrize("plane", sorted(PLANES))
+def test_contact_rows_that_keep_the_modes_apart_use_each_part(plane):
+    """Closed elements (normal rows replaced): each part's modified ILU (the shear part's
+    only for a right-hand side with shear), and GMRES with it solves ``S A + D`` as the dense
+    LU does; rows that mix the modes take the whole-tensor operator's."""
+    from hmatddm.coupled.elastic import ElasticSolver
+    from hmatddm.elasticity.planar import split_rows
+
+    mesh = _mesh(plane, n=8)
+    dense = hd.ElasticityOperator(mesh, MATERIAL).to_dense()
+    op = PlanarElasticityOperator(mesh, MATERIAL, eps=1e-8)
+    full = hd.ElasticityOperator(mesh, MATERIAL, backend="hmatrix", eps=1e-8)
     n, rng = mesh.n_elements, np.random.default_rng(1)
-    select = np.tile(np.eye(3), (n, 1, 1))
-    select[::3] = np.diag([1.0, 1.0, 0.0])  # every third element closed: its normal row replaced
-    direct = np.zeros((n, 3, 3))
-    direct[::3, 2, 2] = 1e12
-    rows = ContactRows(select, direct, np.zeros((n, 3)), "closed")
+    rows = _closed_rows(mesh, 3)
+    assert split_rows(rows, mesh.frames) is not None
+    opening_rhs = (rng.normal(size=n)[:, None] * mesh.normals).ravel()
+    op.modified_inverse(rows)(opening_rhs)
+    assert op.shear_hmatrix is None  # an opening right-hand side never builds the shear part
+    for rhs in (opening_rhs, rng.normal(size=3 * n)):
+        exact = np.linalg.solve(_modified_dense(rows, dense), rhs)
+        solution, iterations = ElasticSolver(op, rtol=1e-11).solve(rhs, rows=rows)
+        assert np.linalg.norm(solution - exact) <= 1e-6 * np.linalg.norm(exact)
+        # as good a preconditioner as the whole tensor's ILU of the same rows
+        assert iterations <= ElasticSolver(full, rtol=1e-11).solve(rhs, rows=rows)[1] + 1
+    assert op._full is None  # the 3 x 3 operator was never built
+    mixed = _closed_rows(mesh, 3, mixed=True)
+    assert split_rows(mixed, mesh.frames) is None
     r = rng.normal(size=3 * n)
-    np.testing.assert_array_equal(op.modified_inverse(rows)(r), full.modified_inverse(rows)(r))
+    np.testing.assert_array_equal(op.modified_inverse(mixed)(r), full.modified_inverse(mixed)(r))
+    exact = np.linalg.solve(_modified_dense(mixed, dense), r)
+    solution, _ = ElasticSolver(op, rtol=1e-11).solve(r, rows=mixed)
+    assert np.linalg.norm(solution - exact) <= 1e-6 * np.linalg.norm(exact)
 
 
 def test_a_grown_planar_operator_matches_the_dense_one_and_reuses_the_last_border(pair):
@@ -113,13 +155,22 @@ def test_a_grown_planar_operator_matches_the_dense_one_and_reuses_the_last_borde
     rhs = dense @ x
     solution, info = grown.solve(rhs, rtol=1e-10)
     assert info["converged"] and np.linalg.norm(solution - x) <= 1e-5 * np.linalg.norm(x)
-    # contact rows: the whole-tensor extension of the same base
-    select = np.tile(np.eye(3), (n, 1, 1))
-    select[::4] = np.diag([1.0, 1.0, 0.0])
-    direct = np.zeros((n, 3, 3))
-    direct[::4, 2, 2] = 1e12
-    rows = ContactRows(select, direct, np.zeros((n, 3)), "closed")
-    np.testing.assert_array_equal(grown.modified_inverse(rows)(x), ExtendedElasticityOperator(base, mesh).modified_inverse(rows)(x))
+    # contact rows that keep the modes apart: each part's block-triangular modified inverse,
+    # and GMRES with it solves S A + D as the dense LU does
+    from hmatddm.coupled.elastic import ElasticSolver
+
+    rows = _closed_rows(mesh, 4)
+    for rhs in (opening, x):
+        exact = np.linalg.solve(_modified_dense(rows, dense), rhs)
+        solution, iterations = ElasticSolver(grown, rtol=1e-11).solve(rhs, rows=rows)
+        assert np.linalg.norm(solution - exact) <= 1e-5 * np.linalg.norm(exact)
+        whole = ElasticSolver(ExtendedElasticityOperator(base, mesh), rtol=1e-11).solve(rhs, rows=rows)[1]
+        assert iterations <= whole + 1, (iterations, whole)
+    assert grown._full is None
+    # rows that mix them: the whole-tensor extension of the same base
+    mixed = _closed_rows(mesh, 4, mixed=True)
+    np.testing.assert_array_equal(grown.modified_inverse(mixed)(x),
+                                  ExtendedElasticityOperator(base, mesh).modified_inverse(mixed)(x))
 
 
 def test_refuses_what_does_not_split():
