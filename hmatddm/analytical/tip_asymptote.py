@@ -23,7 +23,9 @@ the opening satisfies ``s^ = g_delta(K^, C^)``,
 
 (``beta_c = 0.9911799823``, the constant of their paper). ``K^ = 1`` is the k-vertex
 (``s^ = 0``), ``K^ = C^ = 0`` gives ``delta = 1/3``, ``C_1 = 6 sqrt(3) = beta_m^3 / 3`` and the
-m-vertex. Everything here is vectorised numpy (bisection: robust, no derivative).
+m-vertex. ``g_delta`` and ``residual`` here are vectorised numpy; ``width`` and
+``front_distance`` bisect (robust, no derivative) point by point in compiled code
+(:mod:`.tip_asymptote_kernels`, the same formulas).
 
 The asymptote is the opening of a semi-infinite crack. A fracture of radius (3D) or
 half-length (2D) ``L`` opens by ``w(s) (1 - s/(2L))^lambda`` near its front: exactly so for
@@ -56,18 +58,36 @@ def toughness_prime(toughness):
     return 4.0 * np.sqrt(2.0 / np.pi) * toughness
 
 
+#: ``f`` from its series beyond this ``C`` (see :func:`_f`), with :data:`SERIES_TERMS` terms
+SERIES_FROM = 10.0
+SERIES_TERMS = 20
+
+
 def _f(k_hat, c_hat, c_1):
-    """Dontsov and Peirce's ``f(K, C, C_1)``; for ``C > 1e3`` (the k-m~ edge, where the closed
-    form cancels to round-off) its series ``[(1 - K^4)/(4 C) - (1 - K^5)/(5 C^2) + (1 - K^6)/(6
-    C^3)] / C_1`` (the expansion of the logarithm; Dontsov 2016's code does the same)."""
+    """Dontsov and Peirce's ``f(K, C, C_1)``.
+
+    The closed form cancels terms of size ``C^3`` down to ``f ~ (1 - K^4) / (4 C C_1)``: in
+    double precision it keeps ``eps 4 C^4`` of it, 1e-5 at ``C = 340`` and 1e-3 at ``C =
+    1e3``. Expanding the logarithm, ``ln((C + 1)/(C + K)) = sum_j (-1)^(j+1) (1 - K^j) / (j
+    C^j)``, the first three terms cancel the polynomial exactly and::
+
+        f = sum_{j >= 4} (-1)^j (1 - K^j) / (j C^(j-3)) / C_1
+
+    which converges for ``C > 1``; beyond ``C = SERIES_FROM`` (10) its first
+    :data:`SERIES_TERMS` (20) terms leave < 1e-20 relative (the k-m~ edge, where Dontsov
+    2016's code also takes a series, there of three terms from ``C = 1e3``).
+    """
     k = np.minimum(k_hat, 1.0)
     c = c_hat
+    series_point = c > SERIES_FROM
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         log_term = np.where(c > 0.0, c**3 * np.log((c + 1.0) / (c + k)), 0.0)
         closed = (1.0 - k**3 - 1.5 * c * (1.0 - k * k) + 3.0 * c * c * (1.0 - k) - 3.0 * log_term) / (3.0 * c_1)
-        big = np.where(c > 1e3, c, 1e3)
-        series = ((1.0 - k**4) / (4.0 * big) - (1.0 - k**5) / (5.0 * big**2) + (1.0 - k**6) / (6.0 * big**3)) / c_1
-    return np.where(c > 1e3, series, closed)
+        inverse = 1.0 / np.where(series_point, c, SERIES_FROM)
+        series = np.zeros(np.shape(inverse))
+        for j in range(4 + SERIES_TERMS - 1, 3, -1):  # smallest terms first
+            series = series + (-1.0) ** j * (1.0 - k**j) / j * inverse ** (j - 3)
+    return np.where(series_point, series / c_1, closed)
 
 
 def g_delta(k_hat, c_hat):
@@ -98,6 +118,12 @@ class TipAsymptote:
         self.k_prime = float(toughness_prime(toughness))
         self.mu_prime = float(viscosity_prime)
 
+    def compiled_carter(self):
+        """The Carter ``C'`` with which :mod:`.tip_asymptote_kernels` evaluates this
+        asymptote (0: none), or None when a subclass changed :meth:`residual` (its own
+        bisection then runs in numpy)."""
+        return 0.0 if type(self).residual is TipAsymptote.residual else None
+
     def residual(self, s, velocity, w):
         """``s^ - g_delta(K^, C^)``: negative when ``w`` is wider than the asymptote at
         ``(s, V)``, positive when narrower (``w >= K' s^(1/2)/E'``)."""
@@ -121,7 +147,14 @@ class TipAsymptote:
         Bisection in ``log w`` between ``max(w_k, w_m)`` and ``w_k + w_m`` (the
         asymptote lies between them; tests/analytical/test_tip_asymptote.py checks it over 16 decades
         of ``s``), so 36 halvings of a ratio <= 2 give ~1e-11 relative precision.
+        Point by point in compiled code (:mod:`.tip_asymptote_kernels`) unless a subclass
+        changed :meth:`residual`.
         """
+        if self.compiled_carter() is not None:
+            from . import tip_asymptote_kernels
+
+            return tip_asymptote_kernels.width(s, velocity, self.k_prime, self.e_prime, self.mu_prime,
+                                               self.compiled_carter(), iterations, length)
         s, velocity = np.broadcast_arrays(np.asarray(s, float), np.asarray(velocity, float))
         s = np.maximum(s, 0.0)
         w_k = self.toughness_width(s)
@@ -148,8 +181,14 @@ class TipAsymptote:
         stands still). With a finite ``length`` ``L`` the opening is read against the asymptote
         times :func:`finite_fracture_factor` (which keeps that product growing with ``s``):
         ``s_k`` solves ``s (1 - s/(2L)) = (E' w / K')^2`` (``s (3/4)`` beyond ``L/2``).
-        Returns ``(s, V)``.
+        Returns ``(s, V)``. Point by point in compiled code (:mod:`.tip_asymptote_kernels`)
+        unless a subclass changed :meth:`residual`.
         """
+        if self.compiled_carter() is not None:
+            from . import tip_asymptote_kernels
+
+            return tip_asymptote_kernels.front_distance(w, distance_old, dt, self.k_prime, self.e_prime,
+                                                        self.mu_prime, self.compiled_carter(), iterations, length)
         w, s_old = np.broadcast_arrays(np.asarray(w, float), np.asarray(distance_old, float))
         w = np.maximum(w, 1e-300)
         s_k = (self.e_prime * w / self.k_prime) ** 2

@@ -33,6 +33,10 @@ class LeakOffTipAsymptote(TipAsymptote):
         super().__init__(plane_strain_modulus, toughness, viscosity_prime)
         self.carter = float(carter)
 
+    def compiled_carter(self):
+        """``C'`` for :mod:`.tip_asymptote_kernels` (None when a subclass changed :meth:`residual`)."""
+        return self.carter if type(self).residual is LeakOffTipAsymptote.residual else None
+
     def residual(self, s, velocity, w):
         """``s^ - g_delta(K^, C^)`` (negative when ``w`` is wider than the asymptote)."""
         s, velocity, w = np.broadcast_arrays(np.asarray(s, float), np.asarray(velocity, float), np.asarray(w, float))
@@ -48,7 +52,13 @@ class LeakOffTipAsymptote(TipAsymptote):
     def width(self, s, velocity, iterations=36, length=np.inf):
         """Opening ``w(s)`` behind a front moving at ``velocity`` (the parent's bisection in
         ``log w``, from the no-leak-off bracket ``[max(w_k, w_m), w_k + w_m]`` widened
-        upwards until it holds the root: leak-off widens the opening)."""
+        upwards until it holds the root: leak-off widens the opening). Point by point in
+        compiled code (:mod:`.tip_asymptote_kernels`) unless a subclass changed :meth:`residual`."""
+        if self.compiled_carter() is not None:
+            from . import tip_asymptote_kernels
+
+            return tip_asymptote_kernels.width(s, velocity, self.k_prime, self.e_prime, self.mu_prime,
+                                               self.compiled_carter(), iterations, length)
         s, velocity = np.broadcast_arrays(np.asarray(s, float), np.asarray(velocity, float))
         s = np.maximum(s, 0.0)
         w_k = self.toughness_width(s)

@@ -84,3 +84,23 @@ def test_finite_fracture_asymptote_is_griffith_and_sneddon_near_the_front():
     np.testing.assert_allclose(distance, s_true, rtol=1e-9)
     bare, _ = asymptote.front_distance(w, s_old, dt)
     assert np.all(bare < s_true)  # the semi-infinite asymptote reads the front short
+
+
+@pytest.mark.skipif(np.finfo(np.longdouble).eps > 1e-18, reason="needs an extended-precision long double")
+def test_f_series_beyond_c_10_is_the_closed_form_in_extended_precision():
+    """Beyond C = 10, f is its series (the closed form cancels terms of size C^3): the
+    closed form in 80-bit arithmetic (eps 1e-19: round-off ~1e-19 C^3) agrees with it."""
+    from hmatddm.analytical.tip_asymptote import SERIES_FROM, _f
+
+    c = np.array([SERIES_FROM * 1.0001, 30.0, 120.0, 340.0])[:, None]
+    k = np.array([0.0, 0.5, 0.97, 0.999])[None, :]
+    c_l, k_l = c.astype(np.longdouble), k.astype(np.longdouble)
+    one = np.longdouble(1)
+    closed = (one - k_l**3 - 1.5 * c_l * (one - k_l**2) + 3 * c_l**2 * (one - k_l)
+              - 3 * c_l**3 * np.log((c_l + one) / (c_l + k_l))) / 3
+    series = _f(np.broadcast_to(k, (4, 4)), np.broadcast_to(c, (4, 4)), 1.0)
+    closed = closed.astype(float)
+    assert np.all(np.abs(series - closed) <= 1e-12 * np.abs(closed) + 4e-19 * c**3)
+    # the double-precision closed form is what the series replaces: 1e-6 off at C = 340
+    closed_double = (1 - k**3 - 1.5 * c * (1 - k**2) + 3 * c**2 * (1 - k) - 3 * c**3 * np.log((c + 1) / (c + k))) / 3
+    assert np.max(np.abs(closed_double / closed - 1.0)[-1]) > 1e-7
