@@ -173,3 +173,33 @@ def nearest_circle(points, centers, distances):
         phi[i] = best
         nearest[i] = where
     return phi, nearest
+
+
+@njit(cache=True)
+def interpolate(phi, low, h, points, out):
+    """``out[i]``: ``phi`` (cell centres of a 2D box whose first cell is ``low``, spacing
+    ``h``; a 1D box as ``(n, 1)`` with its points' second coordinate 0) bilinear at
+    ``points[i]`` (in plane), +inf outside the box, as :meth:`.front.FrontField.__call__`
+    did it in numpy: corners in the order (0, 0), (0, 1), (1, 0), (1, 1), a corner of zero
+    weight skipped, an infinite corner value kept (``inf - inf``: NaN, read as +inf)."""
+    n0, n1 = phi.shape
+    for i in range(points.shape[0]):
+        u0 = points[i, 0] / h - low[0]
+        u1 = points[i, 1] / h - low[1]
+        b0 = math.floor(u0)
+        b1 = math.floor(u1)
+        f0 = u0 - b0
+        f1 = u1 - b1
+        total = 0.0
+        for c0 in range(2):
+            w0 = f0 if c0 == 1 else 1.0 - f0
+            for c1 in range(2):
+                weight = w0 * (f1 if c1 == 1 else 1.0 - f1)
+                if weight > 0.0:
+                    j0 = int(b0) + c0
+                    j1 = int(b1) + c1
+                    value = phi[j0, j1] if 0 <= j0 < n0 and 0 <= j1 < n1 else np.inf
+                    total = total + weight * value
+                else:
+                    total = total + 0.0
+        out[i] = np.inf if math.isnan(total) else total

@@ -22,7 +22,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..mesh import Mesh2D, Mesh3D
-from .fast_marching import march, nearest_circle
+from .fast_marching import interpolate, march, nearest_circle
 
 CHANNEL, TIP, EMPTY, FILLED = 0, 1, 2, 3  # FILLED: fully fractured during the last step
 
@@ -159,20 +159,16 @@ class FrontField:
         return out
 
     def __call__(self, points):
-        """``phi`` at in-plane points (M, k), (multi)linear between cell centres."""
+        """``phi`` at in-plane points (M, k), (multi)linear between cell centres (compiled:
+        :func:`.fast_marching.interpolate`; +inf outside the box)."""
         points = np.asarray(points, float).reshape(-1, self.k)
-        u = points / self.h - self.low
-        base = np.floor(u).astype(np.int64)
-        frac = u - base
-        out = np.zeros(len(points))
-        corners = np.array(np.meshgrid(*([[0, 1]] * self.k), indexing="ij")).reshape(self.k, -1).T
-        for corner in corners:
-            weight = np.prod(np.where(corner == 1, frac, 1.0 - frac), axis=1)
-            value = self.at_cells(base + corner + self.low)
-            value = np.where(weight > 0.0, value, 0.0)
-            with np.errstate(invalid="ignore"):
-                out = out + np.where(weight > 0.0, weight * value, 0.0)
-        return np.where(np.isnan(out), np.inf, out)
+        phi, low = self.phi, self.low.astype(float)
+        if self.k == 1:
+            phi, low = phi.reshape(-1, 1), np.append(low, 0.0)
+            points = np.column_stack([points, np.zeros(len(points))])
+        out = np.empty(len(points))
+        interpolate(phi, low, self.h, np.ascontiguousarray(points), out)
+        return out
 
     def velocity(self, points):
         """``V`` of the ribbon nearest each point."""

@@ -97,3 +97,43 @@ def test_march_refuses_a_strided_array():
     phi = np.zeros((8, 8))[:, ::2]
     with pytest.raises(ValueError, match="C-contiguous"):
         march(phi, np.zeros((8, 4), bool), np.ones((8, 4), bool), 1.0)
+
+
+def _numpy_interpolation(field, points):
+    """The numpy bilinear interpolation that FrontField.__call__ was (the reference)."""
+    points = np.asarray(points, float).reshape(-1, field.k)
+    u = points / field.h - field.low
+    base = np.floor(u).astype(np.int64)
+    frac = u - base
+    out = np.zeros(len(points))
+    corners = np.array(np.meshgrid(*([[0, 1]] * field.k), indexing="ij")).reshape(field.k, -1).T
+    for corner in corners:
+        weight = np.prod(np.where(corner == 1, frac, 1.0 - frac), axis=1)
+        value = field.at_cells(base + corner + field.low)
+        value = np.where(weight > 0.0, value, 0.0)
+        with np.errstate(invalid="ignore"):
+            out = out + np.where(weight > 0.0, weight * value, 0.0)
+    return np.where(np.isnan(out), np.inf, out)
+
+
+@pytest.mark.parametrize("k", [1, 2])
+def test_compiled_interpolation_is_the_numpy_one_to_the_bit(k):
+    from hmatddm.fracture.front import FrontField
+
+    rng = np.random.default_rng(7)
+    h = 0.37
+    if k == 2:
+        channel = np.array([(i, j) for i in range(-6, 7) for j in range(-6, 7) if i * i + j * j <= 30])
+        ribbon = np.array([(i, j) for i, j in channel if 20 <= i * i + j * j <= 30])
+    else:
+        channel = np.arange(-8, 9)[:, None]
+        ribbon = np.array([[-8], [8]])
+    field = FrontField(ribbon, rng.uniform(0.1, 0.4, len(ribbon)) * h, np.ones(len(ribbon)), channel, h, margin=3)
+    field.phi[tuple(np.argwhere(np.isfinite(field.phi))[:3].T)] = -np.inf  # unreached cells inside
+    extent = (np.max(np.abs(channel)) + 6) * h
+    points = np.concatenate([rng.uniform(-extent, extent, (3000, k)),  # some outside the box
+                             channel * h, (channel + 0.5) * h])  # on centres and on cell edges
+    compiled = field(points)
+    reference = _numpy_interpolation(field, points)
+    assert np.isinf(compiled).any() and np.isfinite(compiled).any()
+    np.testing.assert_array_equal(compiled, reference)
