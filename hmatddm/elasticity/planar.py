@@ -364,14 +364,16 @@ class OperatorPart:
         return (n, n)
 
     def modified_inverse(self, rows):
-        """The ILU of the part's modified near field ``S A_near + D`` (``rows`` of
-        :attr:`dof` unknowns per element, from :func:`split_rows`) as a callable."""
-        from .inverse import modified_near_field_inverse
+        """The block ILU(0) of the part's modified near field ``S A_near + D`` (``rows`` of
+        :attr:`dof` unknowns per element, from :func:`split_rows`) as a callable
+        (:func:`~hmatddm.elasticity.inverse.modified_near_field_block_ilu`: the asymptotic
+        front asks for a new one at every front iteration)."""
+        from .inverse import modified_near_field_block_ilu
 
         if rows.d != self.dof or rows.n != self.mesh.n_elements:
             raise InputError(f"rows must have {self.dof} unknown(s) per element for the {self.name} part and "
                              f"{self.mesh.n_elements} elements, got {rows.d} and {rows.n}")
-        inverse = modified_near_field_inverse(self, rows)
+        inverse = modified_near_field_block_ilu(self, rows)
         return lambda r: inverse @ np.asarray(r, dtype=np.float64).ravel()
 
 
