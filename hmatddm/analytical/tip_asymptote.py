@@ -47,20 +47,12 @@ def finite_fracture_factor(s, length):
     return np.sqrt(1.0 - 0.5 * np.minimum(np.asarray(s, float), 0.5 * length) / length)
 import numpy as np
 
-BETA_M3 = 2.0 * 3.0**2.5          # beta_m^3 = 18 sqrt(3)
-BETA_M = BETA_M3 ** (1.0 / 3.0)
-BETA_C = 0.9911799823             # Dontsov and Peirce (2015): the leak-off term of delta
-_C1_M = BETA_M3 / 3.0              # C_1(1/3) = 6 sqrt(3)
+from .tip_asymptote_constants import _C1_M, BETA_C, BETA_M, BETA_M3, SERIES_FROM, SERIES_TERMS  # noqa: F401
 
 
 def toughness_prime(toughness):
     """K' = 4 (2/pi)^(1/2) K_Ic."""
     return 4.0 * np.sqrt(2.0 / np.pi) * toughness
-
-
-#: ``f`` from its series beyond this ``C`` (see :func:`_f`), with :data:`SERIES_TERMS` terms
-SERIES_FROM = 10.0
-SERIES_TERMS = 20
 
 
 def _f(k_hat, c_hat, c_1):

@@ -20,8 +20,8 @@ import math
 import numpy as np
 from numba import njit
 
-from .tip_asymptote import _C1_M as C1_M
-from .tip_asymptote import BETA_C, BETA_M, SERIES_FROM, SERIES_TERMS
+from .tip_asymptote_constants import _C1_M as C1_M
+from .tip_asymptote_constants import BETA_C, BETA_M, SERIES_FROM, SERIES_TERMS
 
 
 @njit(cache=True, nogil=True)

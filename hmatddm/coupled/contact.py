@@ -54,6 +54,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from ..element_blocks import apply_blocks
 from ..errors import InputError
 
 OPEN, STICK, SLIP = 0, 1, 2
@@ -98,7 +99,7 @@ class ContactRows:
         self.key = key
 
     def _blocks(self, blocks, x):
-        return np.einsum("eij,ej->ei", blocks, np.asarray(x, dtype=np.float64).reshape(self.n, self.d)).ravel()
+        return apply_blocks(blocks, x)
 
     def select_rows(self, v):
         """``S v`` for a flat traction vector ``v``."""

@@ -11,6 +11,8 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from ..element_blocks import apply_blocks
+
 
 #: The flow block of the split is symmetric with a positive diagonal (finite-volume
 #: transmissibilities plus the compliance diagonal): an ordering of ``A + A^T`` and
@@ -48,14 +50,13 @@ class _CoupledLinearSystem:
         return spla.LinearOperator((size, size), matvec=self._matvec, dtype=np.float64)
 
     def left_scale(self, residual_u, residual_p):
-        n, d = self.problem.n, self.problem.d
-        u = np.einsum("eij,ej->ei", self.block_inverse, residual_u.reshape(n, d)).ravel() / self.s_u
+        u = apply_blocks(self.block_inverse, residual_u) / self.s_u
         return np.concatenate([u, residual_p / (self.s_p * self.flow_diagonal)])
 
     def unscale_left(self, z):
         """Inverse of :meth:`left_scale`."""
         n, d = self.problem.n, self.problem.d
-        u = np.einsum("eij,ej->ei", self.blocks, z[:n * d].reshape(n, d)).ravel() * self.s_u
+        u = apply_blocks(self.blocks, z[:n * d]) * self.s_u
         return u, z[n * d:] * self.s_p * self.flow_diagonal
 
     def split(self, y):

@@ -32,6 +32,7 @@ import numpy as np
 from numba import njit
 from scipy.sparse.linalg import LinearOperator
 
+from ..element_blocks import join_frame, split_frame
 from ..errors import InputError
 from ..kernels.drivers import self_blocks, traction_block
 from ..material import Elastic
@@ -104,11 +105,9 @@ def shear_traction_block(data, rows, cols, out):
 def split_modes(x, normals, axes):
     """(opening part (N,), shear part (2N,) or None when it is round-off) of the flat,
     global DDs (or tractions) ``x``, in the elements' frames (``normals`` (N, 3), ``axes``
-    (N, 2, 3))."""
-    vectors = np.asarray(x, dtype=np.float64).reshape(-1, 3)
-    opening = np.einsum("ek,ek->e", vectors, normals)
-    shear = np.einsum("eak,ek->ea", axes, vectors).ravel()
-    if not np.any(np.abs(shear) > SHEAR_ROUND_OFF * np.abs(vectors).max(initial=0.0)):
+    (N, 2, 3)); compiled (:func:`hmatddm.element_blocks.split_frame`)."""
+    opening, shear, largest_shear, largest = split_frame(x, normals, axes)
+    if not largest_shear > SHEAR_ROUND_OFF * largest:
         shear = None
     return opening, shear
 
@@ -124,8 +123,6 @@ def split_rows(rows, frames):
     ``S = 0``, ``D = k I``; the asymptotic front's tip rows ``DD_i = w_i n_i``) turn
     ``S A + D`` of a planar crack into ``S_n A_nn + D_n`` and ``S_s A_ss + D_s`` (module
     docstring), so each part's modified inverse is that of its own operator."""
-    from ..coupled.contact import ContactRows
-
     select = np.einsum("eip,epq,ejq->eij", frames, rows.select, frames)
     direct = np.einsum("eip,epq,ejq->eij", frames, rows.direct, frames)
     for blocks in (select, direct):
@@ -134,9 +131,10 @@ def split_rows(rows, frames):
         if np.any(coupling > SPLIT_ROUND_OFF * scale):
             return None
     n = rows.n
-    normal = ContactRows(np.ascontiguousarray(select[:, 2:, 2:]), np.ascontiguousarray(direct[:, 2:, 2:]),
+    rows_type = type(rows)  # hmatddm.coupled.contact.ContactRows (a layer above this one)
+    normal = rows_type(np.ascontiguousarray(select[:, 2:, 2:]), np.ascontiguousarray(direct[:, 2:, 2:]),
                          np.zeros((n, 1)), (rows.key, "normal"))
-    shear = ContactRows(np.ascontiguousarray(select[:, :2, :2]), np.ascontiguousarray(direct[:, :2, :2]),
+    shear = rows_type(np.ascontiguousarray(select[:, :2, :2]), np.ascontiguousarray(direct[:, :2, :2]),
                         np.zeros((n, 2)), (rows.key, "shear"))
     return normal, shear
 
@@ -161,10 +159,7 @@ def split_modified_inverse(normal_inverse, shear_inverse, normals, axes):
 
 def join_modes(opening, shear, normals, axes):
     """The flat global vector of an opening part and a shear part (None: zero)."""
-    vectors = opening[:, None] * normals
-    if shear is not None:
-        vectors += np.einsum("ea,eak->ek", shear.reshape(-1, 2), axes)
-    return vectors.ravel()
+    return join_frame(opening, shear, normals, axes)
 
 
 class PlanarElasticityOperator(ElasticityOperator):
