@@ -58,11 +58,11 @@ from . import okada3d
 from .image_points3d import image_point_displacement, image_point_stress, kelvin_point_displacement, kelvin_point_stress
 from .image_tracer import trace_capacity
 from .images2d import _lame, zero_in_void
-from .image_tracer3d import _trace_range, _traced_buffer, trace, trace_points
+from .image_tracer3d import _trace_range, _traced_buffer, drop_surface_range, trace, trace_points
 from .remainder_table3d import keep_near_range, rectangle_covered, remainder_rectangle_stress
 from .potentials3d import Workspace, base_derivatives, inverse_distance_derivatives
 from .rectangle_quadrature import (FAR_TOL, _cached_rules, _image_order, _integrate, far_order, image_rectangle_stress,
-                                   remainder_order,
+                                   image_rectangle_stress_without, remainder_order,
                                    nearest_singularity, square_rule, subdivisions)
 
 __all__ = ["LayeredRectangles", "workspace", "source_state", "element_traction", "element_stress",
@@ -100,7 +100,8 @@ class LayeredRectangles(NamedTuple):
     closed_form: np.ndarray = None  #: (N,) bool: the source's images in closed form (a half-space, :mod:`.okada3d`)
     okada: np.ndarray = None  #: (N, 3, 3) rows strike, up-dip, normal of each closed-form element (:mod:`.okada3d`)
     okada_half: np.ndarray = None  #: (N, 2) half sides along the strike and the dip
-    surface: float = 0.0  #: height of the free surface of a half-space (closed-form elements)
+    surface: float = 0.0  #: height of the free surface (closed-form elements, ``surface_form`` elements)
+    surface_form: np.ndarray = None  #: (N,) bool: the source's reflection in the free surface in closed form (two or more solid layers, :func:`.influence3d.surface_form`)
 
 
 @njit(cache=True)
@@ -175,15 +176,23 @@ def element_traction(data, i, j, state, work, block):
         image[:] = 0.0
         tabulated = near_only and rectangle_covered(table, point, lr, center, frame, a, b, ls)
         entry_tol = data.entry_tol * data.entry_scale
+        # the reflection in the free surface in closed form: the quadrature neither takes it
+        # nor refines for its singular point (the receiver's mirror in the surface)
+        surface_form = data.surface_form[j]
+        skip = ls - 1 if surface_form and lr == ls else -1
+        if surface_form and lr == ls:
+            okada3d.okada_traction(point, normal, center, data.okada[j], data.okada_half[j, 0], data.okada_half[j, 1],
+                                   data.surface, g[ls], nu[ls], False, True, okada_work, corners, block)
         if near_only and not tabulated and table.pair_index[ls, lr] >= 0:
             # outside the table's range: every triple by quadrature
             n_gauss, n_sub = _image_order(point, lr, center, frame, a, b, ls, interfaces, data.gauss_points,
-                                          data.max_subdivisions, data.far_tol, entry_tol)
-            image_rectangle_stress(point, lr, center, frame, a, b, ls, interfaces, g, nu, data.n_images, n_gauss,
-                                   n_sub, image, False, table.bottoms, table.tops)
+                                          data.max_subdivisions, data.far_tol, entry_tol, skip)
+            image_rectangle_stress_without(point, lr, center, frame, a, b, ls, interfaces, g, nu, data.n_images,
+                                           n_gauss, n_sub, image, False, table.bottoms, table.tops, surface_form,
+                                           data.surface)
         elif not (tabulated and abs(lr - ls) >= 2):  # two layers apart, every triple is far
             n_gauss, n_sub = _image_order(point, lr, center, frame, a, b, ls, interfaces, data.gauss_points,
-                                          data.max_subdivisions, data.far_tol, entry_tol)
+                                          data.max_subdivisions, data.far_tol, entry_tol, skip)
             if n_sub <= 2:
                 slot = n_gauss - 1 if n_sub == 1 else data.gauss_points
                 lo, hi = start[slot], start[slot + 1]
@@ -191,12 +200,15 @@ def element_traction(data, i, j, state, work, block):
                     _trace_range(center, frame, a, b, ls, interfaces, g, nu, data.n_images, xi, eta, lo, hi, traced)
                     if near_only:
                         keep_near_range(traced, lo, hi, center, frame, a, b, xi, eta, ls, table.bottoms, table.tops)
+                    if surface_form:
+                        drop_surface_range(traced, lo, hi, center, frame, a, b, xi, eta, ls, data.surface)
                     is_traced[slot] = True
                 _integrate(point, lr, center, frame, a, b, ls, g, nu, xi[lo:hi], eta[lo:hi], wt[lo:hi], traced, lo,
                            image, gradient, ws, ws1, kelvin)
             else:
-                image_rectangle_stress(point, lr, center, frame, a, b, ls, interfaces, g, nu, data.n_images, n_gauss,
-                                       n_sub, image, near_only, table.bottoms, table.tops)
+                image_rectangle_stress_without(point, lr, center, frame, a, b, ls, interfaces, g, nu, data.n_images,
+                                               n_gauss, n_sub, image, near_only, table.bottoms, table.tops,
+                                               surface_form, data.surface)
         if tabulated:
             # the far triples' points lie below or above the source points, at least
             # the clearance outside the receiver's layer
@@ -241,14 +253,24 @@ def element_stress(data, point, point_layer, j, work, out):
                 for k in range(3):
                     out[q, i, k] += image[q, i, k]
     elif data.interfaces.shape[0] > 0:
+        surface_form = data.surface_form[j]
+        skip = ls - 1 if surface_form and point_layer == ls else -1
         n_gauss, n_sub = _image_order(point, point_layer, center, frame, a, b, ls, data.interfaces,
-                                      data.gauss_points, data.max_subdivisions, data.far_tol, 0.0)
-        image_rectangle_stress(point, point_layer, center, frame, a, b, ls, data.interfaces, g, nu, data.n_images,
-                               n_gauss, n_sub, image, False, data.table.bottoms, data.table.tops)
+                                      data.gauss_points, data.max_subdivisions, data.far_tol, 0.0, skip)
+        image_rectangle_stress_without(point, point_layer, center, frame, a, b, ls, data.interfaces, g, nu,
+                                       data.n_images, n_gauss, n_sub, image, False, data.table.bottoms,
+                                       data.table.tops, surface_form, data.surface)
         for q in range(3):
             for i in range(3):
                 for k in range(3):
                     out[q, i, k] += image[q, i, k]
+        if surface_form and point_layer == ls:
+            okada3d.okada_stress(point, center, data.okada[j], data.okada_half[j, 0], data.okada_half[j, 1],
+                                 data.surface, g[ls], nu[ls], False, True, work[8], work[9], image)
+            for q in range(3):
+                for i in range(3):
+                    for k in range(3):
+                        out[q, i, k] += image[q, i, k]
 
 
 register_kind(LayeredRectangles, KernelKind(workspace, source_state, element_traction, element_stress,
