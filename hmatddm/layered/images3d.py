@@ -24,13 +24,30 @@ ones, the smooth layered remainder, come from a table built once per medium and 
 extent (:mod:`.remainder_table3d`, ``LayeredMedium(method="table")``, the default;
 ``method="quadrature"`` integrates every triple, the cross-check). In a half-space (one
 solid layer under a void) the image and surface terms of a rectangle with a horizontal side
-are in closed form (:mod:`.okada3d`, Okada 1992; ``LayeredRectangles.closed_form``); a
-rectangle without one, and any medium with two solid layers, keeps the quadrature. Beyond the
-half-space the image terms are not integrated in closed form: the Hansen base functions ``F = r - sigma r3 log(r + sigma r3)`` and
-``L = log(r + sigma r3)`` (and their horizontal derivatives) of every image, with
-coefficients polynomial in the source height, have no primitive over a rectangle of any
-orientation among the uniform-rock kernel's primitives of ``1/r`` (their integrals are
-those of angular dislocations); only the ``1/r``-derivative parts would be.
+are in closed form (:mod:`.okada3d`, Okada 1992; ``LayeredRectangles.closed_form``). With
+two or more solid layers under a void, a source of the top solid layer with a horizontal
+side takes its reflection in the free surface in closed form too (that triple is the
+half-space's image triple, coefficient for coefficient:
+:func:`.influence3d.surface_reflection_alone`; ``LayeredRectangles.surface_form``,
+:func:`.image_tracer3d.drop_surface_range`), and the quadrature neither integrates it nor
+refines for its singular point. A rectangle without a horizontal side keeps the quadrature.
+
+What is not in closed form, and why (measured in ``_derive_closed_form3d.py``): every other
+near triple, i.e. the reflections in an interface between two solids and the
+transmissions. Each triple is a point-source field built from the Hansen base functions
+``F = r - sigma r3 log(r + sigma r3)``, ``L = log(r + sigma r3)`` and ``1/r`` (ref. Eqs
+3.14-3.17, 3.22, 3.24) whose coefficients of ``D^n`` are polynomials of degree <= min(n, 2)
+in the source height (ref. Eqs 3.25-3.28; measured up to ``images=4``, the ``D`` order
+growing to 5), so its integral over a rectangle with a horizontal side is elementary, as
+Okada's is; the earlier claim here that no primitive exists was wrong for such rectangles.
+But it is not Okada's closed form reweighted: his image terms split into their seven
+coefficient groups (parts A, B, C) fit the reflection at a bi-material interface only to
+0.3-1.2 % (separate weights per dislocation component; 4e-15 for a free surface): his
+grouped expressions fix combinations of the terms that the free surface's reflection
+coefficients make, and ``c1, c2, c3`` of an interface between solids (ref. Eq. 3.27) make
+others. A closed form
+needs the primitives of each term, the integral of ``P(t) d1^a d2^b d3^c B`` over the
+rectangle with ``deg P <= 2`` for ``B`` in ``F, L, 1/r`` of either gauge; not derived here.
 
 Coordinates: ``(x, y, z)`` with ``z`` vertical (the reference's ``x3``); interfaces are
 the planes ``z = d_k`` (see :class:`LayeredMedium`, docs/conventions.md §3).
@@ -148,7 +165,9 @@ def element_traction(data, i, j, state, work, block):
     the rest; a receiver outside the table's range takes every triple by quadrature. In a
     half-space, a source with a horizontal side (``closed_form``) takes its image and
     surface terms in closed form instead (:func:`.okada3d.okada_traction`, Okada 1992),
-    whatever the number of images (the closed form is the exact half-space)."""
+    whatever the number of images (the closed form is the exact half-space). With two or
+    more solid layers, a ``surface_form`` source adds its reflection in the free surface
+    the same way for receivers of its layer and leaves it out of the quadrature."""
     traced, is_traced, near_only = state
     local, image, gradient, kelvin, ws1, ws, room, rules, okada_work, corners = work
     xi, eta, wt, start = rules
@@ -232,7 +251,8 @@ def element_stress(data, point, point_layer, j, work, out):
     for a unit global DD ``q`` of rectangle ``j``, closed form plus images (the
     quadrature of :func:`element_traction`). A point within ``near_fraction`` smaller
     half sides of an edge counts as on it. A ``closed_form`` source: the image and surface
-    terms of :func:`.okada3d.okada_stress`."""
+    terms of :func:`.okada3d.okada_stress`; a ``surface_form`` source: its reflection in
+    the free surface, for points of its layer (the rest by quadrature)."""
     local, image = work[0], work[1]
     if zero_in_void(data.shear_modulus, point_layer, out):
         return

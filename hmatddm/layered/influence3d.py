@@ -47,7 +47,10 @@ def influence_data(mesh, medium, singular_shift, alpha, near_fraction, n_images)
     :data:`TABLE_MIN_ELEMENTS` elements, the layered remainder's table
     (:func:`remainder_table`). In a half-space (:func:`is_half_space`) with ``medium.method``
     other than ``"quadrature"``, the elements with a horizontal side take their image and
-    surface terms in closed form (:mod:`.okada3d`; ``closed_form``), the others by quadrature."""
+    surface terms in closed form (:mod:`.okada3d`; ``closed_form``), the others by quadrature.
+    With two or more solid layers under a void (:func:`surface_form`), the elements of the
+    top solid layer with a horizontal side take their reflection in the free surface in
+    closed form (``surface_form``) and their other triples by quadrature."""
     layers = element_layers(mesh, medium)
     interfaces, g, nu = medium.arrays()
     scale = entry_scale(mesh.half_a, mesh.half_b, layers, g, nu) / g.max() if interfaces.shape[0] > 0 else 0.0

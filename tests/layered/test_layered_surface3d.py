@@ -198,3 +198,15 @@ def test_drop_surface_range_removes_exactly_the_mirror_triple():
         for kept in left:
             gone.remove(kept)
         assert gone == [(1, np.round(-t, 12), -1.0)]
+
+
+def test_triple_coefficients_are_at_most_quadratic_in_the_source_height():
+    """The structure a closed form of the other triples would rest on
+    (hmatddm/layered/_derive_closed_form3d.py): the coefficient of D^n of every triple is a
+    polynomial of degree <= min(n, 2) in the source height, up to 4 images in three solid
+    layers, while the D order grows (to 5)."""
+    from hmatddm.layered._derive_closed_form3d import coefficient_degrees
+    found = coefficient_degrees(images=(4,), n_heights=9)
+    for counts in found.values():
+        assert all(degree <= min(order, 2) for order, degree in counts)
+        assert max(order for order, _ in counts) == 5 and max(degree for _, degree in counts) == 2
