@@ -39,7 +39,7 @@ transmissions. Each triple is a point-source field built from the Hansen base fu
 3.14-3.17, 3.22, 3.24) whose coefficients of ``D^n`` are polynomials of degree <= min(n, 2)
 in the source height (ref. Eqs 3.25-3.28; measured up to ``images=4``, the ``D`` order
 growing to 5), so its integral over a rectangle with a horizontal side is elementary, as
-Okada's is; the earlier claim here that no primitive exists was wrong for such rectangles.
+Okada's is, though not from the uniform-rock kernel's primitives of ``1/r`` alone.
 But it is not Okada's closed form reweighted: his image terms split into their seven
 coefficient groups (parts A, B, C) fit the reflection at a bi-material interface only to
 0.3-1.2 % (separate weights per dislocation component; 4e-15 for a free surface): his

@@ -15,9 +15,9 @@ from hmatddm.layered.influence3d import influence_data
 
 G, NU = 1.0, 0.25
 # a free surface and two interfaces, G, 2G, G (the contrast), thinner layers;
-# gauss_points=6 as in test_layered_fast3d.py: the default 4 leaves 1e-5 of the largest
-# entry on the self entry of a square 0.25 m under an interface (the quadrature of the other
-# triples, with or without the closed form)
+# gauss_points=6 as in test_layered_fast3d.py: the default 4 leaves 2.6e-6 of the largest
+# entry on the self entry of a square 0.25 m under an interface (the quadrature of the
+# other triples, with or without the closed form; 6 leaves 1.2e-9)
 LAYERS = dict(interfaces=[0.0, -2.0, -4.0], shear_modulus=[0.0, G, 2.0 * G, G], poisson_ratio=[NU, 0.3, 0.2, NU],
               images=2, gauss_points=6)
 HALF = 0.25  # 0.5 m squares
