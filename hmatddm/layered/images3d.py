@@ -88,6 +88,7 @@ from .images2d import _lame, zero_in_void
 from .image_tracer3d import _trace_range, _traced_buffer, drop_surface_range, trace, trace_points
 from .remainder_table3d import keep_near_range, rectangle_covered, remainder_rectangle_stress
 from .potentials3d import Workspace, base_derivatives, inverse_distance_derivatives
+from .vertical3d import vertical_image_stress, vertical_workspace
 from .rectangle_quadrature import (FAR_TOL, _cached_rules, _image_order, _integrate, far_order, image_rectangle_stress,
                                    image_rectangle_stress_without, remainder_order,
                                    nearest_singularity, square_rule, subdivisions)
@@ -97,6 +98,11 @@ __all__ = ["LayeredRectangles", "workspace", "source_state", "element_traction",
            "base_derivatives", "inverse_distance_derivatives", "Workspace", "trace", "trace_points",
            "kelvin_point_stress", "image_point_stress", "kelvin_point_displacement", "image_point_displacement",
            "square_rule", "nearest_singularity", "subdivisions", "FAR_TOL", "far_order", "image_rectangle_stress"]
+
+
+#: Gauss points per side from which a vertical source's near triples are taken in closed
+#: form (:mod:`.vertical3d`) rather than by the one-square rule (sub-squares: always).
+VERTICAL_FROM = 4
 
 
 class LayeredRectangles(NamedTuple):
@@ -129,6 +135,7 @@ class LayeredRectangles(NamedTuple):
     okada_half: np.ndarray = None  #: (N, 2) half sides along the strike and the dip
     surface: float = 0.0  #: height of the free surface (closed-form elements, ``surface_form`` elements)
     surface_form: np.ndarray = None  #: (N,) bool: the source's reflection in the free surface in closed form (two or more solid layers, :func:`.influence3d.surface_form`)
+    vertical_form: np.ndarray = None  #: (N,) bool: a vertical source whose near triples are in closed form next to it (:mod:`.vertical3d`)
 
 
 @njit(cache=True)
@@ -136,7 +143,8 @@ def workspace(data):
     """Scratch: local stress (3, 3, 3), image stress (3, 3, 3), gradient (3, 3, 3, 3), the
     Kelvin scratch (2, 3, 3, 1), the :func:`Workspace` of order 1 and of the largest order
     of any source layer's triples, the tracer's room per layer ``(cap, n_orders)``, the
-    :func:`_cached_rules` and the scratch of :func:`.okada3d.okada_stress`."""
+    :func:`_cached_rules`, the scratch of :func:`.okada3d.okada_stress` and of
+    :func:`.vertical3d.vertical_image_stress`."""
     n_layers = data.shear_modulus.shape[0]
     room = np.zeros((n_layers, 2), dtype=np.int64)
     n_orders = 1
@@ -146,23 +154,60 @@ def workspace(data):
                 room[layer, 0], room[layer, 1] = trace_capacity(layer, data.shear_modulus, data.n_images)
                 n_orders = max(n_orders, room[layer, 1])
     return (np.empty((3, 3, 3)), np.zeros((3, 3, 3)), np.empty((3, 3, 3, 3)), np.zeros((2, 3, 3, 1)), Workspace(1),
-            Workspace(n_orders), room, _cached_rules(data.gauss_points), np.empty((5, 3, 3, 3)), np.empty((30, 4)))
+            Workspace(n_orders), room, _cached_rules(data.gauss_points), np.empty((5, 3, 3, 3)), np.empty((30, 4)),
+            vertical_workspace(), np.empty((3, 3, 3)))
 
 
 @njit(cache=True)
 def source_state(data, j, work):
     """What the receivers of source ``j`` share: room for the image triples at the points
     of the cached rules, traced when a receiver first needs a rule, and whether they are
-    the near triples only (the source's layer has a tabulated remainder). A source whose
-    images are in closed form (``closed_form``) traces nothing: its room is one point."""
+    the near triples only (the source's layer has a tabulated remainder), and, for a
+    ``vertical_form`` source, those triples traced at its bottom, middle and top heights
+    (:func:`.vertical3d.vertical_image_stress`). A source whose images are in closed form
+    (``closed_form``) traces nothing: its room is one point."""
     room = work[6]
     start = work[7][3]
     ls = data.layer[j]
     near_only = data.table.pair_index[ls].max() >= 0
     if data.closed_form[j]:
-        return _traced_buffer(1, 1, 1), np.zeros(start.shape[0] - 1, dtype=np.bool_), near_only
-    return (_traced_buffer(start[-1], max(room[ls, 0], 1), max(room[ls, 1], 1)),
-            np.zeros(start.shape[0] - 1, dtype=np.bool_), near_only)
+        return (_traced_buffer(1, 1, 1), np.zeros(start.shape[0] - 1, dtype=np.bool_), near_only,
+                _traced_buffer(3, 1, 1), np.zeros(3))
+    cap, n_orders = max(room[ls, 0], 1), max(room[ls, 1], 1)
+    three, heights = _three_heights(data, j, near_only, cap, n_orders)
+    return (_traced_buffer(start[-1], cap, n_orders), np.zeros(start.shape[0] - 1, dtype=np.bool_), near_only,
+            three, heights)
+
+
+@njit(cache=True)
+def _three_heights(data, j, near_only, cap, n_orders):
+    """``(traced, heights)``: the triples of a ``vertical_form`` source at its bottom,
+    middle and top heights (:mod:`.vertical3d`), near ones only with a table, without the
+    free surface's when it is in closed form; one empty point otherwise."""
+    heights = np.zeros(3)
+    if not data.vertical_form[j]:
+        return _traced_buffer(3, 1, 1), heights
+    ls = data.layer[j]
+    center = data.centers[j]
+    frame = data.frames[j]
+    a = data.half_a[j]
+    b = data.half_b[j]
+    xi = np.zeros(3)
+    eta = np.zeros(3)
+    for p in range(3):
+        if abs(frame[1, 2]) > abs(frame[0, 2]):
+            eta[p] = (p - 1.0) * frame[1, 2]
+        else:
+            xi[p] = (p - 1.0) * frame[0, 2]
+        heights[p] = center[2] + xi[p] * a * frame[0, 2] + eta[p] * b * frame[1, 2]
+    three = _traced_buffer(3, cap, n_orders)
+    _trace_range(center, frame, a, b, ls, data.interfaces, data.shear_modulus, data.poisson_ratio, data.n_images, xi,
+                 eta, 0, 3, three)
+    if near_only:
+        keep_near_range(three, 0, 3, center, frame, a, b, xi, eta, ls, data.table.bottoms, data.table.tops)
+    if data.surface_form[j]:
+        drop_surface_range(three, 0, 3, center, frame, a, b, xi, eta, ls, data.surface)
+    return three, heights
 
 
 @njit(cache=True)
@@ -177,9 +222,13 @@ def element_traction(data, i, j, state, work, block):
     surface terms in closed form instead (:func:`.okada3d.okada_traction`, Okada 1992),
     whatever the number of images (the closed form is the exact half-space). With two or
     more solid layers, a ``surface_form`` source adds its reflection in the free surface
-    the same way for receivers of its layer and leaves it out of the quadrature."""
-    traced, is_traced, near_only = state
-    local, image, gradient, kelvin, ws1, ws, room, rules, okada_work, corners = work
+    the same way for receivers of its layer and leaves it out of the quadrature. A
+    ``vertical_form`` source (a vertical rectangle, interfaces between solids) takes its
+    near triples in closed form (:func:`.vertical3d.vertical_image_stress`) where the
+    quadrature would need sub-squares or :data:`VERTICAL_FROM` points per side, the
+    quadrature elsewhere."""
+    traced, is_traced, near_only, three, heights = state
+    local, image, gradient, kelvin, ws1, ws, room, rules, okada_work, corners, vwork, uniform = work
     xi, eta, wt, start = rules
     g = data.shear_modulus
     nu = data.poisson_ratio
@@ -222,7 +271,18 @@ def element_traction(data, i, j, state, work, block):
         elif not (tabulated and abs(lr - ls) >= 2):  # two layers apart, every triple is far
             n_gauss, n_sub = _image_order(point, lr, center, frame, a, b, ls, interfaces, data.gauss_points,
                                           data.max_subdivisions, data.far_tol, entry_tol, skip)
-            if n_sub <= 2:
+            closed = False
+            if data.vertical_form[j] and (n_sub > 1 or n_gauss >= VERTICAL_FROM):
+                # next to the images: every triple traced at three heights, in closed form
+                closed = vertical_image_stress(point, lr, center, data.okada[j, 0], data.okada_half[j, 0],
+                                               data.okada_half[j, 1], heights, three, g, nu, ls, vwork, image)
+                if closed and lr != ls:  # minus the whole space of the source's material
+                    rectangle3d.stress_pair(point, center, frame, a, b, g[ls], nu[ls], 0.0, uniform, local)
+                    for q in range(3):
+                        for p in range(3):
+                            for kk in range(3):
+                                image[q, p, kk] -= uniform[q, p, kk]
+            if not closed and n_sub <= 2:
                 slot = n_gauss - 1 if n_sub == 1 else data.gauss_points
                 lo, hi = start[slot], start[slot + 1]
                 if not is_traced[slot]:
@@ -234,7 +294,7 @@ def element_traction(data, i, j, state, work, block):
                     is_traced[slot] = True
                 _integrate(point, lr, center, frame, a, b, ls, g, nu, xi[lo:hi], eta[lo:hi], wt[lo:hi], traced, lo,
                            image, gradient, ws, ws1, kelvin)
-            else:
+            elif not closed:
                 image_rectangle_stress_without(point, lr, center, frame, a, b, ls, interfaces, g, nu, data.n_images,
                                                n_gauss, n_sub, image, near_only, table.bottoms, table.tops,
                                                surface_form, data.surface)

@@ -8,7 +8,7 @@ import numpy as np
 from .._validation import finite_array
 from ..errors import InputError
 from ..kernels.drivers import finite_stress_sum, with_self_max
-from . import images3d, okada3d, remainder_build3d, remainder_table3d
+from . import images3d, okada3d, remainder_build3d, remainder_table3d, vertical3d
 from .image_tracer3d import trace_points
 from .influence2d import choose_images as _choose_images
 from .influence2d import layers_of_extents, with_images
@@ -60,6 +60,8 @@ def influence_data(mesh, medium, singular_shift, alpha, near_fraction, n_images)
         table = remainder_table(mesh, medium, layers, int(n_images), scale * g.max())[0]
     closed, okada, half = okada3d.halfspace_geometry(mesh.frames, mesh.half_a, mesh.half_b)
     surface = closed & (layers == 1) & surface_form(medium, int(n_images))
+    vertical = (closed & (np.abs(okada[:, 1, 2]) >= vertical3d.VERTICAL) & (interfaces.shape[0] > 0)
+                & (medium.method != "quadrature") & (int(n_images) >= 1) & (not is_half_space(medium)))
     if not is_half_space(medium) or medium.method == "quadrature":
         closed[:] = False
     return with_self_max(images3d.LayeredRectangles(
@@ -68,7 +70,7 @@ def influence_data(mesh, medium, singular_shift, alpha, near_fraction, n_images)
         singular_shift=float(singular_shift), near_fraction=float(near_fraction), alpha=float(alpha),
         self_max=np.zeros(mesh.n_elements), entry_tol=float(ENTRY_TOL), entry_scale=float(scale), table=table,
         closed_form=closed, okada=okada, okada_half=half,
-        surface=float(interfaces[0]) if interfaces.shape[0] else 0.0, surface_form=surface))
+        surface=float(interfaces[0]) if interfaces.shape[0] else 0.0, surface_form=surface, vertical_form=vertical))
 
 
 def is_half_space(medium):
