@@ -28,8 +28,8 @@ package; run ``python -m hmatddm.layered._derive_closed_form3d`` (about a minute
    ``P(t) d1^a d2^b d3^c B`` against the quadrature (5e-13), and
    :func:`check_vertical_rectangles` whole image entries against
    :func:`.rectangle_quadrature.image_rectangle_stress` (bi-material and a free surface
-   over two interfaces, receivers on both sides: 1.4e-14, 2.8e-14 of the largest). A
-   Python prototype of the mapping, not the operator's path.
+   over two interfaces, receivers on both sides: 1.4e-14, 2.8e-14 of the largest). The
+   Python prototype of :mod:`.vertical3d`, the operator's compiled path.
 """
 import inspect
 import re
@@ -323,7 +323,7 @@ def vertical_rectangle_image_stress(y, receiver_layer, center, half_strike, half
     rectangle (:func:`vertical_term`; the ``s``-weighted ones apart), and its ``_stress``
     and the moment contraction are used as they are. Derivative orders bound it to
     triples of ``D`` order <= 3 (``images`` <= 2): the tables stop at 5 horizontal
-    derivatives. A prototype in Python, not the operator's path."""
+    derivatives. The prototype of :mod:`.vertical3d` (which holds more orders)."""
     from ..kernels import rectangle3d
     from .images2d import _lame, receiver_constants
     from .potentials3d import _contract, _stress

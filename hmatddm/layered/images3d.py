@@ -54,10 +54,13 @@ exceeds the number of ``d3``), needing only ``d3^-1 F = K = 3/4 r3 r + (rho^2/4 
 - rho^2/8`` and ``d3^-1 L = -sigma F``; along the strike ``d1^-1`` is a difference of the
 derivative tables at the corners, and for the terms without ``d1`` (after the Laplace
 equation) a derivative of ``log(r + r1)``, the ``L`` of :mod:`.potentials3d` with the axes
-turned. Whole image entries of every triple, reflections in interfaces between solids and
-transmissions, agree with the quadrature to 3e-14 (a Python prototype; the operator still
-integrates them by quadrature). Dipping rectangles need primitives along a dip that is not
-the vertical: not derived.
+turned. Compiled in :mod:`.vertical3d` (``LayeredRectangles.vertical_form``): a vertical
+source takes its near triples in closed form where the quadrature would need sub-squares
+or :data:`VERTICAL_FROM` points per side; whole image entries of every triple, reflections
+in interfaces between solids and transmissions, agree with the quadrature to ~1e-14.
+Dipping rectangles (and horizontal ones, beyond the free surface's reflection) keep the
+quadrature: along a dip that is not the vertical, ``d3`` is no total derivative and the
+weights ``P(t)`` need primitives of their own, not derived.
 
 Coordinates: ``(x, y, z)`` with ``z`` vertical (the reference's ``x3``); interfaces are
 the planes ``z = d_k`` (see :class:`LayeredMedium`, docs/conventions.md §3).
@@ -134,8 +137,11 @@ class LayeredRectangles(NamedTuple):
     okada: np.ndarray = None  #: (N, 3, 3) rows strike, up-dip, normal of each closed-form element (:mod:`.okada3d`)
     okada_half: np.ndarray = None  #: (N, 2) half sides along the strike and the dip
     surface: float = 0.0  #: height of the free surface (closed-form elements, ``surface_form`` elements)
-    surface_form: np.ndarray = None  #: (N,) bool: the source's reflection in the free surface in closed form (two or more solid layers, :func:`.influence3d.surface_form`)
-    vertical_form: np.ndarray = None  #: (N,) bool: a vertical source whose near triples are in closed form next to it (:mod:`.vertical3d`)
+    #: (N,) bool: the source's reflection in the free surface in closed form (two or more
+    #: solid layers, :func:`.influence3d.surface_form`)
+    surface_form: np.ndarray = None
+    #: (N,) bool: a vertical source whose near triples are in closed form next to it (:mod:`.vertical3d`)
+    vertical_form: np.ndarray = None
 
 
 @njit(cache=True)

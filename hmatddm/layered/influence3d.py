@@ -50,7 +50,10 @@ def influence_data(mesh, medium, singular_shift, alpha, near_fraction, n_images)
     surface terms in closed form (:mod:`.okada3d`; ``closed_form``), the others by quadrature.
     With two or more solid layers under a void (:func:`surface_form`), the elements of the
     top solid layer with a horizontal side take their reflection in the free surface in
-    closed form (``surface_form``) and their other triples by quadrature."""
+    closed form (``surface_form``) and their other triples by quadrature. Vertical
+    rectangles in a medium with interfaces (not a half-space, not ``"quadrature"``, at least
+    one image) take their near triples in closed form next to them (``vertical_form``,
+    :mod:`.vertical3d`)."""
     layers = element_layers(mesh, medium)
     interfaces, g, nu = medium.arrays()
     scale = entry_scale(mesh.half_a, mesh.half_b, layers, g, nu) / g.max() if interfaces.shape[0] > 0 else 0.0

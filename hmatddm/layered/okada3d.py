@@ -39,7 +39,8 @@ under a void). With two or more solid layers under a void it gives one triple of
 method exactly, the top layer's reflection in the free surface (``real=False``; the other
 triples keep the image method: :mod:`.images3d`, ``surface_form``); a reflection in an
 interface between two solids is not a reweighting of these terms
-(``_derive_closed_form3d.py``).
+(``_derive_closed_form3d.py``); for vertical rectangles it is in closed form by other
+primitives (:mod:`.vertical3d`).
 """
 import math
 
