@@ -207,12 +207,13 @@ def _three_heights(data, j, near_only, cap, n_orders):
             xi[p] = (p - 1.0) * frame[0, 2]
         heights[p] = center[2] + xi[p] * a * frame[0, 2] + eta[p] * b * frame[1, 2]
     three = _traced_buffer(3, cap, n_orders)
+    first, last = np.int64(0), np.int64(3)  # not literals: the same compiled functions as element_traction's
     _trace_range(center, frame, a, b, ls, data.interfaces, data.shear_modulus, data.poisson_ratio, data.n_images, xi,
-                 eta, 0, 3, three)
+                 eta, first, last, three)
     if near_only:
-        keep_near_range(three, 0, 3, center, frame, a, b, xi, eta, ls, data.table.bottoms, data.table.tops)
+        keep_near_range(three, first, last, center, frame, a, b, xi, eta, ls, data.table.bottoms, data.table.tops)
     if data.surface_form[j]:
-        drop_surface_range(three, 0, 3, center, frame, a, b, xi, eta, ls, data.surface)
+        drop_surface_range(three, first, last, center, frame, a, b, xi, eta, ls, data.surface)
     return three, heights
 
 

@@ -204,8 +204,7 @@ def vertical_workspace():
     edge = (np.empty((6, 6)), np.empty((6, 6)), np.empty((4, 6)), np.empty((6, 6, M_MAX - 2)),
             np.empty((2, 6, 6, M_MAX - 1)), np.empty((n_log, n_log)), np.empty((n_log + 1, n_log + 1, n_log)),
             np.empty((4, n_log + 1)))
-    tables = (np.empty((2, 6, 6, M_MAX)), np.empty((2, 6, 6, M_MAX)), np.zeros((3, 3, 6, 6, 6)),
-              np.zeros((3, 3, 6, 6, 6)), np.zeros((3, 3, 6, 6, 6)), np.zeros((3, 3, 6, 6, 6)))
+    tables = (np.empty((2, 6, 6, M_MAX)), np.empty((2, 6, 6, M_MAX)), np.zeros((4, 3, 3, 6, 6, 6)))
     return edge, tables, np.zeros((3, 3, 3, 3)), np.zeros((3, 3)), np.zeros((3, 3)), np.zeros((3, 3, 3)), np.zeros(3)
 
 
@@ -219,7 +218,8 @@ def vertical_image_stress(y, receiver_layer, center, strike, hs, hd, heights, tr
     ``receiver_layer``, in closed form (module docstring). Returns False, adding nothing,
     where the triples differ between the heights or a table does not reach."""
     edge, tables, gradient, with_s, without, local, yr = work
-    sj_bot, sj_top, plain, weighted, dplain, dweighted = tables
+    sj_bot, sj_top, integrated = tables
+    plain, weighted, dplain, dweighted = integrated[0], integrated[1], integrated[2], integrated[3]
     n_pairs, layer, z, eps, sigma, coef, dcoef = traced
     s0, s1 = strike[0], strike[1]
     dx = y[0] - center[0]
@@ -269,10 +269,11 @@ def vertical_image_stress(y, receiver_layer, center, strike, hs, hd, heights, tr
         _edge_table(ends, yr[1], yr[2] - (z0 + e * t_bot), sg, sj_bot, edge)
         _edge_table(ends, yr[1], yr[2] - (z0 + e * t_top), sg, sj_top, edge)
         sa = yr[2] - z0  # s = y3 - z(t) = sa - e t
-        _integrated_table(polys, sa, -e, False, 3, e, t_bot, t_top, sj_bot, sj_top, plain)
-        _integrated_table(polys, sa, -e, True, 3, e, t_bot, t_top, sj_bot, sj_top, weighted)
-        _integrated_table(dpolys, sa, -e, False, 2, e, t_bot, t_top, sj_bot, sj_top, dplain)
-        _integrated_table(dpolys, sa, -e, True, 2, e, t_bot, t_top, sj_bot, sj_top, dweighted)
+        # run-time flags and orders: one compiled _integrated_table, not one per literal
+        for which in range(4):
+            order = 3 - which // 2
+            _integrated_table(polys if order == 3 else dpolys, sa, -e, which % 2 == 1, order, e, t_bot, t_top,
+                              sj_bot, sj_top, integrated[which])
         for f in range(3):
             for v in range(4):
                 da = 1 if v == 0 else 0
