@@ -93,6 +93,28 @@ def merge_coincident(n, pair_layer, pair_z, pair_eps, pair_sigma, pair_coef, pai
 
 
 @njit(cache=True)
+def drop_surface_range(traced, lo, hi, center, frame, a, b, xi, eta, source_layer, surface):
+    """Remove, from the triples traced at the points ``lo .. hi - 1`` of the rule ``(xi,
+    eta)`` on a rectangle, the reflection of the source in the free surface ``z = surface``
+    over its layer: the triple of the source's layer whose point is ``2 surface - t``
+    (``eps = -1``), which :mod:`.okada3d` gives in closed form (it is the half-space's only
+    triple, coefficient for coefficient: :func:`hmatddm.layered.influence3d.surface_reflection_alone`
+    checks that no other path merged into it). The last triple takes its place."""
+    n_pairs, layer, z, eps, sigma, coef, dcoef = traced
+    for g in range(lo, hi):
+        t = center[2] + xi[g] * a * frame[0, 2] + eta[g] * b * frame[1, 2]
+        target = 2.0 * surface - t
+        tol = 1e-12 * (1.0 + abs(target))
+        n = n_pairs[g]
+        for k in range(n):
+            if layer[g, k] == source_layer and eps[g, k] < 0.0 and abs(z[g, k] - target) <= tol:
+                if k != n - 1:
+                    copy_triple(n - 1, k, layer[g], z[g], eps[g], sigma[g], coef[g], dcoef[g])
+                n_pairs[g] = n - 1
+                break
+
+
+@njit(cache=True)
 def _traced_buffer(n_points, cap, n_orders):
     """Room for the triples of ``n_points`` source points (see :func:`trace_points`)."""
     return (np.zeros(n_points, dtype=np.int64), np.empty((n_points, cap), dtype=np.int64),

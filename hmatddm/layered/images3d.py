@@ -24,13 +24,43 @@ ones, the smooth layered remainder, come from a table built once per medium and 
 extent (:mod:`.remainder_table3d`, ``LayeredMedium(method="table")``, the default;
 ``method="quadrature"`` integrates every triple, the cross-check). In a half-space (one
 solid layer under a void) the image and surface terms of a rectangle with a horizontal side
-are in closed form (:mod:`.okada3d`, Okada 1992; ``LayeredRectangles.closed_form``); a
-rectangle without one, and any medium with two solid layers, keeps the quadrature. Beyond the
-half-space the image terms are not integrated in closed form: the Hansen base functions ``F = r - sigma r3 log(r + sigma r3)`` and
-``L = log(r + sigma r3)`` (and their horizontal derivatives) of every image, with
-coefficients polynomial in the source height, have no primitive over a rectangle of any
-orientation among the uniform-rock kernel's primitives of ``1/r`` (their integrals are
-those of angular dislocations); only the ``1/r``-derivative parts would be.
+are in closed form (:mod:`.okada3d`, Okada 1992; ``LayeredRectangles.closed_form``). With
+two or more solid layers under a void, a source of the top solid layer with a horizontal
+side takes its reflection in the free surface in closed form too (that triple is the
+half-space's image triple, coefficient for coefficient:
+:func:`.influence3d.surface_reflection_alone`; ``LayeredRectangles.surface_form``,
+:func:`.image_tracer3d.drop_surface_range`), and the quadrature neither integrates it nor
+refines for its singular point. A rectangle without a horizontal side keeps the quadrature.
+
+What is not in closed form, and why (measured in ``_derive_closed_form3d.py``): every other
+near triple, i.e. the reflections in an interface between two solids and the
+transmissions. Each triple is a point-source field built from the Hansen base functions
+``F = r - sigma r3 log(r + sigma r3)``, ``L = log(r + sigma r3)`` and ``1/r`` (ref. Eqs
+3.14-3.17, 3.22, 3.24) whose coefficients of ``D^n`` are polynomials of degree <= min(n, 2)
+in the source height (ref. Eqs 3.25-3.28; measured up to ``images=4``, the ``D`` order
+growing to 5), so its integral over a rectangle with a horizontal side is elementary, as
+Okada's is, though not from the uniform-rock kernel's primitives of ``1/r`` alone.
+But it is not Okada's closed form reweighted: his image terms split into their seven
+coefficient groups (parts A, B, C) fit the reflection at a bi-material interface only to
+0.3-1.2 % (separate weights per dislocation component; 4e-15 for a free surface): his
+grouped expressions fix combinations of the terms that the free surface's reflection
+coefficients make, and ``c1, c2, c3`` of an interface between solids (ref. Eq. 3.27) make
+others. A closed form
+needs the primitives of each term, the integral of ``P(t) d1^a d2^b d3^c B`` over the
+rectangle (``deg P <= 3`` with the ``s`` factor, ``B`` in ``F, L`` of either gauge). For a
+*vertical* rectangle they are derived and checked (``_derive_closed_form3d.py``, item 4):
+along the dip ``d3 = -eps d/dt``, so the height integral is exact by parts (``deg P`` never
+exceeds the number of ``d3``), needing only ``d3^-1 F = K = 3/4 r3 r + (rho^2/4 - r3^2/2) L
+- rho^2/8`` and ``d3^-1 L = -sigma F``; along the strike ``d1^-1`` is a difference of the
+derivative tables at the corners, and for the terms without ``d1`` (after the Laplace
+equation) a derivative of ``log(r + r1)``, the ``L`` of :mod:`.potentials3d` with the axes
+turned. Compiled in :mod:`.vertical3d` (``LayeredRectangles.vertical_form``): a vertical
+source takes its near triples in closed form where the quadrature would need sub-squares
+or :data:`VERTICAL_FROM` points per side; whole image entries of every triple, reflections
+in interfaces between solids and transmissions, agree with the quadrature to ~1e-14.
+Dipping rectangles (and horizontal ones, beyond the free surface's reflection) keep the
+quadrature: along a dip that is not the vertical, ``d3`` is no total derivative and the
+weights ``P(t)`` need primitives of their own, not derived.
 
 Coordinates: ``(x, y, z)`` with ``z`` vertical (the reference's ``x3``); interfaces are
 the planes ``z = d_k`` (see :class:`LayeredMedium`, docs/conventions.md §3).
@@ -58,11 +88,12 @@ from . import okada3d
 from .image_points3d import image_point_displacement, image_point_stress, kelvin_point_displacement, kelvin_point_stress
 from .image_tracer import trace_capacity
 from .images2d import _lame, zero_in_void
-from .image_tracer3d import _trace_range, _traced_buffer, trace, trace_points
+from .image_tracer3d import _trace_range, _traced_buffer, drop_surface_range, trace, trace_points
 from .remainder_table3d import keep_near_range, rectangle_covered, remainder_rectangle_stress
 from .potentials3d import Workspace, base_derivatives, inverse_distance_derivatives
+from .vertical3d import vertical_image_stress, vertical_workspace
 from .rectangle_quadrature import (FAR_TOL, _cached_rules, _image_order, _integrate, far_order, image_rectangle_stress,
-                                   remainder_order,
+                                   image_rectangle_stress_without, remainder_order,
                                    nearest_singularity, square_rule, subdivisions)
 
 __all__ = ["LayeredRectangles", "workspace", "source_state", "element_traction", "element_stress",
@@ -70,6 +101,11 @@ __all__ = ["LayeredRectangles", "workspace", "source_state", "element_traction",
            "base_derivatives", "inverse_distance_derivatives", "Workspace", "trace", "trace_points",
            "kelvin_point_stress", "image_point_stress", "kelvin_point_displacement", "image_point_displacement",
            "square_rule", "nearest_singularity", "subdivisions", "FAR_TOL", "far_order", "image_rectangle_stress"]
+
+
+#: Gauss points per side from which a vertical source's near triples are taken in closed
+#: form (:mod:`.vertical3d`) rather than by the one-square rule (sub-squares: always).
+VERTICAL_FROM = 4
 
 
 class LayeredRectangles(NamedTuple):
@@ -100,7 +136,12 @@ class LayeredRectangles(NamedTuple):
     closed_form: np.ndarray = None  #: (N,) bool: the source's images in closed form (a half-space, :mod:`.okada3d`)
     okada: np.ndarray = None  #: (N, 3, 3) rows strike, up-dip, normal of each closed-form element (:mod:`.okada3d`)
     okada_half: np.ndarray = None  #: (N, 2) half sides along the strike and the dip
-    surface: float = 0.0  #: height of the free surface of a half-space (closed-form elements)
+    surface: float = 0.0  #: height of the free surface (closed-form elements, ``surface_form`` elements)
+    #: (N,) bool: the source's reflection in the free surface in closed form (two or more
+    #: solid layers, :func:`.influence3d.surface_form`)
+    surface_form: np.ndarray = None
+    #: (N,) bool: a vertical source whose near triples are in closed form next to it (:mod:`.vertical3d`)
+    vertical_form: np.ndarray = None
 
 
 @njit(cache=True)
@@ -108,7 +149,8 @@ def workspace(data):
     """Scratch: local stress (3, 3, 3), image stress (3, 3, 3), gradient (3, 3, 3, 3), the
     Kelvin scratch (2, 3, 3, 1), the :func:`Workspace` of order 1 and of the largest order
     of any source layer's triples, the tracer's room per layer ``(cap, n_orders)``, the
-    :func:`_cached_rules` and the scratch of :func:`.okada3d.okada_stress`."""
+    :func:`_cached_rules`, the scratch of :func:`.okada3d.okada_stress` and of
+    :func:`.vertical3d.vertical_image_stress`."""
     n_layers = data.shear_modulus.shape[0]
     room = np.zeros((n_layers, 2), dtype=np.int64)
     n_orders = 1
@@ -118,23 +160,61 @@ def workspace(data):
                 room[layer, 0], room[layer, 1] = trace_capacity(layer, data.shear_modulus, data.n_images)
                 n_orders = max(n_orders, room[layer, 1])
     return (np.empty((3, 3, 3)), np.zeros((3, 3, 3)), np.empty((3, 3, 3, 3)), np.zeros((2, 3, 3, 1)), Workspace(1),
-            Workspace(n_orders), room, _cached_rules(data.gauss_points), np.empty((5, 3, 3, 3)), np.empty((30, 4)))
+            Workspace(n_orders), room, _cached_rules(data.gauss_points), np.empty((5, 3, 3, 3)), np.empty((30, 4)),
+            vertical_workspace(), np.empty((3, 3, 3)))
 
 
 @njit(cache=True)
 def source_state(data, j, work):
     """What the receivers of source ``j`` share: room for the image triples at the points
     of the cached rules, traced when a receiver first needs a rule, and whether they are
-    the near triples only (the source's layer has a tabulated remainder). A source whose
-    images are in closed form (``closed_form``) traces nothing: its room is one point."""
+    the near triples only (the source's layer has a tabulated remainder), and, for a
+    ``vertical_form`` source, those triples traced at its bottom, middle and top heights
+    (:func:`.vertical3d.vertical_image_stress`). A source whose images are in closed form
+    (``closed_form``) traces nothing: its room is one point."""
     room = work[6]
     start = work[7][3]
     ls = data.layer[j]
     near_only = data.table.pair_index[ls].max() >= 0
     if data.closed_form[j]:
-        return _traced_buffer(1, 1, 1), np.zeros(start.shape[0] - 1, dtype=np.bool_), near_only
-    return (_traced_buffer(start[-1], max(room[ls, 0], 1), max(room[ls, 1], 1)),
-            np.zeros(start.shape[0] - 1, dtype=np.bool_), near_only)
+        return (_traced_buffer(1, 1, 1), np.zeros(start.shape[0] - 1, dtype=np.bool_), near_only,
+                _traced_buffer(3, 1, 1), np.zeros(3))
+    cap, n_orders = max(room[ls, 0], 1), max(room[ls, 1], 1)
+    three, heights = _three_heights(data, j, near_only, cap, n_orders)
+    return (_traced_buffer(start[-1], cap, n_orders), np.zeros(start.shape[0] - 1, dtype=np.bool_), near_only,
+            three, heights)
+
+
+@njit(cache=True)
+def _three_heights(data, j, near_only, cap, n_orders):
+    """``(traced, heights)``: the triples of a ``vertical_form`` source at its bottom,
+    middle and top heights (:mod:`.vertical3d`), near ones only with a table, without the
+    free surface's when it is in closed form; one empty point otherwise."""
+    heights = np.zeros(3)
+    if not data.vertical_form[j]:
+        return _traced_buffer(3, 1, 1), heights
+    ls = data.layer[j]
+    center = data.centers[j]
+    frame = data.frames[j]
+    a = data.half_a[j]
+    b = data.half_b[j]
+    xi = np.zeros(3)
+    eta = np.zeros(3)
+    for p in range(3):
+        if abs(frame[1, 2]) > abs(frame[0, 2]):
+            eta[p] = (p - 1.0) * frame[1, 2]
+        else:
+            xi[p] = (p - 1.0) * frame[0, 2]
+        heights[p] = center[2] + xi[p] * a * frame[0, 2] + eta[p] * b * frame[1, 2]
+    three = _traced_buffer(3, cap, n_orders)
+    first, last = np.int64(0), np.int64(3)  # not literals: the same compiled functions as element_traction's
+    _trace_range(center, frame, a, b, ls, data.interfaces, data.shear_modulus, data.poisson_ratio, data.n_images, xi,
+                 eta, first, last, three)
+    if near_only:
+        keep_near_range(three, first, last, center, frame, a, b, xi, eta, ls, data.table.bottoms, data.table.tops)
+    if data.surface_form[j]:
+        drop_surface_range(three, first, last, center, frame, a, b, xi, eta, ls, data.surface)
+    return three, heights
 
 
 @njit(cache=True)
@@ -147,9 +227,15 @@ def element_traction(data, i, j, state, work, block):
     the rest; a receiver outside the table's range takes every triple by quadrature. In a
     half-space, a source with a horizontal side (``closed_form``) takes its image and
     surface terms in closed form instead (:func:`.okada3d.okada_traction`, Okada 1992),
-    whatever the number of images (the closed form is the exact half-space)."""
-    traced, is_traced, near_only = state
-    local, image, gradient, kelvin, ws1, ws, room, rules, okada_work, corners = work
+    whatever the number of images (the closed form is the exact half-space). With two or
+    more solid layers, a ``surface_form`` source adds its reflection in the free surface
+    the same way for receivers of its layer and leaves it out of the quadrature. A
+    ``vertical_form`` source (a vertical rectangle, interfaces between solids) takes its
+    near triples in closed form (:func:`.vertical3d.vertical_image_stress`) where the
+    quadrature would need sub-squares or :data:`VERTICAL_FROM` points per side, the
+    quadrature elsewhere."""
+    traced, is_traced, near_only, three, heights = state
+    local, image, gradient, kelvin, ws1, ws, room, rules, okada_work, corners, vwork, uniform = work
     xi, eta, wt, start = rules
     g = data.shear_modulus
     nu = data.poisson_ratio
@@ -175,28 +261,50 @@ def element_traction(data, i, j, state, work, block):
         image[:] = 0.0
         tabulated = near_only and rectangle_covered(table, point, lr, center, frame, a, b, ls)
         entry_tol = data.entry_tol * data.entry_scale
+        # the reflection in the free surface in closed form: the quadrature neither takes it
+        # nor refines for its singular point (the receiver's mirror in the surface)
+        surface_form = data.surface_form[j]
+        skip = ls - 1 if surface_form and lr == ls else -1
+        if surface_form and lr == ls:
+            okada3d.okada_traction(point, normal, center, data.okada[j], data.okada_half[j, 0], data.okada_half[j, 1],
+                                   data.surface, g[ls], nu[ls], False, True, okada_work, corners, block)
         if near_only and not tabulated and table.pair_index[ls, lr] >= 0:
             # outside the table's range: every triple by quadrature
             n_gauss, n_sub = _image_order(point, lr, center, frame, a, b, ls, interfaces, data.gauss_points,
-                                          data.max_subdivisions, data.far_tol, entry_tol)
-            image_rectangle_stress(point, lr, center, frame, a, b, ls, interfaces, g, nu, data.n_images, n_gauss,
-                                   n_sub, image, False, table.bottoms, table.tops)
+                                          data.max_subdivisions, data.far_tol, entry_tol, skip)
+            image_rectangle_stress_without(point, lr, center, frame, a, b, ls, interfaces, g, nu, data.n_images,
+                                           n_gauss, n_sub, image, False, table.bottoms, table.tops, surface_form,
+                                           data.surface)
         elif not (tabulated and abs(lr - ls) >= 2):  # two layers apart, every triple is far
             n_gauss, n_sub = _image_order(point, lr, center, frame, a, b, ls, interfaces, data.gauss_points,
-                                          data.max_subdivisions, data.far_tol, entry_tol)
-            if n_sub <= 2:
+                                          data.max_subdivisions, data.far_tol, entry_tol, skip)
+            closed = False
+            if data.vertical_form[j] and (n_sub > 1 or n_gauss >= VERTICAL_FROM):
+                # next to the images: every triple traced at three heights, in closed form
+                closed = vertical_image_stress(point, lr, center, data.okada[j, 0], data.okada_half[j, 0],
+                                               data.okada_half[j, 1], heights, three, g, nu, ls, vwork, image)
+                if closed and lr != ls:  # minus the whole space of the source's material
+                    rectangle3d.stress_pair(point, center, frame, a, b, g[ls], nu[ls], 0.0, uniform, local)
+                    for q in range(3):
+                        for p in range(3):
+                            for kk in range(3):
+                                image[q, p, kk] -= uniform[q, p, kk]
+            if not closed and n_sub <= 2:
                 slot = n_gauss - 1 if n_sub == 1 else data.gauss_points
                 lo, hi = start[slot], start[slot + 1]
                 if not is_traced[slot]:
                     _trace_range(center, frame, a, b, ls, interfaces, g, nu, data.n_images, xi, eta, lo, hi, traced)
                     if near_only:
                         keep_near_range(traced, lo, hi, center, frame, a, b, xi, eta, ls, table.bottoms, table.tops)
+                    if surface_form:
+                        drop_surface_range(traced, lo, hi, center, frame, a, b, xi, eta, ls, data.surface)
                     is_traced[slot] = True
                 _integrate(point, lr, center, frame, a, b, ls, g, nu, xi[lo:hi], eta[lo:hi], wt[lo:hi], traced, lo,
                            image, gradient, ws, ws1, kelvin)
-            else:
-                image_rectangle_stress(point, lr, center, frame, a, b, ls, interfaces, g, nu, data.n_images, n_gauss,
-                                       n_sub, image, near_only, table.bottoms, table.tops)
+            elif not closed:
+                image_rectangle_stress_without(point, lr, center, frame, a, b, ls, interfaces, g, nu, data.n_images,
+                                               n_gauss, n_sub, image, near_only, table.bottoms, table.tops,
+                                               surface_form, data.surface)
         if tabulated:
             # the far triples' points lie below or above the source points, at least
             # the clearance outside the receiver's layer
@@ -220,7 +328,8 @@ def element_stress(data, point, point_layer, j, work, out):
     for a unit global DD ``q`` of rectangle ``j``, closed form plus images (the
     quadrature of :func:`element_traction`). A point within ``near_fraction`` smaller
     half sides of an edge counts as on it. A ``closed_form`` source: the image and surface
-    terms of :func:`.okada3d.okada_stress`."""
+    terms of :func:`.okada3d.okada_stress`; a ``surface_form`` source: its reflection in
+    the free surface, for points of its layer (the rest by quadrature)."""
     local, image = work[0], work[1]
     if zero_in_void(data.shear_modulus, point_layer, out):
         return
@@ -241,14 +350,24 @@ def element_stress(data, point, point_layer, j, work, out):
                 for k in range(3):
                     out[q, i, k] += image[q, i, k]
     elif data.interfaces.shape[0] > 0:
+        surface_form = data.surface_form[j]
+        skip = ls - 1 if surface_form and point_layer == ls else -1
         n_gauss, n_sub = _image_order(point, point_layer, center, frame, a, b, ls, data.interfaces,
-                                      data.gauss_points, data.max_subdivisions, data.far_tol, 0.0)
-        image_rectangle_stress(point, point_layer, center, frame, a, b, ls, data.interfaces, g, nu, data.n_images,
-                               n_gauss, n_sub, image, False, data.table.bottoms, data.table.tops)
+                                      data.gauss_points, data.max_subdivisions, data.far_tol, 0.0, skip)
+        image_rectangle_stress_without(point, point_layer, center, frame, a, b, ls, data.interfaces, g, nu,
+                                       data.n_images, n_gauss, n_sub, image, False, data.table.bottoms,
+                                       data.table.tops, surface_form, data.surface)
         for q in range(3):
             for i in range(3):
                 for k in range(3):
                     out[q, i, k] += image[q, i, k]
+        if surface_form and point_layer == ls:
+            okada3d.okada_stress(point, center, data.okada[j], data.okada_half[j, 0], data.okada_half[j, 1],
+                                 data.surface, g[ls], nu[ls], False, True, work[8], work[9], image)
+            for q in range(3):
+                for i in range(3):
+                    for k in range(3):
+                        out[q, i, k] += image[q, i, k]
 
 
 register_kind(LayeredRectangles, KernelKind(workspace, source_state, element_traction, element_stress,

@@ -8,7 +8,8 @@ import numpy as np
 from .._validation import finite_array
 from ..errors import InputError
 from ..kernels.drivers import finite_stress_sum, with_self_max
-from . import images3d, okada3d, remainder_build3d, remainder_table3d
+from . import images3d, okada3d, remainder_build3d, remainder_table3d, vertical3d
+from .image_tracer3d import trace_points
 from .influence2d import choose_images as _choose_images
 from .influence2d import layers_of_extents, with_images
 from .rectangle_quadrature import ENTRY_TOL, entry_scale
@@ -46,7 +47,13 @@ def influence_data(mesh, medium, singular_shift, alpha, near_fraction, n_images)
     :data:`TABLE_MIN_ELEMENTS` elements, the layered remainder's table
     (:func:`remainder_table`). In a half-space (:func:`is_half_space`) with ``medium.method``
     other than ``"quadrature"``, the elements with a horizontal side take their image and
-    surface terms in closed form (:mod:`.okada3d`; ``closed_form``), the others by quadrature."""
+    surface terms in closed form (:mod:`.okada3d`; ``closed_form``), the others by quadrature.
+    With two or more solid layers under a void (:func:`surface_form`), the elements of the
+    top solid layer with a horizontal side take their reflection in the free surface in
+    closed form (``surface_form``) and their other triples by quadrature. Vertical
+    rectangles in a medium with interfaces (not a half-space, not ``"quadrature"``, at least
+    one image) take their near triples in closed form next to them (``vertical_form``,
+    :mod:`.vertical3d`)."""
     layers = element_layers(mesh, medium)
     interfaces, g, nu = medium.arrays()
     scale = entry_scale(mesh.half_a, mesh.half_b, layers, g, nu) / g.max() if interfaces.shape[0] > 0 else 0.0
@@ -55,6 +62,9 @@ def influence_data(mesh, medium, singular_shift, alpha, near_fraction, n_images)
             and mesh.n_elements >= TABLE_MIN_ELEMENTS):
         table = remainder_table(mesh, medium, layers, int(n_images), scale * g.max())[0]
     closed, okada, half = okada3d.halfspace_geometry(mesh.frames, mesh.half_a, mesh.half_b)
+    surface = closed & (layers == 1) & surface_form(medium, int(n_images))
+    vertical = (closed & (np.abs(okada[:, 1, 2]) >= vertical3d.VERTICAL) & (interfaces.shape[0] > 0)
+                & (medium.method != "quadrature") & (int(n_images) >= 1) & (not is_half_space(medium)))
     if not is_half_space(medium) or medium.method == "quadrature":
         closed[:] = False
     return with_self_max(images3d.LayeredRectangles(
@@ -63,13 +73,53 @@ def influence_data(mesh, medium, singular_shift, alpha, near_fraction, n_images)
         singular_shift=float(singular_shift), near_fraction=float(near_fraction), alpha=float(alpha),
         self_max=np.zeros(mesh.n_elements), entry_tol=float(ENTRY_TOL), entry_scale=float(scale), table=table,
         closed_form=closed, okada=okada, okada_half=half,
-        surface=float(interfaces[0]) if interfaces.shape[0] else 0.0))
+        surface=float(interfaces[0]) if interfaces.shape[0] else 0.0, surface_form=surface, vertical_form=vertical))
 
 
 def is_half_space(medium):
     """True when ``medium`` is a half-space: one solid layer under a void one (a free
     surface at ``interfaces[0]``), the case :mod:`.okada3d` gives in closed form."""
     return medium.n_layers == 2 and medium.shear_modulus[0] == 0.0 and medium.shear_modulus[1] > 0.0
+
+
+def surface_form(medium, n_images):
+    """True when the sources of the top solid layer of ``medium`` take their reflection in
+    the free surface in closed form (:mod:`.okada3d`) and the rest of their images by the
+    image method: two or more solid layers under a void one (a half-space, one solid layer,
+    takes every image in closed form: :func:`is_half_space`), ``method`` other than
+    ``"quadrature"``, at least one image, and the reflection alone at its point
+    (:func:`surface_reflection_alone`)."""
+    return (medium.n_layers >= 3 and medium.shear_modulus[0] == 0.0 and medium.method != "quadrature"
+            and n_images >= 1 and surface_reflection_alone(medium, n_images))
+
+
+def surface_reflection_alone(medium, n_images):
+    """True when the triple of the top solid layer whose point is the source's mirror in
+    the free surface (``2 d_0 - t``, ``eps = -1``) is, at three source heights, the
+    half-space's image triple coefficient for coefficient, so that no other path of the
+    tracer merged into it (:func:`.image_tracer3d.merge_coincident`; a merged path would
+    need reflections at depths whose alternating sum is the surface's, a coincidence of
+    the layer thicknesses) and :mod:`.okada3d` gives exactly that triple's field."""
+    interfaces, g, nu = medium.arrays()
+    top, bottom = interfaces[0], interfaces[1]
+    heights = top + (bottom - top) * np.array([0.2, 0.5, 0.8])
+    layered = trace_points(heights, 1, interfaces, g, nu, n_images)
+    half = trace_points(heights, 1, interfaces[:1], g[:2], nu[:2], 1)
+    orders = half[5].shape[-1]
+    for p, t in enumerate(heights):
+        n_pairs, layer, z, eps = layered[0][p], layered[1][p], layered[2][p], layered[3][p]
+        found = [k for k in range(n_pairs) if layer[k] == 1 and eps[k] < 0.0
+                 and abs(z[k] - (2.0 * top - t)) <= 1e-12 * (1.0 + abs(z[k]))]
+        if len(found) != 1 or half[0][p] != 1:
+            return False
+        coef, dcoef = layered[5][p, found[0]], layered[6][p, found[0]]
+        scale = np.abs(half[5][p, 0]).max()
+        if coef.shape[-1] < orders or np.abs(coef[:, :, orders:]).max(initial=0.0) > 1e-13 * scale:
+            return False
+        if (np.abs(coef[:, :, :orders] - half[5][p, 0]).max() > 1e-13 * scale
+                or np.abs(dcoef[:, :, :orders] - half[6][p, 0]).max() > 1e-13 * np.abs(half[6][p, 0]).max()):
+            return False
+    return True
 
 
 #: Tables built in this process, by medium, images, tolerance and domain (the latest few).

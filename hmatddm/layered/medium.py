@@ -60,8 +60,12 @@ class LayeredMedium:
         triple (the cross-check). 2D is the same either way. A 3D half-space (a void layer
         over one solid layer) takes, with ``"table"``, the image and surface terms of every
         rectangle with a horizontal side in closed form (Okada 1992,
-        :mod:`hmatddm.layered.okada3d`), whatever ``images``; ``"quadrature"`` integrates
-        them (the cross-check).
+        :mod:`hmatddm.layered.okada3d`), whatever ``images``; with two or more solid layers
+        under a void, the top layer's rectangles with a horizontal side take their
+        reflection in the free surface in closed form (the other image triples as above),
+        and vertical rectangles take their near image triples in closed form next to them
+        (:mod:`hmatddm.layered.vertical3d`); ``"quadrature"`` integrates them (the
+        cross-check).
     table_tol : float in (0, 1e-4]
         Error of the remainder table allowed relative to the largest influence entry.
     """

@@ -16,7 +16,7 @@ from ..kernels.rectangle3d import distance_to_rectangle as _distance, rectangle_
 from ..kernels.rectangle3d import traction_pair as _traction_pair
 from .image_points3d import _complementary_gradient
 from .image_tracer import trace_capacity
-from .image_tracer3d import _trace_range, _traced_buffer
+from .image_tracer3d import _trace_range, _traced_buffer, drop_surface_range
 from .images2d import _lame
 from .potentials3d import Workspace, _contract
 from .remainder_table3d import keep_near_range
@@ -48,18 +48,20 @@ def square_rule(n_gauss, n_sub):
 
 
 @njit(cache=True)
-def nearest_singularity(y, receiver_layer, center, frame, a, b, source_layer, interfaces):
+def nearest_singularity(y, receiver_layer, center, frame, a, b, source_layer, interfaces, skip=-1):
     """Distance from the receiver ``y`` to the nearest singular point of the image
     integrand: the rectangle's mirror images in the interfaces bounding the source's and
     the receiver's layers (the distance of the mirrored receiver to the rectangle), and
-    the rectangle itself when the receiver is in another layer."""
+    the rectangle itself when the receiver is in another layer. ``skip``: an interface
+    whose mirror is left out (-1: none), the free surface whose reflection is integrated
+    in closed form (:func:`.image_tracer3d.drop_surface_range`)."""
     dmin = np.inf
     if receiver_layer != source_layer:
         dmin = rectangle_distance(y, center, frame, a, b)
     n_if = interfaces.shape[0]
     for layer in (source_layer, receiver_layer):
         for k in (layer - 1, layer):
-            if 0 <= k < n_if:
+            if 0 <= k < n_if and k != skip:
                 dmin = min(dmin, _distance(y[0], y[1], 2.0 * interfaces[k] - y[2], center, frame, a, b))
     return dmin
 
@@ -180,6 +182,17 @@ def image_rectangle_stress(y, receiver_layer, center, frame, a, b, source_layer,
     rectangle, by ``n_gauss^2`` points on each of ``n_sub^2`` sub-squares; ``near_only``:
     of the near triples only (:func:`.remainder_table3d.keep_near`, layers bounded by
     ``bottoms``, ``tops``), the remainder being tabulated."""
+    image_rectangle_stress_without(y, receiver_layer, center, frame, a, b, source_layer, interfaces, shear_modulus,
+                                   poisson_ratio, n_images, n_gauss, n_sub, out, near_only, bottoms, tops, False, 0.0)
+
+
+@njit(cache=True, inline="always")
+def image_rectangle_stress_without(y, receiver_layer, center, frame, a, b, source_layer, interfaces, shear_modulus,
+                                   poisson_ratio, n_images, n_gauss, n_sub, out, near_only, bottoms, tops,
+                                   drop_surface, surface):
+    """:func:`image_rectangle_stress`, without the source's reflection in the free surface
+    ``z = surface`` when ``drop_surface`` (:func:`.image_tracer3d.drop_surface_range`: it
+    is added in closed form, :mod:`.okada3d`)."""
     xi, eta, wt = square_rule(n_gauss, n_sub)
     cap, n_orders = trace_capacity(source_layer, shear_modulus, n_images)
     traced = _traced_buffer(xi.shape[0], cap, n_orders)
@@ -188,6 +201,8 @@ def image_rectangle_stress(y, receiver_layer, center, frame, a, b, source_layer,
                  xi.shape[0], traced)
     if near_only:
         keep_near_range(traced, first, xi.shape[0], center, frame, a, b, xi, eta, source_layer, bottoms, tops)
+    if drop_surface:
+        drop_surface_range(traced, first, xi.shape[0], center, frame, a, b, xi, eta, source_layer, surface)
     out[:] = 0.0
     _integrate(y, receiver_layer, center, frame, a, b, source_layer, shear_modulus, poisson_ratio, xi, eta, wt,
                traced, first, out, np.empty((3, 3, 3, 3)), Workspace(n_orders), Workspace(1),
@@ -196,12 +211,14 @@ def image_rectangle_stress(y, receiver_layer, center, frame, a, b, source_layer,
 
 @njit(cache=True)
 def _image_order(y, receiver_layer, center, frame, a, b, source_layer, interfaces, gauss_points, max_sub, far_tol,
-                 entry_tol):
+                 entry_tol, skip):
     """``(n_gauss, n_sub)`` of the image quadrature of a rectangle at ``y``: sub-squares
     by :func:`subdivisions` rounded up to a power of two, and, on one square,
     :func:`far_order` points per side, or fewer by :func:`entry_order` when
-    ``entry_tol > 0`` (the error allowed relative to the largest entry, over ``G_max``)."""
-    dmin = nearest_singularity(y, receiver_layer, center, frame, a, b, source_layer, interfaces)
+    ``entry_tol > 0`` (the error allowed relative to the largest entry, over ``G_max``);
+    ``skip``: an interface whose mirror is no singular point of the triples integrated
+    (:func:`nearest_singularity`; -1: none)."""
+    dmin = nearest_singularity(y, receiver_layer, center, frame, a, b, source_layer, interfaces, skip)
     n_sub = 2 ** subdivision_level(_sub_count(dmin, a, b, max_sub))
     if n_sub == 1:
         n = far_order(dmin / max(a, b), gauss_points, far_tol)
