@@ -34,13 +34,10 @@ corners are finite; ``|cos(dip)| < COS_ZERO`` takes the vertical forms of part B
 
 Where the closed form does not apply: a rectangle with no horizontal edge (neither
 ``e1`` nor ``e2`` horizontal) has no strike in Okada's sense; such elements keep the
-image quadrature (:mod:`.images3d`). The closed form is the half-space's (one solid layer
-under a void). With two or more solid layers under a void it gives one triple of the image
-method exactly, the top layer's reflection in the free surface (``real=False``; the other
-triples keep the image method: :mod:`.images3d`, ``surface_form``); a reflection in an
-interface between two solids is not a reweighting of these terms
-(``_derive_closed_form3d.py``); for vertical rectangles it is in closed form by other
-primitives (:mod:`.vertical3d`).
+image quadrature (:mod:`.images3d`). Beyond the half-space it gives the top layer's
+reflection in the free surface exactly (``real=False``; :mod:`.images3d` ``surface_form``);
+a reflection in an interface between solids is no reweighting of these terms
+(``_derive_closed_form3d.py``; vertical rectangles: :mod:`.vertical3d`).
 """
 import math
 
