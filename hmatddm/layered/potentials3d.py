@@ -197,6 +197,19 @@ def _base_table(sigma, n_c, sf, sl, q, base):
                 base[1, a, b, c] = sign * q[a, b, c - 1]
 
 
+@njit(cache=True, inline="always")
+def potential_base(f, j):
+    """``(kind, ia, ib)``: the base function of force ``f``'s potential ``phi_j`` -- ``L``
+    (``kind`` 1) for ``f = 2``, else ``F`` (``kind`` 0) differentiated once along ``x1``
+    (``ia``) or ``x2`` (``ib``) -- as the indices into a base table ``base[kind, a + ia, b +
+    ib, ...]`` (ref. Eqs 3.14-3.17)."""
+    if f == 2:
+        return 1, 0, 0
+    if (f == 0) == (j < 2):
+        return 0, 1, 0
+    return 0, 0, 1
+
+
 @njit(cache=True)
 def _potential_table(coef, base, order, table):
     """``table[f, j, a, b, c] = d1^a d2^b d3^c phi_j`` of force ``f`` for the triple
@@ -208,12 +221,7 @@ def _potential_table(coef, base, order, table):
         for j in range(3):
             if f == 2 and j == 2:
                 continue
-            if f == 2:
-                kind, ia, ib = 1, 0, 0
-            elif (f == 0) == (j < 2):
-                kind, ia, ib = 0, 1, 0
-            else:
-                kind, ia, ib = 0, 0, 1
+            kind, ia, ib = potential_base(f, j)
             n0 = 0
             while n0 < n_orders and coef[f, j, n0] == 0.0:
                 n0 += 1

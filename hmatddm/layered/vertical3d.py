@@ -26,7 +26,8 @@ import math
 import numpy as np
 from numba import njit
 
-from .potentials3d import _axis_series, _base_table, _contract, _stress, base_derivatives, inverse_distance_derivatives
+from .potentials3d import (_axis_series, _base_table, _contract, _stress, base_derivatives, inverse_distance_derivatives,
+                           potential_base)
 
 #: Largest vertical derivative order held in the edge tables (D orders up to 5 and the
 #: Laplace turns of the terms without d1: 4 + 5 + 4 + 1).
@@ -160,12 +161,7 @@ def _integrated_table(polys, s0, s1, weighted, order, eps, t_bot, t_top, sj_bot,
                 continue
             if weighted and j != 1:
                 continue
-            if f == 2:
-                kind, ia, ib = 1, 0, 0
-            elif (f == 0) == (j < 2):
-                kind, ia, ib = 0, 1, 0
-            else:
-                kind, ia, ib = 0, 0, 1
+            kind, ia, ib = potential_base(f, j)
             first = order + 1 if weighted else order
             last = order + 1 if j == 1 else order
             for n in range(polys.shape[2]):
