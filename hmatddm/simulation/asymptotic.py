@@ -339,7 +339,9 @@ class AsymptoticFront:
             prescribed = (state == TIP) | (state == EMPTY)
             if far_ribbon:  # a filled element keeps the asymptote's opening (module docstring)
                 prescribed |= state == FILLED
-            settings = self.inner_settings(sim.settings, change, prop.front_tolerance) if grid.k == 2 else sim.settings
+            last_try = iterations == prop.front_iterations  # the step may end on this solve: full accuracy
+            settings = (self.inner_settings(sim.settings, change, prop.front_tolerance)
+                        if grid.k == 2 and not last_try else sim.settings)
             loose = settings is not sim.settings
             try:
                 solved, info, flow = self._solve(sim, trial, start, prescribed, width, t_old, t_new, relaxation,
