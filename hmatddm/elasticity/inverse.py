@@ -61,6 +61,19 @@ def modified_near_field_inverse(operator, rows):
                           matvec=lambda x: np.einsum("eij,ej->ei", blocks, np.reshape(x, (n, d))).ravel())
 
 
+def near_field_blocks(hmatrix):
+    """``(indptr, indices, block_row, blocks)`` (int64 arrays, blocks (nnz, d, d)) of the
+    near-field element blocks the default preconditioner keeps
+    (:meth:`~hmatddm.hmatrix.HMatrix.near_field_bsr`), the input of
+    :func:`modified_near_field_block_ilu`."""
+    from ..hmatrix.preconditioners import DEFAULT_ILU
+
+    near = hmatrix.near_field_bsr(part="near", threshold=DEFAULT_ILU["threshold"])
+    indptr = near.indptr.astype(np.int64)
+    block_row = np.repeat(np.arange(indptr.size - 1), np.diff(indptr))
+    return indptr, near.indices.astype(np.int64), block_row, near.data
+
+
 def modified_near_field_block_ilu(operator, rows):
     """Block ILU(0) (:mod:`hmatddm.hmatrix.block_ilu`, compiled, no fill-in) of ``S A_near + D``
     on the element blocks the default preconditioner keeps, as a LinearOperator; the scalar
@@ -71,13 +84,14 @@ def modified_near_field_block_ilu(operator, rows):
     its outer ring prescribed, 0.01 s against SuperLU's 0.20 s (drop 1e-3, fill 5), for 21
     GMRES iterations against 19 (benchmarks/RESULTS.md, issue 33)."""
     from ..hmatrix.block_ilu import block_ilu0, block_ilu_solve
-    from ..hmatrix.preconditioners import DEFAULT_ILU
 
-    near = operator.hmatrix.near_field_bsr(part="near", threshold=DEFAULT_ILU["threshold"])
-    indptr = near.indptr.astype(np.int64)
-    indices = near.indices.astype(np.int64)
-    block_row = np.repeat(np.arange(rows.n), np.diff(indptr))
-    data = np.einsum("bij,bjk->bik", rows.select[block_row], near.data)
+    near_field = getattr(operator, "near_field_blocks", None)
+    if near_field is not None:  # kept by the operator: the rows change, the near field does not
+        indptr, indices, block_row, near_data = near_field()
+    else:
+        indptr, indices, block_row, near_data = near_field_blocks(operator.hmatrix)
+    select = rows.select[block_row]
+    data = select * near_data if rows.d == 1 else np.einsum("bij,bjk->bik", select, near_data)
     diagonal = indices == block_row
     data[diagonal] += rows.direct[block_row[diagonal]]
     values, inverse_diagonal, diagonal_position, failed = block_ilu0(indptr, indices, np.ascontiguousarray(data))

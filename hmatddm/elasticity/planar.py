@@ -339,6 +339,17 @@ class OperatorPart:
         self.dof = 1 if name == "normal" else 2
         self.block_kernel = normal_traction_block if name == "normal" else shear_traction_block
         self.stats = {}
+        self._near_field = None
+
+    def near_field_blocks(self):
+        """The near-field blocks of :func:`~hmatddm.elasticity.inverse.near_field_blocks`,
+        gathered once per part (the asymptotic front modifies their rows at every front
+        iteration: 76 ms a gathering at 8.7k elements, 258 of them in a 0.25 m radial run)."""
+        from .inverse import near_field_blocks
+
+        if self._near_field is None:
+            self._near_field = near_field_blocks(self.hmatrix)
+        return self._near_field
 
     @property
     def hmatrix(self):
