@@ -5,7 +5,9 @@ The operator is rebuilt only when the mesh has grown, never inside the nonlinear
 iterations of a step. A planar 3D mesh in a homogeneous medium gets the ``hmatrix``
 backend's opening and shear operators apart, and their border blocks apart while it grows
 in its plane (:mod:`hmatddm.elasticity.planar`; the same matrix, ~7x faster products for a
-crack loaded in opening) unless :data:`SPLIT_PLANAR_MODES` is False.
+crack loaded in opening) unless :data:`SPLIT_PLANAR_MODES` is False; and a planar lattice
+mesh gets the FFT operator of :mod:`hmatddm.elasticity.lattice` unless
+:data:`LATTICE_PLANAR` is False.
 """
 import warnings
 from dataclasses import asdict
@@ -16,10 +18,17 @@ from ..errors import MeshQualityWarning
 from ..elasticity.extended import ExtendedElasticityOperator, compresses_borders
 from ..material import Elastic
 from ..elasticity.operator import ElasticityOperator
+from ..elasticity.lattice import LatticePlanarOperator, lattice_of
 from ..elasticity.planar import PlanarElasticityOperator, PlanarExtendedOperator, is_planar
 
 #: Build a planar mesh's operator as its opening and shear parts (see the module docstring).
 SPLIT_PLANAR_MODES = True
+
+#: A planar mesh of equal rectangles on one lattice (the asymptotic front's) in a
+#: homogeneous medium gets the FFT operator (:mod:`hmatddm.elasticity.lattice`): exact
+#: products, no H-matrix, no border blocks, a new kernel table only when the crack
+#: outgrows its box.
+LATTICE_PLANAR = True
 
 
 class GrowingOperator:
@@ -41,6 +50,10 @@ class GrowingOperator:
         compressed base plus exact borders if the mesh only grew a little, else a new build."""
         if self._mesh is mesh:
             return self._operator
+        if self._on_lattice(mesh):
+            operator = self._lattice_operator(mesh)
+            self._operator, self._mesh = operator, mesh
+            return operator
         base = self.base
         n = mesh.n_elements
         extends = (base is not None and n >= base.mesh.n_elements
@@ -61,6 +74,22 @@ class GrowingOperator:
         self._operator, self._mesh = operator, mesh
         return operator
 
+    def _on_lattice(self, mesh):
+        """Whether ``mesh`` gets the FFT operator of a lattice (module docstring)."""
+        return (LATTICE_PLANAR and self.operator_settings.backend == "hmatrix" and isinstance(self.material, Elastic)
+                and lattice_of(mesh) is not None)
+
+    def _lattice_operator(self, mesh):
+        """The lattice operator of ``mesh``, sharing the kernel tables of the last one; a
+        new table (the crack outgrew its box) counts as a build."""
+        settings = asdict(self.operator_settings)
+        previous = self._operator if isinstance(self._operator, LatticePlanarOperator) else self.base
+        operator = LatticePlanarOperator(mesh, self.material, previous=previous,
+                                         singular_correction=settings["singular_correction"], alpha=settings["alpha"])
+        self.base = operator
+        self.builds += operator.tables_computed
+        return operator
+
     def _border_bytes_per_element(self, base):
         """Bytes of compressed border blocks per added element: measured on the last grown
         operator of ``base``, else expected from the base's own memory per element (twice:
@@ -74,6 +103,8 @@ class GrowingOperator:
 
     def build(self, mesh):
         """A full build of the operator of ``mesh``, which becomes the base."""
+        if self._on_lattice(mesh):
+            return self._lattice_operator(mesh)
         # the mesh-quality check runs at every build of a growing mesh: warn once per run
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", MeshQualityWarning)

@@ -184,8 +184,12 @@ def test_refuses_what_does_not_split():
 
 
 def test_a_growing_planar_run_is_the_same_with_the_parts_apart_or_together(monkeypatch):
-    """The simulation builds the split operator for a planar mesh; the run matches the one
-    with the 3 x 3 operator to the GMRES tolerance (the H-matrices differ within eps)."""
+    """Without the lattice operator, the simulation builds the split operator for a planar
+    mesh; the run matches the one with the 3 x 3 operator to the GMRES tolerance (the
+    H-matrices differ within eps), and both match the lattice's FFT operator (exact), which
+    the simulation takes by default for this mesh."""
+    from hmatddm.elasticity.lattice import LatticePlanarOperator
+
     runs = {"grown": []}
     grow = growing_operator.GrowingOperator.__call__
 
@@ -195,8 +199,9 @@ def test_a_growing_planar_run_is_the_same_with_the_parts_apart_or_together(monke
         return operator
 
     monkeypatch.setattr(growing_operator.GrowingOperator, "__call__", recorded)
-    for split in (True, False):
-        monkeypatch.setattr(growing_operator, "SPLIT_PLANAR_MODES", split)
+    for split in ("lattice", True, False):
+        monkeypatch.setattr(growing_operator, "LATTICE_PLANAR", split == "lattice")
+        monkeypatch.setattr(growing_operator, "SPLIT_PLANAR_MODES", bool(split))
         start = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 6.0, 6.0, 3, 3)
         simulation = hd.Simulation(start, hd.Elastic(24e9, 0.25), hd.Fluid(1e-3, 4.4e-10),
                                    [hd.Cluster((0, 0, 0), 0.01, 0.005)], far_field_stress=np.diag([0, 0, -8e6]),
@@ -205,14 +210,18 @@ def test_a_growing_planar_run_is_the_same_with_the_parts_apart_or_together(monke
         records = simulation.run(6.0)
         runs[split] = records, simulation.operators.base
     (split_records, split_base), (whole_records, whole_base) = runs[True], runs[False]
+    lattice_records, lattice_base = runs["lattice"]
+    assert isinstance(lattice_base, LatticePlanarOperator) and lattice_base.shear_hmatrix is None
     assert isinstance(split_base, PlanarElasticityOperator) and split_base.shear_hmatrix is None
+    assert not isinstance(split_base, LatticePlanarOperator)
     assert any(isinstance(o, PlanarExtendedOperator) for o in runs["grown"])
     assert not isinstance(whole_base, PlanarElasticityOperator)
     assert split_records[-1]["n_elements"] > 9  # it grew
-    assert [r["n_elements"] for r in split_records] == [r["n_elements"] for r in whole_records]
-    for a, b in zip(split_records, whole_records):
-        np.testing.assert_allclose(a["wellbore_pressure"], b["wellbore_pressure"], rtol=1e-6)
-        np.testing.assert_allclose(a["max_opening"], b["max_opening"], rtol=1e-5)
+    for records in (whole_records, lattice_records):
+        assert [r["n_elements"] for r in split_records] == [r["n_elements"] for r in records]
+        for a, b in zip(split_records, records):
+            np.testing.assert_allclose(a["wellbore_pressure"], b["wellbore_pressure"], rtol=1e-6)
+            np.testing.assert_allclose(a["max_opening"], b["max_opening"], rtol=1e-5)
 
 
 def _planar_run(**kwargs):
@@ -223,10 +232,12 @@ def _planar_run(**kwargs):
                          backend="hmatrix", eps=1e-6, **kwargs)
 
 
-@pytest.mark.parametrize("split", [True, False])
+@pytest.mark.parametrize("split", ["lattice", True, False])
 def test_a_resumed_planar_run_repeats_the_uninterrupted_one(tmp_path, monkeypatch, split):
-    """The resumed run rebuilds the interrupted run's split base (GrowingOperator.restore)."""
-    monkeypatch.setattr(growing_operator, "SPLIT_PLANAR_MODES", split)
+    """The resumed run rebuilds the interrupted run's split base (GrowingOperator.restore);
+    the lattice operator's kernel table depends on the mesh's box alone."""
+    monkeypatch.setattr(growing_operator, "LATTICE_PLANAR", split == "lattice")
+    monkeypatch.setattr(growing_operator, "SPLIT_PLANAR_MODES", bool(split))
     whole = _planar_run().run(6.0)
     _planar_run(checkpoint_dir=tmp_path).run(3.0)
     resumed = _planar_run(checkpoint_dir=tmp_path).run(6.0, resume=True)
