@@ -73,11 +73,18 @@ class _CoupledLinearSystem:
     def rhs(self, flow_rhs):
         return self.left_scale(self.problem.elastic_rhs(self.rows), flow_rhs)
 
-    def compliance_preconditioner(self, omega):
-        """Inverse of the scaled fracture-compliance split, as a LinearOperator."""
+    def compliance_preconditioner(self, omega, previous=None):
+        """Inverse of the scaled fracture-compliance split, as a LinearOperator, and the
+        :class:`FlowFactor` it uses: ``previous``'s when it may serve again
+        (:meth:`FlowFactor.reusable`), else a new factorisation of this iterate's flow block."""
         problem = self.problem
-        schur = (self.flow_matrix + sp.diags(omega * problem.compliance_term)).tocsc()
-        flow_lu = spla.splu(schur, **SYMMETRIC_LU)
+        if previous is not None and previous.reusable(omega, problem.n):
+            factor = previous
+            factor.uses += 1
+        else:
+            schur = (self.flow_matrix + sp.diags(omega * problem.compliance_term)).tocsc()
+            factor = FlowFactor(spla.splu(schur, **SYMMETRIC_LU), omega, problem.n)
+        flow_lu = factor.lu
         nd = problem.n * problem.d
 
         def apply(z):
@@ -88,4 +95,34 @@ class _CoupledLinearSystem:
                                                      self.rows)
             return np.concatenate([dd / self.s_u, p / self.s_p])
 
-        return spla.LinearOperator((nd + problem.n,) * 2, matvec=apply, dtype=np.float64)
+        return spla.LinearOperator((nd + problem.n,) * 2, matvec=apply, dtype=np.float64), factor
+
+
+class FlowFactor:
+    """The LU of one iterate's flow block ``D + omega C'`` (the split preconditioner's
+    expensive part), kept for the next iterates of the same step problem (same mesh): a
+    preconditioner may lag the widths (the Krylov solve still meets its tolerance), and on
+    a 55k-cell disc a factorisation costs 0.23 s against 5.6 ms for a solve. It serves
+    again while the GMRES iterations of the iterates that reused it stay within
+    :data:`REUSE_ITERATIONS` times (plus 2) those of the iterate that made it, at most
+    :data:`REUSE_LIMIT` times."""
+
+    REUSE_ITERATIONS = 1.5
+    REUSE_LIMIT = 4
+
+    def __init__(self, lu, omega, n):
+        self.lu, self.omega, self.n = lu, omega, n
+        self.uses = 0
+        self.fresh_iterations = None  # GMRES iterations of the iterate that made it
+        self.last_iterations = None   # ... of the last iterate that used it
+
+    def record(self, iterations):
+        """The GMRES iterations of an iterate that used this factor."""
+        if self.fresh_iterations is None:
+            self.fresh_iterations = iterations
+        self.last_iterations = iterations
+
+    def reusable(self, omega, n):
+        if omega != self.omega or n != self.n or self.uses >= self.REUSE_LIMIT or self.fresh_iterations is None:
+            return False
+        return self.last_iterations <= self.REUSE_ITERATIONS * self.fresh_iterations + 2

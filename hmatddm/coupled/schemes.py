@@ -115,9 +115,10 @@ def _coupled_iteration(problem, settings, dd, p, alpha, counters, first=False, p
         raise _Diverged("non-finite flow matrix")
     try:
         system = _CoupledLinearSystem(problem, matrix, dd, p)
-        preconditioner = None
+        preconditioner = factor = None
         if settings.scheme == "krylov":
-            preconditioner = system.compliance_preconditioner(settings.omega)
+            preconditioner, factor = system.compliance_preconditioner(settings.omega, problem.flow_factor)
+            problem.flow_factor = factor
     except (RuntimeError, np.linalg.LinAlgError) as error:  # singular flow or diagonal blocks
         raise _Diverged(f"singular coupled system: {error}") from None
     guess = np.concatenate([dd / system.s_u, p / system.s_p])
@@ -127,7 +128,10 @@ def _coupled_iteration(problem, settings, dd, p, alpha, counters, first=False, p
                            restart=settings.linear_restart, maxiter=settings.linear_maxiter, x0=guess,
                            pause_rtol=levels or None)
     paused = PausedIterate(solver, system.split, dd, p, alpha, counters)
+    linear = counters["linear"]
     iterate = _continued(paused.advance)
+    if factor is not None:
+        factor.record(counters["linear"] - linear)
     if pause is not None and not paused.done:
         pause.append(paused)
     return iterate

@@ -106,6 +106,7 @@ class StepProblem:
             self.coupling = (keep @ self.coupling).tocsr()
             self.compliance_term = np.where(self.fixed, 0.0, self.compliance_term)
         self._last_product = (None, None)  # (dd, A dd) of the last elastic product
+        self.flow_factor = None  # the last iterate's FlowFactor (hmatddm.coupled.scaled_system)
 
     def elastic_matvec(self, dd):
         """``A dd``; the last product is kept: an iteration's first residual (and the

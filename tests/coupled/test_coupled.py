@@ -6,7 +6,7 @@ import pytest
 import hmatddm as hd
 from hmatddm.mesh import topology
 from hmatddm.coupled import ElasticSolver, SchemeSettings, StepProblem, solve_step
-from hmatddm.coupled.scaled_system import _CoupledLinearSystem
+from hmatddm.coupled.scaled_system import FlowFactor, _CoupledLinearSystem
 from hmatddm.flow import LeakOff, LubricationModel, fracture_compliance
 
 
@@ -106,11 +106,14 @@ def test_scaling_makes_the_coupled_matrix_well_conditioned():
 
 
 @pytest.mark.parametrize("scheme", ["krylov", "fully-coupled"])
-def test_contraction_stopping_matches_the_change_rule_within_the_tolerance(scheme):
+def test_contraction_stopping_matches_the_change_rule_within_the_tolerance(scheme, monkeypatch):
     # the default rule (stop on the extrapolated next change, first GMRES solve at
     # first_linear_rtol) against the plain one (change between iterates, every GMRES solve
     # at linear_rtol), both at the default tolerance 1e-6, and against a tight solve. A thin
     # fluid (K-vertex-like) contracts fast: the contraction rule saves an iteration there.
+    # Each iterate factors its own flow block, so that the GMRES counts compare the rules
+    # alone (a reused factor is tested below).
+    monkeypatch.setattr(FlowFactor, "REUSE_LIMIT", 0)
     mesh = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 8.0, 8.0, 8, 8)
     tight = SchemeSettings(scheme="krylov", tolerance_pressure=1e-10, tolerance_opening=1e-10, linear_rtol=1e-12,
                            stopping="change")
@@ -256,3 +259,31 @@ def test_a_provisional_solve_converges_at_once_without_a_loose_first_iteration()
         assert not PendingSolve(problem, SchemeSettings(scheme=scheme), dd0, p0, 1.0).loose_first
     with pytest.raises(hd.errors.InputError, match="growth_check"):
         SchemeSettings(growth_check="never")
+
+
+@pytest.mark.parametrize("limit", [0, FlowFactor.REUSE_LIMIT])
+def test_a_reused_flow_factor_gives_the_fresh_factors_solution(monkeypatch, limit):
+    """The split preconditioner's flow LU kept across the iterates of a step problem: the
+    same solution as a new LU at every iterate, to the solver's tolerance, and fewer
+    factorisations."""
+    from hmatddm.coupled import scaled_system
+
+    mesh = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 8.0, 8.0, 8, 8)
+    factorisations = []
+    splu = scaled_system.spla.splu
+    monkeypatch.setattr(scaled_system.spla, "splu", lambda *a, **k: factorisations.append(1) or splu(*a, **k))
+    tight = SchemeSettings(scheme="krylov", tolerance_pressure=1e-10, tolerance_opening=1e-10, linear_rtol=1e-12,
+                           stopping="change")
+    problem, dd0, p0 = _problem(mesh, rate=1e-2, viscosity=1e-3)
+    dd_ref, p_ref, _ = solve_step(problem, tight, dd0, p0, 1.0)
+    monkeypatch.setattr(FlowFactor, "REUSE_LIMIT", limit)
+    factorisations.clear()
+    problem, dd0, p0 = _problem(mesh, rate=1e-2, viscosity=1e-3)
+    dd, p, info = solve_step(problem, SchemeSettings(scheme="krylov"), dd0, p0, 1.0)
+    tolerance = 1e-6 / info["relaxation"]
+    np.testing.assert_allclose(p, p_ref, atol=tolerance * np.abs(p_ref).max())
+    np.testing.assert_allclose(dd, dd_ref, atol=tolerance * np.abs(dd_ref).max())
+    if limit == 0:
+        assert len(factorisations) == info["nonlinear_iterations"]
+    else:
+        assert info["nonlinear_iterations"] > 2 and len(factorisations) < info["nonlinear_iterations"]
