@@ -176,6 +176,29 @@ def nearest_circle(points, centers, distances):
 
 
 @njit(cache=True)
+def first_nearest(points, centers, candidates):
+    """For each point, the first of the centres nearest it among its ``candidates`` (M, c)
+    (the distance as :func:`nearest_circle` computes it, ties to the lowest index)."""
+    m, k = points.shape
+    nearest = np.empty(m, np.int64)
+    for i in range(m):
+        best = np.inf
+        where = -1
+        for c in range(candidates.shape[1]):
+            r = candidates[i, c]
+            square = 0.0
+            for axis in range(k):
+                d = points[i, axis] - centers[r, axis]
+                square += d * d
+            value = math.sqrt(square)
+            if value < best or (value == best and r < where):
+                best = value
+                where = r
+        nearest[i] = where
+    return nearest
+
+
+@njit(cache=True)
 def interpolate(phi, low, h, points, out):
     """``out[i]``: ``phi`` (cell centres of a 2D box whose first cell is ``low``, spacing
     ``h``; a 1D box as ``(n, 1)`` with its points' second coordinate 0) bilinear at

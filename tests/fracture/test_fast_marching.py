@@ -137,3 +137,20 @@ def test_compiled_interpolation_is_the_numpy_one_to_the_bit(k):
     reference = _numpy_interpolation(field, points)
     assert np.isinf(compiled).any() and np.isfinite(compiled).any()
     np.testing.assert_array_equal(compiled, reference)
+
+
+def test_the_nearest_ribbon_by_k_d_tree_is_the_brute_force_one_on_a_lattice():
+    """FrontField.velocity's k-d tree candidates and exact choice give the brute-force
+    search's ribbon for every sample point of the fill, cell corners (4-way ties) included."""
+    from hmatddm.fracture import front
+
+    cells = np.array([(i, j) for i in range(-30, 31) for j in range(-30, 31) if 24 ** 2 <= i * i + j * j < 27 ** 2])
+    h = 0.25
+    field = front.FrontField(cells, np.full(len(cells), 0.1), np.arange(len(cells), dtype=float), cells, h, 4)
+    inner, corners = front.sample_offsets(2, 8)
+    offsets = np.concatenate([inner, corners])
+    points = ((cells[::3, None, :] + offsets[None]) * h).reshape(-1, 2)
+    points = np.concatenate([points, np.random.default_rng(0).uniform(-8.0, 8.0, (4000, 2))])
+    assert len(points) * len(cells) > front.BRUTE_FORCE_PAIRS  # the k-d tree path
+    _, brute = level_set(points, cells * h, np.zeros(len(cells)))
+    np.testing.assert_array_equal(field.velocity(points), field.velocities[brute])
