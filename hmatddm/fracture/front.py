@@ -206,12 +206,14 @@ def sample_offsets(k, n_sub):
     return np.column_stack([x.ravel(), y.ravel()]), corners
 
 
-def fill(cells, field, asymptote, n_sub=8, length=np.inf):
+def fill(cells, field, asymptote, n_sub=8, length=np.inf, full_widths=True):
     """Filled fraction, mean opening and "fully inside" of cells (M, k) of the grid.
 
     The mean opening is the asymptote ``w(-phi, V)`` (with the finite-fracture factor of
     ``length``, :func:`~hmatddm.analytical.tip_asymptote.finite_fracture_factor`) averaged over
-    the cell's sample points, zero outside the front.
+    the cell's sample points, zero outside the front. ``full_widths=False``: not evaluated
+    for the cells fully inside (0 there), whose opening a caller that does not prescribe it
+    never reads (the 3D asymptotic front: a third of the fill's inversions of the asymptote).
     """
     cells = np.asarray(cells, np.int64).reshape(-1, field.k)
     k, h = field.k, field.h
@@ -221,13 +223,14 @@ def fill(cells, field, asymptote, n_sub=8, length=np.inf):
     points = (centre[:, None, :] + h * inner[None]).reshape(-1, k)
     phi = field(points)
     inside = phi < 0.0
-    width = np.zeros(len(points))
-    if np.any(inside):
-        width[inside] = asymptote.width(-phi[inside], field.velocity(points[inside]), length=length)
     fraction = inside.reshape(m, n_s).mean(axis=1)
-    mean_width = width.reshape(m, n_s).mean(axis=1)
     corner_phi = field((centre[:, None, :] + h * corners[None]).reshape(-1, k))
     full = (fraction == 1.0) & np.all(corner_phi.reshape(m, len(corners)) < 0.0, axis=1)
+    wanted = inside if full_widths else inside & ~np.repeat(full, n_s)
+    width = np.zeros(len(points))
+    if np.any(wanted):
+        width[wanted] = asymptote.width(-phi[wanted], field.velocity(points[wanted]), length=length)
+    mean_width = width.reshape(m, n_s).mean(axis=1)
     return fraction, mean_width, full
 
 

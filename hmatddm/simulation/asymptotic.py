@@ -306,7 +306,8 @@ class AsymptoticFront:
             filled_before = filled.copy()
             field = self.field(cells[ribbon], distance, velocity, cells[channel])
             candidates = self._candidates(cells, channel, field)
-            fraction, mean_width, full = fill(candidates, field, self.asymptote, SUB_SAMPLES[self.grid.k], length)
+            fraction, mean_width, full = fill(candidates, field, self.asymptote, SUB_SAMPLES[self.grid.k], length,
+                                              full_widths=far_ribbon)  # a full cell's opening is prescribed there only
             index = {key: i for i, key in enumerate(grid.key(cells).tolist())}
             where = np.array([index.get(key, -1) for key in grid.key(candidates).tolist()], np.int64)
             new = (where < 0) & (fraction > 0.0)
