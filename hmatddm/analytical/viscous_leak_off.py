@@ -333,7 +333,21 @@ def radial_m_leak_off_vertex(t, injection_rate, viscosity, carter, material):
     return radial_leak_off_radius(t, q, c), 1.0574 * (mu_prime**4 * q**6 * t / (e_prime**4 * c * c)) ** (1.0 / 16.0)
 
 
-__all__ = ["kgd_m_leak_off_scale", "kgd_m_leak_off_vertex", "kgd_m_leak_off_similarity", "KGD_M_LEAK_OFF_PRESSURE", "kgd_m_leak_off_profile", "radial_leak_off_transition",
+def radial_m_leak_off_profile(rho, t, injection_rate, viscosity, carter, material):
+    """Opening of the radial M~ vertex at ``rho = r / R`` in [0, 1] at one time ``t``: ``w(0)
+    (1 - rho)^(5/8) (1 + rho)^0.397`` (Dontsov 2016: the m~ tip asymptote times ``((1 +
+    rho)/2)^lambda``, ``lambda`` = 0.397 at M~). Returns ``(R, w)``."""
+    rho = finite_array("rho", rho)
+    if np.any((rho < 0.0) | (rho > 1.0)):
+        raise InputError("rho must be in [0, 1] (r / R)")
+    if np.size(t) != 1:
+        raise InputError("t must be a scalar > 0 for radial_m_leak_off_profile")
+    radius, w0 = (float(np.ravel(v)[0]) for v in radial_m_leak_off_vertex(np.ravel(t), injection_rate, viscosity,
+                                                                          carter, material))
+    return radius, w0 * (1.0 - rho) ** 0.625 * (1.0 + rho) ** 0.397
+
+
+__all__ = ["kgd_m_leak_off_scale", "radial_m_leak_off_profile", "kgd_m_leak_off_vertex", "kgd_m_leak_off_similarity", "KGD_M_LEAK_OFF_PRESSURE", "kgd_m_leak_off_profile", "radial_leak_off_transition",
            "kgd_leak_off_transition",
            "radial_leak_off_profile",
            "radial_m_leak_off_vertex", "KGD_M_LEAK_OFF_OPENING"]
