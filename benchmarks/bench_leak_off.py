@@ -32,6 +32,13 @@ as ``Pi = p / (E'^3 mu' C'^2 / (Q t))^(1/4)``, the M~ scaling, against the verte
 similarity solution, :func:`~hmatddm.analytical.viscous_leak_off.kgd_m_leak_off_similarity`;
 Dontsov's solution gives no pressure).
 
+Then the radial rows (``RADIAL_VISCOUS_CASES``; ``--radial N`` runs row N alone, ``--h`` and
+``--end-time`` set its element size and end): a fracture from M towards M~ (mu 1e-3 Pa s, C_m
+2.4-6.9) and one deep in M~ (mu 2.5e-5 Pa s, c_l 2e-10, Q 2e-2 m^3/s: C_m 3.5 at the first
+step to 25 at 8 s), each against Dontsov's (2016) solution with leak-off and the radial M~
+vertex (``radial-m-leak-off``), with the reference block's warning where the vertex does not
+apply over the run.
+
 Also the leak-off coefficient from the reservoir (ref. Eq. 4.26,
 :func:`hmatddm.flow.carter_coefficient`) for the reference's Table 5.2 / 6.2 rock (shown,
 not run: with ``k_r = 0`` it is zero).
