@@ -216,9 +216,10 @@ SOLUTIONS.update({
 })
 SOLUTIONS["radial-m-leak-off"] = Solution(
     "radial-m-leak-off", "radial M~ vertex (zero toughness, all the fluid leaked off)",
-    "R = 0.4502 (Q^2 t / C'^2)^(1/4), w0 = 1.0574 (mu'^4 Q^6 t / (E'^4 C'^2))^(1/16), "
+    "R = 0.4502 (Q^2 t / C'^2)^(1/4), w0 = 1.0600 (mu'^4 Q^6 t / (E'^4 C'^2))^(1/16), "
     "w = w0 (1 - rho)^(5/8) (1 + rho)^0.397",
-    "Madyarova 2003; Detournay 2016; Dontsov 2016, R. Soc. open sci. 3:160737")
+    "Madyarova 2003; Detournay 2016; Dontsov 2016, R. Soc. open sci. 3:160737 (w0 1.0574, profile); the "
+    "similarity solution (hmatddm.analytical.viscous_leak_off.radial_m_leak_off_similarity)")
 # the vertex of the toughness number whose side each K-K~ edge lies on (zero viscosity: the K
 # side at any leak-off number)
 LEAK_OFF_VERTEX = {"kgd-k-leak-off": "kgd-k", "radial-k-leak-off": "radial-k"}
