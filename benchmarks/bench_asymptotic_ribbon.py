@@ -16,6 +16,15 @@ opening for ``s_r``, so a ribbon ``e`` too wide puts the front ``2 e s_r`` too f
 (toughness: ``w ~ s^(1/2)``) -- and, the opening of a square-root tip having no length scale,
 the same ``e`` at every ``h``: an apparent toughness ``1 + e`` that refinement alone does not
 remove.
+
+    python benchmarks/bench_asymptotic_ribbon.py --viscous
+
+does the same at a viscous tip (issue 39): the crack is the KGD M vertex (zero toughness,
+:func:`hmatddm.analytical.m_vertex_numeric.kgd_m_vertex_numeric`, in units ``E' = 1``,
+half-length ``gamma``, ``w = Omega(x / gamma)``), the free segments loaded with its net
+pressure ``Pi`` at their centres, the segments within ``c h`` of the front holding its opening
+averaged over them; ``c`` = 0.5 (a ribbon next to the front, ``s_r`` in ``[0.5, 1.5] h``) and
+1.5 (``[1.5, 2.5] h``), at L = 25, 50 and 100 h.
 """
 import os
 import sys
@@ -31,8 +40,11 @@ from _common import machine, print_table  # noqa: E402
 E_PRIME, PRESSURE = 1.0, 1.0
 
 
-def ribbon_error(half_length, h, c, n_sub=2000):
-    """(ribbon opening / exact - 1, s_r / h, opening at the centre / exact - 1)."""
+def ribbon_error(half_length, h, c, n_sub=2000, vertex=None):
+    """(ribbon opening / exact - 1, s_r / h, opening at the centre / exact - 1); ``vertex``: the
+    KGD M vertex (:func:`hmatddm.analytical.m_vertex_numeric.kgd_m_vertex_numeric`) of
+    half-length ``half_length`` instead of Griffith's crack (E' = 1, ``w = Omega(x/l)``, ``p =
+    Pi(x/l)`` in its scaling with ``L = l / gamma``)."""
     n = int(np.ceil(half_length / h + 0.5)) + 1
     centres = np.arange(-n, n + 1) * h
     distance = half_length - np.abs(centres)
@@ -41,9 +53,20 @@ def ribbon_error(half_length, h, c, n_sub=2000):
     stiffness = E_PRIME / (4.0 * np.pi) * (1.0 / (x - (centres - h / 2)[None]) - 1.0 / (x - (centres + h / 2)[None]))
 
     def exact(points):
+        if vertex is not None:
+            xi = np.abs(np.asarray(points, float)) / half_length
+            out = np.zeros(xi.shape)
+            inside = xi < 1.0
+            out[inside] = vertex.opening(xi[inside]) * half_length / vertex.gamma
+            return out
         return 4.0 * PRESSURE / E_PRIME * np.sqrt(np.maximum(half_length**2 - points**2, 0.0))
 
-    matrix, rhs = stiffness.copy(), np.full(len(centres), PRESSURE)
+    if vertex is None:
+        load = np.full(len(centres), PRESSURE)
+    else:
+        load = np.zeros(len(centres))
+        load[free] = vertex.pressure(np.minimum(np.abs(centres[free]) / half_length, 1.0 - 1e-12))
+    matrix, rhs = stiffness.copy(), load
     for i in np.flatnonzero(~free):
         matrix[i] = 0.0
         matrix[i, i] = 1.0
@@ -54,8 +77,27 @@ def ribbon_error(half_length, h, c, n_sub=2000):
             opening[n] / exact(0.0) - 1.0)
 
 
+def viscous():
+    """The ribbon's error at the KGD M vertex's tip (module docstring, ``--viscous``)."""
+    from hmatddm.analytical.m_vertex_numeric import kgd_m_vertex_numeric
+
+    vertex = kgd_m_vertex_numeric()
+    rows = []
+    cpu = time.process_time()
+    for c in (0.5, 1.5):
+        for offset in np.arange(10) / 10.0:
+            errors = [ribbon_error(length + (offset + 0.5 - c) % 1.0, 1.0, c, n_sub=400, vertex=vertex)
+                      for length in (25.0, 50.0, 100.0)]
+            rows.append([f"{c:g}", f"{errors[0][1]:.2f}", *(f"{100 * e[0]:+.2f}%" for e in errors)])
+    rows.sort(key=lambda row: (float(row[0]), float(row[1])))
+    print_table(["c (s_r >= c h)", "s_r / h", "ribbon error, L = 25 h", "L = 50 h", "L = 100 h"], rows)
+    print(f"CPU {time.process_time() - cpu:.1f} s")
+
+
 def main():
     print(f"Machine: {machine()}")
+    if "--viscous" in sys.argv[1:]:
+        return viscous()
     rows = []
     cpu = time.process_time()
     for c in (0.5, 1.0, 1.5, 2.0, 3.0):

@@ -32,6 +32,13 @@ as ``Pi = p / (E'^3 mu' C'^2 / (Q t))^(1/4)``, the M~ scaling, against the verte
 similarity solution, :func:`~hmatddm.analytical.viscous_leak_off.kgd_m_leak_off_similarity`;
 Dontsov's solution gives no pressure).
 
+Then the radial rows (``RADIAL_VISCOUS_CASES``; ``--radial N`` runs row N alone, ``--h`` and
+``--end-time`` set its element size and end): a fracture from M towards M~ (mu 1e-3 Pa s, C_m
+2.4-6.9) and one deep in M~ (mu 2.5e-5 Pa s, c_l 2e-10, Q 2e-2 m^3/s: C_m 3.5 at the first
+step to 25 at 8 s), each against Dontsov's (2016) solution with leak-off and the radial M~
+vertex (``radial-m-leak-off``), with the reference block's warning where the vertex does not
+apply over the run.
+
 Also the leak-off coefficient from the reservoir (ref. Eq. 4.26,
 :func:`hmatddm.flow.carter_coefficient`) for the reference's Table 5.2 / 6.2 rock (shown,
 not run: with ``k_r = 0`` it is zero).
@@ -231,13 +238,18 @@ def run_viscous(name, viscosity, h, n_initial, first_step, max_step, end_time):
             "cpu": cpu, "wall": wall, "elements": records[-1]["n_elements"] if records else 0, "failure": failure}
 
 
-def run_radial_viscous(end_time=8.0, h=0.2):
-    """A radial fracture from M towards M~ (Q 1e-2 m^3/s, mu 1e-3 Pa s, K_Ic 10 kPa m^1/2, c_l
-    1e-10 at s_v - p_r = 20 MPa: C' = 2e-3 m/s^1/2; 3 x 3 initial elements of ``h``; steps of 0.3
-    elements, the first 0.05 s) against Dontsov's (2016) solution with leak-off
-    (``radial-km-leak-off``) and the radial M~ vertex."""
+#: the radial rows: name, injection rate (m^3/s), viscosity (Pa s), c_l (m/(s^1/2 Pa)), first step (s)
+RADIAL_VISCOUS_CASES = (
+    ("radial M to M~", 1e-2, 1e-3, 1e-10, 0.05),
+    ("radial M~ (mu 2.5e-5, C' 4e-3)", 2e-2, 2.5e-5, 2e-10, 0.05),
+)
+
+
+def radial_viscous_scene(end_time=8.0, h=0.2, rate=1e-2, viscosity=1e-3, c_l=1e-10, first_step=0.05,
+                         kind="radial-km-leak-off"):
+    """A radial fracture with viscous leak-off (K_Ic 10 kPa m^1/2, s_v - p_r = 20 MPa: C' = c_l
+    20 MPa; 3 x 3 initial elements of ``h``; steps of 0.3 elements), the scene's data."""
     import hmatddm.scene as hs
-    from hmatddm.analytical.viscous_leak_off import radial_m_leak_off_vertex
 
     text = f"""
 dimension = 3
@@ -245,7 +257,7 @@ dimension = 3
 shear_modulus = 1e9
 poisson_ratio = 0.25
 [fluid]
-viscosity = 1e-3
+viscosity = {viscosity}
 compressibility = 0.0
 [stress]
 s_hmin = 40e6
@@ -253,7 +265,7 @@ s_hmax = 40e6
 s_v = 20e6
 [[cluster]]
 position = [0.0, 0.0, 0.0]
-rate = 1e-2
+rate = {rate}
 [[initial_fracture]]
 shape = "rectangle"
 center = [0.0, 0.0, 0.0]
@@ -266,11 +278,11 @@ element_size = {h}
 toughness = 1e4
 front = "asymptotic"
 [leak_off]
-coefficient = 1e-10
+coefficient = {c_l}
 pore_pressure = 0.0
 [numerics]
 time_step = "auto"
-first_time_step = 0.05
+first_time_step = {first_step}
 max_time_step = 0.5
 step_advance = 0.3
 end_time = {end_time}
@@ -278,25 +290,38 @@ backend = "dense"
 initial_pressure = 20e6
 initial_opening = 1e-6
 [reference]
-kind = "radial-km-leak-off"
+kind = "{kind}"
 """
-    data = hs.scene_from_dict(hs.parse_scene(text).data, "radial-viscous-leak-off").data
+    return hs.scene_from_dict(hs.parse_scene(text).data, "radial-viscous-leak-off").data
+
+
+def run_radial_viscous(name="radial M to M~", rate=1e-2, viscosity=1e-3, c_l=1e-10, first_step=0.05, end_time=8.0,
+                       h=0.2):
+    """A radial fracture towards (or at) M~ (:func:`radial_viscous_scene`) against Dontsov's (2016)
+    solution with leak-off (``radial-km-leak-off``) and the radial M~ vertex
+    (``radial-m-leak-off``), with the C_m of each row and the reference block's warning."""
+    import hmatddm.scene as hs
+
+    data = radial_viscous_scene(end_time, h, rate, viscosity, c_l, first_step)
+    vertex_data = radial_viscous_scene(end_time, h, rate, viscosity, c_l, first_step, kind="radial-m-leak-off")
     simulation = hs.build_simulation(data)
     wall, cpu = time.perf_counter(), time.process_time()
     records = simulation.run(end_time)
     wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
-    rows = hs.reference_values(data, records)
+    rows, vertex = hs.reference_values(data, records), hs.reference_values(vertex_data, records)
     t = np.array([r["time"] for r in records])
-    vertex_r, vertex_w = radial_m_leak_off_vertex(t, 1e-2, 1e-3, 2e-3, MATERIAL)
-    pick = np.unique(np.clip(np.searchsorted(t, [0.5, 1, 2, 4, 8]), 0, len(t) - 1))
+    pick = np.unique(np.clip(np.searchsorted(t, [0.5, 1, 2, 4, 8, 16]), 0, len(t) - 1))
     table = [[f"{t[i]:.3g}", f"{rows[i]['regime']['leak_off']['value']:.2f}",
               f"{100 * records[i]['fracture_volume'] / records[i]['injected_volume']:.1f}%",
               f"{records[i]['radius']:.3f}", f"{100 * rows[i]['relative_error']['radius']:+.1f}%",
-              f"{100 * (records[i]['radius'] / vertex_r[i] - 1):+.1f}%", f"{1e3 * records[i]['max_opening']:.4f}",
+              f"{100 * vertex[i]['relative_error']['radius']:+.1f}%", f"{1e3 * records[i]['max_opening']:.4f}",
               f"{100 * rows[i]['relative_error']['max_opening']:+.1f}%",
-              f"{100 * (records[i]['max_opening'] / vertex_w[i] - 1):+.1f}%"] for i in pick]
-    print(f"\nradial M to M~ (Q 1e-2, mu 1e-3, C' 2e-3), {h} m: {records[-1]['n_elements']} elements at the end; "
-          f"CPU {cpu:.1f} s, wall {wall:.1f} s; front circularity {records[-1]['front_circularity']:.3f}")
+              f"{100 * vertex[i]['relative_error']['max_opening']:+.1f}%"] for i in pick]
+    print(f"\n{name} (Q {rate:g}, mu {viscosity:g}, C' {c_l * S_HMIN:g}), {h} m: {records[-1]['n_elements']} elements "
+          f"at the end; CPU {cpu:.1f} s, wall {wall:.1f} s; front circularity {records[-1]['front_circularity']:.3f}; "
+          f"largest budget residual {max(abs(r['budget']['residual']) / r['injected_volume'] for r in records):.1e} "
+          f"of the injected volume")
+    print(f"radial-m-leak-off warning: {hs.reference_warning(vertex_data)}")
     print_table(["t (s)", "C_m", "stored", "R DDM (m)", "R vs Dontsov", "R vs M~", "w0 DDM (mm)", "w0 vs Dontsov",
                  "w0 vs M~"], table)
 
@@ -350,12 +375,17 @@ def main(argv=None):
     parser.add_argument("--quick", action="store_true", help="10 s runs")
     parser.add_argument("--plot", default=os.path.join(HERE, "leak_off_kgd.png"))
     parser.add_argument("--viscous", action="store_true", help="only the viscous leak-off (M~) rows")
+    parser.add_argument("--radial", type=int, help="with --viscous: only this radial row (0, 1), no KGD rows")
+    parser.add_argument("--h", type=float, default=0.2, help="element size of the radial viscous rows (m)")
+    parser.add_argument("--end-time", type=float, help="end of the radial viscous rows (s; default 8)")
     args = parser.parse_args(argv)
     print(f"Machine: {machine()}")
     if args.viscous:
-        print_viscous([run_viscous(*case, end_time=4.0 if args.quick else VISCOUS["end_time"])
-                       for case in VISCOUS_CASES])
-        run_radial_viscous(end_time=2.0 if args.quick else 8.0)
+        if args.radial is None:
+            print_viscous([run_viscous(*case, end_time=4.0 if args.quick else VISCOUS["end_time"])
+                           for case in VISCOUS_CASES])
+        for case in RADIAL_VISCOUS_CASES if args.radial is None else [RADIAL_VISCOUS_CASES[args.radial]]:
+            run_radial_viscous(*case, end_time=args.end_time or (2.0 if args.quick else 8.0), h=args.h)
         return
     # ref. Eq. 4.26 for a shale and a tight sand (reservoir fluid: oil 1 cP; c_t 1e-9 1/Pa)
     md = 9.869233e-16

@@ -31,12 +31,13 @@ _LEAK_OFF = ("kgd_leak_off_half_length", "radial_leak_off_radius", "kgd_toughnes
              "radial_toughness_leak_off_edge")
 _REGIMES = (
     "radial_toughness_number", "kgd_toughness_number", "radial_leak_off_number", "kgd_leak_off_number",
-    "applicable_solution",
+    "applicable_solution", "m_leak_off_toughness_number",
 )
 _TABLES = ("RadialTransitionTable", "radial_transition_table")
 _M_VERTEX = ("kgd_m_vertex_numeric", "radial_m_vertex_numeric")
 _VISCOUS_LEAK_OFF = ("kgd_m_leak_off_vertex", "kgd_m_leak_off_profile", "kgd_leak_off_transition",
-                     "radial_leak_off_transition", "radial_leak_off_profile", "radial_m_leak_off_vertex")
+                     "radial_leak_off_transition", "radial_leak_off_profile", "radial_m_leak_off_vertex",
+                     "radial_m_leak_off_profile")
 _EXPORTS = {**{name: ".solutions" for name in _SOLUTIONS}, **{name: ".leak_off" for name in _LEAK_OFF},
             **{name: ".regimes" for name in _REGIMES}, **{name: ".transition_table" for name in _TABLES},
             **{name: ".m_vertex_numeric" for name in _M_VERTEX},

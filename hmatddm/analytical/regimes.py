@@ -33,10 +33,12 @@ solution, so a scene's ``[reference]`` with them refuses leak-off (:mod:`hmatddm
 the leak-off numbers say how far a scene with leak-off is from them. A scene with leak-off
 is judged by a K-K~ edge (``kgd-k-leak-off``, ``radial-k-leak-off``; :mod:`.leak_off`,
 zero viscosity at any leak-off number): it applies where the toughness number says K (the
-viscosity is negligible; :data:`LEAK_OFF_VERTEX`); by the plane-strain M~ vertex
-(``kgd-m-leak-off``, where the toughness number says M; it assumes all the fluid leaked:
-``C_m`` large, the stored share about ``C_m^(-3/2)``); or by Dontsov's solutions at any
-``K_m`` and ``C_m`` (``kgd-km-leak-off``, ``radial-km-leak-off``; :mod:`.viscous_leak_off`).
+viscosity is negligible; :data:`LEAK_OFF_VERTEX`); by the M~ vertices
+(``kgd-m-leak-off``, ``radial-m-leak-off``; they assume all the fluid leaked: they apply
+where ``C_m`` is at least :data:`M_LEAK_OFF_LIMITS` and the toughness number of the M~
+scaling at most :data:`M_LEAK_OFF_TOUGHNESS`, :func:`applicable_solution`); or by Dontsov's
+solutions at any ``K_m`` and ``C_m`` (``kgd-km-leak-off``, ``radial-km-leak-off``;
+:mod:`.viscous_leak_off`).
 Its reference block records ``C_m`` beside ``K_m``, with ``C' = c_l (sigma_0 - p_r)``
 (:func:`carter_prime`).
 """
@@ -212,9 +214,24 @@ SOLUTIONS.update({
         "Q t = stored + 4 pi alpha B(2 alpha, 3/2) C' t^(1/2) R^2",
         "Dontsov 2016, R. Soc. open sci. 3:160737; hmatddm.analytical.radial_leak_off_transition"),
 })
-# the vertex of the toughness number whose side each leak-off closed form lies on (a K-K~
-# edge, zero viscosity: the K side at any leak-off number; the M~ vertex: the M side)
-LEAK_OFF_VERTEX = {"kgd-k-leak-off": "kgd-k", "radial-k-leak-off": "radial-k", "kgd-m-leak-off": "kgd-m"}
+SOLUTIONS["radial-m-leak-off"] = Solution(
+    "radial-m-leak-off", "radial M~ vertex (zero toughness, all the fluid leaked off)",
+    "R = 0.4502 (Q^2 t / C'^2)^(1/4), w0 = 1.0600 (mu'^4 Q^6 t / (E'^4 C'^2))^(1/16), "
+    "w = w0 (1 - rho)^(5/8) (1 + rho)^0.397",
+    "Madyarova 2003; Detournay 2016; Dontsov 2016, R. Soc. open sci. 3:160737 (w0 1.0574, profile); the "
+    "similarity solution (hmatddm.analytical.viscous_leak_off.radial_m_leak_off_similarity)")
+# the vertex of the toughness number whose side each K-K~ edge lies on (zero viscosity: the K
+# side at any leak-off number)
+LEAK_OFF_VERTEX = {"kgd-k-leak-off": "kgd-k", "radial-k-leak-off": "radial-k"}
+# Where the M~ vertices apply (issue 36): the leak-off number C_m at or above which Dontsov's
+# solution at any C_m (kgd-km-leak-off, radial-km-leak-off) is within 1% of the vertex's size
+# (the convention of the K_m limits; the size error is about the stored share of the fluid,
+# KGD C_m^(-3/2), half that for radial: 2% at C_m 7.2 (KGD) and 6.1 (radial)), and the
+# toughness number of the M~ scaling at or below which the vertex holds (K_m~ = K_m for KGD,
+# K_m C_m^(-1/8) = K' (t / (mu'^4 Q^2 E'^12 C'^2))^(1/16) for radial; at K_m~ = 1 Dontsov's
+# opening is +2.8% (KGD) and +1% (radial) from the vertex's, its size unchanged).
+M_LEAK_OFF_LIMITS = {"kgd": 10.4, "radial": 11.4}
+M_LEAK_OFF_TOUGHNESS = 1.0
 
 # what applies where a vertex does not: the transition solutions
 _TRANSITION = {
@@ -222,21 +239,55 @@ _TRANSITION = {
     "kgd": "the plane-strain K-M transition (Dontsov 2017, or Garagash 2006's large-toughness expansion; "
            "not in this package)",
 }
+_LEAK_OFF_TRANSITION = {
+    "radial": "radial-km-leak-off (Dontsov 2016 with leak-off, in this package)",
+    "kgd": "kgd-km-leak-off (Dontsov 2017 with leak-off, in this package)",
+}
 
 
-def applicable_solution(kind, toughness_numbers):
+def m_leak_off_toughness_number(toughness_numbers, leak_off_numbers, geometry):
+    """The toughness number of the M~ scaling from the M scaling's ``K_m`` and ``C_m``:
+    ``K_m`` itself for plane strain (both scale as ``K' / (E'^3 mu' Q)^(1/4)``), ``K_m
+    C_m^(-1/8)`` for radial (``= K' (t / (mu'^4 Q^2 E'^12 C'^2))^(1/16)``, Madyarova 2003)."""
+    _limits(geometry)
+    k_m = np.asarray(toughness_numbers, float)
+    if geometry == "kgd":
+        return k_m
+    return k_m * np.asarray(leak_off_numbers, float) ** -0.125
+
+
+def _m_leak_off_applies(kind, toughness_numbers, leak_off_numbers):
+    """``(applies, instead)`` of an M~ vertex: every ``C_m`` at or above
+    :data:`M_LEAK_OFF_LIMITS` and every toughness number of the M~ scaling at or below
+    :data:`M_LEAK_OFF_TOUGHNESS`."""
+    geometry = "radial" if kind.startswith("radial") else "kgd"
+    if leak_off_numbers is None:
+        raise InputError(f"leak_off_numbers (C_m at the run's times) are needed to judge {kind!r}")
+    c_m = np.ravel(np.asarray(leak_off_numbers, float))
+    k_mt = np.ravel(m_leak_off_toughness_number(toughness_numbers, c_m, geometry))
+    if c_m.min() >= M_LEAK_OFF_LIMITS[geometry] and k_mt.max() <= M_LEAK_OFF_TOUGHNESS:
+        return True, None
+    return False, _LEAK_OFF_TRANSITION[geometry]
+
+
+def applicable_solution(kind, toughness_numbers, leak_off_numbers=None):
     """Whether the closed form ``kind`` applies at every toughness number of
-    ``toughness_numbers`` (the run's times), and, where it does not, the solution that does.
+    ``toughness_numbers`` (the run's times) and, for an M~ vertex, every leak-off number
+    ``leak_off_numbers`` (``C_m`` at the same times), and, where it does not, the solution that
+    does.
 
     Returns ``(applies, name_of_the_solution_that_applies)`` (the name is None when it
     applies). A vertex applies when every number is on its side of the limits
-    (:data:`RADIAL_LIMITS`, :data:`KGD_LIMITS`); the radial transition applies at any ``K_m``.
+    (:data:`RADIAL_LIMITS`, :data:`KGD_LIMITS`; the M~ vertices :data:`M_LEAK_OFF_LIMITS` and
+    :data:`M_LEAK_OFF_TOUGHNESS`); the transition solutions apply at any ``K_m`` and ``C_m``.
     """
     if kind not in SOLUTIONS:
         raise InputError(f"reference kind must be one of {sorted(SOLUTIONS)}, got {kind!r}")
     geometry = "radial" if kind.startswith("radial") else "kgd"
     if kind in ("radial-km", "radial-km-leak-off", "kgd-km-leak-off"):
         return True, None
+    if kind in ("kgd-m-leak-off", "radial-m-leak-off"):
+        return _m_leak_off_applies(kind, toughness_numbers, leak_off_numbers)
     kind = LEAK_OFF_VERTEX.get(kind, kind)  # a K-K~ edge: where the K-vertex's toughness number says K
     vertices = {vertex(float(k), geometry) for k in np.ravel(toughness_numbers)}
     wanted = kind.rsplit("-", 1)[1].upper()

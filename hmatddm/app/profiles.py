@@ -84,7 +84,7 @@ def closed_form_profile(scene, time_value):
                              np.full(SAMPLES, float(curves["net_pressure"][0])), size)
         profile["label"] = f"{kind.split('-')[0]} K-K~ edge (leak-off)"
         return profile
-    if kind in ("kgd-m-leak-off", "kgd-km-leak-off", "radial-km-leak-off"):  # viscous with leak-off: no net pressure
+    if kind in ("kgd-m-leak-off", "kgd-km-leak-off", "radial-km-leak-off", "radial-m-leak-off"):  # no net pressure
         from ..analytical import viscous_leak_off
         from ..scene.build import _closed_form, confining_stress, leak_off
 
@@ -95,6 +95,10 @@ def closed_form_profile(scene, time_value):
                                                                   c_prime, rock)
             profile = _symmetric(rho, width, None, size)
             profile["label"] = "kgd M~ vertex (Dontsov 2017)"
+        elif kind == "radial-m-leak-off":
+            size, width = viscous_leak_off.radial_m_leak_off_profile(rho, t, rate, viscosity, c_prime, rock)
+            profile = _symmetric(rho, width, None, size)
+            profile["label"] = "radial M~ vertex (Dontsov 2016)"
         elif kind == "kgd-km-leak-off":
             size, width = viscous_leak_off.kgd_leak_off_transition(t, rate / scene["height"], viscosity, toughness,
                                                                    c_prime, rock, profile=rho)

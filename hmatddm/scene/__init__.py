@@ -146,7 +146,9 @@ The format, annotated (``=`` values are the defaults unless marked REQUIRED)::
                                    # needs one cluster, [propagation] and no leak-off;
                                    # with leak-off: "kgd-k-leak-off", "radial-k-leak-off"
                                    # (the K-K~ edge, Carter leak-off; records C_m too),
-                                   # "kgd-m-leak-off" (M~ vertex), "kgd-km-leak-off",
+                                   # "kgd-m-leak-off", "radial-m-leak-off" (the M~
+                                   # vertices; warned off below C_m 10.4 / 11.4),
+                                   # "kgd-km-leak-off",
                                    # "radial-km-leak-off" (Dontsov 2017 / 2016 at any
                                    # K_m, C_m; no net pressure);
                                    # or "three-layer-height" (2D, three [[layer]]s: the

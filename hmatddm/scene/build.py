@@ -291,12 +291,16 @@ def _leak_off_closed_form(scene, times, kind, curves):
     c_l = leak_off(scene).coefficient
     excess = confining_stress(scene) - scene["leak_off"]["pore_pressure"]
     c_prime = regimes.carter_prime(c_l, excess)
-    if kind in ("kgd-m-leak-off", "kgd-km-leak-off", "radial-km-leak-off"):  # viscous: Dontsov's solutions have
-        from ..analytical import viscous_leak_off  # no net pressure (hmatddm.analytical.viscous_leak_off)
+    if kind in ("kgd-m-leak-off", "kgd-km-leak-off", "radial-km-leak-off", "radial-m-leak-off"):  # viscous:
+        from ..analytical import viscous_leak_off  # Dontsov's solutions have no net pressure
 
-        if kind == "radial-km-leak-off":
-            curves["radius"], curves["max_opening"], _ = viscous_leak_off.radial_leak_off_transition(
-                times, rate, viscosity, toughness, c_prime, mat)
+        if kind.startswith("radial"):
+            if kind == "radial-m-leak-off":
+                curves["radius"], curves["max_opening"] = viscous_leak_off.radial_m_leak_off_vertex(
+                    times, rate, viscosity, c_prime, mat)
+            else:
+                curves["radius"], curves["max_opening"], _ = viscous_leak_off.radial_leak_off_transition(
+                    times, rate, viscosity, toughness, c_prime, mat)
             curves["dimensionless_toughness"] = analytical.radial_regime(times, rate, viscosity, toughness, mat)
             curves["leak_off_number"] = regimes.radial_leak_off_number(times, rate, viscosity, c_prime, mat)
         else:
@@ -335,11 +339,12 @@ def reference_regime(scene, times):
     from ..analytical import regimes
 
     kind = scene["reference"]["kind"]
-    values = _closed_form(scene, times)["dimensionless_toughness"]
+    curves = _closed_form(scene, times)
+    values, leak_off_numbers = curves["dimensionless_toughness"], curves.get("leak_off_number")
     geometry = "radial" if kind.startswith("radial") else "kgd"
-    applies, instead = regimes.applicable_solution(kind, values)
+    applies, instead = regimes.applicable_solution(kind, values, leak_off_numbers)
     return {"number": "K_m", "values": values, "vertex": [regimes.vertex(float(k), geometry) for k in values],
-            "applies": applies, "instead": instead}
+            "applies": applies, "instead": instead, "leak_off_numbers": leak_off_numbers}
 
 
 def run_times(scene):
@@ -359,15 +364,23 @@ def reference_warning(scene):
     regime = reference_regime(scene, times)
     if regime["applies"]:
         return None
-    from ..analytical.regimes import KGD_LIMITS, RADIAL_LIMITS, SOLUTIONS
+    from ..analytical.regimes import KGD_LIMITS, M_LEAK_OFF_LIMITS, M_LEAK_OFF_TOUGHNESS, RADIAL_LIMITS, SOLUTIONS
 
     kind = scene["reference"]["kind"]
-    low, high = RADIAL_LIMITS if kind.startswith("radial") else KGD_LIMITS
-    k_first, k_last = regime["values"]
-    over = (f"K_m = {k_first:.2f}" if abs(k_last - k_first) < 5e-3 else f"K_m = {k_first:.2f} to {k_last:.2f}")
-    return (f"reference.kind = {kind!r} ({SOLUTIONS[kind].name}) does not apply over this run: {over} between "
-            f"t = {times[0]:g} and {times[1]:g} s (M-vertex at K_m <= {low:g}, K-vertex at K_m >= {high:g}); "
-            f"the solution that applies is {regime['instead']}")
+    geometry = "radial" if kind.startswith("radial") else "kgd"
+    low, high = RADIAL_LIMITS if geometry == "radial" else KGD_LIMITS
+
+    def over(name, first, last):
+        return f"{name} = {first:.2f}" if abs(last - first) < 5e-3 else f"{name} = {first:.2f} to {last:.2f}"
+
+    numbers = over("K_m", *regime["values"])
+    limits = f"M-vertex at K_m <= {low:g}, K-vertex at K_m >= {high:g}"
+    if kind.endswith("-m-leak-off"):  # an M~ vertex: the leak-off number and the M~ toughness number
+        numbers += ", " + over("C_m", *regime["leak_off_numbers"])
+        limits = (f"the M~ vertex at C_m >= {M_LEAK_OFF_LIMITS[geometry]:g} and "
+                  f"{'K_m' if geometry == 'kgd' else 'K_m C_m^(-1/8)'} <= {M_LEAK_OFF_TOUGHNESS:g}")
+    return (f"reference.kind = {kind!r} ({SOLUTIONS[kind].name}) does not apply over this run: {numbers} between "
+            f"t = {times[0]:g} and {times[1]:g} s ({limits}); the solution that applies is {regime['instead']}")
 
 
 def reference_curves(scene, end_time=None, samples=200):

@@ -13,7 +13,7 @@ REFERENCE_KINDS = ("radial-k", "radial-m", "radial-km", "kgd-k", "kgd-m", "three
 # closed forms with Carter leak-off: the K-K~ edges (zero viscosity, any leak-off;
 # hmatddm.analytical.leak_off), for a scene whose leak_off.coefficient is > 0
 LEAK_OFF_REFERENCE_KINDS = ("kgd-k-leak-off", "radial-k-leak-off", "kgd-m-leak-off", "kgd-km-leak-off",
-                            "radial-km-leak-off")
+                            "radial-km-leak-off", "radial-m-leak-off")
 REFERENCE_KINDS += LEAK_OFF_REFERENCE_KINDS
 SHAPES = {2: ("line",), 3: ("rectangle", "penny")}
 CROSSING_CRITERIA = ("mohr-coulomb", "energy-release-rate", "stress-intensity")

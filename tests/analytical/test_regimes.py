@@ -92,6 +92,53 @@ def test_which_solution_applies():
         regimes.vertex(1.0, "penny")
 
 
+def test_an_m_tilde_vertex_applies_deep_in_leak_off_and_at_low_toughness_only():
+    # the M~ toughness number: radial K' (t / (mu'^4 Q^2 E'^12 C'^2))^(1/16), the ratio of the
+    # toughness opening K' L^(1/2) / E' to the M~ width scale at the M~ length L = (Q^2 t / C'^2)^(1/4)
+    t, q, mu, k, c_prime = np.array([2.0, 40.0]), 0.01, 1e-3, 3e5, 2e-3
+    e_prime, k_prime, mu_prime = _primes(ROCK, k, mu)
+    length = (q * q * t / c_prime**2) ** 0.25
+    width = (mu_prime**4 * q**6 * t / (e_prime**4 * c_prime**2)) ** (1.0 / 16.0)
+    k_m = regimes.radial_toughness_number(t, q, mu, k, ROCK)
+    c_m = regimes.radial_leak_off_number(t, q, mu, c_prime, ROCK)
+    np.testing.assert_allclose(regimes.m_leak_off_toughness_number(k_m, c_m, "radial"),
+                               k_prime * np.sqrt(length) / (e_prime * width), rtol=1e-12)
+    assert regimes.m_leak_off_toughness_number([0.3], [50.0], "kgd") == pytest.approx([0.3])
+    assert regimes.applicable_solution("kgd-m-leak-off", [0.01], [11.0, 14.0]) == (True, None)
+    for k_ms, c_ms in (([0.01], [5.0, 8.0]), ([1.5], [20.0, 30.0])):  # too little leak-off; too tough
+        applies, instead = regimes.applicable_solution("kgd-m-leak-off", k_ms, c_ms)
+        assert not applies and instead.startswith("kgd-km-leak-off") and "Dontsov 2017" in instead
+    # radial: K_m 1.2 is M~ deep in leak-off (K_m C_m^(-1/8) = 0.54 at C_m 600), not at C_m 12 with K_m 2
+    assert regimes.applicable_solution("radial-m-leak-off", [1.2, 1.2], [600.0, 700.0]) == (True, None)
+    applies, instead = regimes.applicable_solution("radial-m-leak-off", [2.0, 2.0], [12.0, 13.0])
+    assert not applies and instead.startswith("radial-km-leak-off") and "Dontsov 2016" in instead
+    with pytest.raises(InputError, match="leak_off_numbers"):
+        regimes.applicable_solution("radial-m-leak-off", [0.1])
+
+
+def test_the_m_tilde_limits_are_where_dontsovs_solution_is_one_percent_from_the_vertex():
+    # measured with the package's Dontsov 2016 / 2017 at nearly zero toughness: the size is 1%
+    # from the vertex's at the limit, more below it, less above it
+    from hmatddm.analytical import viscous_leak_off as vl
+
+    mu, c_prime = 1e-3, 2e-3
+    for geometry, q in (("kgd", 1e-3), ("radial", 1e-2)):
+        limit = regimes.M_LEAK_OFF_LIMITS[geometry]
+        number = regimes.kgd_leak_off_number if geometry == "kgd" else regimes.radial_leak_off_number
+        # C_m grows as t^(1/6) (KGD), t^(7/18) (radial): the times of C_m = limit x (0.8, 1, 1.25)
+        unit = float(number(np.array([1.0]), q, mu, c_prime, ROCK)[0])
+        power = 6.0 if geometry == "kgd" else 18.0 / 7.0
+        t = (limit * np.array([0.8, 1.0, 1.25]) / unit) ** power
+        if geometry == "kgd":
+            size = vl.kgd_leak_off_transition(t, q, mu, 1e2, c_prime, ROCK)[0]
+            vertex = vl.kgd_m_leak_off_vertex(t, q, mu, c_prime, ROCK)[0]
+        else:
+            size = vl.radial_leak_off_transition(t, q, mu, 1e2, c_prime, ROCK)[0]
+            vertex = vl.radial_m_leak_off_vertex(t, q, mu, c_prime, ROCK)[0]
+        error = np.abs(size / vertex - 1.0)
+        assert error[0] > 0.0115 and abs(error[1] - 0.01) < 3e-4 and error[2] < 0.0085, (geometry, error)
+
+
 # every embedded scene with a [reference]: the regime the scene claims, by the formula above
 SCENE_REGIMES = {"radial-k": ("K", 4.0), "radial-m": ("M", None), "radial-km": ("transition", None),
                  "default": ("transition", None), "kgd": ("K", 4.0)}

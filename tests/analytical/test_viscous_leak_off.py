@@ -119,7 +119,7 @@ def test_deep_in_the_m_tilde_vertex_dontsovs_solutions_give_his_vertex_constants
     r_v, w_v = radial_m_leak_off_vertex(t, 1e-3, 0.01, 1e-2, ROCK)
     assert np.all(efficiency < 1e-3)
     np.testing.assert_allclose(radius, r_v, rtol=1e-3)
-    np.testing.assert_allclose(width, w_v, rtol=1e-3)  # 1.0574 (Dontsov 2016)
+    np.testing.assert_allclose(width, w_v * 1.0574 / 1.0600, rtol=1e-3)  # Dontsov 2016's 1.0574 (the vertex: 1.0600)
     length, width, efficiency = kgd_leak_off_transition(t, 1e-3, 0.01, 1e2, 1e-2, ROCK)
     l_v, w_v = kgd_m_leak_off_vertex(t, 1e-3, 0.01, 1e-2, ROCK)
     assert np.all(efficiency < 1e-3)
@@ -145,3 +145,17 @@ def test_the_m_tilde_similarity_solution_gives_dontsovs_opening_and_the_pressure
     _, _, p0 = kgd_m_leak_off_vertex(t, q, mu, c, ROCK, pressure=True)
     e_prime = ROCK.plane_strain_modulus
     assert p0[0] == pytest.approx(pressure * (e_prime**3 * 12 * mu * c * c / (q * t[0])) ** 0.25, rel=1e-4)
+
+
+def test_the_radial_m_tilde_similarity_solution_gives_the_vertex_opening():
+    # the radial M~ vertex's w(0) / (mu'^4 Q^6 t / (E'^4 C'^2))^(1/16) from its similarity solution
+    # (all the fluid leaked: the flux Q (1 - (2/pi) arcsin rho^2) / (2 pi R rho), Poiseuille,
+    # Sneddon's penny, K = 0): 1.05991 with 6 terms, 1.05996 with 10; Dontsov's (2016)
+    # approximate solution gives 1.0574, 0.24% lower
+    from hmatddm.analytical.viscous_leak_off import RADIAL_M_LEAK_OFF_OPENING, radial_m_leak_off_similarity
+
+    opening = radial_m_leak_off_similarity(terms=6, logs=1)
+    assert opening == pytest.approx(RADIAL_M_LEAK_OFF_OPENING, abs=2e-4)
+    assert 0.001 < opening / 1.0574 - 1.0 < 0.004
+    with pytest.raises(InputError, match="terms"):
+        radial_m_leak_off_similarity(terms=1)

@@ -108,7 +108,7 @@ BAD_SCENES = [
     ("reference.kind", "kgd-k", "reference.kind = 'kgd-k' is a 2D closed form; the scene has dimension = 3"),
     ("reference.kind", "radial", "reference.kind must be one of 'radial-k', 'radial-m', 'radial-km', 'kgd-k', 'kgd-m', "
                                  "'three-layer-height', 'kgd-k-leak-off', 'radial-k-leak-off', 'kgd-m-leak-off', "
-                                 "'kgd-km-leak-off', 'radial-km-leak-off', got 'radial'"),
+                                 "'kgd-km-leak-off', 'radial-km-leak-off', 'radial-m-leak-off', got 'radial'"),
     ("leak_off.coefficient", 1e-12, "reference.kind = 'radial-k' assumes no leak-off"),
     ("dimension", 4, "dimension must be one of [2, 3], got 4"),
     ("height", 2.0, "height is the flow height of a 2D (plane-strain) scene"),

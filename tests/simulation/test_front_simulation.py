@@ -139,3 +139,22 @@ def test_kgd_k_vertex_errors_fall_when_the_mesh_is_refined():
     coarse, fine = kgd_k_errors(1.0), kgd_k_errors(0.5)
     assert np.all(fine < coarse), (coarse, fine)
     assert np.all(coarse < [0.01, 0.02, 0.03])
+
+
+def test_kgd_m_vertex_has_no_offset_from_the_ribbon():
+    # issue 39: the ribbon read next to a viscous front (s_r in [0.5, 1.5] h) is +7% too wide on
+    # average whatever h (an independent solve: +26% at 0.5 h, +2.6% at h), and the KGD M-vertex
+    # run converged to a fracture ~0.4% too long and ~0.25% too thin. With the ribbon 1.5 h behind
+    # the front once the half-length is 20 elements: K_m 0.003, incompressible, no wellbore
+    # storage (the vertex has none), 0.25 m, 0.5 s steps, 40 s (l = 34 h): measured l -0.14%, w0
+    # +0.07%, p(0) +0.06% (the near ribbon: +0.59%, -0.46%, -0.73%); 3 s CPU
+    material = hd.Elastic(10e9, 0.25)
+    sim = hd.Simulation(hd.mesh.line([-1.625, 0.0], [1.625, 0.0], 13), material, hd.Fluid(0.1, 0.0),
+                        [hd.Cluster((0.0, 0.0), 5e-4, 0.0)], far_field_stress=np.diag([-1e6, -0.5e6]), time_step=0.5,
+                        propagation=hd.Propagation(toughness=1e4, front="asymptotic"), initial_pressure=1e6,
+                        initial_opening=1e-6, backend="dense")
+    record = sim.run(40.0)[-1]
+    half_length, width, pressure = hd.analytical.kgd_m_vertex(40.0, 5e-4, 0.1, material)
+    assert abs(record["half_length"] / half_length - 1.0) < 0.003
+    assert abs(record["max_opening"] / width - 1.0) < 0.002
+    assert abs((record["wellbore_pressure"][0] - 0.5e6) / pressure - 1.0) < 0.003
