@@ -159,14 +159,20 @@ def kgd_m_leak_off_similarity(terms=8, points=31):
 def kgd_m_leak_off_profile(xi, t, injection_rate, viscosity, carter, material):
     """Opening of the plane-strain M~ vertex at ``xi = |x| / l`` in [0, 1] at one time ``t``:
     ``w(0) (1 + xi)^0.520 (1 - xi)^(5/8)`` (Dontsov 2017). Returns ``(l, w)``."""
-    xi = finite_array("xi", xi)
-    if np.any((xi < 0.0) | (xi > 1.0)):
-        raise InputError("xi must be in [0, 1] (|x| / l)")
+    return _m_leak_off_profile("xi", "|x| / l", xi, t, kgd_m_leak_off_vertex, KGD_M_LEAK_OFF_LAMBDA,
+                               (injection_rate, viscosity, carter, material), "kgd_m_leak_off_profile")
+
+
+def _m_leak_off_profile(name, meaning, coordinate, t, vertex, exponent, arguments, caller):
+    """``(size, w(0) (1 + x)^exponent (1 - x)^(5/8))`` of an M~ ``vertex`` at one time ``t``,
+    ``coordinate`` (named ``name``, ``meaning``) checked in [0, 1]."""
+    x = finite_array(name, coordinate)
+    if np.any((x < 0.0) | (x > 1.0)):
+        raise InputError(f"{name} must be in [0, 1] ({meaning})")
     if np.size(t) != 1:
-        raise InputError("t must be a scalar > 0 for kgd_m_leak_off_profile")
-    length, w0 = (float(np.ravel(v)[0]) for v in kgd_m_leak_off_vertex(np.ravel(t), injection_rate, viscosity,
-                                                                       carter, material))
-    return length, w0 * (1.0 + xi) ** KGD_M_LEAK_OFF_LAMBDA * (1.0 - xi) ** 0.625
+        raise InputError(f"t must be a scalar > 0 for {caller}")
+    size, w0 = (float(np.ravel(v)[0]) for v in vertex(np.ravel(t), *arguments))
+    return size, w0 * (1.0 + x) ** exponent * (1.0 - x) ** 0.625
 
 
 # --- Dontsov (2016, radial; 2017, plane strain) with leak-off -----------------------------------
@@ -415,14 +421,8 @@ def radial_m_leak_off_profile(rho, t, injection_rate, viscosity, carter, materia
     """Opening of the radial M~ vertex at ``rho = r / R`` in [0, 1] at one time ``t``: ``w(0)
     (1 - rho)^(5/8) (1 + rho)^0.397`` (Dontsov 2016: the m~ tip asymptote times ``((1 +
     rho)/2)^lambda``, ``lambda`` = 0.397 at M~). Returns ``(R, w)``."""
-    rho = finite_array("rho", rho)
-    if np.any((rho < 0.0) | (rho > 1.0)):
-        raise InputError("rho must be in [0, 1] (r / R)")
-    if np.size(t) != 1:
-        raise InputError("t must be a scalar > 0 for radial_m_leak_off_profile")
-    radius, w0 = (float(np.ravel(v)[0]) for v in radial_m_leak_off_vertex(np.ravel(t), injection_rate, viscosity,
-                                                                          carter, material))
-    return radius, w0 * (1.0 - rho) ** 0.625 * (1.0 + rho) ** 0.397
+    return _m_leak_off_profile("rho", "r / R", rho, t, radial_m_leak_off_vertex, 0.397,
+                               (injection_rate, viscosity, carter, material), "radial_m_leak_off_profile")
 
 
 __all__ = ["kgd_m_leak_off_scale", "radial_m_leak_off_profile", "radial_m_leak_off_similarity",
