@@ -233,7 +233,8 @@ PROPAGATION = {  # -> hmatddm.fracture.growth.Propagation (ref. Sec. 4.2.2)
     "growing_fractures": Setting("integers"),
     "front": Setting("choice", "element", choices=FRONTS),
     "front_iterations": Setting("integer", 40, low=1),
-    "front_tolerance": Setting("number", 1e-2, **_UNIT_INTERVAL),  # hmatddm.fracture.growth.Propagation
+    "front_tolerance": Setting("number", **_UNIT_INTERVAL,
+                               doc="elements; default 1e-2, 1e-3 with leak-off (hmatddm.simulation.asymptotic)"),
 }
 
 SCHEME = {  # -> hmatddm.coupled.step_problem.SchemeSettings (ref. Sec. 4.5)

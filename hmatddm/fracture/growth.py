@@ -64,12 +64,8 @@ class Propagation:
         Asymptotic front: fixed-point iterations of the front per time step, >= 1.
     front_tolerance : float
         Asymptotic front: converged when no ribbon distance changes by more than this
-        fraction of the element size, in (0, 1). The default 1e-2 (was 1e-3) moves the
-        front by at most 1% of an element: on radial-k at 0.25 m, 292 growth passes
-        against 531 and 162 s of CPU against 220 s, radius -0.071% against -0.078% and
-        opening +0.330% against +0.328% from the K vertex; on radial-m at 0.5 m, 80
-        passes against 112, radius -0.356% against -0.360% from the M vertex
-        (benchmarks/RESULTS.md, issue 33, "the lattice").
+        fraction of the element size, in (0, 1). None (the default): 1e-2 without
+        leak-off, 1e-3 with it (:data:`hmatddm.simulation.asymptotic.FRONT_TOLERANCE`).
     """
 
     toughness: float
@@ -82,7 +78,7 @@ class Propagation:
     bounds: tuple | None = None
     front: str = "element"
     front_iterations: int = 40
-    front_tolerance: float = 1e-2
+    front_tolerance: float | None = None
 
     def __post_init__(self):
         for name in ("toughness", "criterion", "front", "front_iterations", "front_tolerance", "turning",

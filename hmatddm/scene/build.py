@@ -96,7 +96,7 @@ def propagation(scene):
                        max_growth_passes=settings["max_growth_passes"],
                        bounds=None if bounds is None else tuple(tuple(pair) for pair in bounds),
                        front=settings["front"], front_iterations=settings["front_iterations"],
-                       front_tolerance=settings["front_tolerance"])
+                       front_tolerance=settings.get("front_tolerance"))
 
 
 def leak_off(scene):

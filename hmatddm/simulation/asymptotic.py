@@ -18,7 +18,8 @@ time step, with the ribbon elements (channel elements next to the front) fixed:
 3. the ribbon openings give new ``s_r`` by inverting the asymptote with ``V = (s_r -
    s_r^n) / dt`` (:meth:`~hmatddm.analytical.tip_asymptote.TipAsymptote.front_distance`);
 
-until no ``s_r`` changes by more than ``front_tolerance`` element sizes. The update of
+until no ``s_r`` changes by more than ``front_tolerance`` element sizes (by default
+:data:`FRONT_TOLERANCE`, :data:`LEAK_OFF_FRONT_TOLERANCE` with leak-off). The update of
 ``s_r`` is relaxed when it oscillates and, in 3D, accelerated by Anderson mixing of the
 last iterates (:mod:`hmatddm.simulation.front_acceleration`).
 
@@ -104,6 +105,17 @@ logger = logging.getLogger(__name__)
 # (2D: a segment, fine and cheap; 3D: 8 x 8, the fraction of the front's many tip elements
 # averages out)
 SUB_SAMPLES = {1: 256, 2: 8}
+
+#: The front tolerance (element sizes) when the scene sets none. 1e-2: finer iterations
+#: chased the fill's discrete events (a cell turning tip or filled) for up to 30 solves a
+#: step at 0.25 m without moving the answer (radial-k 0.25 m: 292 growth passes against 531,
+#: radius -0.071% against -0.078%, opening +0.330% against +0.328% from the K vertex;
+#: radial-m 0.5 m: 80 passes against 112, radius -0.356% against -0.360%; kgd: 150 against
+#: 329, the same half-length); benchmarks/RESULTS.md, issue 33, "the lattice".
+FRONT_TOLERANCE = 1e-2
+#: ... with leak-off: at an M~ tip 1e-2 left the radial M~ run's centre opening 6.7% from
+#: the vertex at 1.6 s against 1.8% at 1e-3 (tests/scene/test_leak_off_reference.py).
+LEAK_OFF_FRONT_TOLERANCE = 1e-3
 
 
 class PrescribedOpening:
@@ -298,6 +310,8 @@ class AsymptoticFront:
         ribbon = np.flatnonzero(channel)[~np.all(np.isin(around, channel_keys), axis=1)]
         distance_old = np.maximum(-old.at_cells(cells[ribbon]), 0.0)
         leaking = self.leak_off.coefficient != 0.0
+        tolerance = prop.front_tolerance if prop.front_tolerance is not None else \
+            (LEAK_OFF_FRONT_TOLERANCE if leaking else FRONT_TOLERANCE)
         if leaking:  # C' = c_l (p - p_r) at the ribbon's mean pressure at t_old
             self.asymptote.carter = self.leak_off.coefficient * max(
                 float(np.mean(begin.pressure[ribbon])) - self.leak_off.pore_pressure, 0.0)
@@ -353,7 +367,7 @@ class AsymptoticFront:
             if far_ribbon:  # a filled element keeps the asymptote's opening (module docstring)
                 prescribed |= state == FILLED
             last_try = iterations == prop.front_iterations  # the step may end on this solve: full accuracy
-            settings = (self.inner_settings(sim.settings, change, prop.front_tolerance)
+            settings = (self.inner_settings(sim.settings, change, tolerance)
                         if grid.k == 2 and not last_try else sim.settings)
             loose = settings is not sim.settings
             try:
@@ -414,7 +428,7 @@ class AsymptoticFront:
             logger.debug("front iteration %d: %d elements, %d ribbon, %d tip, %d empty, change %.3g elements",
                          iterations, mesh.n_elements, len(ribbon), np.count_nonzero(state == TIP),
                          np.count_nonzero(state == EMPTY), change)
-            if change < prop.front_tolerance and not loose:  # a loose solve: once more at full accuracy
+            if change < tolerance and not loose:  # a loose solve: once more at full accuracy
                 break
         if not np.isfinite(change) or change > 0.05:
             raise ConvergenceError(f"the asymptotic front did not converge in step {begin.step + 1} (t = {t_new:g} "
