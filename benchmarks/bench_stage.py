@@ -97,7 +97,7 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--large", action="store_true", help="the larger version only")
     parser.add_argument("--dense", action="store_true", help="open and limited with the dense operator")
-    parser.add_argument("--end", type=float, default=90.0, help="pump time, s (the scene's: 90)")
+    parser.add_argument("--end", type=float, default=70.0, help="pump time, s (the scene's: 70)")
     parser.add_argument("--only", default=None, help="comma-separated variants (of: " + ", ".join(VARIANTS) + ")")
     args = parser.parse_args()
     print(f"Machine: {machine()}")
