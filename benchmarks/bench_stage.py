@@ -1,5 +1,5 @@
 """The completion stage of issue 35 (the embedded scene `stage`: five clusters on one pump, a
-three-layer stress stack, a natural-fracture network, microseismic monitoring): time, memory,
+three-layer stack (stiffer, more stressed bounding layers), a natural-fracture network, microseismic monitoring): time, memory,
 iterations and the rate split of the scene as embedded, its limited-entry and uniform-rock
 variants, and a larger version (>= 5x the elements).
 
@@ -7,6 +7,7 @@ variants, and a larger version (>= 5x the elements).
     python benchmarks/bench_stage.py --large      # the larger version only (1 m elements)
     python benchmarks/bench_stage.py --dense      # open and limited with the dense operator (~15 min)
     python benchmarks/bench_stage.py --end 30     # a shorter pump time
+    python benchmarks/bench_stage.py --only open,stress-only   # chosen variants
 
 Each run is a fresh process (its own peak memory, a warm numba cache). Columns: CPU and wall
 seconds, peak resident memory, steps, elements at the end (hydraulic and joined natural),
@@ -16,11 +17,15 @@ the worst fluid-budget residual over the fluid moved (the error beside the time)
 microseismic events.
 
 Variants: `open` is the scene as embedded (24 perforations of 8 mm per cluster: kPa of
-perforation friction); `limited` sets well.perforations = 1 (MPa: limited entry);
-`uniform` is `limited` with the bounding layers' s_hmin equal to the pay zone's (the
-containment check); `large` is `limited` with 1 m elements for the initial fractures and the
-network (4x the elements per area, twice the rows over the height); `-dense` runs use the dense
-operator instead of the scene's H-matrix.
+perforation friction; bounding layers stiffer and 3 MPa more stressed than the pay zone);
+`limited` sets well.perforations = 1 (MPa: limited entry); `uniform` is `limited` with the
+bounding layers' s_hmin and shear modulus equal to the pay zone's (uniform rock: the
+containment check); `stress-only` and `limited-stress-only` give the bounding layers the pay
+zone's modulus and keep their stress (the scene before its stiff layers); `large` is
+`limited-stress-only` with 1 m elements for the initial fractures and the network (4x the
+elements per area, twice the rows over the height; with the stiff layers' images it would
+take hours: benchmarks/RESULTS.md, issue 35); `-dense` runs use the dense operator instead of
+the scene's H-matrix.
 """
 import argparse
 import json
@@ -36,11 +41,17 @@ sys.path.insert(0, os.path.dirname(__file__))
 from _common import machine, peak_rss_bytes, print_table  # noqa: E402
 
 LIMITED = ["well.perforations=1"]
-UNIFORM = LIMITED + ["layer[0].s_hmin=35.85e6", "layer[2].s_hmin=35.85e6"]
-LARGE = LIMITED + [f"initial_fracture[{k}].element_size=1.0" for k in range(5)] + ["network.element_size=1.0"]
+#: uniform rock: the bounding layers with the pay zone's stress and moduli
+UNIFORM = LIMITED + ["layer[0].s_hmin=35.85e6", "layer[2].s_hmin=35.85e6", "layer[0].shear_modulus=6.62e9",
+                     "layer[2].shear_modulus=6.62e9"]
+#: the bounding layers with the pay zone's moduli, their stress kept (the scene before issue 35's stiff layers)
+STRESS_ONLY = ["layer[0].shear_modulus=6.62e9", "layer[2].shear_modulus=6.62e9"]
+LARGE = LIMITED + STRESS_ONLY + [f"initial_fracture[{k}].element_size=1.0" for k in range(5)] + [
+    "network.element_size=1.0"]
 DENSE = ["numerics.backend=dense"]
 VARIANTS = {"open": [], "limited": LIMITED, "uniform": UNIFORM, "large": LARGE, "open-dense": DENSE,
-            "limited-dense": LIMITED + DENSE}
+            "limited-dense": LIMITED + DENSE, "stress-only": STRESS_ONLY,
+            "limited-stress-only": LIMITED + STRESS_ONLY}
 
 
 def _run(name, overrides, end, queue):
@@ -86,11 +97,14 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--large", action="store_true", help="the larger version only")
     parser.add_argument("--dense", action="store_true", help="open and limited with the dense operator")
-    parser.add_argument("--end", type=float, default=90.0, help="pump time, s (the scene's: 90)")
+    parser.add_argument("--end", type=float, default=70.0, help="pump time, s (the scene's: 70)")
+    parser.add_argument("--only", default=None, help="comma-separated variants (of: " + ", ".join(VARIANTS) + ")")
     args = parser.parse_args()
     print(f"Machine: {machine()}")
     names = ["large"] if args.large else ["open-dense", "limited-dense"] if args.dense else [
         "open", "limited", "uniform"]
+    if args.only:
+        names = args.only.split(",")
     rows = []
     for name in names:
         r = run(name, args.end)

@@ -85,6 +85,9 @@ class NaturalNetwork:
         #: :class:`ScreenMemory` of the last screened remote-failure check (a cache: a
         #: check finds the same failures with or without it)
         self.screen_memory = None
+        #: :class:`hmatddm.elasticity.stress_columns.StressColumns` of the last layered
+        #: check (a cache: each active element's stress at the targets, computed once)
+        self.stress_columns = None
         self._target_tree = None
 
     def target_tree(self):
@@ -136,9 +139,18 @@ class NaturalNetwork:
         element size of an active element's edge are near misses (stress ~1/gap),
         averaged like the DDM operator's collocation points. ``material`` a
         :class:`hmatddm.LayeredMedium`: the direct layered sum with ``n_images`` images
-        (None: the medium's choice; ``method`` and ``info`` do not apply)."""
+        (None: the medium's choice; ``method`` and ``info`` do not apply); in 3D with
+        ``n_images`` given, each active element's terms are kept across calls
+        (:class:`hmatddm.elasticity.stress_columns.StressColumns`: the elements appended
+        since the last call are the only ones computed)."""
         near = NEAR_SINGULAR_FRACTION if singular_correction == "average" else 0.0
         if isinstance(material, LayeredMedium):
+            from ..elasticity.stress_columns import StressColumns
+
+            self.stress_columns = StressColumns.reuse(self.stress_columns, active_mesh, material, self.mesh.centers,
+                                                      targets, n_images, singular_correction, near)
+            if self.stress_columns is not None:
+                return self.stress_columns.stress(active_mesh, dd, targets)
             from ..layered.engine import induced_stress
 
             return induced_stress(active_mesh, material, dd, self.mesh.centers[targets], singular_correction, near,
