@@ -163,7 +163,7 @@ def workspace(data):
                 n_orders = max(n_orders, room[layer, 1])
     return (np.empty((3, 3, 3)), np.zeros((3, 3, 3)), np.empty((3, 3, 3, 3)), np.zeros((2, 3, 3, 1)), Workspace(1),
             Workspace(n_orders), room, _cached_rules(data.gauss_points), np.empty((5, 3, 3, 3)), np.empty((30, 4)),
-            vertical_workspace(), np.empty((3, 3, 3)))
+            vertical_workspace(n_orders), np.empty((3, 3, 3)))
 
 
 @njit(cache=True)
@@ -308,7 +308,8 @@ def _complementary_stress(data, point, lr, j, state, work, entry_tol, image):
         if data.vertical_form[j] and (n_sub > 1 or n_gauss >= VERTICAL_FROM):
             # next to the images: every triple traced at three heights, in closed form
             closed = vertical_image_stress(point, lr, center, data.okada[j, 0], data.okada_half[j, 0],
-                                           data.okada_half[j, 1], heights, three, g, nu, ls, vwork, image)
+                                           data.okada_half[j, 1], heights, three, g, nu, ls, data.far_tol,
+                                           entry_tol, vwork, image)
             if closed and lr != ls:  # minus the whole space of the source's material
                 rectangle3d.stress_pair(point, center, frame, a, b, g[ls], nu[ls], 0.0, uniform, local)
                 for q in range(3):

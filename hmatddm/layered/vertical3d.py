@@ -26,11 +26,17 @@ import math
 import numpy as np
 from numba import njit
 
-from .potentials3d import _axis_series, _base_table, _contract, _stress, base_derivatives, potential_base
+from .potentials3d import (Workspace, _axis_series, _base_table, _contract, _pair_stress_gradient, _stress,
+                           base_derivatives, potential_base)
+from .rectangle_quadrature import entry_order, far_order
+from .segment_quadrature import gauss_legendre
 
 #: Largest vertical derivative order held in the edge tables (D orders up to 5 and the
 #: Laplace turns of the terms without d1: 4 + 5 + 4 + 1).
 M_MAX = 15
+#: Gauss points per side from which a triple is taken in closed form rather than by
+#: quadrature (:func:`vertical_image_stress`).
+CLOSED_FROM = 4
 #: |e_z| of a side above which the rectangle counts as vertical (as okada3d.COS_ZERO).
 VERTICAL = 1.0 - 1e-12
 
@@ -244,26 +250,61 @@ def _integrated_table(polys, s0, s1, weighted, order, eps, t_bot, t_top, sj_bot,
 
 
 @njit(cache=True)
-def vertical_workspace():
-    """Scratch of :func:`vertical_image_stress`."""
+def _far_triple(yr, hs, hd, t_mid, z0, e, sg, polys, dpolys, n_gauss, delta, shear_modulus, lame, coef_t, dcoef_t,
+                work, gradient):
+    """``gradient +=`` the source-derivative gradient of one triple (point ``z0 + e t``,
+    gauge ``sg``) integrated over the rectangle by ``n_gauss`` Gauss points per side
+    (:func:`.potentials3d._pair_stress_gradient` at each, its coefficients at the point's
+    height ``t`` from the quadratic fits ``polys``, ``dpolys``, times the weight: the
+    gradient is linear in them). ``yr``: the receiver in the turned frame."""
+    x, w = gauss_legendre(n_gauss)
+    n_orders = polys.shape[2]
+    for ia in range(n_gauss):
+        r1 = yr[0] - hs * x[ia]
+        for ib in range(n_gauss):
+            t = t_mid + hd * x[ib]
+            weight = w[ia] * w[ib] * hs * hd
+            for f in range(3):
+                for j in range(3):
+                    for n in range(n_orders):
+                        p = polys[f, j, n]
+                        coef_t[f, j, n] = weight * (p[0] + t * (p[1] + t * p[2]))
+                        p = dpolys[f, j, n]
+                        dcoef_t[f, j, n] = weight * (p[0] + t * (p[1] + t * p[2]))
+            _pair_stress_gradient(r1, yr[1], yr[2] - (z0 + e * t), e, sg, coef_t, dcoef_t, delta, shear_modulus,
+                                  lame, gradient, work)
+
+
+@njit(cache=True)
+def vertical_workspace(n_orders):
+    """Scratch of :func:`vertical_image_stress` for triples of up to ``n_orders`` orders of
+    ``D`` (the tracer's buffer)."""
     n_log = M_MAX - 1
     edge = (np.empty((6, 6)), np.empty((6, 6)), np.empty((4, 6)), np.empty((6, 6, M_MAX - 2)),
             np.empty((2, 6, 6, M_MAX - 1)), np.empty((n_log, n_log)), np.empty((2, n_log - 1, n_log - 1)),
             np.empty((4, n_log + 1)))
     tables = (np.empty((2, 6, 6, M_MAX)), np.empty((2, 6, 6, M_MAX)), np.zeros((2, 4, 3, 3, 6, 6, 6)))
-    return edge, tables, np.zeros((3, 3, 3, 3)), np.zeros((3, 3)), np.zeros((3, 3)), np.zeros((3, 3, 3)), np.zeros(3)
+    return (edge, tables, np.zeros((3, 3, 3, 3)), np.zeros((3, 3)), np.zeros((3, 3)), np.zeros((3, 3, 3)), np.zeros(3),
+            Workspace(n_orders), np.zeros((3, 3, n_orders)), np.zeros((3, 3, n_orders)))
 
 
 @njit(cache=True)
 def vertical_image_stress(y, receiver_layer, center, strike, hs, hd, heights, traced, shear_modulus, poisson_ratio,
-                          source_layer, work, out):
+                          source_layer, far_tol, triple_tol, work, out):
     """``out[b, i, k] +=`` the stress at ``y`` (global) of a unit global DD ``b`` on the
     vertical rectangle (centre ``center``, horizontal side along ``strike``, half sides
     ``hs`` along it and ``hd`` up) of the triples ``traced`` (three points: the heights
     ``heights`` = bottom, middle, top; the same triples at each) acting in
-    ``receiver_layer``, in closed form (module docstring). Returns False, adding nothing,
-    where the triples differ between the heights or a table does not reach."""
-    edge, tables, gradient, with_s, without, local, yr = work
+    ``receiver_layer``, in closed form (module docstring). A triple whose image of the
+    rectangle is far enough from ``y`` to need fewer than :data:`CLOSED_FROM` Gauss points
+    per side takes those points instead, its coefficients at their heights from the same
+    quadratic fit (:func:`_far_triple`): the rule of
+    :func:`.rectangle_quadrature._image_order` for that triple alone, :func:`far_order`
+    to the relative error ``far_tol`` (0: every triple in closed form), or fewer by
+    :func:`entry_order` when ``triple_tol > 0`` (the error allowed per unit largest shear
+    modulus). Returns False, adding nothing, where the triples differ between the heights
+    or a table does not reach."""
+    edge, tables, gradient, with_s, without, local, yr, far_work, coef_t, dcoef_t = work
     sj_bot, sj_top, integrated = tables
     n_pairs, layer, z, eps, sigma, coef, dcoef = traced
     s0, s1 = strike[0], strike[1]
@@ -314,6 +355,20 @@ def vertical_image_stress(y, receiver_layer, center, strike, hs, hd, heights, tr
                         target[f, j, n, 0] = c0 if top >= 0 else 0.0
                         target[f, j, n, 1] = c1 if top >= 1 else 0.0
                         target[f, j, n, 2] = c2 if top >= 2 else 0.0
+        if far_tol > 0.0:
+            # distance from y to the triple's image of the rectangle (x along the strike)
+            z_lo = min(z0 + e * t_bot, z0 + e * t_top)
+            z_hi = max(z0 + e * t_bot, z0 + e * t_top)
+            along = max(abs(yr[0]) - hs, 0.0)
+            up = max(z_lo - yr[2], yr[2] - z_hi, 0.0)
+            distance = math.sqrt(along * along + yr[1] * yr[1] + up * up)
+            n_gauss = far_order(distance / max(hs, hd), CLOSED_FROM, far_tol)
+            if triple_tol > 0.0:
+                n_gauss = min(n_gauss, entry_order(distance, hs, hd, CLOSED_FROM, triple_tol))
+            if n_gauss < CLOSED_FROM:
+                _far_triple(yr, hs, hd, t_mid, z0, e, sg, polys, dpolys, n_gauss, delta_r, g_r, lame_r, coef_t,
+                            dcoef_t, far_work, gradient)
+                continue
         _edge_table(ends, yr[1], yr[2] - (z0 + e * t_bot), sg, sj_bot, edge)
         _edge_table(ends, yr[1], yr[2] - (z0 + e * t_top), sg, sj_top, edge)
         sa = yr[2] - z0  # s = y3 - z(t) = sa - e t

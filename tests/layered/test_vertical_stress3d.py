@@ -46,10 +46,11 @@ def _reference(mesh, dd, points):
 
 def test_stress_at_points_matches_the_quadrature_of_every_triple():
     """The default path (closed form next to the images, the few-point quadrature far from
-    them) within 1e-10 of the largest stress, the closed form alone (every pair in closed
-    form: ``far_tol = 0`` keeps four Gauss points everywhere, the closed form's threshold)
-    within 1e-12 (both measured 1.4e-15); both far closer than the default quadrature
-    (6.3e-8: sub-squares next to the interfaces)."""
+    them, and within the closed form the triples far from the point by a few Gauss points)
+    within 1e-10 of the largest stress (measured 6.2e-11), the closed form of every triple
+    (``far_tol = 0`` keeps four Gauss points for every pair, the closed form's threshold;
+    ``entry_tol = 0``: no triple by quadrature) within 1e-12 (measured 1.4e-15); both far
+    closer than the default quadrature (6.3e-8: sub-squares next to the interfaces)."""
     mesh = _vertical_mesh((-0.5, -1.5, -2.5, -3.6))
     points = _points()
     dd = np.random.default_rng(6).normal(size=(mesh.n_elements, 3))
@@ -57,11 +58,11 @@ def test_stress_at_points_matches_the_quadrature_of_every_triple():
     got = hd.stress_at(mesh, medium, dd, points)
     want = _reference(mesh, dd, points)
     scale = np.abs(want).max()
-    assert np.abs(got - want).max() <= 1e-10 * scale  # measured 1.4e-15
+    assert np.abs(got - want).max() <= 1e-10 * scale  # measured 6.2e-11
     points_, dd_, data = _prepared(mesh, medium, dd, points, "none", 0.0, None)
     assert data.vertical_form.all() and data.surface_form.sum() == 6  # the top solid layer
     layers = medium.layer_of(points[:, 2]).astype(np.int64)
-    closed = drivers.stress_sum(data._replace(far_tol=0.0), points, dd, layers)
+    closed = drivers.stress_sum(data._replace(far_tol=0.0, entry_tol=0.0), points, dd, layers)
     assert np.abs(closed - want).max() <= 1e-12 * scale
     before = hd.stress_at(mesh, LayeredMedium(**THREE, method="quadrature"), dd, points)
     assert np.abs(before - want).max() > 10.0 * np.abs(got - want).max()
