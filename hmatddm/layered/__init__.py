@@ -10,7 +10,9 @@
   3D Hansen potentials (ref. Eq. 3.24); :mod:`.influence3d` builds their kernel data. Its
   parts: :mod:`.potentials3d` (the potentials and the field of one image triple),
   :mod:`.image_tracer3d` (the triples through the interfaces), :mod:`.image_points3d` (the
-  field of a point source), :mod:`.rectangle_quadrature` (the quadrature over a rectangle).
+  field of a point source), :mod:`.rectangle_quadrature` (the quadrature over a rectangle),
+  :mod:`.okada3d` and :mod:`.vertical3d` (image terms in closed form), :mod:`.stress3d`
+  (the stress at points behind :func:`hmatddm.stress_at`, each source traced once).
 * :mod:`.displacement`: the displacement at points (ref. Eqs 2.43, 2.55-2.57 with the
   images' displacement of ref. Eq. 3.22), behind :func:`hmatddm.displacement_at`; its
   kernels :mod:`.displacement3d` (rectangles) and :mod:`.displacement2d` (segments).
@@ -25,7 +27,7 @@ from .medium import LayeredMedium
 def __getattr__(name):
     if name in ("images2d", "influence2d", "images3d", "influence3d", "image_tracer", "segment_quadrature",
                 "segments2d", "potentials3d", "image_tracer3d", "image_points3d", "rectangle_quadrature",
-                "displacement", "displacement2d", "displacement3d"):
+                "displacement", "displacement2d", "displacement3d", "okada3d", "vertical3d", "stress3d"):
         return importlib.import_module(f"{__name__}.{name}")
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 

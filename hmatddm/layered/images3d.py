@@ -31,6 +31,8 @@ half-space's image triple, coefficient for coefficient:
 :func:`.influence3d.surface_reflection_alone`; ``LayeredRectangles.surface_form``,
 :func:`.image_tracer3d.drop_surface_range`), and the quadrature neither integrates it nor
 refines for its singular point. A rectangle without a horizontal side keeps the quadrature.
+The stress at points takes the same per-pair terms (:func:`element_stress_traced`) with
+sources outside and points inside (:mod:`.stress3d`: each source traced once).
 
 What is not in closed form, and why (measured in ``_derive_closed_form3d.py``): every other
 near triple, i.e. the reflections in an interface between two solids and the
@@ -96,7 +98,7 @@ from .rectangle_quadrature import (FAR_TOL, _cached_rules, _image_order, _integr
                                    image_rectangle_stress_without, remainder_order,
                                    nearest_singularity, square_rule, subdivisions)
 
-__all__ = ["LayeredRectangles", "workspace", "source_state", "element_traction", "element_stress",
+__all__ = ["LayeredRectangles", "workspace", "source_state", "element_traction", "element_stress", "element_stress_traced",
            # re-exported from the parts (module docstring)
            "base_derivatives", "inverse_distance_derivatives", "Workspace", "trace", "trace_points",
            "kelvin_point_stress", "image_point_stress", "kelvin_point_displacement", "image_point_displacement",
@@ -161,7 +163,7 @@ def workspace(data):
                 n_orders = max(n_orders, room[layer, 1])
     return (np.empty((3, 3, 3)), np.zeros((3, 3, 3)), np.empty((3, 3, 3, 3)), np.zeros((2, 3, 3, 1)), Workspace(1),
             Workspace(n_orders), room, _cached_rules(data.gauss_points), np.empty((5, 3, 3, 3)), np.empty((30, 4)),
-            vertical_workspace(), np.empty((3, 3, 3)))
+            vertical_workspace(n_orders), np.empty((3, 3, 3)))
 
 
 @njit(cache=True)
@@ -221,26 +223,17 @@ def _three_heights(data, j, near_only, cap, n_orders):
 def element_traction(data, i, j, state, work, block):
     """``block`` (3, 3): traction at the centre of element ``i`` (its normal) for a unit
     global DD of rectangle ``j``: closed form of the source layer's material (with the
-    closed-form kernel's singular and near-miss handling) plus images (:func:`_image_order`),
-    the source's traced triples reused across receivers. With a tabulated remainder
-    (:mod:`.remainder_table3d`) the quadrature takes the near triples only and the table
-    the rest; a receiver outside the table's range takes every triple by quadrature. In a
-    half-space, a source with a horizontal side (``closed_form``) takes its image and
-    surface terms in closed form instead (:func:`.okada3d.okada_traction`, Okada 1992),
-    whatever the number of images (the closed form is the exact half-space). With two or
-    more solid layers, a ``surface_form`` source adds its reflection in the free surface
-    the same way for receivers of its layer and leaves it out of the quadrature. A
-    ``vertical_form`` source (a vertical rectangle, interfaces between solids) takes its
-    near triples in closed form (:func:`.vertical3d.vertical_image_stress`) where the
-    quadrature would need sub-squares or :data:`VERTICAL_FROM` points per side, the
-    quadrature elsewhere."""
-    traced, is_traced, near_only, three, heights = state
-    local, image, gradient, kelvin, ws1, ws, room, rules, okada_work, corners, vwork, uniform = work
-    xi, eta, wt, start = rules
+    closed-form kernel's singular and near-miss handling) plus images
+    (:func:`_complementary_stress`, the source's traced triples reused across receivers, the
+    Gauss order of an entry: :func:`_image_order` with ``entry_tol``). In a half-space, a
+    source with a horizontal side (``closed_form``) takes its image and surface terms in
+    closed form instead (:func:`.okada3d.okada_traction`, Okada 1992), whatever the number
+    of images (the closed form is the exact half-space). With two or more solid layers, a
+    ``surface_form`` source adds its reflection in the free surface the same way for
+    receivers of its layer (and the quadrature leaves it out)."""
+    local, image, okada_work, corners = work[0], work[1], work[8], work[9]
     g = data.shear_modulus
     nu = data.poisson_ratio
-    interfaces = data.interfaces
-    table = data.table
     ls = data.layer[j]
     center = data.centers[j]
     frame = data.frames[j]
@@ -256,80 +249,115 @@ def element_traction(data, i, j, state, work, block):
     if data.closed_form[j]:
         okada3d.okada_traction(point, normal, center, data.okada[j], data.okada_half[j, 0], data.okada_half[j, 1],
                                data.surface, g[ls], nu[ls], False, True, okada_work, corners, block)
-    elif interfaces.shape[0] > 0:
+    elif data.interfaces.shape[0] > 0:
         lr = data.layer[i]
-        image[:] = 0.0
-        tabulated = near_only and rectangle_covered(table, point, lr, center, frame, a, b, ls)
-        entry_tol = data.entry_tol * data.entry_scale
-        # the reflection in the free surface in closed form: the quadrature neither takes it
-        # nor refines for its singular point (the receiver's mirror in the surface)
-        surface_form = data.surface_form[j]
-        skip = ls - 1 if surface_form and lr == ls else -1
-        if surface_form and lr == ls:
+        if data.surface_form[j] and lr == ls:
             okada3d.okada_traction(point, normal, center, data.okada[j], data.okada_half[j, 0], data.okada_half[j, 1],
                                    data.surface, g[ls], nu[ls], False, True, okada_work, corners, block)
-        if near_only and not tabulated and table.pair_index[ls, lr] >= 0:
-            # outside the table's range: every triple by quadrature
-            n_gauss, n_sub = _image_order(point, lr, center, frame, a, b, ls, interfaces, data.gauss_points,
-                                          data.max_subdivisions, data.far_tol, entry_tol, skip)
-            image_rectangle_stress_without(point, lr, center, frame, a, b, ls, interfaces, g, nu, data.n_images,
-                                           n_gauss, n_sub, image, False, table.bottoms, table.tops, surface_form,
-                                           data.surface)
-        elif not (tabulated and abs(lr - ls) >= 2):  # two layers apart, every triple is far
-            n_gauss, n_sub = _image_order(point, lr, center, frame, a, b, ls, interfaces, data.gauss_points,
-                                          data.max_subdivisions, data.far_tol, entry_tol, skip)
-            closed = False
-            if data.vertical_form[j] and (n_sub > 1 or n_gauss >= VERTICAL_FROM):
-                # next to the images: every triple traced at three heights, in closed form
-                closed = vertical_image_stress(point, lr, center, data.okada[j, 0], data.okada_half[j, 0],
-                                               data.okada_half[j, 1], heights, three, g, nu, ls, vwork, image)
-                if closed and lr != ls:  # minus the whole space of the source's material
-                    rectangle3d.stress_pair(point, center, frame, a, b, g[ls], nu[ls], 0.0, uniform, local)
-                    for q in range(3):
-                        for p in range(3):
-                            for kk in range(3):
-                                image[q, p, kk] -= uniform[q, p, kk]
-            if not closed and n_sub <= 2:
-                slot = n_gauss - 1 if n_sub == 1 else data.gauss_points
-                lo, hi = start[slot], start[slot + 1]
-                if not is_traced[slot]:
-                    _trace_range(center, frame, a, b, ls, interfaces, g, nu, data.n_images, xi, eta, lo, hi, traced)
-                    if near_only:
-                        keep_near_range(traced, lo, hi, center, frame, a, b, xi, eta, ls, table.bottoms, table.tops)
-                    if surface_form:
-                        drop_surface_range(traced, lo, hi, center, frame, a, b, xi, eta, ls, data.surface)
-                    is_traced[slot] = True
-                _integrate(point, lr, center, frame, a, b, ls, g, nu, xi[lo:hi], eta[lo:hi], wt[lo:hi], traced, lo,
-                           image, gradient, ws, ws1, kelvin)
-            elif not closed:
-                image_rectangle_stress_without(point, lr, center, frame, a, b, ls, interfaces, g, nu, data.n_images,
-                                               n_gauss, n_sub, image, near_only, table.bottoms, table.tops,
-                                               surface_form, data.surface)
-        if tabulated:
-            # the far triples' points lie below or above the source points, at least
-            # the clearance outside the receiver's layer
-            r1 = point[0] - center[0]
-            r2 = point[1] - center[1]
-            beside = max(0.0, math.sqrt(r1 * r1 + r2 * r2) - a - b)
-            clearance = table.clearance[ls, lr]
-            n = remainder_order(math.sqrt(clearance * clearance + beside * beside), a, b, data.gauss_points,
-                                data.far_tol, entry_tol)
-            lo, hi = start[n - 1], start[n]
-            remainder_rectangle_stress(table, point, lr, center, frame, a, b, ls, g[ls], _lame(g[ls], nu[ls]),
-                                       xi[lo:hi], eta[lo:hi], wt[lo:hi], image)
+        _complementary_stress(data, point, lr, j, state, work, data.entry_tol * data.entry_scale, image)
         for p in range(3):
             for q in range(3):
                 block[p, q] += image[q, p, 0] * normal[0] + image[q, p, 1] * normal[1] + image[q, p, 2] * normal[2]
 
 
+@njit(cache=True, inline="always")
+def _complementary_stress(data, point, lr, j, state, work, entry_tol, image):
+    """``image[q, i, k]``: the complementary (image) stress at ``point`` (in layer ``lr``)
+    of a unit global DD ``q`` of rectangle ``j`` (interfaces present, not ``closed_form``),
+    what :func:`element_traction` and :func:`element_stress_traced` share: the quadrature
+    of the source's triples (``state``: traced once per source, reused across receivers;
+    :func:`_image_order`, ``entry_tol``: the error allowed relative to the largest entry,
+    0 for the relative rule of :func:`far_order` alone). With a tabulated remainder
+    (:mod:`.remainder_table3d`) the quadrature takes the near triples only and the table
+    the rest; a receiver outside the table's range takes every triple by quadrature. A
+    ``surface_form`` source's reflection in the free surface is left out for receivers of
+    its layer (the caller adds it in closed form), and the quadrature does not refine for
+    it. A ``vertical_form`` source (a vertical rectangle, interfaces between solids) takes
+    its triples in closed form (:func:`.vertical3d.vertical_image_stress`) where the
+    quadrature would need sub-squares or :data:`VERTICAL_FROM` points per side, the
+    quadrature elsewhere."""
+    traced, is_traced, near_only, three, heights = state
+    local, gradient, kelvin, ws1, ws, rules, vwork, uniform = work[0], work[2], work[3], work[4], work[5], work[7], \
+        work[10], work[11]
+    xi, eta, wt, start = rules
+    g = data.shear_modulus
+    nu = data.poisson_ratio
+    interfaces = data.interfaces
+    table = data.table
+    ls = data.layer[j]
+    center = data.centers[j]
+    frame = data.frames[j]
+    a = data.half_a[j]
+    b = data.half_b[j]
+    image[:] = 0.0
+    tabulated = near_only and rectangle_covered(table, point, lr, center, frame, a, b, ls)
+    # the reflection in the free surface in closed form: the quadrature neither takes it
+    # nor refines for its singular point (the receiver's mirror in the surface)
+    surface_form = data.surface_form[j]
+    skip = ls - 1 if surface_form and lr == ls else -1
+    if near_only and not tabulated and table.pair_index[ls, lr] >= 0:
+        # outside the table's range: every triple by quadrature
+        n_gauss, n_sub = _image_order(point, lr, center, frame, a, b, ls, interfaces, data.gauss_points,
+                                      data.max_subdivisions, data.far_tol, entry_tol, skip)
+        image_rectangle_stress_without(point, lr, center, frame, a, b, ls, interfaces, g, nu, data.n_images, n_gauss,
+                                       n_sub, image, False, table.bottoms, table.tops, surface_form, data.surface)
+    elif not (tabulated and abs(lr - ls) >= 2):  # two layers apart, every triple is far
+        n_gauss, n_sub = _image_order(point, lr, center, frame, a, b, ls, interfaces, data.gauss_points,
+                                      data.max_subdivisions, data.far_tol, entry_tol, skip)
+        closed = False
+        if data.vertical_form[j] and (n_sub > 1 or n_gauss >= VERTICAL_FROM):
+            # next to the images: every triple traced at three heights, in closed form
+            closed = vertical_image_stress(point, lr, center, data.okada[j, 0], data.okada_half[j, 0],
+                                           data.okada_half[j, 1], heights, three, g, nu, ls, data.far_tol,
+                                           entry_tol, vwork, image)
+            if closed and lr != ls:  # minus the whole space of the source's material
+                rectangle3d.stress_pair(point, center, frame, a, b, g[ls], nu[ls], 0.0, uniform, local)
+                for q in range(3):
+                    for p in range(3):
+                        for kk in range(3):
+                            image[q, p, kk] -= uniform[q, p, kk]
+        if not closed and n_sub <= 2:
+            slot = n_gauss - 1 if n_sub == 1 else data.gauss_points
+            lo, hi = start[slot], start[slot + 1]
+            if not is_traced[slot]:
+                _trace_range(center, frame, a, b, ls, interfaces, g, nu, data.n_images, xi, eta, lo, hi, traced)
+                if near_only:
+                    keep_near_range(traced, lo, hi, center, frame, a, b, xi, eta, ls, table.bottoms, table.tops)
+                if surface_form:
+                    drop_surface_range(traced, lo, hi, center, frame, a, b, xi, eta, ls, data.surface)
+                is_traced[slot] = True
+            _integrate(point, lr, center, frame, a, b, ls, g, nu, xi[lo:hi], eta[lo:hi], wt[lo:hi], traced, lo,
+                       image, gradient, ws, ws1, kelvin)
+        elif not closed:
+            image_rectangle_stress_without(point, lr, center, frame, a, b, ls, interfaces, g, nu, data.n_images,
+                                           n_gauss, n_sub, image, near_only, table.bottoms, table.tops, surface_form,
+                                           data.surface)
+    if tabulated:
+        # the far triples' points lie below or above the source points, at least
+        # the clearance outside the receiver's layer
+        r1 = point[0] - center[0]
+        r2 = point[1] - center[1]
+        beside = max(0.0, math.sqrt(r1 * r1 + r2 * r2) - a - b)
+        clearance = table.clearance[ls, lr]
+        n = remainder_order(math.sqrt(clearance * clearance + beside * beside), a, b, data.gauss_points, data.far_tol,
+                            entry_tol)
+        lo, hi = start[n - 1], start[n]
+        remainder_rectangle_stress(table, point, lr, center, frame, a, b, ls, g[ls], _lame(g[ls], nu[ls]),
+                                   xi[lo:hi], eta[lo:hi], wt[lo:hi], image)
+
+
 @njit(cache=True)
-def element_stress(data, point, point_layer, j, work, out):
+def element_stress_traced(data, point, point_layer, j, state, work, out):
     """``out[q, i, k]``: stress at ``point`` (in ``point_layer``; zero in a void layer)
-    for a unit global DD ``q`` of rectangle ``j``, closed form plus images (the
-    quadrature of :func:`element_traction`). A point within ``near_fraction`` smaller
-    half sides of an edge counts as on it. A ``closed_form`` source: the image and surface
-    terms of :func:`.okada3d.okada_stress`; a ``surface_form`` source: its reflection in
-    the free surface, for points of its layer (the rest by quadrature)."""
+    for a unit global DD ``q`` of rectangle ``j``, closed form plus images, with the
+    source's ``state`` (:func:`source_state`: its triples traced once for every point;
+    the sum over points of :mod:`.stress3d`). A point within ``near_fraction`` smaller half
+    sides of an edge counts as on it. The images as :func:`element_traction`'s
+    (:func:`_complementary_stress`) with the relative Gauss rule (no ``entry_tol``: a point's
+    stress has no largest entry to be small against) and no table unless ``data`` has one;
+    a ``closed_form`` source: the image and surface terms of :func:`.okada3d.okada_stress`;
+    a ``surface_form`` source: its reflection in the free surface in closed form, for points
+    of its layer."""
     local, image = work[0], work[1]
     if zero_in_void(data.shear_modulus, point_layer, out):
         return
@@ -350,24 +378,26 @@ def element_stress(data, point, point_layer, j, work, out):
                 for k in range(3):
                     out[q, i, k] += image[q, i, k]
     elif data.interfaces.shape[0] > 0:
-        surface_form = data.surface_form[j]
-        skip = ls - 1 if surface_form and point_layer == ls else -1
-        n_gauss, n_sub = _image_order(point, point_layer, center, frame, a, b, ls, data.interfaces,
-                                      data.gauss_points, data.max_subdivisions, data.far_tol, 0.0, skip)
-        image_rectangle_stress_without(point, point_layer, center, frame, a, b, ls, data.interfaces, g, nu,
-                                       data.n_images, n_gauss, n_sub, image, False, data.table.bottoms,
-                                       data.table.tops, surface_form, data.surface)
+        _complementary_stress(data, point, point_layer, j, state, work, 0.0, image)
         for q in range(3):
             for i in range(3):
                 for k in range(3):
                     out[q, i, k] += image[q, i, k]
-        if surface_form and point_layer == ls:
+        if data.surface_form[j] and point_layer == ls:
             okada3d.okada_stress(point, center, data.okada[j], data.okada_half[j, 0], data.okada_half[j, 1],
                                  data.surface, g[ls], nu[ls], False, True, work[8], work[9], image)
             for q in range(3):
                 for i in range(3):
                     for k in range(3):
                         out[q, i, k] += image[q, i, k]
+
+
+@njit(cache=True)
+def element_stress(data, point, point_layer, j, work, out):
+    """:func:`element_stress_traced` for one point (the registered per-pair function of
+    :func:`hmatddm.kernels.drivers.stress_block`, which has no source state: the source's
+    triples are traced for this point alone; :mod:`.stress3d` traces them once per source)."""
+    element_stress_traced(data, point, point_layer, j, source_state(data, j, work), work, out)
 
 
 register_kind(LayeredRectangles, KernelKind(workspace, source_state, element_traction, element_stress,

@@ -7,8 +7,8 @@ import numpy as np
 
 from .._validation import finite_array
 from ..errors import InputError
-from ..kernels.drivers import finite_stress_sum, with_self_max
-from . import images3d, okada3d, remainder_build3d, remainder_table3d, vertical3d
+from ..kernels.drivers import with_self_max
+from . import images3d, okada3d, remainder_build3d, remainder_table3d, stress3d, vertical3d
 from .image_tracer3d import trace_points
 from .influence2d import choose_images as _choose_images
 from .influence2d import layers_of_extents, with_images
@@ -40,7 +40,7 @@ def element_layers(mesh, medium):
                              mesh.fracture_id, noun="rectangle")
 
 
-def influence_data(mesh, medium, singular_shift, alpha, near_fraction, n_images):
+def influence_data(mesh, medium, singular_shift, alpha, near_fraction, n_images, with_table=True):
     """The kernel data (:class:`images3d.LayeredRectangles`) of ``mesh`` in ``medium``
     with ``n_images`` images; ``alpha > 0`` fills ``self_max`` for ref. Eq. 6.11. With
     ``medium.method == "table"``, far image triples (two or more interfaces) and at least
@@ -53,12 +53,13 @@ def influence_data(mesh, medium, singular_shift, alpha, near_fraction, n_images)
     closed form (``surface_form``) and their other triples by quadrature. Vertical
     rectangles in a medium with interfaces (not a half-space, not ``"quadrature"``, at least
     one image) take their near triples in closed form next to them (``vertical_form``,
-    :mod:`.vertical3d`)."""
+    :mod:`.vertical3d`). ``with_table=False``: never a table (the stress at points,
+    :func:`stress_at`, takes every triple itself)."""
     layers = element_layers(mesh, medium)
     interfaces, g, nu = medium.arrays()
     scale = entry_scale(mesh.half_a, mesh.half_b, layers, g, nu) / g.max() if interfaces.shape[0] > 0 else 0.0
     table = remainder_table3d.empty_table(g.shape[0])
-    if (medium.method == "table" and n_images > 0 and interfaces.shape[0] >= 2
+    if (with_table and medium.method == "table" and n_images > 0 and interfaces.shape[0] >= 2
             and mesh.n_elements >= TABLE_MIN_ELEMENTS):
         table = remainder_table(mesh, medium, layers, int(n_images), scale * g.max())[0]
     closed, okada, half = okada3d.halfspace_geometry(mesh.frames, mesh.half_a, mesh.half_b)
@@ -164,22 +165,33 @@ def _prepared(mesh, medium, dd, points, singular_correction, near_fraction, n_im
     points = finite_array("points", points, (None, 3))
     dd = finite_array("dd", dd).reshape(mesh.n_elements, 3)
     shift = AVERAGE_SHIFT if singular_correction == "average" else 0.0
-    data = influence_data(mesh, medium, shift, 0.0, near_fraction, 0)
+    data = influence_data(mesh, medium, shift, 0.0, near_fraction, 0, with_table=False)
     if n_images is None:
         n_images = choose_images(mesh, medium, data)
-    return points, dd, with_images(data, n_images)
+    if int(n_images) == 0:
+        return points, dd, data
+    # built again for the number of images: the closed forms that need at least one
+    # (surface_form, vertical_form) are decided with it
+    return points, dd, influence_data(mesh, medium, shift, 0.0, near_fraction, int(n_images), with_table=False)
 
 
 def stress_at(mesh, medium, dd, points, singular_correction="none", near_fraction=0.0, n_images=None):
     """Stress (M, 3, 3) at ``points`` (M, 3) in a layered medium from the DDs ``dd``
-    (N, 3) of a :class:`Mesh3D` (direct sum, parallel over points; points in void
-    layers get zero; a point on an interface belongs to the layer above).
+    (N, 3) of a :class:`Mesh3D` (direct sum, parallel over points, each source's image
+    triples traced once: :mod:`.stress3d`; vertical rectangles' triples in closed form
+    next to their images; points in void layers get zero; a point on an interface
+    belongs to the layer above).
     ``n_images``: None = ``medium.images``, or for ``"auto"`` the number an
     :class:`ElasticityOperator` of ``mesh`` would choose."""
     if mesh.dim != 3:
         raise InputError("influence3d.stress_at takes a Mesh3D")
     points, dd, data = _prepared(mesh, medium, dd, points, singular_correction, near_fraction, n_images)
-    return finite_stress_sum(data, points, dd, medium.layer_of(points[:, 2]).astype(np.int64))
+    out = stress3d.stress_sum(data, points, dd, medium.layer_of(points[:, 2]).astype(np.int64))
+    bad = np.flatnonzero(~np.all(np.isfinite(out.reshape(len(out), -1)), axis=1))
+    if bad.size:  # the message of kernels.drivers.finite_stress_sum
+        raise InputError(f"points[{int(bad[0])}] lies on an element edge, where the stress is singular; move it or "
+                         "pass singular_correction='average'")
+    return out
 
 
 def mean_stress_at(mesh, medium, dd, points, singular_correction="none", near_fraction=0.0, n_images=None):

@@ -26,14 +26,69 @@ import math
 import numpy as np
 from numba import njit
 
-from .potentials3d import (_axis_series, _base_table, _contract, _stress, base_derivatives, inverse_distance_derivatives,
-                           potential_base)
+from .potentials3d import (Workspace, _axis_series, _base_table, _contract, _pair_stress_gradient, _stress,
+                           base_derivatives, potential_base)
+from .rectangle_quadrature import entry_order, far_order
+from .segment_quadrature import gauss_legendre
 
 #: Largest vertical derivative order held in the edge tables (D orders up to 5 and the
 #: Laplace turns of the terms without d1: 4 + 5 + 4 + 1).
 M_MAX = 15
+#: Gauss points per side from which a triple is taken in closed form rather than by
+#: quadrature (:func:`vertical_image_stress`).
+CLOSED_FROM = 4
 #: |e_z| of a side above which the rectangle counts as vertical (as okada3d.COS_ZERO).
 VERTICAL = 1.0 - 1e-12
+
+
+@njit(cache=True)
+def _low_inverse_distance(r1, r2, r3, q):
+    """``q[a, b, c] = d1^a d2^b d3^c (1/r)`` for ``a < q.shape[0]`` and a total order
+    ``a + b + c < q.shape[1]`` (``q`` (na, n, n)): the recurrence of
+    :func:`.potentials3d.inverse_distance_derivatives` by total order, for the ``a <= 1``
+    entries that :func:`_log_table` reads (the whole table to its orders cost ten times
+    as much: 13.5 us of the 41 us of an :func:`_edge_table`)."""
+    r = math.sqrt(r1 * r1 + r2 * r2 + r3 * r3)
+    inv = 1.0 / r
+    x0 = r1 * inv
+    x1 = r2 * inv
+    x2 = r3 * inv
+    na = q.shape[0]
+    top = q.shape[1]
+    q[0, 0, 0] = 1.0
+    for n in range(1, top):
+        for a in range(min(na, n + 1)):
+            for b in range(n - a + 1):
+                c = n - a - b
+                s = 0.0
+                if a >= 1:
+                    s += x0 * q[a - 1, b, c]
+                if b >= 1:
+                    s += x1 * q[a, b - 1, c]
+                if c >= 1:
+                    s += x2 * q[a, b, c - 1]
+                s *= 2 * n - 1
+                t = 0.0
+                if a >= 2:
+                    t += q[a - 2, b, c]
+                if b >= 2:
+                    t += q[a, b - 2, c]
+                if c >= 2:
+                    t += q[a, b, c - 2]
+                q[a, b, c] = -(s + (n - 1) * t) / n
+    # t_k / r^(n+1) * a! b! c!, from the highest order down (the recurrence read the unscaled)
+    for n in range(top):
+        for a in range(min(na, n + 1)):
+            for b in range(n - a + 1):
+                c = n - a - b
+                f = inv ** (n + 1)
+                for k in range(2, a + 1):
+                    f *= k
+                for k in range(2, b + 1):
+                    f *= k
+                for k in range(2, c + 1):
+                    f *= k
+                q[a, b, c] *= f
 
 
 @njit(cache=True)
@@ -105,10 +160,12 @@ def _edge_table(ends, r2, r3, sigma, sj, work):
         for kind in range(2):
             for a in range(1, 6):
                 for b in range(6 - a):
-                    for m in range(-1, n_m - 1):
+                    # m = -1 from the primitive in the height; m >= 0 the tables as they are
+                    sj[kind, a, b, 0] += sign * _vertical_primitive(kind, a - 1, b, -1, ends[e], r2, sigma * r3,
+                                                                    sigma, sf, sl, base)
+                    for m in range(n_m - 1):
                         if m < base.shape[3]:
-                            sj[kind, a, b, m + 1] += sign * _vertical_primitive(kind, a - 1, b, m, ends[e], r2,
-                                                                                sigma * r3, sigma, sf, sl, base)
+                            sj[kind, a, b, m + 1] += sign * base[kind, a - 1, b, m]
                         else:
                             sj[kind, a, b, m + 1] = math.nan
     # the terms without d1: d2^(0, 1) d3^m of 1/r through log(r + r1); both ends on one branch
@@ -116,7 +173,7 @@ def _edge_table(ends, r2, r3, sigma, sj, work):
     n_log = logs.shape[0]
     for e in range(2):
         sign = 1.0 if e == 1 else -1.0
-        inverse_distance_derivatives(ends[e], r2, r3, qlog)
+        _low_inverse_distance(ends[e], r2, r3, qlog)
         _log_table(ends[e], r2, r3, flip, logs, qlog, serlog)
         for b in range(2):
             for m in range(-1, n_m - 1):
@@ -150,10 +207,9 @@ def _poly_derivative(p, i, t):
 
 @njit(cache=True)
 def _integrated_table(polys, s0, s1, weighted, order, eps, t_bot, t_top, sj_bot, sj_top, out):
-    """``out[f, j, a, b, c]``: the potential table of :func:`.potentials3d._potential_table`
+    """``out[f, j, a, b, c] +=`` the potential table of :func:`.potentials3d._potential_table`
     integrated over the rectangle, ``polys[f, j, n]`` the quadratic coefficients of ``D^n``
     (times ``s = s0 + s1 t`` when ``weighted``, for the entries the ``s`` term reads)."""
-    out[:] = 0.0
     p = np.zeros(4)
     for f in range(3):
         for j in range(3):
@@ -194,28 +250,62 @@ def _integrated_table(polys, s0, s1, weighted, order, eps, t_bot, t_top, sj_bot,
 
 
 @njit(cache=True)
-def vertical_workspace():
-    """Scratch of :func:`vertical_image_stress`."""
+def _far_triple(yr, hs, hd, t_mid, z0, e, sg, polys, dpolys, n_gauss, delta, shear_modulus, lame, coef_t, dcoef_t,
+                work, gradient):
+    """``gradient +=`` the source-derivative gradient of one triple (point ``z0 + e t``,
+    gauge ``sg``) integrated over the rectangle by ``n_gauss`` Gauss points per side
+    (:func:`.potentials3d._pair_stress_gradient` at each, its coefficients at the point's
+    height ``t`` from the quadratic fits ``polys``, ``dpolys``, times the weight: the
+    gradient is linear in them). ``yr``: the receiver in the turned frame."""
+    x, w = gauss_legendre(n_gauss)
+    n_orders = polys.shape[2]
+    for ia in range(n_gauss):
+        r1 = yr[0] - hs * x[ia]
+        for ib in range(n_gauss):
+            t = t_mid + hd * x[ib]
+            weight = w[ia] * w[ib] * hs * hd
+            for f in range(3):
+                for j in range(3):
+                    for n in range(n_orders):
+                        p = polys[f, j, n]
+                        coef_t[f, j, n] = weight * (p[0] + t * (p[1] + t * p[2]))
+                        p = dpolys[f, j, n]
+                        dcoef_t[f, j, n] = weight * (p[0] + t * (p[1] + t * p[2]))
+            _pair_stress_gradient(r1, yr[1], yr[2] - (z0 + e * t), e, sg, coef_t, dcoef_t, delta, shear_modulus,
+                                  lame, gradient, work)
+
+
+@njit(cache=True)
+def vertical_workspace(n_orders):
+    """Scratch of :func:`vertical_image_stress` for triples of up to ``n_orders`` orders of
+    ``D`` (the tracer's buffer)."""
     n_log = M_MAX - 1
     edge = (np.empty((6, 6)), np.empty((6, 6)), np.empty((4, 6)), np.empty((6, 6, M_MAX - 2)),
-            np.empty((2, 6, 6, M_MAX - 1)), np.empty((n_log, n_log)), np.empty((n_log + 1, n_log + 1, n_log)),
+            np.empty((2, 6, 6, M_MAX - 1)), np.empty((n_log, n_log)), np.empty((2, n_log - 1, n_log - 1)),
             np.empty((4, n_log + 1)))
-    tables = (np.empty((2, 6, 6, M_MAX)), np.empty((2, 6, 6, M_MAX)), np.zeros((4, 3, 3, 6, 6, 6)))
-    return edge, tables, np.zeros((3, 3, 3, 3)), np.zeros((3, 3)), np.zeros((3, 3)), np.zeros((3, 3, 3)), np.zeros(3)
+    tables = (np.empty((2, 6, 6, M_MAX)), np.empty((2, 6, 6, M_MAX)), np.zeros((2, 4, 3, 3, 6, 6, 6)))
+    return (edge, tables, np.zeros((3, 3, 3, 3)), np.zeros((3, 3)), np.zeros((3, 3)), np.zeros((3, 3, 3)), np.zeros(3),
+            Workspace(n_orders), np.zeros((3, 3, n_orders)), np.zeros((3, 3, n_orders)))
 
 
 @njit(cache=True)
 def vertical_image_stress(y, receiver_layer, center, strike, hs, hd, heights, traced, shear_modulus, poisson_ratio,
-                          source_layer, work, out):
+                          source_layer, far_tol, triple_tol, work, out):
     """``out[b, i, k] +=`` the stress at ``y`` (global) of a unit global DD ``b`` on the
     vertical rectangle (centre ``center``, horizontal side along ``strike``, half sides
     ``hs`` along it and ``hd`` up) of the triples ``traced`` (three points: the heights
     ``heights`` = bottom, middle, top; the same triples at each) acting in
-    ``receiver_layer``, in closed form (module docstring). Returns False, adding nothing,
-    where the triples differ between the heights or a table does not reach."""
-    edge, tables, gradient, with_s, without, local, yr = work
+    ``receiver_layer``, in closed form (module docstring). A triple whose image of the
+    rectangle is far enough from ``y`` to need fewer than :data:`CLOSED_FROM` Gauss points
+    per side takes those points instead, its coefficients at their heights from the same
+    quadratic fit (:func:`_far_triple`): the rule of
+    :func:`.rectangle_quadrature._image_order` for that triple alone, :func:`far_order`
+    to the relative error ``far_tol`` (0: every triple in closed form), or fewer by
+    :func:`entry_order` when ``triple_tol > 0`` (the error allowed per unit largest shear
+    modulus). Returns False, adding nothing, where the triples differ between the heights
+    or a table does not reach."""
+    edge, tables, gradient, with_s, without, local, yr, far_work, coef_t, dcoef_t = work
     sj_bot, sj_top, integrated = tables
-    plain, weighted, dplain, dweighted = integrated[0], integrated[1], integrated[2], integrated[3]
     n_pairs, layer, z, eps, sigma, coef, dcoef = traced
     s0, s1 = strike[0], strike[1]
     dx = y[0] - center[0]
@@ -235,6 +325,9 @@ def vertical_image_stress(y, receiver_layer, center, strike, hs, hd, heights, tr
     polys = np.zeros((3, 3, n_orders, 3))
     dpolys = np.zeros((3, 3, n_orders, 3))
     ends = np.array([yr[0] - hs, yr[0] + hs])
+    # the integrated tables of every triple of one eps summed (the stress is linear in
+    # them, and eps is all it needs of the triple besides): one _stress pass per sign
+    used = np.zeros(2, dtype=np.bool_)
     for k in range(n_pairs[0]):
         if layer[0, k] != receiver_layer:
             continue
@@ -262,14 +355,38 @@ def vertical_image_stress(y, receiver_layer, center, strike, hs, hd, heights, tr
                         target[f, j, n, 0] = c0 if top >= 0 else 0.0
                         target[f, j, n, 1] = c1 if top >= 1 else 0.0
                         target[f, j, n, 2] = c2 if top >= 2 else 0.0
+        if far_tol > 0.0:
+            # distance from y to the triple's image of the rectangle (x along the strike)
+            z_lo = min(z0 + e * t_bot, z0 + e * t_top)
+            z_hi = max(z0 + e * t_bot, z0 + e * t_top)
+            along = max(abs(yr[0]) - hs, 0.0)
+            up = max(z_lo - yr[2], yr[2] - z_hi, 0.0)
+            distance = math.sqrt(along * along + yr[1] * yr[1] + up * up)
+            n_gauss = far_order(distance / max(hs, hd), CLOSED_FROM, far_tol)
+            if triple_tol > 0.0:
+                n_gauss = min(n_gauss, entry_order(distance, hs, hd, CLOSED_FROM, triple_tol))
+            if n_gauss < CLOSED_FROM:
+                _far_triple(yr, hs, hd, t_mid, z0, e, sg, polys, dpolys, n_gauss, delta_r, g_r, lame_r, coef_t,
+                            dcoef_t, far_work, gradient)
+                continue
         _edge_table(ends, yr[1], yr[2] - (z0 + e * t_bot), sg, sj_bot, edge)
         _edge_table(ends, yr[1], yr[2] - (z0 + e * t_top), sg, sj_top, edge)
         sa = yr[2] - z0  # s = y3 - z(t) = sa - e t
+        side = 0 if e > 0.0 else 1
+        if not used[side]:
+            integrated[side] = 0.0
+            used[side] = True
         # run-time flags and orders: one compiled _integrated_table, not one per literal
         for which in range(4):
             order = 3 - which // 2
             _integrated_table(polys if order == 3 else dpolys, sa, -e, which % 2 == 1, order, e, t_bot, t_top,
-                              sj_bot, sj_top, integrated[which])
+                              sj_bot, sj_top, integrated[side, which])
+    for side in range(2):
+        if not used[side]:
+            continue
+        e = 1.0 if side == 0 else -1.0
+        plain, weighted, dplain, dweighted = (integrated[side, 0], integrated[side, 1], integrated[side, 2],
+                                              integrated[side, 3])
         for f in range(3):
             for v in range(4):
                 da = 1 if v == 0 else 0

@@ -34,7 +34,7 @@ def _closed(y, receiver_layer, center, frame, a, b, source_layer, medium, n_imag
     traced = trace_points(heights, source_layer, interfaces, g, nu, n_images)
     out = np.zeros((3, 3, 3))
     assert vertical_image_stress(y, receiver_layer, center, strike, hs, hd_, heights, traced, g, nu, source_layer,
-                                 vertical_workspace(), out)
+                                 0.0, 0.0, vertical_workspace(traced[5].shape[-1]), out)
     if receiver_layer != source_layer:
         uniform = np.empty((3, 3, 3))
         rectangle3d.stress_pair(y, center, frame, a, b, g[source_layer], nu[source_layer], 0.0, uniform,

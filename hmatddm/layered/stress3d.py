@@ -1,0 +1,60 @@
+"""The stress at points of constant rectangles in a plane-layered 3D medium (ref. Secs
+3.2-3.3; the direct sum behind :func:`hmatddm.stress_at`, the remote-failure check of
+natural fractures, the microseismic forward model and the monitors in layered rock).
+
+Sources outside, points inside (:func:`stress_points`): each source's image triples are
+traced once for all the points (:func:`.images3d.source_state`: the points of its Gauss
+rules, and for a vertical rectangle its three heights), and each point-source pair takes
+the per-pair image terms of the operator (:func:`.images3d.element_stress_traced`: the
+closed forms of :mod:`.okada3d` and :mod:`.vertical3d`, the quadrature elsewhere). The
+generic driver :func:`hmatddm.kernels.drivers.stress_block` loops over points outside and
+has no source state, so it traces every source's triples again at every point (issue 32,
+a free surface over two interfaces, ``images=4``: 857 us a pair against 643 us with sources
+outside, both by quadrature; ``benchmarks/bench_layered3d_stress.py``, benchmarks/RESULTS.md).
+"""
+import numpy as np
+from numba import njit
+
+from ..kernels.drivers import _in_parts
+from .images3d import element_stress_traced, source_state, workspace
+
+__all__ = ["stress_points", "stress_sum"]
+
+
+@njit(cache=True, nogil=True)
+def stress_points(data, points, point_layer, dd, out):
+    """``out`` (M, 3, 3): the stress at ``points`` (M, 3) in layers ``point_layer`` (M,)
+    of the global DDs ``dd`` (N, 3) of every rectangle of the
+    :class:`.images3d.LayeredRectangles` ``data`` (each point's sum in element order)."""
+    work = workspace(data)
+    pair = np.empty((3, 3, 3))
+    for m in range(points.shape[0]):
+        for i in range(3):
+            for k in range(3):
+                out[m, i, k] = 0.0
+    for j in range(data.centers.shape[0]):
+        state = source_state(data, j, work)
+        for m in range(points.shape[0]):
+            element_stress_traced(data, points[m], point_layer[m], j, state, work, pair)
+            for i in range(3):
+                for k in range(3):
+                    acc = 0.0
+                    for q in range(3):
+                        acc += pair[q, i, k] * dd[j, q]
+                    out[m, i, k] += acc
+
+
+def stress_sum(data, points, dd, point_layer):
+    """(M, 3, 3): :func:`stress_points` of ``dd`` ((N, 3) or (3N,)) at ``points`` (M, 3),
+    one range of points per thread (each range traces every source once: fewer, longer
+    ranges trace less)."""
+    points = np.ascontiguousarray(points, dtype=np.float64)
+    point_layer = np.ascontiguousarray(point_layer, dtype=np.int64)
+    dd = np.ascontiguousarray(np.asarray(dd, dtype=np.float64).reshape(data.centers.shape[0], 3))
+    out = np.zeros((len(points), 3, 3))
+
+    def part(start, stop):
+        stress_points(data, points[start:stop], point_layer[start:stop], dd, out[start:stop])
+
+    _in_parts(part, len(points), parts_per_thread=1)
+    return out
