@@ -78,6 +78,9 @@ it, issue 39; not re-measured with this rule).
 **Carter leak-off** (a Newtonian fluid): the tip asymptote with leak-off, the elements the
 front crosses leaking point by point, and the front iteration bracketed --
 :mod:`hmatddm.simulation.front_leak_off`, where the measurements are.
+
+Over 500 lines: one step's front iteration (fill, solve, inversion, relaxation, leak-off
+brackets, far ribbons) reads best as one loop.
 """
 import logging
 import time
@@ -106,16 +109,11 @@ logger = logging.getLogger(__name__)
 # averages out)
 SUB_SAMPLES = {1: 256, 2: 8}
 
-#: The front tolerance (element sizes) when the scene sets none. 1e-2: finer iterations
-#: chased the fill's discrete events (a cell turning tip or filled) for up to 30 solves a
-#: step at 0.25 m without moving the answer (radial-k 0.25 m: 292 growth passes against 531,
-#: radius -0.071% against -0.078%, opening +0.330% against +0.328% from the K vertex;
-#: radial-m 0.5 m: 80 passes against 112, radius -0.356% against -0.360%; kgd: 150 against
-#: 329, the same half-length); benchmarks/RESULTS.md, issue 33, "the lattice".
-FRONT_TOLERANCE = 1e-2
-#: ... with leak-off: at an M~ tip 1e-2 left the radial M~ run's centre opening 6.7% from
-#: the vertex at 1.6 s against 1.8% at 1e-3 (tests/scene/test_leak_off_reference.py).
-LEAK_OFF_FRONT_TOLERANCE = 1e-3
+#: The front tolerance (element sizes) when the scene sets none: 1e-3 chased the fill's
+#: discrete events for up to 30 solves a step without moving the answer (benchmarks/
+#: RESULTS.md, issue 33, "the lattice"); with leak-off 1e-2 left the radial M~ run's centre
+#: opening 6.7% from the vertex against 1.8% (tests/scene/test_leak_off_reference.py).
+FRONT_TOLERANCE, LEAK_OFF_FRONT_TOLERANCE = 1e-2, 1e-3
 
 
 class PrescribedOpening:
