@@ -122,6 +122,28 @@ def base_derivatives(r1, r2, r3, sf, sl, q, ser):
             sl[a, b] = -sl[a + 2, b - 2] - q[a, b - 2, 1]
 
 
+@njit(cache=True, inline="always")
+def inverse_distance_step(q, a, b, c, n, x0, x1, x2):
+    """One entry (orders ``a, b, c``, ``n = a + b + c``) of the recurrence of the unscaled
+    derivatives of ``1/r`` from the lower orders already in ``q`` (``x_k = r_k / r``)."""
+    s = 0.0
+    if a >= 1:
+        s += x0 * q[a - 1, b, c]
+    if b >= 1:
+        s += x1 * q[a, b - 1, c]
+    if c >= 1:
+        s += x2 * q[a, b, c - 1]
+    s *= 2 * n - 1
+    t = 0.0
+    if a >= 2:
+        t += q[a - 2, b, c]
+    if b >= 2:
+        t += q[a, b - 2, c]
+    if c >= 2:
+        t += q[a, b, c - 2]
+    return -(s + (n - 1) * t) / n
+
+
 @njit(cache=True)
 def inverse_distance_derivatives(r1, r2, r3, q):
     """``q[a, b, c] = d1^a d2^b d3^c (1/r)`` for ``a + b < q.shape[0]``, ``c < q.shape[2]``
@@ -142,22 +164,7 @@ def inverse_distance_derivatives(r1, r2, r3, q):
                 if n == 0:
                     q[0, 0, 0] = 1.0
                     continue
-                s = 0.0
-                if a >= 1:
-                    s += x0 * q[a - 1, b, c]
-                if b >= 1:
-                    s += x1 * q[a, b - 1, c]
-                if c >= 1:
-                    s += x2 * q[a, b, c - 1]
-                s *= 2 * n - 1
-                t = 0.0
-                if a >= 2:
-                    t += q[a - 2, b, c]
-                if b >= 2:
-                    t += q[a, b - 2, c]
-                if c >= 2:
-                    t += q[a, b, c - 2]
-                q[a, b, c] = -(s + (n - 1) * t) / n
+                q[a, b, c] = inverse_distance_step(q, a, b, c, n, x0, x1, x2)
     # t_k / r^(n+1) * a! b! c!
     fc = inv
     for c in range(nc):

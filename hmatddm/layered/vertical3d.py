@@ -27,7 +27,7 @@ import numpy as np
 from numba import njit
 
 from .potentials3d import (Workspace, _axis_series, _base_table, _contract, _pair_stress_gradient, _stress,
-                           base_derivatives, potential_base)
+                           base_derivatives, inverse_distance_step, potential_base)
 from .rectangle_quadrature import entry_order, far_order
 from .segment_quadrature import gauss_legendre
 
@@ -59,23 +59,7 @@ def _low_inverse_distance(r1, r2, r3, q):
     for n in range(1, top):
         for a in range(min(na, n + 1)):
             for b in range(n - a + 1):
-                c = n - a - b
-                s = 0.0
-                if a >= 1:
-                    s += x0 * q[a - 1, b, c]
-                if b >= 1:
-                    s += x1 * q[a, b - 1, c]
-                if c >= 1:
-                    s += x2 * q[a, b, c - 1]
-                s *= 2 * n - 1
-                t = 0.0
-                if a >= 2:
-                    t += q[a - 2, b, c]
-                if b >= 2:
-                    t += q[a, b - 2, c]
-                if c >= 2:
-                    t += q[a, b, c - 2]
-                q[a, b, c] = -(s + (n - 1) * t) / n
+                q[a, b, n - a - b] = inverse_distance_step(q, a, b, n - a - b, n, x0, x1, x2)
     # t_k / r^(n+1) * a! b! c!, from the highest order down (the recurrence read the unscaled)
     for n in range(top):
         for a in range(min(na, n + 1)):
