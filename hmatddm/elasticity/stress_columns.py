@@ -13,9 +13,10 @@ the kept terms with the current DDs. The stage scene with stiffer bounding layer
 (issue 35): every check recomputed 20-500 elements at 2074 points; now each element is
 computed once per run (benchmarks/RESULTS.md, issue 35).
 
-The terms are those of the direct sum (:func:`hmatddm.kernels.drivers.stress_columns`,
-the per-pair function :func:`hmatddm.kernels.drivers.stress_block` sums), so the stress is
-the direct sum's up to the order of the additions (1e-16 relative). A mesh that is not the
+The terms are those of the direct sum (:func:`hmatddm.layered.stress3d.stress_columns`,
+the per-pair function :func:`hmatddm.layered.stress3d.stress_points` sums, each source traced
+once, vertical sources in closed form), so the stress is the direct sum's up to the order of
+the additions (1e-16 relative). A mesh that is not the
 last one plus appended elements (same first elements, bit for bit), another medium, number
 of images, correction or set of points starts again; points outside the first call's set
 start again too (the intact set only shrinks in a run). Above :data:`MEMORY_BUDGET` bytes
@@ -24,7 +25,6 @@ of terms the caller sums directly (:meth:`StressColumns.reuse` returns None).
 import numpy as np
 
 from ..errors import InputError
-from ..kernels.drivers import stress_columns_at
 from ..options import AVERAGE_SHIFT
 
 #: Largest size (bytes) of the kept terms (points x elements x 27 float64); beyond it
@@ -99,12 +99,15 @@ class StressColumns:
         n0, n = self.n_elements, mesh.n_elements
         if n == n0:
             return
-        from ..layered.influence3d import influence_data, with_images
+        from ..layered.influence3d import influence_data
+        from ..layered.stress3d import stress_columns
 
         new = mesh.subset(np.arange(n0, n))
         shift = AVERAGE_SHIFT if self.singular_correction == "average" else 0.0
-        data = with_images(influence_data(new, self.medium, shift, 0.0, self.near_fraction, 0), self.n_images)
-        terms = stress_columns_at(data, self.points[self.rows], self.point_layer, np.arange(n - n0))
+        # built as hd.stress_at builds it (influence3d._prepared): the closed forms that need
+        # images are chosen with the number of images
+        data = influence_data(new, self.medium, shift, 0.0, self.near_fraction, int(self.n_images), with_table=False)
+        terms = stress_columns(data, self.points[self.rows], self.point_layer)  # [m, k, u, a, b]
         m = len(self.rows)  # [m, k, u, a, b] -> [m, a b, k u]
         self.blocks.append((n0, n, np.ascontiguousarray(terms.transpose(0, 3, 4, 1, 2).reshape(m, 9, 3 * (n - n0)))))
         self.geometry = tuple(np.array(array) for array in _geometry(mesh))

@@ -52,8 +52,7 @@ plus its own geometry and material (:func:`kernel_record` makes the classes). El
 Compiled entry points are few on purpose, as each one compiles (and LLVM optimises) the
 whole per-pair kernel it calls again: per record type only :func:`traction_block` (the
 H-matrix's block generator, with exactly the signature the H-matrix build calls it with),
-:func:`stress_block`, :func:`edge_distance` and :func:`stress_columns` (compiled only for
-the kinds that use it: the layered 3D remote-failure check). The dense matrix, the stress at many
+:func:`stress_block` and :func:`edge_distance`. The dense matrix, the stress at many
 points and the singular-pair test call those two from Python (in parallel on numba's
 thread count where it pays: the compiled drivers release the GIL); the self-block maxima
 call :func:`traction_block` through a pointer from a small compiled loop (the kernel is not
@@ -324,20 +323,6 @@ def stress_block(data, points, point_layer, dd, out):
     _hold(scratch)
 
 
-@njit(cache=True, nogil=True)
-def stress_columns(data, points, point_layer, cols, out):
-    """``out[m, k]`` (``out`` (M, K, d, dim, dim)): the global stress at ``points[m]`` (in
-    layer ``point_layer[m]``) for each unit DD unknown of element ``cols[k]``, the terms
-    :func:`stress_block` sums, kept apart (a growing mesh's field at fixed points keeps the
-    columns of the elements it has seen: :class:`hmatddm.elasticity.stress_columns.StressColumns`)."""
-    scratch = (_workspace(data),)
-    data_, points_, point_layer_, cols_, out_, work = borrowed((data, points, point_layer, cols, out, scratch[0]))
-    for m in range(points_.shape[0]):
-        for k in range(cols_.shape[0]):
-            _element_stress(data_, points_[m], point_layer_[m], cols_[k], work, out_[m, k])
-    _hold(scratch)
-
-
 @njit(cache=True)
 def edge_distance(data, i, j):
     """Distance from the collocation point(s) of element ``i`` to the nearest edge (end)
@@ -454,21 +439,6 @@ def stress_at_points(data, points, point_layer, dd, out):
     _in_parts(part, len(points))
 
 
-def stress_columns_at(data, points, point_layer, cols):
-    """(M, K, d, dim, dim): :func:`stress_columns` of elements ``cols`` (K,) at ``points``
-    (M, dim) in layers ``point_layer`` (M,), parallel over points."""
-    points = np.ascontiguousarray(points, dtype=np.float64)
-    point_layer = np.ascontiguousarray(point_layer, dtype=np.int64)
-    cols = np.ascontiguousarray(cols, dtype=np.int64)
-    dim = points.shape[1]
-    out = np.empty((len(points), len(cols), element_unknowns(data), dim, dim))
-
-    def part(start, stop):
-        stress_columns(data, points[start:stop], point_layer[start:stop], cols, out[start:stop])
-    _in_parts(part, len(points))
-    return out
-
-
 def stress_sum(data, points, dd, point_layer=None):
     """(M, dim, dim): :func:`stress_at_points` of ``dd`` (N, d) at ``points`` (M, dim)
     (``point_layer`` None: zeros, a homogeneous medium)."""
@@ -497,6 +467,6 @@ def finite_stress_sum(data, points, dd, point_layer, edge="element edge"):
 
 __all__ = ["COMMON_FIELDS", "HOMOGENEOUS_FIELDS", "kernel_record", "KernelKind", "register_kind", "no_source_state",
            "kind_of", "element_unknowns", "borrowed", "traction_block", "stress_block", "edge_distance",
-           "stress_columns", "stress_columns_at", "traction_matrix", "influence_matrix", "singular_pairs",
+           "traction_matrix", "influence_matrix", "singular_pairs",
            "self_blocks", "self_block_max", "with_self_max", "self_block_maxima", "stress_at_points", "stress_sum",
            "finite_stress_sum"]

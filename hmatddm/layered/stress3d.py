@@ -18,7 +18,7 @@ from numba import njit
 from ..kernels.drivers import _in_parts
 from .images3d import element_stress_traced, source_state, workspace
 
-__all__ = ["stress_points", "stress_sum"]
+__all__ = ["stress_points", "stress_sum", "stress_columns_points", "stress_columns"]
 
 
 @njit(cache=True, nogil=True)
@@ -55,6 +55,34 @@ def stress_sum(data, points, dd, point_layer):
 
     def part(start, stop):
         stress_points(data, points[start:stop], point_layer[start:stop], dd, out[start:stop])
+
+    _in_parts(part, len(points), parts_per_thread=1)
+    return out
+
+
+@njit(cache=True, nogil=True)
+def stress_columns_points(data, points, point_layer, out):
+    """``out[m, j, q]`` (M, N, 3, 3, 3): the stress at ``points[m]`` of a unit DD component
+    ``q`` of rectangle ``j``, each source traced once -- the terms :func:`stress_points` sums
+    (the same function per pair, so a sum of these terms is its sum up to the order of the
+    additions)."""
+    work = workspace(data)
+    pair = np.empty((3, 3, 3))
+    for j in range(data.centers.shape[0]):
+        state = source_state(data, j, work)
+        for m in range(points.shape[0]):
+            element_stress_traced(data, points[m], point_layer[m], j, state, work, pair)
+            out[m, j] = pair
+
+
+def stress_columns(data, points, point_layer):
+    """(M, N, 3, 3, 3): :func:`stress_columns_points`, one range of points per thread."""
+    points = np.ascontiguousarray(points, dtype=np.float64)
+    point_layer = np.ascontiguousarray(point_layer, dtype=np.int64)
+    out = np.empty((len(points), data.centers.shape[0], 3, 3, 3))
+
+    def part(start, stop):
+        stress_columns_points(data, points[start:stop], point_layer[start:stop], out[start:stop])
 
     _in_parts(part, len(points), parts_per_thread=1)
     return out
