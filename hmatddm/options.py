@@ -39,7 +39,7 @@ SCHEME_DEFAULTS = dict(scheme="krylov", omega=1.0, relaxation=1.0, min_relaxatio
                        tolerance_pressure=1e-6, tolerance_opening=1e-6, max_iterations=400, linear_rtol=1e-9,
                        linear_restart=100, linear_maxiter=20, relaxation_growth=None, stopping="contraction",
                        first_linear_rtol=1e-6, growth_check="first",
-                       provisional_linear_rtol=1e-4)  # SchemeSettings
+                       provisional_linear_rtol=1e-4, linear_forcing=0.1)  # SchemeSettings
 
 CRITERIA = ("mcs", "energy")                    # hmatddm.fracture.growth.Propagation
 TURNING = ("none", "plan", "any")

@@ -261,6 +261,10 @@ SCHEME = {  # -> hmatddm.coupled.step_problem.SchemeSettings (ref. Sec. 4.5)
                                        doc="relative residual at which the first GMRES solve of a growth-deciding "
                                            "solve pauses first (then tenfold smaller, down to first_linear_rtol): "
                                            "a pass decides there when no tip is near its threshold"),
+    "linear_forcing": Setting("number", SCHEME_DEFAULTS["linear_forcing"], low=0.0, high=1.0, high_open=True,
+                              doc="coupled schemes: an iterate after the first is solved to this times the "
+                                  "last relative change (between linear_rtol and first_linear_rtol; 0: "
+                                  "every one to linear_rtol); an accepted iterate is always solved to linear_rtol"),
     "growth_check": Setting("choice", SCHEME_DEFAULTS["growth_check"], choices=GROWTH_CHECKS,
                             doc="element front: first: decide a growth pass on a solve's first (loose) iterate "
                                 "and converge only the mesh the step keeps; converged: on the converged solve"),

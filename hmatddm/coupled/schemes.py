@@ -103,13 +103,14 @@ def _segregated_iteration(problem, settings, dd, p, alpha, counters, first=False
     return alpha * dd_new + (1.0 - alpha) * dd, alpha * p_new + (1.0 - alpha) * p
 
 
-def _coupled_iteration(problem, settings, dd, p, alpha, counters, first=False, pause=None):
+def _coupled_iteration(problem, settings, dd, p, alpha, counters, first=False, pause=None, rtol=None):
     """One coupled iterate from ``(dd, p)`` (the widths lagged there); ``first``: its GMRES at
     ``first_linear_rtol``. ``pause`` (a list, with ``first``): the GMRES solve pauses at
     :func:`~hmatddm.coupled.paused.pause_levels` (:class:`hmatddm.hmatrix.solvers.PausableGmres`),
     the iterate returned is the first paused one, and a
     :class:`~hmatddm.coupled.paused.PausedIterate` appended to ``pause``
-    continues the same solve (nothing appended when it ended before a pause)."""
+    continues the same solve (nothing appended when it ended before a pause). ``rtol``: the
+    GMRES tolerance of a later iterate (default ``linear_rtol``; :meth:`PendingSolve.linear_rtol`)."""
     matrix, flow_rhs = problem.flow_matrices(dd, p)
     if not (np.all(np.isfinite(matrix.data)) and np.all(np.isfinite(flow_rhs))):
         raise _Diverged("non-finite flow matrix")
@@ -122,7 +123,10 @@ def _coupled_iteration(problem, settings, dd, p, alpha, counters, first=False, p
     except (RuntimeError, np.linalg.LinAlgError) as error:  # singular flow or diagonal blocks
         raise _Diverged(f"singular coupled system: {error}") from None
     guess = np.concatenate([dd / system.s_u, p / system.s_p])
-    rtol = max(settings.linear_rtol, settings.first_linear_rtol) if first else settings.linear_rtol
+    if first:
+        rtol = max(settings.linear_rtol, settings.first_linear_rtol)
+    elif rtol is None:
+        rtol = settings.linear_rtol
     levels = pause_levels(settings) if pause is not None else None
     solver = PausableGmres(system.operator, system.rhs(flow_rhs), M=preconditioner, rtol=rtol,
                            restart=settings.linear_restart, maxiter=settings.linear_maxiter, x0=guess,
@@ -227,6 +231,22 @@ class PendingSolve:
         self.history = []
         self.iteration = 0
         self.last_change = math.nan
+        self.accurate_next = False  # an iterate solved loosely passed the test: the next at linear_rtol
+        self.last_rtol = None       # GMRES tolerance of the last iterate (None: linear_rtol)
+
+    def linear_rtol(self, iteration):
+        """The GMRES tolerance of iterate ``iteration`` after the first of an attempt
+        (``SchemeSettings.linear_forcing``): ``linear_forcing`` times the last relative
+        change, within ``[linear_rtol, first_linear_rtol]``; ``linear_rtol`` once a loosely
+        solved iterate passed the convergence test. None: ``linear_rtol`` (segregated
+        schemes, the first iterate, forcing off)."""
+        settings = self.settings
+        if iteration == 0 or not self.coupled or not settings.linear_forcing > 0.0 or self.accurate_next:
+            return None
+        if not math.isfinite(self.last_change):
+            return None
+        ceiling = max(settings.first_linear_rtol, settings.linear_rtol)
+        return max(settings.linear_rtol, min(ceiling, settings.linear_forcing * self.last_change))
 
     @property
     def looser_provisional(self):
@@ -302,8 +322,11 @@ class PendingSolve:
                     # a loosely solved first iteration may return its guess (its residual already
                     # below first_linear_rtol): only a full-accuracy iterate can be accepted
                     loose = iteration == 0 and self.loose_first
-                    if not loose and _converged(settings.stopping, change, self.history) and changed == 0:
-                        return self.dd, self.p, self._finished(pending=False)
+                    forced = self.last_rtol is not None and self.last_rtol > settings.linear_rtol
+                    if _converged(settings.stopping, change, self.history) and changed == 0:
+                        if not (loose or forced):
+                            return self.dd, self.p, self._finished(pending=False)
+                        self.accurate_next = True  # the next at linear_rtol (SchemeSettings.linear_forcing)
                     history = self.history
                     history.append(change)
                     # divergence: the change grew for 5 iterations in a row AND doubled over its
@@ -332,6 +355,7 @@ class PendingSolve:
         continued, or ``self.iterate``, its first GMRES solve paused at
         ``provisional_linear_rtol`` for a provisional return."""
         first = iteration == 0
+        self.last_rtol = None
         if first and self._continue:
             paused, mode, self._continue = self._paused, self._continue, None
             out = _continued(paused.advance if mode == "advance" else paused.finish)
@@ -341,8 +365,9 @@ class PendingSolve:
         if not self.coupled:
             return self.iterate(self.problem, self.settings, self.dd, self.p, self.alpha, self.counters, first=first)
         pause = [] if first and provisional and self.looser_provisional else None
+        self.last_rtol = None if first else self.linear_rtol(iteration)
         out = self.iterate(self.problem, self.settings, self.dd, self.p, self.alpha, self.counters, first=first,
-                           pause=pause)
+                           pause=pause, rtol=self.last_rtol)
         self._paused = pause[0] if pause else None
         return out
 

@@ -38,6 +38,14 @@ class SchemeSettings:
         decides on such a cheaper iterate when no tip is near its threshold;
         ``PendingSolve.refine`` and ``finish`` continue the same GMRES solve, so the
         iterates that follow are a plain solve's, bit for bit.
+    linear_forcing : float in [0, 1), the forcing term of the inexact (Picard) iteration
+        (coupled schemes): an iterate after an attempt's first is solved to
+        ``linear_forcing`` times the relative change of the iterate before it, clipped to
+        ``[linear_rtol, first_linear_rtol]``, since a linear solve far below the change
+        the next iterate makes is work thrown away; an iterate that would be accepted
+        from such a loose solve is not: the next is solved to ``linear_rtol`` (so the
+        solution a step ends on, and its fluid budget, are those of full-accuracy solves).
+        0: every iterate to ``linear_rtol`` (before issue 33).
     growth_check : ``"first"`` or ``"converged"``: on which iterate a simulation with the
         element front (and no natural fractures) decides a growth pass. ``"first"``: on the
         first (loose) iterate of a coupled solve, converging it only when no element grows
@@ -68,6 +76,7 @@ class SchemeSettings:
     first_linear_rtol: float = SCHEME_DEFAULTS["first_linear_rtol"]
     growth_check: str = SCHEME_DEFAULTS["growth_check"]
     provisional_linear_rtol: float = SCHEME_DEFAULTS["provisional_linear_rtol"]
+    linear_forcing: float = SCHEME_DEFAULTS["linear_forcing"]
 
     def __post_init__(self):
         object.__setattr__(self, "scheme", SCHEME["scheme"].value("scheme", self.scheme))
@@ -75,7 +84,8 @@ class SchemeSettings:
             object.__setattr__(self, "relaxation_growth", 2.0 if self.scheme in COUPLED_SCHEMES else 1.0)
         for name in ("relaxation_growth", "omega", "relaxation", "min_relaxation", "tolerance_pressure",
                      "tolerance_opening", "linear_rtol", "max_iterations", "linear_restart", "linear_maxiter",
-                     "stopping", "first_linear_rtol", "growth_check", "provisional_linear_rtol"):
+                     "stopping", "first_linear_rtol", "growth_check", "provisional_linear_rtol",
+                     "linear_forcing"):
             object.__setattr__(self, name, SCHEME[name].value(name, getattr(self, name)))
 
 

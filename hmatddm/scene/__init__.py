@@ -119,6 +119,7 @@ The format, annotated (``=`` values are the defaults unless marked REQUIRED)::
     linear_maxiter = 20            # GMRES restart cycles, >= 1
     stopping = "contraction"       # "contraction" (also stop on the extrapolated next change) or "change"
     first_linear_rtol = 1e-6       # GMRES relative residual of a solve's first iteration, (0, 1)
+    linear_forcing = 0.1           # later iterations: this times the last change (>= linear_rtol), [0, 1)
     growth_check = "first"         # growth pass decided on a solve's first iterate, or "converged"
     provisional_linear_rtol = 1e-4  # that first GMRES solve pauses there first to decide, (0, 1)
     initial_pressure = 10e6        # Pa, fluid pressure at t = 0 (default 0)

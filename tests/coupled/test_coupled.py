@@ -123,7 +123,7 @@ def test_contraction_stopping_matches_the_change_rule_within_the_tolerance(schem
     for stopping, first in (("change", 1e-12), ("contraction", 1e-6)):
         problem, dd0, p0 = _problem(mesh, rate=1e-2, viscosity=1e-5)
         settings = SchemeSettings(scheme=scheme, linear_rtol=1e-12, stopping=stopping, first_linear_rtol=first,
-                                  max_iterations=3000)
+                                  max_iterations=3000, linear_forcing=0.0)  # the rules alone (forcing below)
         results[stopping] = solve_step(problem, settings, dd0, p0, 1.0)
     (dd_c, p_c, info_c), (dd_s, p_s, info_s) = results["contraction"], results["change"]
     tolerance = 1e-6 / info_s["relaxation"]  # a relaxed iteration stops within about tol/alpha
@@ -166,6 +166,44 @@ def test_a_loose_first_solve_is_never_accepted():
     assert info["nonlinear_iterations"] >= 2
     np.testing.assert_allclose(p, p_ref, atol=1e-6 * np.abs(p_ref).max())
     np.testing.assert_allclose(dd, dd_ref, atol=1e-6 * np.abs(dd_ref).max())
+
+
+def test_the_forcing_term_solves_loosely_but_accepts_only_an_accurate_iterate(monkeypatch):
+    # linear_forcing: iterates after the first are solved to forcing x the last change
+    # (fewer GMRES iterations in all), and the iterate a solve ends on to linear_rtol: the
+    # same solution as every iterate at linear_rtol, within the nonlinear tolerance, and the
+    # flow equations of the accepted iterate hold to linear_rtol's accuracy
+    from hmatddm.coupled import schemes
+
+    mesh = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 8.0, 8.0, 8, 8)
+    tolerances = []
+    original = schemes._coupled_iteration
+
+    def recorded(*args, rtol=None, **kwargs):
+        tolerances.append(rtol)
+        return original(*args, rtol=rtol, **kwargs)
+
+    monkeypatch.setattr(schemes, "_coupled_iteration", recorded)
+    results = {}
+    for forcing in (0.0, 0.1):
+        problem, dd0, p0 = _problem(mesh, rate=1e-2, viscosity=1e-3)
+        settings = SchemeSettings(scheme="krylov", linear_rtol=1e-12, linear_forcing=forcing)
+        tolerances.clear()
+        dd, p, info = solve_step(problem, settings, dd0, p0, 1.0)
+        matrix, rhs = problem.flow_matrices(dd, p)
+        flow_residual = np.abs(problem.coupling @ dd + matrix @ p - rhs).max() / np.abs(rhs).max()
+        results[forcing] = dd, p, info, list(tolerances), flow_residual
+    dd_0, p_0, info_0, rtols_0, residual_0 = results[0.0]
+    dd_f, p_f, info_f, rtols_f, residual_f = results[0.1]
+    assert all(rtol is None for rtol in rtols_0)
+    assert any(rtol is not None and rtol > 1e-12 for rtol in rtols_f)  # some iterates were solved loosely
+    assert rtols_f[-1] is None  # ... not the accepted one
+    assert info_f["linear_iterations"] < info_0["linear_iterations"]
+    np.testing.assert_allclose(p_f, p_0, atol=2e-6 * np.abs(p_0).max())
+    np.testing.assert_allclose(dd_f, dd_0, atol=2e-6 * np.abs(dd_0).max())
+    assert residual_f < 1e-6 and residual_0 < 1e-6
+    with pytest.raises(hd.errors.InputError, match="linear_forcing"):
+        SchemeSettings(linear_forcing=1.0)
 
 
 @pytest.mark.parametrize("backend", ["dense", "hmatrix"])
