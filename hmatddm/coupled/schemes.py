@@ -154,6 +154,13 @@ def _continued(call):
 # tolerance (the rate of the first iterations varies; measured on the radial K-vertex run
 # at h = 1 m, the change after an accepted iterate was at most 0.9 tolerance)
 CONTRACTION_SAFETY = 3.0
+#: The contraction rate assumed for the second iterate of an attempt, whose rate is unknown
+#: (PendingSolve.linear_rtol: an iterate expected to pass the test is solved to linear_rtol)
+FIRST_RATE = 0.1
+#: ... and an iterate whose change is expected within this many tolerances is solved to
+#: linear_rtol (measured on the radial K-vertex at 0.5 m: the changes of a solve's iterates
+#: run ~1200, ~57, <1 tolerances; forcing the second-to-last iterate cost one more iterate)
+FORCING_FROM = 10.0
 
 
 def _converged(stopping, change, history):
@@ -240,10 +247,16 @@ class PendingSolve:
         change, within ``[linear_rtol, first_linear_rtol]``; ``linear_rtol`` once a loosely
         solved iterate passed the convergence test. None: ``linear_rtol`` (segregated
         schemes, the first iterate, forcing off)."""
-        settings = self.settings
+        settings, history = self.settings, self.history
         if iteration == 0 or not self.coupled or not settings.linear_forcing > 0.0 or self.accurate_next:
             return None
-        if not math.isfinite(self.last_change):
+        if not (math.isfinite(self.last_change) and history):
+            return None
+        # the next change extrapolated from the last two (an unknown rate: FIRST_RATE); where
+        # it is within FORCING_FROM tolerances the iterate may well be the accepted one: solved
+        # to linear_rtol at once (a loose one would cost an extra accurate iterate)
+        rate = history[-1] / history[-2] if len(history) >= 2 and history[-2] > 0.0 else FIRST_RATE
+        if rate * history[-1] < FORCING_FROM:
             return None
         ceiling = max(settings.first_linear_rtol, settings.linear_rtol)
         return max(settings.linear_rtol, min(ceiling, settings.linear_forcing * self.last_change))

@@ -37,11 +37,14 @@ def test_radial_m_vertex_early_growth_is_round_and_conserves_volume():
 
 
 def test_dense_and_hmatrix_runs_agree():
+    # each run's nonlinear solves stop within the tolerance 1e-6 of their fixed point, on
+    # iterates that differ with the backend (the forcing term solves them to the changes'
+    # accuracy, not to 1e-9): the two runs agree to twice the tolerance, the mesh exactly
     runs = [radial(h=2.0, backend=backend).run(3.0) for backend in ("dense", "hmatrix")]
     for dense, hmatrix in zip(*runs):
         assert dense["n_elements"] == hmatrix["n_elements"]
-        assert hmatrix["radius"] == pytest.approx(dense["radius"], rel=1e-6)
-        assert hmatrix["wellbore_pressure"][0] == pytest.approx(dense["wellbore_pressure"][0], rel=1e-6)
+        assert hmatrix["radius"] == pytest.approx(dense["radius"], rel=2e-6)
+        assert hmatrix["wellbore_pressure"][0] == pytest.approx(dense["wellbore_pressure"][0], rel=2e-6)
 
 
 def test_resume_from_checkpoint_gives_the_same_run(tmp_path):
