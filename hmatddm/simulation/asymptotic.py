@@ -42,7 +42,7 @@ Both the inversion (3) and the tip openings (1) use the asymptote of a fracture 
 ``sqrt(A/pi)`` (3D) or the half-length (2D) at the start of the step plus the trial front's
 mean advance (``AsymptoticFront.finite_fracture = False``: the bare semi-infinite asymptote).
 
-**The ribbon stays away from the front (2D).** In a plane-strain run an element the front
+**The ribbon stays away from the front.** In a plane-strain run an element the front
 has crossed (*filled*) keeps its prescribed opening (the asymptote, fully inside the front)
 and joins the channel only at the start of a step where its centre lies at least ``c h``
 behind the front, ``c = max(ribbon_elements, ribbon_growth (L/h)^(1/2))``
@@ -72,8 +72,19 @@ run converge in h to a fracture 0.4% too long and 0.25% too thin (issue 39); wit
 1.5 h away the errors fall to 0.03-0.05% at 0.125 m. On a coarse mesh (fewer than ~20
 elements in the half-length) ``2.5 h`` is too far for the semi-infinite asymptote at a
 viscous tip (the KGD M-vertex at 1 m, 24 s: half-length -1.5% with it, 0.0% without), so there
-the ribbon stays next to the front. 3D keeps ``s_r >= h/2`` (the radial runs converge with
-it, issue 39; not re-measured with this rule).
+the ribbon stays next to the front. **3D**: the same rule (``c = 1.5``, the radius for ``L``) at
+a tip that is not toughness-dominated, once the radius is ``resolved_tip`` elements
+(``AsymptoticFront.far_ribbon_3d``). The ribbon next to a penny crack's front has the same
+scale-free error (bench_asymptotic_ribbon.py ``--penny``, squares: at the radial M vertex +10%
+at ``s_r`` in ``[0.5, 0.75) h``, +4% in ``[0.75, 1) h``, +1% in ``[1, 1.25) h``, +4-5% averaged
+over the near ribbon, within +-0.1% from 1.5 h on; Sneddon's crack +8%, +2%, -0.4..-0.9%, +2-3%
+averaged, -0.2..-0.4% from 1.5 h on), and the radial M-vertex run (K_m 0.005) converged with the
+near ribbon to a fracture too long and thin (R +0.06 / +0.30%, w0 -0.12 / -0.33% at 0.5 / 0.25
+m); with the far ribbon -0.36 / -0.10%, +0.35 / +0.05% (benchmarks/RESULTS.md, issue 39, "the far
+ribbon in 3D"). At a toughness tip (by ``toughness_share``: radial-k and radial-km) 3D keeps
+``s_r >= h/2``: there the far ribbon moved radial-k (K_m 4-6, 0.5 m) from R -0.23% / w0 +0.54%
+to -0.37% / +1.10% against the K vertex (Dontsov's transition: -0.10% / +0.50%), for a reason
+not found.
 
 **Carter leak-off** (a Newtonian fluid): the tip asymptote with leak-off, the elements the
 front crosses leaking point by point, and the front iteration bracketed --
@@ -148,7 +159,7 @@ class AsymptoticFront:
     """The asymptotic front of one :class:`~hmatddm.Simulation` (checks its setup)."""
 
     finite_fracture = True  # the asymptote of a fracture of the current size (module docstring)
-    # 2D: a filled element joins the channel where its centre is >= c h behind the front,
+    # a filled element joins the channel where its centre is >= c h behind the front,
     # c = max(ribbon_elements, ribbon_growth (L/h)^(1/2)) (module docstring)
     ribbon_elements = 1.5
     ribbon_growth = 0.5
@@ -156,6 +167,9 @@ class AsymptoticFront:
     # ... and at any other tip c = ribbon_elements once the half-length is at least this many
     # elements (issue 39: the ribbon next to a viscous front reads +7% wide on average)
     resolved_tip = 20.0
+    # ... and in 3D at such a (not toughness-dominated) tip once the radius is resolved_tip elements
+    # (issue 39, "the far ribbon in 3D"); False: 3D keeps the ribbon next to the front everywhere
+    far_ribbon_3d = True
     # Anderson acceleration of the front iteration, 3D only (hmatddm.simulation.front_acceleration):
     # a 0.5 m radial K-vertex run takes half the front iterations with the same errors to 0.07
     # points; a plane-strain run's errors, 0.1-0.3 % and falling with h, moved by up to 0.08
@@ -298,9 +312,12 @@ class AsymptoticFront:
         size = self.measures(begin, sim)
         size = size["radius"] if grid.k == 2 else size["half_length"]
         filled_old = begin.front_class == FILLED
-        toughness_tip = grid.k == 1 and self.toughness_share(begin, size) >= self.toughness_tip
-        far_ribbon = grid.k == 1 and (toughness_tip or size >= self.resolved_tip * h)
-        if far_ribbon:  # 2D: a filled element joins the channel c h behind the front
+        toughness_tip = self.toughness_share(begin, size) >= self.toughness_tip
+        resolved = size >= self.resolved_tip * h
+        # 3D: at a resolved tip that is not toughness-dominated (module docstring)
+        far_ribbon = (toughness_tip or resolved) if grid.k == 1 else \
+            (self.far_ribbon_3d and resolved and not toughness_tip)
+        if far_ribbon:  # a filled element joins the channel c h behind the front
             filled_old &= old.at_cells(cells) <= -self.ribbon_distance(size, toughness_tip) * h
         channel = (begin.front_class == CHANNEL) | filled_old
         channel_keys = grid.key(cells[channel])
