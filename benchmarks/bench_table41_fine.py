@@ -4,7 +4,7 @@ Figs 4.4, 4.5, 4.8, 4.9).
 
     python benchmarks/bench_table41_fine.py                  # both columns at 0.1 m (hours of CPU, one thread)
     python benchmarks/bench_table41_fine.py --h 0.5          # the same study at 0.5 m (a minute)
-    python benchmarks/bench_table41_fine.py --report M_DIR K_DIR   # tables and plot from two run folders
+    python benchmarks/bench_table41_fine.py --report DIR [DIR ...]   # tables and plot from run folders
 
 The two columns of ref. Table 4.1 are the embedded scenes ``radial-m`` (K_Ic 1 MPa m^1/2, K_m
 0.37-0.6: the M vertex applies) and ``radial-km`` (K_Ic 5 MPa m^1/2, K_m 1.8-2.9: the K-M
@@ -27,7 +27,7 @@ log-singular at the well and at the tip) relative to its value at r = R/2. Plot:
 ``benchmarks/table41_fine_profiles.png`` (ring means and every 50th element against the
 closed forms).
 
-``--report`` reads the two folders (``radial-m`` first); when a folder holds ``time.log``,
+``--report`` reads run folders (each named by its scene); when a folder holds ``time.log``,
 the output of ``/usr/bin/time -v`` for its run, its CPU time and peak memory are reported.
 """
 import argparse
@@ -195,12 +195,13 @@ def main():
     parser.add_argument("--h", type=float, default=0.1, help="element size (m); the reference's is 0.1")
     parser.add_argument("--out", default=os.path.join(HERE, "out", "table41_fine"))
     parser.add_argument("--plot", default=os.path.join(HERE, "table41_fine_profiles.png"))
-    parser.add_argument("--report", nargs=2, metavar=("M_DIR", "K_DIR"), default=None,
-                        help="report two run folders (radial-m, radial-km) instead of running")
+    parser.add_argument("--report", nargs="+", metavar="DIR", default=None,
+                        help="report run folders (of radial-m, radial-km) instead of running")
     args = parser.parse_args()
     rows, shapes = [], []
     if args.report:
-        for case, folder in zip(CASES, args.report):
+        for folder in args.report:
+            case = json.load(open(os.path.join(folder, "summary.json")))["scene"]["name"]
             row, shape = summary_row(folder, case)
             rows.append(row)
             shapes.append((case, shape))
