@@ -49,6 +49,9 @@ __all__ = ["RECORD_KEYS", "Simulation", "State"]
 
 logger = logging.getLogger(__name__)
 
+#: A fixed step that does not converge is split in halves at most this deep (:meth:`Simulation.step`).
+MAX_FIXED_STEP_SPLITS = 6
+
 
 class Simulation:
     """A hydraulic fracture (or several) driven by injection (ref. Ch. 4).
@@ -364,28 +367,53 @@ class Simulation:
         step) when growth would take the mesh past ``max_elements``. With front-following
         steps (``step_control``), a step whose solve does not converge is tried again at
         half its length, down to ``min_time_step`` (the record's ``step_retries`` counts the
-        tries); with fixed steps the :class:`~hmatddm.errors.ConvergenceError` is raised.
+        tries). A fixed step that does not converge is tried again in halves (down to
+        ``1 / 2**MAX_FIXED_STEP_SPLITS`` of it), the steps after it the rest of the fixed
+        step, so that the run stays on the grid of its fixed steps; then
+        :class:`~hmatddm.errors.ConvergenceError` is raised. (A step over which an element fed
+        through a throttled face fills from below the minimum width, its conductance
+        ``~ w^3``, may have no solution that the iteration from the step's start reaches: the
+        dfn-3cluster scene at 4x its area, t = 27 s; its halves converge.)
         """
         if self.front is not None:  # propagation.front = "asymptotic" (hmatddm.simulation.asymptotic)
             return self.front.step(self, end_time)
-        if self.step_control is None:
-            return self._step(end_time)
-        # front-following steps: a step that does not converge is tried again at half its
-        # length (down to min_time_step), from the same state and the same base operator
+        # a step that does not converge is tried again at half its length, from the same
+        # state and the same base operator: front-following steps down to min_time_step,
+        # fixed steps down to 1 / 2**MAX_FIXED_STEP_SPLITS of theirs (then back on their grid)
         base, clock, retries = self.operators.base, time.perf_counter(), 0
         while True:
             try:
                 record = self._step(end_time)
             except ConvergenceError:
-                shorter = max(0.5 * self.state.time_step, self.step_control.minimum)
-                if shorter >= self.state.time_step:
+                shorter = self._shorter_step()
+                if shorter is None:
                     raise
                 self.state = replace(self.state, time_step=shorter)
                 self.operators.reset(base)
                 retries += 1
                 continue
+            if self.step_control is None and self.state.time_step != self.time_step:
+                self.state = replace(self.state, time_step=self._rest_of_fixed_step())
             record.update(solve_seconds=float(time.perf_counter() - clock), step_retries=retries)
             return record
+
+    def _shorter_step(self):
+        """Half the step that did not converge, or None when it may not be shorter (see
+        :meth:`step`)."""
+        step = self.state.time_step
+        if self.step_control is not None:
+            shorter = max(0.5 * step, self.step_control.minimum)
+            return shorter if shorter < step else None
+        shortest = self.time_step / 2.0**MAX_FIXED_STEP_SPLITS
+        return 0.5 * step if 0.5 * step >= shortest * (1.0 - 1e-9) else None
+
+    def _rest_of_fixed_step(self):
+        """After a split fixed step ends at ``t``: the step to the next point of the fixed
+        grid ``k * time_step`` (a whole step when ``t`` is on it)."""
+        dt, t = self.time_step, self.state.time
+        grid = np.ceil(t / dt - 1e-9) * dt
+        rest = grid - t
+        return rest if rest > 1e-9 * dt else dt
 
     def _step(self, end_time):
         """One step of the element front (see :meth:`step`)."""
