@@ -6,7 +6,9 @@ solving: ``solve`` (dense: cached LU; otherwise GMRES preconditioned by its appr
 inverse, warm-started), ``approximate_inverse`` (what the Krylov-accelerated coupled
 scheme uses inside its preconditioner: the exact LU solve for ``dense``, one
 application of the near-field preconditioner otherwise, no inner iteration) and
-``modified_inverse`` for contact rows.
+``modified_inverse`` for contact rows; with an exact (dense LU) inverse also
+``exact_inverse_times``, the solve of a block of columns (the exact Schur complement of the
+``"krylov"`` preconditioner, :mod:`hmatddm.coupled.scaled_system`).
 
 Every method takes optional contact ``rows`` (:class:`~hmatddm.coupled.contact.ContactRows`):
 the operator is then ``S A + D`` (closed elements, see :mod:`hmatddm.coupled.contact`),
@@ -16,9 +18,11 @@ are cached here for the last set of statuses. Contact rows fall back to this sca
 of ``S A_near + D``: the two-level correction is not built for modified rows.
 """
 import numpy as np
+import scipy.linalg
 import scipy.sparse.linalg as spla
 
 from ..elasticity.inverse import solve_with_inverse
+from ..hmatrix._threads import single_threaded_blas
 
 
 class ElasticSolver:
@@ -33,6 +37,7 @@ class ElasticSolver:
         self._diagonal_blocks = None
         self._modified_key = None
         self._modified_inverse = None
+        self._modified_factors = None  # dense LU of S A + D (exact operators), for _modified_key
 
     @property
     def shape(self):
@@ -62,10 +67,34 @@ class ElasticSolver:
         return self._modified(rows)(rhs)
 
     def _modified(self, rows):
-        """Approximate inverse of ``S A + D`` for ``rows`` (cached for the last key)."""
+        """Approximate inverse of ``S A + D`` for ``rows`` (cached for the last key); for an
+        exact operator the solve with the LU factors of :meth:`exact_inverse_times` (the
+        factorisation of the operator's own ``modified_inverse``, made once for both)."""
         if self._modified_key != rows.key or self._modified_inverse is None:
-            self._modified_key, self._modified_inverse = rows.key, self.operator.modified_inverse(rows)
+            self._modified_factors = None
+            if self.operator.inverse_is_exact:
+                with single_threaded_blas():  # as the GMRES around it (hmatddm.hmatrix._threads)
+                    factors = scipy.linalg.lu_factor(rows.modify_dense(self.operator.to_dense()), check_finite=False)
+                self._modified_factors = factors
+                inverse = lambda r: scipy.linalg.lu_solve(factors, np.asarray(r, dtype=np.float64).ravel(),  # noqa: E731
+                                                          check_finite=False)
+            else:
+                inverse = self.operator.modified_inverse(rows)
+            self._modified_key, self._modified_inverse = rows.key, inverse
         return self._modified_inverse
+
+    def exact_inverse_times(self, columns, rows=None):
+        """``A^-1 M`` (``(S A + D)^-1 M`` with ``rows``) for the dense ``(dN, k)`` columns
+        ``M``, from the dense LU factors; None when the operator's inverse is not exact
+        (:attr:`inverse_is_exact`: the ``hmatrix`` backend, a grown operator)."""
+        if not self.operator.inverse_is_exact:
+            return None
+        if rows is None:
+            factors = self.operator.lu()
+        else:
+            self._modified(rows)
+            factors = self._modified_factors
+        return scipy.linalg.lu_solve(factors, columns, check_finite=False)
 
     def diagonal_blocks(self, rows=None):
         """(N, d, d) self-influence block of each element (``S_i A_ii + D_i`` with rows)."""

@@ -8,10 +8,12 @@ preconditioner of the ``"krylov"`` scheme. The iteration that solves it is
 import math
 
 import numpy as np
+import scipy.linalg
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..element_blocks import apply_blocks
+from ..hmatrix._threads import single_threaded_blas
 
 
 #: The flow block of the split is symmetric with a positive diagonal (finite-volume
@@ -75,22 +77,33 @@ class _CoupledLinearSystem:
 
     def compliance_preconditioner(self, omega, previous=None):
         """Inverse of the scaled fracture-compliance split, as a LinearOperator, and the
-        :class:`FlowFactor` it uses: ``previous``'s when it may serve again
-        (:meth:`FlowFactor.reusable`), else a new factorisation of this iterate's flow block."""
+        :class:`FlowFactor` it uses. The flow block is ``D + omega C'`` (ref. Eq. 4.50), its
+        factor ``previous``'s when it may serve again (:meth:`FlowFactor.reusable`), else a
+        new factorisation of this iterate's flow block; or, with an exact elasticity solve,
+        the exact Schur complement ``D - C A^-1 B`` (:meth:`StepProblem.coupled_compliance`;
+        the split is then the exact block-triangular factor, GMRES needs ~2 iterations, and
+        no factor is kept: None)."""
         problem = self.problem
-        leaking = bool(np.any(problem.leak_off_rate))  # see FlowFactor: not kept with leak-off
-        if previous is not None and not leaking and previous.reusable(omega, problem.n):
-            factor = previous
-            factor.uses += 1
+        coupled = problem.coupled_compliance(self.rows)
+        if coupled is not None:
+            with single_threaded_blas():  # an N x N block of a small mesh (hmatddm.hmatrix._threads)
+                factors = scipy.linalg.lu_factor(self.flow_matrix.toarray() - coupled, check_finite=False)
+            flow_solve = lambda r: scipy.linalg.lu_solve(factors, r, check_finite=False)  # noqa: E731
+            factor = None
         else:
-            schur = (self.flow_matrix + sp.diags(omega * problem.compliance_term)).tocsc()
-            factor = FlowFactor(spla.splu(schur, **SYMMETRIC_LU), omega, problem.n)
-        flow_lu = factor.lu
+            leaking = bool(np.any(problem.leak_off_rate))  # see FlowFactor: not kept with leak-off
+            if previous is not None and not leaking and previous.reusable(omega, problem.n):
+                factor = previous
+                factor.uses += 1
+            else:
+                schur = (self.flow_matrix + sp.diags(omega * problem.compliance_term)).tocsc()
+                factor = FlowFactor(spla.splu(schur, **SYMMETRIC_LU), omega, problem.n)
+            flow_solve = factor.lu.solve
         nd = problem.n * problem.d
 
         def apply(z):
             r_u, r_p = self.unscale_left(np.asarray(z).ravel())
-            p = flow_lu.solve(r_p)
+            p = flow_solve(r_p)
             b_p = problem.b_times(p)
             dd = problem.elastic.approximate_inverse(r_u - (b_p if self.rows is None else self.rows.select_rows(b_p)),
                                                      self.rows)

@@ -6,6 +6,7 @@ import pytest
 import hmatddm as hd
 from hmatddm.mesh import topology
 from hmatddm.coupled import ElasticSolver, SchemeSettings, StepProblem, solve_step
+from hmatddm.coupled import step_problem
 from hmatddm.coupled.scaled_system import FlowFactor, _CoupledLinearSystem
 from hmatddm.flow import LeakOff, LubricationModel, fracture_compliance
 
@@ -236,11 +237,14 @@ def test_a_provisional_solve_finishes_with_the_iterates_of_a_plain_one(backend):
 
 
 @pytest.mark.parametrize("backend", ["dense", "hmatrix"])
-def test_a_paused_provisional_iterate_finishes_with_the_iterates_of_a_plain_one(backend):
+def test_a_paused_provisional_iterate_finishes_with_the_iterates_of_a_plain_one(backend, monkeypatch):
     # provisional_linear_rtol > first_linear_rtol (the default): the provisional iterate is
     # the first GMRES solve paused at provisional_linear_rtol (fewer GMRES iterations);
     # refine() continues that solve to the plain first iterate, finish() to the converged
     # one: bit for bit the plain solve's, with its counts (also when refine() is skipped).
+    # (The diagonal compliance split: with the exact Schur complement of a dense mesh every
+    # solve takes 2 GMRES iterations, and a pause saves none.)
+    monkeypatch.setattr(step_problem, "EXACT_SCHUR_MAX_ELEMENTS", 0)
     mesh = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 8.0, 8.0, 8, 8)
     settings = SchemeSettings(scheme="krylov", provisional_linear_rtol=1e-3)
     assert SchemeSettings().provisional_linear_rtol > SchemeSettings().first_linear_rtol
@@ -303,9 +307,11 @@ def test_a_provisional_solve_converges_at_once_without_a_loose_first_iteration()
 def test_a_reused_flow_factor_gives_the_fresh_factors_solution(monkeypatch, limit):
     """The split preconditioner's flow LU kept across the iterates of a step problem: the
     same solution as a new LU at every iterate, to the solver's tolerance, and fewer
-    factorisations."""
+    factorisations. (The diagonal compliance split, which a dense mesh of at most
+    EXACT_SCHUR_MAX_ELEMENTS replaces by the exact Schur complement and keeps no factor.)"""
     from hmatddm.coupled import scaled_system
 
+    monkeypatch.setattr(step_problem, "EXACT_SCHUR_MAX_ELEMENTS", 0)
     mesh = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 8.0, 8.0, 8, 8)
     factorisations = []
     splu = scaled_system.spla.splu
@@ -342,3 +348,22 @@ def test_an_attempt_whose_changes_stagnate_is_given_up():
     slow = [1e6 * 0.97**k for k in range(2 * STAGNATION_WINDOW)]  # 0.97 per iteration: ~390 more to go
     assert _stagnated(slow, left=300) and not _stagnated(slow, left=1000)
     assert _stagnated([5.0, 6.0] * STAGNATION_WINDOW, left=1000)  # oscillating without contraction
+
+
+def test_the_exact_schur_complement_gives_the_same_step_in_two_gmres_iterations(monkeypatch):
+    """With a dense (exact) elasticity solve the "krylov" split uses the exact Schur
+    complement ``D - C A^-1 B``: the preconditioned matrix is ``[[I, 0], [C A^-1, I]]`` and
+    each GMRES solve takes at most 2 iterations (the dfn-3cluster scene took 24-50 with the
+    diagonal compliance ``C'``), for the same step solution to the solver tolerance."""
+    mesh = hd.mesh.line([-5, 0], [5, 0], 20)
+    settings = SchemeSettings(scheme="krylov", tolerance_pressure=1e-9, tolerance_opening=1e-9, linear_rtol=1e-12)
+    results = {}
+    for limit in (0, step_problem.EXACT_SCHUR_MAX_ELEMENTS):
+        monkeypatch.setattr(step_problem, "EXACT_SCHUR_MAX_ELEMENTS", limit)
+        problem, dd0, p0 = _problem(mesh, leak=1e-12)
+        results[limit] = solve_step(problem, settings, dd0, p0, 1.0)
+    (dd_diag, p_diag, info_diag), (dd, p, info) = results.values()
+    assert info["linear_iterations"] <= 2 * info["nonlinear_iterations"]
+    assert info_diag["linear_iterations"] > 3 * info["linear_iterations"]
+    np.testing.assert_allclose(p, p_diag, rtol=1e-8)
+    np.testing.assert_allclose(dd, dd_diag, atol=1e-8 * np.abs(dd_diag).max())
