@@ -52,7 +52,9 @@ def run(scene, h, steps, folder, source=ROOT, label="this", extra=()):
     _, status, usage = os.wait4(child.pid, 0)  # this child's own CPU time and peak memory
     child.returncode = os.waitstatus_to_exitcode(status)
     wall = time.perf_counter() - start
-    if child.returncode != 0:
+    # exit 3: did not converge; its summary.json holds the steps up to the last converged one,
+    # reported as a failed row (the run's CPU is still its cost so far)
+    if child.returncode != 0 and not (child.returncode == 3 and os.path.exists(os.path.join(out, "summary.json"))):
         raise RuntimeError(f"hmatddm {' '.join(arguments)} exited {child.returncode}")
     summary = json.load(open(os.path.join(out, "summary.json")))
     records = [record for record in summary["steps"] if record["step"] > 0]  # step 0: the initial state
@@ -64,7 +66,8 @@ def run(scene, h, steps, folder, source=ROOT, label="this", extra=()):
     return dict(version=label, scene=scene, h=h, steps=steps, elements=records[-1]["n_elements"], n_steps=len(records),
                 passes=total("growth_passes"), nonlinear=total("nonlinear_iterations"),
                 gmres=total("linear_iterations"), matvecs=total("matvecs"), builds=total("operator_builds"), wall=wall,
-                cpu=usage.ru_utime + usage.ru_stime, peak_mb=usage.ru_maxrss / 1024.0, error=error)
+                cpu=usage.ru_utime + usage.ru_stime, peak_mb=usage.ru_maxrss / 1024.0, error=error,
+                failed=None if child.returncode == 0 else f"no convergence after t = {records[-1]['time']:g} s")
 
 
 def main():
@@ -122,6 +125,8 @@ def main():
                 exponent += f" ({row['cpu'] / p['cpu']:.1f}x CPU for {row['area'] / p['area']:g}x area)"
         error = row["error"]
         size = f"{row['h']:g}" if row["h"] is not None else f"area x{row['area']:g}"
+        if row["failed"]:
+            size += f" (FAILED: {row['failed']})"
         body.append([row["version"], row["scene"], size, row["steps"], row["elements"], row["n_steps"], row["passes"],
                      row["nonlinear"], row["gmres"], row["matvecs"], f"{row['matvecs'] / row['n_steps']:.0f}",
                      row["builds"], f"{row['wall']:.1f}", f"{row['cpu']:.1f}",
