@@ -47,6 +47,33 @@ def test_dense_and_hmatrix_runs_agree():
         assert hmatrix["wellbore_pressure"][0] == pytest.approx(dense["wellbore_pressure"][0], rel=2e-6)
 
 
+def test_a_front_iteration_after_an_easy_solve_starts_at_a_grown_relaxation(monkeypatch):
+    # the alpha one trial front needed is not kept for the next trial fronts: each solve that
+    # converged without a restart lets the next start at relaxation_growth times its alpha (as a
+    # step does). Kept, an alpha of 1/128 from one bad trial front contracted the radial M~ run's
+    # iteration by ~0.996 per iteration, and its full-tolerance solves failed one after the other
+    # (tests/scene/test_leak_off_reference.py, benchmarks/RESULTS.md issue 33)
+    from dataclasses import replace
+    from hmatddm.simulation.asymptotic import AsymptoticFront
+
+    calls = []
+    solve = AsymptoticFront._solve
+
+    def recorded(self, sim, trial, start, prescribed, width, t_old, t_new, relaxation, *args, **kwargs):
+        out = solve(self, sim, trial, start, prescribed, width, t_old, t_new, relaxation, *args, **kwargs)
+        calls.append((relaxation, out[1]["relaxation"], out[1]["restarts"]))
+        return out
+
+    monkeypatch.setattr(AsymptoticFront, "_solve", recorded)
+    sim = radial(h=2.0, backend="dense")
+    sim.state = replace(sim.state, relaxation=0.25)
+    sim.run(1.0)
+    assert len(calls) >= 3 and calls[0][0] == 0.25
+    for (_, alpha, restarts), (start, _, _) in zip(calls, calls[1:]):
+        assert start == (min(1.0, 2.0 * alpha) if restarts == 0 else alpha)
+    assert calls[-1][0] > calls[0][0]
+
+
 def test_resume_from_checkpoint_gives_the_same_run(tmp_path):
     whole = radial(h=2.0, backend="dense").run(3.0)
     first = radial(h=2.0, backend="dense", checkpoint_dir=tmp_path)
