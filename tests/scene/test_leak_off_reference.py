@@ -348,6 +348,8 @@ def test_a_radial_run_reaches_the_m_tilde_vertex():
     # The run starts at C_m 3.5 (0.05 s), so the vertex is warned off over it; from 1.2 s on (C_m >=
     # 11.9, where the vertex is within 1% of Dontsov's solution) measured R +0.0..+0.13%, w0
     # +2.1..+2.6%, roundness 1.047: held to 1%, 4% and 1.06; nearly all the fluid leaked. 10 s CPU
+    # (issue 33: with each front iteration's solve starting at a grown-back alpha, the stagnation
+    # rule and the exact Schur complement: R -0.0..+0.09%, w0 +1.8..+2.8%, roundness 1.044, 8 s CPU)
     data = radial_m_leak_off_scene(end_time=1.6)
     assert "C_m = 3.47 to 13.34" in hs.reference_warning(data)
     records = hs.build_simulation(data).run(1.6)
