@@ -279,14 +279,28 @@ class ElasticityOperator(ProductCounter, LinearOperator):
 
 
 def _refuse_coincident(mesh):
-    """Two elements with the same centre and plane make the matrix singular: refuse them."""
+    """Two elements of one plane of which one holds the other's centre (coincident, or
+    overlapping) make the matrix singular, or nearly so: refuse them. Each centre is looked
+    for within its element's circumradius, so a mesh whose elements only touch costs one
+    k-d tree query per element."""
     from scipy.spatial import cKDTree
 
-    tolerance = 1e-9 * float(np.min(mesh.radii))
-    for i, j in sorted(cKDTree(mesh.centers).query_pairs(tolerance)):
-        if abs(float(mesh.normals[i] @ mesh.normals[j])) > 1.0 - 1e-9:
-            raise InputError(f"elements {i} and {j} coincide (same centre and plane), which makes the DDM "
-                             "system singular; remove one of them")
+    radii = np.asarray(mesh.radii, dtype=np.float64)
+    tolerance = 1e-9 * float(np.min(radii))
+    # half sizes in the element's frame (rows e1, [e2,] n; 2D: tangent, normal)
+    half = np.column_stack([mesh.half_a, mesh.half_b]) if mesh.dim == 3 else mesh.half_length[:, None]
+    tree = cKDTree(mesh.centers)
+    for i, near in enumerate(tree.query_ball_point(mesh.centers, radii * (1.0 + 1e-9) + tolerance)):
+        for j in near:
+            if j == i or abs(float(mesh.normals[i] @ mesh.normals[j])) <= 1.0 - 1e-9:
+                continue
+            local = mesh.frames[i] @ (mesh.centers[j] - mesh.centers[i])
+            if abs(local[-1]) <= tolerance and np.all(np.abs(local[:-1]) < half[i] - tolerance):
+                kind = "coincide (same centre and plane)" if np.all(np.abs(local) <= tolerance) else \
+                    f"overlap (the centre of element {j} lies inside element {i}, in its plane)"
+                first, second = sorted((i, j))
+                raise InputError(f"elements {first} and {second} {kind}, which makes the DDM system singular; "
+                                 "remove or re-mesh one of them")
 
 
 def influence_data(mesh, material, singular_correction="none", alpha=None, n_images=None):
