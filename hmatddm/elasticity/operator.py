@@ -289,18 +289,24 @@ def _refuse_coincident(mesh):
     tolerance = 1e-9 * float(np.min(radii))
     # half sizes in the element's frame (rows e1, [e2,] n; 2D: tangent, normal)
     half = np.column_stack([mesh.half_a, mesh.half_b]) if mesh.dim == 3 else mesh.half_length[:, None]
-    tree = cKDTree(mesh.centers)
-    for i, near in enumerate(tree.query_ball_point(mesh.centers, radii * (1.0 + 1e-9) + tolerance)):
-        for j in near:
-            if j == i or abs(float(mesh.normals[i] @ mesh.normals[j])) <= 1.0 - 1e-9:
-                continue
-            local = mesh.frames[i] @ (mesh.centers[j] - mesh.centers[i])
-            if abs(local[-1]) <= tolerance and np.all(np.abs(local[:-1]) < half[i] - tolerance):
-                kind = "coincide (same centre and plane)" if np.all(np.abs(local) <= tolerance) else \
-                    f"overlap (the centre of element {j} lies inside element {i}, in its plane)"
-                first, second = sorted((i, j))
-                raise InputError(f"elements {first} and {second} {kind}, which makes the DDM system singular; "
-                                 "remove or re-mesh one of them")
+    near = cKDTree(mesh.centers).query_ball_point(mesh.centers, radii * (1.0 + 1e-9) + tolerance)
+    counts = np.fromiter(map(len, near), dtype=np.int64, count=len(near))
+    if np.all(counts <= 1):  # every centre alone within its element's circumradius (a mesh that only touches)
+        return
+    first = np.repeat(np.arange(len(near)), counts)
+    second = np.concatenate([np.asarray(found, dtype=np.int64) for found in near])
+    keep = (first != second) & (np.abs(np.einsum("ij,ij->i", mesh.normals[first], mesh.normals[second]))
+                                > 1.0 - 1e-9)
+    first, second = first[keep], second[keep]
+    local = np.einsum("eij,ej->ei", mesh.frames[first], mesh.centers[second] - mesh.centers[first])
+    inside = (np.abs(local[:, -1]) <= tolerance) & np.all(np.abs(local[:, :-1]) < half[first] - tolerance, axis=1)
+    if np.any(inside):
+        k = int(np.flatnonzero(inside)[0])
+        i, j = int(first[k]), int(second[k])
+        kind = "coincide (same centre and plane)" if np.all(np.abs(local[k]) <= tolerance) else \
+            f"overlap (the centre of element {j} lies inside element {i}, in its plane)"
+        raise InputError(f"elements {min(i, j)} and {max(i, j)} {kind}, which makes the DDM system singular; "
+                         "remove or re-mesh one of them")
 
 
 def influence_data(mesh, material, singular_correction="none", alpha=None, n_images=None):
