@@ -5,6 +5,7 @@ variants, and a larger version (>= 5x the elements).
 
     python benchmarks/bench_stage.py              # the three variants of the scene (~8 min)
     python benchmarks/bench_stage.py --large      # the larger version only (1 m elements)
+    python benchmarks/bench_stage.py --only large-stiff --end 90   # the larger version, stiff layers
     python benchmarks/bench_stage.py --dense      # open and limited with the dense operator (~15 min)
     python benchmarks/bench_stage.py --end 30     # a shorter pump time
     python benchmarks/bench_stage.py --only open,stress-only   # chosen variants
@@ -24,7 +25,9 @@ containment check); `stress-only` and `limited-stress-only` give the bounding la
 zone's modulus and keep their stress (the scene before its stiff layers); `large` is
 `limited-stress-only` with 1 m elements for the initial fractures and the network (4x the
 elements per area, twice the rows over the height; with the stiff layers' images it would
-take hours: benchmarks/RESULTS.md, issue 35); `-dense` runs use the dense operator instead of
+take hours: benchmarks/RESULTS.md, issue 35); `large-stiff` is `limited` with those 1 m elements
+and the scene's stiff bounding layers (the remote-failure check keeps each element's layered
+stress at the ~8300 natural targets: 2.5 GB); `-dense` runs use the dense operator instead of
 the scene's H-matrix.
 """
 import argparse
@@ -48,8 +51,11 @@ UNIFORM = LIMITED + ["layer[0].s_hmin=35.85e6", "layer[2].s_hmin=35.85e6", "laye
 STRESS_ONLY = ["layer[0].shear_modulus=6.62e9", "layer[2].shear_modulus=6.62e9"]
 LARGE = LIMITED + STRESS_ONLY + [f"initial_fracture[{k}].element_size=1.0" for k in range(5)] + [
     "network.element_size=1.0"]
+#: the larger version with the scene's stiff bounding layers
+LARGE_STIFF = LIMITED + [f"initial_fracture[{k}].element_size=1.0" for k in range(5)] + ["network.element_size=1.0"]
 DENSE = ["numerics.backend=dense"]
-VARIANTS = {"open": [], "limited": LIMITED, "uniform": UNIFORM, "large": LARGE, "open-dense": DENSE,
+VARIANTS = {"open": [], "limited": LIMITED, "uniform": UNIFORM, "large": LARGE, "large-stiff": LARGE_STIFF,
+            "open-dense": DENSE,
             "limited-dense": LIMITED + DENSE, "stress-only": STRESS_ONLY,
             "limited-stress-only": LIMITED + STRESS_ONLY}
 

@@ -16,7 +16,8 @@ computed once per run (benchmarks/RESULTS.md, issue 35).
 The terms are those of the direct sum (:func:`hmatddm.layered.stress3d.stress_columns`,
 the per-pair function :func:`hmatddm.layered.stress3d.stress_points` sums, each source traced
 once, vertical sources in closed form), so the stress is the direct sum's up to the order of
-the additions (1e-16 relative). A mesh that is not the
+the additions (1e-16 relative); each term's stress is symmetric to the bit (the same
+expression gives ``ik`` and ``ki``), so six components are kept and mirrored. A mesh that is not the
 last one plus appended elements (same first elements, bit for bit), another medium, number
 of images, correction or set of points starts again; points outside the first call's set
 start again too (the intact set only shrinks in a run). Above :data:`MEMORY_BUDGET` bytes
@@ -27,9 +28,15 @@ import numpy as np
 from ..errors import InputError
 from ..options import AVERAGE_SHIFT
 
-#: Largest size (bytes) of the kept terms (points x elements x 27 float64); beyond it
-#: :meth:`StressColumns.reuse` returns None and the caller sums directly.
-MEMORY_BUDGET = 2 << 30
+#: Largest size (bytes) of the kept terms (points x elements x 18 float64); beyond it
+#: :meth:`StressColumns.reuse` returns None and the caller sums directly. 4 GiB: a sixth
+#: of the project's 24 GiB machine; the larger stage of issue 35 with its stiff layers
+#: (2092 elements at ~8300 natural targets) keeps 2.5 GB (benchmarks/RESULTS.md).
+MEMORY_BUDGET = 4 << 30
+#: The six independent components of the symmetric stress (xx, yy, zz, xy, xz, yz) and,
+#: for each of the nine (i, k), which of the six it is.
+_SYMMETRIC = np.array([0, 4, 8, 1, 2, 5])
+_FULL = np.array([0, 3, 4, 3, 1, 5, 4, 5, 2])
 
 __all__ = ["StressColumns", "MEMORY_BUDGET"]
 
@@ -53,7 +60,7 @@ class StressColumns:
         self.near_fraction = float(near_fraction)
         self.point_layer = np.ascontiguousarray(medium.layer_of(points[rows, 2]), dtype=np.int64)
         self.geometry = tuple(np.zeros((0,) + shape) for shape in ((3,), (3, 3), (), ()))
-        #: (start, stop, terms (len(rows), 9, 3 (stop - start))) per batch of elements
+        #: (start, stop, terms (len(rows), 6, 3 (stop - start))) per batch of elements
         self.blocks = []
         #: elements computed over the object's life (the cost)
         self.computed = 0
@@ -75,7 +82,7 @@ class StressColumns:
         if mesh.dim != 3 or n_images is None or getattr(mesh, "element_order", 0) != 0:
             return None
         rows = np.asarray(rows, dtype=np.int64)
-        if rows.size * mesh.n_elements * 27 * 8 > MEMORY_BUDGET:
+        if rows.size * mesh.n_elements * 18 * 8 > MEMORY_BUDGET:
             return None
         if previous is not None and previous.serves(mesh, medium, points, rows, n_images, singular_correction,
                                                     near_fraction):
@@ -108,8 +115,10 @@ class StressColumns:
         # images are chosen with the number of images
         data = influence_data(new, self.medium, shift, 0.0, self.near_fraction, int(self.n_images), with_table=False)
         terms = stress_columns(data, self.points[self.rows], self.point_layer)  # [m, k, u, a, b]
-        m = len(self.rows)  # [m, k, u, a, b] -> [m, a b, k u]
-        self.blocks.append((n0, n, np.ascontiguousarray(terms.transpose(0, 3, 4, 1, 2).reshape(m, 9, 3 * (n - n0)))))
+        m = len(self.rows)  # [m, k, u, a, b] -> [m, a b, k u], the six of the symmetric stress
+        terms = terms.transpose(0, 3, 4, 1, 2).reshape(m, 9, 3 * (n - n0))
+        self.blocks.append((n0, n, np.ascontiguousarray(terms[:, _SYMMETRIC])))
+        del terms
         self.geometry = tuple(np.array(array) for array in _geometry(mesh))
         self.computed += n - n0
 
@@ -119,9 +128,10 @@ class StressColumns:
         :func:`hmatddm.kernels.drivers.finite_stress_sum`)."""
         self._extend(mesh)
         dd = np.asarray(dd, dtype=float).reshape(mesh.n_elements, 3)
-        total = np.zeros((len(self.rows), 9))
+        total = np.zeros((len(self.rows), 6))
         for start, stop, terms in self.blocks:
             total += terms @ dd[start:stop].reshape(-1)
+        total = total[:, _FULL]
         index = np.searchsorted(self.rows, rows) if np.all(self.rows[:-1] <= self.rows[1:]) else \
             np.array([np.flatnonzero(self.rows == r)[0] for r in rows], dtype=np.int64)
         out = total[index].reshape(-1, 3, 3)
