@@ -375,15 +375,16 @@ class Simulation:
         ``~ w^3``, may have no solution that the iteration from the step's start reaches: the
         dfn-3cluster scene at 4x its area, t = 27 s; its halves converge.)
         """
-        if self.front is not None:  # propagation.front = "asymptotic" (hmatddm.simulation.asymptotic)
-            return self.front.step(self, end_time)
         # a step that does not converge is tried again at half its length, from the same
         # state and the same base operator: front-following steps down to min_time_step,
-        # fixed steps down to 1 / 2**MAX_FIXED_STEP_SPLITS of theirs (then back on their grid)
+        # fixed steps down to 1 / 2**MAX_FIXED_STEP_SPLITS of theirs (then back on their grid);
+        # the same for the element front and the asymptotic front (propagation.front =
+        # "asymptotic", hmatddm.simulation.asymptotic: a first step of 0.1 s from a 3 x 3
+        # start with one ribbon element cycled with period two at 1 m elements, its halves converge)
         base, clock, retries = self.operators.base, time.perf_counter(), 0
         while True:
             try:
-                record = self._step(end_time)
+                record = self._step(end_time) if self.front is None else self.front.step(self, end_time)
             except ConvergenceError:
                 shorter = self._shorter_step()
                 if shorter is None:

@@ -10,11 +10,11 @@ from hmatddm.errors import InputError
 MATERIAL = hd.Elastic(24e9, 0.25)
 
 
-def radial(h=1.0, backend="hmatrix", toughness=1e6, viscosity=1e-3, opening=4e-6, **kwargs):
+def radial(h=1.0, backend="hmatrix", toughness=1e6, viscosity=1e-3, opening=4e-6, time_step=1.0, **kwargs):
     """Ref. Table 4.1 (M case by default) with 3 x 3 initial elements of side h."""
     mesh = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 3 * h, 3 * h, 3, 3)
     return hd.Simulation(mesh, MATERIAL, hd.Fluid(viscosity, 4.4e-10), [hd.Cluster((0, 0, 0), 0.01, 0.005)],
-                         far_field_stress=np.diag([0, 0, -8e6]), time_step=1.0,
+                         far_field_stress=np.diag([0, 0, -8e6]), time_step=time_step,
                          propagation=hd.Propagation(toughness=toughness, front="asymptotic"),
                          initial_pressure=10e6, initial_opening=opening, backend=backend, **kwargs)
 
@@ -72,6 +72,34 @@ def test_a_front_iteration_after_an_easy_solve_starts_at_a_grown_relaxation(monk
     for (_, alpha, restarts), (start, _, _) in zip(calls, calls[1:]):
         assert start == (min(1.0, 2.0 * alpha) if restarts == 0 else alpha)
     assert calls[-1][0] > calls[0][0]
+
+
+def test_an_asymptotic_front_step_that_does_not_converge_is_split(monkeypatch):
+    """The asymptotic front's steps go through the same retry as the element front's: a
+    step whose solve raises ConvergenceError is redone in halves from the same state (the
+    radial-m scene with auto steps at 1 m elements: its first 0.1 s step from the 3 x 3 start
+    cycled with period two, its halves converge), and the run comes back to its grid."""
+    from hmatddm.errors import ConvergenceError
+    from hmatddm.simulation.asymptotic import AsymptoticFront
+
+    solve = AsymptoticFront._solve
+
+    def refuses_long_steps(self, sim, trial, start, prescribed, width, t_old, t_new, *args):
+        if t_new - t_old > 1.5:
+            raise ConvergenceError("too long a step for this test", iterations=1)
+        return solve(self, sim, trial, start, prescribed, width, t_old, t_new, *args)
+
+    monkeypatch.setattr(AsymptoticFront, "_solve", refuses_long_steps)
+    split = radial(h=2.0, backend="dense", time_step=2.0)
+    first = split.step()
+    assert first["time"] == 1.0 and first["step_retries"] == 1
+    dd = split.state.dd.copy()
+    records = split.run(4.0)  # (every record of the run)
+    assert [r["time"] for r in records] == [1.0, 2.0, 3.0, 4.0]  # back on the grid of 2 s steps
+    monkeypatch.setattr(AsymptoticFront, "_solve", solve)
+    halves = radial(h=2.0, backend="dense", time_step=1.0)
+    assert halves.step()["step_retries"] == 0
+    np.testing.assert_array_equal(dd, halves.state.dd)  # the same step as a fresh 1 s one
 
 
 def test_resume_from_checkpoint_gives_the_same_run(tmp_path):
