@@ -24,11 +24,11 @@ bounding layers' s_hmin and shear modulus equal to the pay zone's (uniform rock:
 containment check); `stress-only` and `limited-stress-only` give the bounding layers the pay
 zone's modulus and keep their stress (the scene before its stiff layers); `large` is
 `limited-stress-only` with 1 m elements for the initial fractures and the network (4x the
-elements per area, twice the rows over the height; with the stiff layers' images it would
-take hours: benchmarks/RESULTS.md, issue 35); `large-stiff` is `limited` with those 1 m elements
-and the scene's stiff bounding layers (the remote-failure check keeps each element's layered
-stress at the ~8300 natural targets: 2.5 GB); `-dense` runs use the dense operator instead of
-the scene's H-matrix.
+elements per area, twice the rows over the height; 983 s of CPU to 90 s); `large-stiff` is
+`limited` with those 1 m elements and the scene's stiff bounding layers (the remote-failure
+check keeps each element's layered stress at the ~8300 natural targets, 2.5 GB; 2063 elements
+in 2159 s of CPU and 3.5 GB to 90 s at dgemm 49 GFLOP/s: benchmarks/RESULTS.md, issue 35);
+`-dense` runs use the dense operator instead of the scene's H-matrix.
 """
 import argparse
 import json
