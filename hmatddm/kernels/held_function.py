@@ -11,8 +11,9 @@ first-class function value it is not linked: the caller calls its address (as
 it as ``FunctionType(signature)`` and fetches the function's address when the record is
 passed in from Python (the function compiled for that signature, or loaded from numba's
 disk cache, once per process). A record type cannot contain a function of itself, so the
-held function takes the record with that field set to None (:func:`without_functions`)
-as its first argument.
+held function takes the record with its function fields set to None
+(:func:`without_functions`), through a pointer (:func:`address_of`, :func:`dereference`)
+as its first argument; large tuples (a workspace) are best passed the same way.
 
 A call whose argument types differ from the held signature does not compile (numba's
 check of first-class function calls): no call can reach the function with other types.
@@ -33,9 +34,10 @@ _ADDRESSES = {}
 class HeldFunction(WrapperAddressProtocol):
     """``function`` (an njit dispatcher, ``cache=True``) as a value for a field of
     ``record`` (a kernel record whose function fields are None): called as
-    ``function(without_functions(record), *arguments)``, ``types(record)`` (a module-level
-    function, evaluated once, when numba first types the record) giving the numba types
-    ``(result, arguments)``. Pickles without its address."""
+    ``function(address_of(without_functions(record)), *arguments)``, ``types_of(record)`` (a
+    module-level function, evaluated once, when numba first types the record) giving the
+    numba types ``(result, arguments)`` after the record's pointer. Pickles without its
+    address."""
 
     def __init__(self, function, record, types_of):
         self.function = function
@@ -46,7 +48,7 @@ class HeldFunction(WrapperAddressProtocol):
     def signature(self):
         if self._signature is None:
             result, arguments = self.types_of(self.record)
-            self._signature = result(numba.typeof(self.record), *arguments)
+            self._signature = result(types.CPointer(numba.typeof(self.record)), *arguments)
         return self._signature
 
     def __wrapper_address__(self):
@@ -86,4 +88,29 @@ def without_functions(typingctx, record):
     return stripped(record), codegen
 
 
-__all__ = ["HeldFunction", "without_functions"]
+@intrinsic
+def address_of(typingctx, value):
+    """A pointer (``CPointer``) to a copy of ``value`` on the caller's stack, its arrays
+    borrowed (no reference counts): for a call while ``value`` is alive. A held function
+    takes its large arguments so (:func:`dereference` inside): by value, the call passes
+    every array's fields one by one, and compiling that marshalling cost about as much as
+    the small callers' own code."""
+    def codegen(context, builder, signature, args):
+        model = context.data_model_manager[value]
+        slot = cgutils.alloca_once(builder, model.get_data_type())
+        builder.store(model.as_data(builder, _without_reference_count(context, builder, value, args[0])), slot)
+        return slot
+
+    return types.CPointer(value)(value), codegen
+
+
+@intrinsic
+def dereference(typingctx, pointer):
+    """The value :func:`address_of` points to (borrowed, as it was stored)."""
+    def codegen(context, builder, signature, args):
+        return context.data_model_manager[pointer.dtype].load_from_data_pointer(builder, args[0])
+
+    return pointer.dtype(pointer), codegen
+
+
+__all__ = ["HeldFunction", "without_functions", "address_of", "dereference"]

@@ -94,7 +94,7 @@ from numba import njit, typeof, types
 
 from ..kernels import rectangle3d
 from ..kernels.drivers import KernelKind, register_kind
-from ..kernels.held_function import HeldFunction, without_functions
+from ..kernels.held_function import HeldFunction, address_of, dereference, without_functions
 from . import okada3d
 from .image_points3d import image_point_displacement, image_point_stress, kelvin_point_displacement, kelvin_point_stress
 from .image_tracer import trace_capacity
@@ -179,15 +179,16 @@ def _state_type():
 
 def _source_state_types(data):
     """The numba types of :func:`_source_state`'s result and arguments after the record."""
-    return _state_type(), (types.int64, typeof(workspace.py_func(data)))
+    return _state_type(), (types.int64, types.CPointer(typeof(workspace.py_func(data))))
 
 
 def _image_term_types(data):
     """The numba types of :func:`_complementary_stress`'s result and arguments after the
     record: the point, its layer, the source, :func:`source_state`'s tuple,
     :func:`workspace`'s tuple, the entry tolerance and the stress."""
-    return types.none, (types.Array(types.float64, 1, "C"), types.int64, types.int64, _state_type(),
-                        typeof(workspace.py_func(data)), types.float64, types.Array(types.float64, 3, "C"))
+    return types.none, (types.Array(types.float64, 1, "C"), types.int64, types.int64, types.CPointer(_state_type()),
+                        types.CPointer(typeof(workspace.py_func(data))), types.float64,
+                        types.Array(types.float64, 3, "C"))
 
 
 @njit(cache=True)
@@ -220,19 +221,22 @@ def source_state(data, j, work):
     (:func:`.vertical3d.vertical_image_stress`). A source whose images are in closed form
     (``closed_form``) traces nothing: its room is one point. :func:`_source_state` through
     ``data.source_tracer`` (:func:`with_image_terms`)."""
-    return data.source_tracer(without_functions(data), np.int64(j), work)
+    return data.source_tracer(address_of(without_functions(data)), np.int64(j), address_of(work))
 
 
-@njit(cache=True)
-def _source_state(data, j, work):
-    """:func:`source_state` (held by the record: the tracer compiled once)."""
+@njit(cache=True, no_cpython_wrapper=True)  # held: called through its C wrapper only
+def _source_state(data_at, j, work_at):
+    """:func:`source_state` (held by the record: the tracer compiled once), the record and
+    the workspace as pointers."""
+    data, work = dereference(data_at), dereference(work_at)
     room = work[6]
     start = work[7][3]
     ls = data.layer[j]
     near_only = data.table.pair_index[ls].max() >= 0
+    one = np.int64(1)  # not literals: one compiled _traced_buffer (module docstring)
     if data.closed_form[j]:
-        return (_traced_buffer(1, 1, 1), np.zeros(start.shape[0] - 1, dtype=np.bool_), near_only,
-                _traced_buffer(3, 1, 1), np.zeros(3))
+        return (_traced_buffer(one, one, one), np.zeros(start.shape[0] - 1, dtype=np.bool_), near_only,
+                _traced_buffer(np.int64(3), one, one), np.zeros(3))
     cap, n_orders = max(room[ls, 0], 1), max(room[ls, 1], 1)
     three, heights = _three_heights(data, j, near_only, cap, n_orders)
     return (_traced_buffer(start[-1], cap, n_orders), np.zeros(start.shape[0] - 1, dtype=np.bool_), near_only,
@@ -246,7 +250,7 @@ def _three_heights(data, j, near_only, cap, n_orders):
     free surface's when it is in closed form; one empty point otherwise."""
     heights = np.zeros(3)
     if not data.vertical_form[j]:
-        return _traced_buffer(3, 1, 1), heights
+        return _traced_buffer(np.int64(3), np.int64(1), np.int64(1)), heights
     ls = data.layer[j]
     center = data.centers[j]
     frame = data.frames[j]
@@ -260,7 +264,7 @@ def _three_heights(data, j, near_only, cap, n_orders):
         else:
             xi[p] = (p - 1.0) * frame[0, 2]
         heights[p] = center[2] + xi[p] * a * frame[0, 2] + eta[p] * b * frame[1, 2]
-    three = _traced_buffer(3, cap, n_orders)
+    three = _traced_buffer(np.int64(3), cap, n_orders)
     first, last = np.int64(0), np.int64(3)  # not literals: the same compiled functions as element_traction's
     _trace_range(center, frame, a, b, ls, data.interfaces, data.shear_modulus, data.poisson_ratio, data.n_images, xi,
                  eta, first, last, three)
@@ -320,12 +324,12 @@ def _image_terms(data, point, lr, j, state, work, entry_tol, image):
     here = work[12]
     for k in range(3):
         here[k] = point[k]
-    data.image_terms(without_functions(data), here, np.int64(lr), np.int64(j), state, work, np.float64(entry_tol),
-                     image)
+    data.image_terms(address_of(without_functions(data)), here, np.int64(lr), np.int64(j), address_of(state),
+                     address_of(work), np.float64(entry_tol), image)
 
 
-@njit(cache=True)
-def _complementary_stress(data, point, lr, j, state, work, entry_tol, image):
+@njit(cache=True, no_cpython_wrapper=True)  # held: called through its C wrapper only
+def _complementary_stress(data_at, point, lr, j, state_at, work_at, entry_tol, image):
     """``image[q, i, k]``: the complementary (image) stress at ``point`` (in layer ``lr``)
     of a unit global DD ``q`` of rectangle ``j`` (interfaces present, not ``closed_form``),
     what :func:`element_traction` and :func:`element_stress_traced` share: the quadrature
@@ -339,7 +343,9 @@ def _complementary_stress(data, point, lr, j, state, work, entry_tol, image):
     it. A ``vertical_form`` source (a vertical rectangle, interfaces between solids) takes
     its triples in closed form (:func:`.vertical3d.vertical_image_stress`) where the
     quadrature would need sub-squares or :data:`VERTICAL_FROM` points per side, the
-    quadrature elsewhere."""
+    quadrature elsewhere. The record, the state and the workspace come as pointers
+    (:func:`hmatddm.kernels.held_function.address_of`)."""
+    data, state, work = dereference(data_at), dereference(state_at), dereference(work_at)
     traced, is_traced, near_only, three, heights = state
     local, gradient, kelvin, ws1, ws, rules, vwork, uniform = work[0], work[2], work[3], work[4], work[5], work[7], \
         work[10], work[11]
