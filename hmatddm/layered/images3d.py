@@ -81,9 +81,12 @@ the table, the closed forms of :mod:`.vertical3d`) and the tracing of a source's
 (:func:`_source_state`) are held by the record as first-class functions (``image_terms``,
 ``source_tracer``: :func:`with_image_terms`, :mod:`hmatddm.kernels.held_function`) and
 called through their addresses, so that each is compiled once, not again in each compiled
-caller: the operator's ``traction_block``, the stress at points (:mod:`.stress3d`), the
-drivers' generic ``stress_block`` and numba's own compiles of the per-kind functions that
-the drivers inline (they were five copies of the image terms).
+caller: the operator's ``traction_block``, the stress at points (:mod:`.stress3d`,
+:func:`element_stress_traced`), the drivers' generic ``stress_block`` and numba's own
+compiles of the per-kind functions that the drivers inline (they were six copies of the
+image terms; the cold compile of the layered 3D entry points 126 -> 96 s of CPU, RESULTS.md).
+A record built otherwise than by :func:`.influence3d.influence_data` needs
+:func:`with_image_terms` before a compiled function takes it.
 ``benchmarks/bench_layered3d_compile.py`` measures it.
 """
 import math
