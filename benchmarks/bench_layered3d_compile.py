@@ -1,7 +1,9 @@
-"""Cold compile time of the 3D layered kernel (issues 14 and 18): each compiled entry
-point of :mod:`hmatddm.kernels.drivers` for :class:`hmatddm.layered.images3d.LayeredRectangles`
-(``traction_block``, ``stress_block``, ``edge_distance``) first called in a fresh process
-with an empty numba cache (``NUMBA_CACHE_DIR`` set to a new folder: everything it uses is
+"""Cold compile time of the 3D layered kernel (issues 14, 18 and 32): each compiled entry
+point for :class:`hmatddm.layered.images3d.LayeredRectangles` (the operator's
+``traction_block``; ``stress_points`` of :mod:`hmatddm.layered.stress3d`, the stress at
+points of ``hd.stress_at``; the drivers' generic ``stress_block``, which only tests and
+benchmarks call with layered 3D data; ``edge_distance``) first called, in that order, in a
+fresh process with an empty numba cache (``NUMBA_CACHE_DIR`` set to a new folder: everything it uses is
 compiled, the homogeneous rectangle kernel included), then again with that cache warm.
 CPU time beside wall time; the functions taking the most compile CPU (exclusive of the
 njit functions they call, from numba's ``numba:compile`` events; ``llvm`` is the part
@@ -63,8 +65,12 @@ def _child(two_d):
         out = np.empty((dim * n, dim * n))
         timed("traction_block", lambda: drivers.traction_block(data, every, every, out))
         points = np.ascontiguousarray(grid.centers[:2] + 0.1)
-        timed("stress_block", lambda: drivers.stress_sum(data, points, np.ones((n, dim)),
-                                                          medium.layer_of(points[:, -1]).astype(np.int64)))
+        layers = medium.layer_of(points[:, -1]).astype(np.int64)
+        if not two_d:  # the stress at points of hd.stress_at: sources outside (layered/stress3d.py)
+            from hmatddm.layered import stress3d
+
+            timed("stress_points", lambda: stress3d.stress_sum(data, points, np.ones((n, dim)), layers))
+        timed("stress_block", lambda: drivers.stress_sum(data, points, np.ones((n, dim)), layers))
         timed("edge_distance", lambda: drivers.edge_distance(data, 0, 1))
     exclusive = defaultdict(lambda: [0.0, 0.0, 0])  # name -> [CPU s, LLVM CPU s, signatures]
     for record in recorder.records:

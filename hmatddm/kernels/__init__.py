@@ -9,7 +9,9 @@ Each holds the influence of one element at one point (``local_stress``, ``tracti
 ``stress_pair``, ...) and registers its kernel data record with :mod:`.drivers`, the one
 set of loops over element pairs: ``traction_block`` (the block generator of the
 H-matrix), ``traction_matrix`` (dense assembly), ``singular_pairs``, ``edge_distance``
-(for error messages) and ``stress_at_points``. Everything here is pure math on arrays.
+(for error messages) and ``stress_at_points``; :mod:`.held_function` lets a kind hold a
+large per-pair function in its record, called through a pointer (compiled once for every
+driver). Everything here is pure math on arrays.
 """
 import importlib
 

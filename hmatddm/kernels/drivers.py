@@ -58,8 +58,12 @@ thread count where it pays: the compiled drivers release the GIL); the self-bloc
 call :func:`traction_block` through a pointer from a small compiled loop (the kernel is not
 compiled again). Inside an entry point the per-pair function is inlined into the one loop
 nest (no njit helper level between them: each such level would optimise the kernel once
-more). The loops over pairs read :func:`borrowed` arrays: numba's reference
-counts are atomic operations, and a pair's reads of the record would otherwise pay a dozen.
+more); a kind whose per-pair function is large holds its heaviest parts in its record
+as first-class functions (:mod:`.held_function`, the 3D layered kernel), so that they are
+compiled once, not again in each entry point (nor in numba's own compile of each per-kind
+function the drivers inline). The loops over pairs read :func:`borrowed` arrays: numba's
+reference counts are atomic operations, and a pair's reads of the record would otherwise
+pay a dozen.
 The drivers are cached on disk (``cache=True``); the cache of a driver does not notice
 edits in a kind's module: delete ``hmatddm/**/__pycache__/*.nbi|*.nbc`` after changing a
 kernel.
@@ -172,7 +176,10 @@ def _per_kind(stub):
 
     function.__signature__ = resolve.__signature__ = inspect.signature(stub)
     function.__name__, function.__qualname__, function.__doc__ = stub.__name__, stub.__qualname__, stub.__doc__
-    overload(function, inline="always")(resolve)
+    # numba compiles the implementation on its own too before inlining it (never called
+    # from Python: no CPython or C wrapper, each of which unboxes or passes every field of
+    # the record, a large part of a small function's compile)
+    overload(function, inline="always", jit_options=dict(no_cpython_wrapper=True, no_cfunc_wrapper=True))(resolve)
     return function
 
 

@@ -76,16 +76,28 @@ it: the chain is kept short (``_complementary_gradient``, ``image_rectangle_stre
 into thousands of instructions (``_base_table``) run to array sizes; and no njit function
 takes a literal int argument where another call passes a variable (numba compiles one
 specialization per literal: ``first = np.int64(0)``).
+Issue 32: the image terms (:func:`_complementary_stress` and all below it: the quadrature,
+the table, the closed forms of :mod:`.vertical3d`) and the tracing of a source's triples
+(:func:`_source_state`) are held by the record as first-class functions (``image_terms``,
+``source_tracer``: :func:`with_image_terms`, :mod:`hmatddm.kernels.held_function`) and
+called through their addresses, so that each is compiled once, not again in each compiled
+caller: the operator's ``traction_block``, the stress at points (:mod:`.stress3d`,
+:func:`element_stress_traced`), the drivers' generic ``stress_block`` and numba's own
+compiles of the per-kind functions that the drivers inline (they were six copies of the
+image terms; the cold compile of the layered 3D entry points 126 -> 96 s of CPU, RESULTS.md).
+A record built otherwise than by :func:`.influence3d.influence_data` needs
+:func:`with_image_terms` before a compiled function takes it.
 ``benchmarks/bench_layered3d_compile.py`` measures it.
 """
 import math
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
+from numba import njit, typeof, types
 
 from ..kernels import rectangle3d
 from ..kernels.drivers import KernelKind, register_kind
+from ..kernels.held_function import HeldFunction, address_of, dereference, without_functions
 from . import okada3d
 from .image_points3d import image_point_displacement, image_point_stress, kelvin_point_displacement, kelvin_point_stress
 from .image_tracer import trace_capacity
@@ -98,7 +110,7 @@ from .rectangle_quadrature import (FAR_TOL, _cached_rules, _image_order, _integr
                                    image_rectangle_stress_without, remainder_order,
                                    nearest_singularity, square_rule, subdivisions)
 
-__all__ = ["LayeredRectangles", "workspace", "source_state", "element_traction", "element_stress", "element_stress_traced",
+__all__ = ["LayeredRectangles", "with_image_terms", "workspace", "source_state", "element_traction", "element_stress", "element_stress_traced",
            # re-exported from the parts (module docstring)
            "base_derivatives", "inverse_distance_derivatives", "Workspace", "trace", "trace_points",
            "kelvin_point_stress", "image_point_stress", "kelvin_point_displacement", "image_point_displacement",
@@ -144,6 +156,42 @@ class LayeredRectangles(NamedTuple):
     surface_form: np.ndarray = None
     #: (N,) bool: a vertical source whose near triples are in closed form next to it (:mod:`.vertical3d`)
     vertical_form: np.ndarray = None
+    #: :func:`_complementary_stress` held as a first-class function (:func:`with_image_terms`;
+    #: compiled once for every caller, not linked into each)
+    image_terms: object = None
+    #: :func:`_source_state` held the same way (the tracer it calls compiled once)
+    source_tracer: object = None
+
+
+def with_image_terms(data):
+    """``data`` with its ``image_terms`` and ``source_tracer``: :func:`_complementary_stress`
+    and :func:`_source_state` held as first-class functions
+    (:class:`hmatddm.kernels.held_function.HeldFunction`), so that each is compiled once, not
+    again in every compiled caller (module docstring, compile cost)."""
+    core = data._replace(image_terms=None, source_tracer=None)
+    return data._replace(image_terms=HeldFunction(_complementary_stress, core, _image_term_types),
+                         source_tracer=HeldFunction(_source_state, core, _source_state_types))
+
+
+def _state_type():
+    """The numba type of :func:`source_state`'s tuple."""
+    traced = typeof(_traced_buffer.py_func(1, 1, 1))
+    return types.Tuple((traced, types.Array(types.boolean, 1, "C"), types.boolean, traced,
+                        types.Array(types.float64, 1, "C")))
+
+
+def _source_state_types(data):
+    """The numba types of :func:`_source_state`'s result and arguments after the record."""
+    return _state_type(), (types.int64, types.CPointer(typeof(workspace.py_func(data))))
+
+
+def _image_term_types(data):
+    """The numba types of :func:`_complementary_stress`'s result and arguments after the
+    record: the point, its layer, the source, :func:`source_state`'s tuple,
+    :func:`workspace`'s tuple, the entry tolerance and the stress."""
+    return types.none, (types.Array(types.float64, 1, "C"), types.int64, types.int64, types.CPointer(_state_type()),
+                        types.CPointer(typeof(workspace.py_func(data))), types.float64,
+                        types.Array(types.float64, 3, "C"))
 
 
 @njit(cache=True)
@@ -152,7 +200,8 @@ def workspace(data):
     Kelvin scratch (2, 3, 3, 1), the :func:`Workspace` of order 1 and of the largest order
     of any source layer's triples, the tracer's room per layer ``(cap, n_orders)``, the
     :func:`_cached_rules`, the scratch of :func:`.okada3d.okada_stress` and of
-    :func:`.vertical3d.vertical_image_stress`."""
+    :func:`.vertical3d.vertical_image_stress`, the whole-space stress and the receiver point
+    of :func:`_complementary_stress`."""
     n_layers = data.shear_modulus.shape[0]
     room = np.zeros((n_layers, 2), dtype=np.int64)
     n_orders = 1
@@ -163,7 +212,7 @@ def workspace(data):
                 n_orders = max(n_orders, room[layer, 1])
     return (np.empty((3, 3, 3)), np.zeros((3, 3, 3)), np.empty((3, 3, 3, 3)), np.zeros((2, 3, 3, 1)), Workspace(1),
             Workspace(n_orders), room, _cached_rules(data.gauss_points), np.empty((5, 3, 3, 3)), np.empty((30, 4)),
-            vertical_workspace(n_orders), np.empty((3, 3, 3)))
+            vertical_workspace(n_orders), np.empty((3, 3, 3)), np.empty(3))
 
 
 @njit(cache=True)
@@ -173,14 +222,24 @@ def source_state(data, j, work):
     the near triples only (the source's layer has a tabulated remainder), and, for a
     ``vertical_form`` source, those triples traced at its bottom, middle and top heights
     (:func:`.vertical3d.vertical_image_stress`). A source whose images are in closed form
-    (``closed_form``) traces nothing: its room is one point."""
+    (``closed_form``) traces nothing: its room is one point. :func:`_source_state` through
+    ``data.source_tracer`` (:func:`with_image_terms`)."""
+    return data.source_tracer(address_of(without_functions(data)), np.int64(j), address_of(work))
+
+
+@njit(cache=True, no_cpython_wrapper=True)  # held: called through its C wrapper only
+def _source_state(data_at, j, work_at):
+    """:func:`source_state` (held by the record: the tracer compiled once), the record and
+    the workspace as pointers."""
+    data, work = dereference(data_at), dereference(work_at)
     room = work[6]
     start = work[7][3]
     ls = data.layer[j]
     near_only = data.table.pair_index[ls].max() >= 0
+    one = np.int64(1)  # not literals: one compiled _traced_buffer (module docstring)
     if data.closed_form[j]:
-        return (_traced_buffer(1, 1, 1), np.zeros(start.shape[0] - 1, dtype=np.bool_), near_only,
-                _traced_buffer(3, 1, 1), np.zeros(3))
+        return (_traced_buffer(one, one, one), np.zeros(start.shape[0] - 1, dtype=np.bool_), near_only,
+                _traced_buffer(np.int64(3), one, one), np.zeros(3))
     cap, n_orders = max(room[ls, 0], 1), max(room[ls, 1], 1)
     three, heights = _three_heights(data, j, near_only, cap, n_orders)
     return (_traced_buffer(start[-1], cap, n_orders), np.zeros(start.shape[0] - 1, dtype=np.bool_), near_only,
@@ -194,7 +253,7 @@ def _three_heights(data, j, near_only, cap, n_orders):
     free surface's when it is in closed form; one empty point otherwise."""
     heights = np.zeros(3)
     if not data.vertical_form[j]:
-        return _traced_buffer(3, 1, 1), heights
+        return _traced_buffer(np.int64(3), np.int64(1), np.int64(1)), heights
     ls = data.layer[j]
     center = data.centers[j]
     frame = data.frames[j]
@@ -208,7 +267,7 @@ def _three_heights(data, j, near_only, cap, n_orders):
         else:
             xi[p] = (p - 1.0) * frame[0, 2]
         heights[p] = center[2] + xi[p] * a * frame[0, 2] + eta[p] * b * frame[1, 2]
-    three = _traced_buffer(3, cap, n_orders)
+    three = _traced_buffer(np.int64(3), cap, n_orders)
     first, last = np.int64(0), np.int64(3)  # not literals: the same compiled functions as element_traction's
     _trace_range(center, frame, a, b, ls, data.interfaces, data.shear_modulus, data.poisson_ratio, data.n_images, xi,
                  eta, first, last, three)
@@ -254,14 +313,26 @@ def element_traction(data, i, j, state, work, block):
         if data.surface_form[j] and lr == ls:
             okada3d.okada_traction(point, normal, center, data.okada[j], data.okada_half[j, 0], data.okada_half[j, 1],
                                    data.surface, g[ls], nu[ls], False, True, okada_work, corners, block)
-        _complementary_stress(data, point, lr, j, state, work, data.entry_tol * data.entry_scale, image)
+        _image_terms(data, point, lr, j, state, work, data.entry_tol * data.entry_scale, image)
         for p in range(3):
             for q in range(3):
                 block[p, q] += image[q, p, 0] * normal[0] + image[q, p, 1] * normal[1] + image[q, p, 2] * normal[2]
 
 
 @njit(cache=True, inline="always")
-def _complementary_stress(data, point, lr, j, state, work, entry_tol, image):
+def _image_terms(data, point, lr, j, state, work, entry_tol, image):
+    """:func:`_complementary_stress` through ``data.image_terms`` (:func:`with_image_terms`),
+    the arguments in the held signature's types: the point copied to the workspace (any
+    layout), the layer and the source as int64, ``entry_tol`` as float64."""
+    here = work[12]
+    for k in range(3):
+        here[k] = point[k]
+    data.image_terms(address_of(without_functions(data)), here, np.int64(lr), np.int64(j), address_of(state),
+                     address_of(work), np.float64(entry_tol), image)
+
+
+@njit(cache=True, no_cpython_wrapper=True)  # held: called through its C wrapper only
+def _complementary_stress(data_at, point, lr, j, state_at, work_at, entry_tol, image):
     """``image[q, i, k]``: the complementary (image) stress at ``point`` (in layer ``lr``)
     of a unit global DD ``q`` of rectangle ``j`` (interfaces present, not ``closed_form``),
     what :func:`element_traction` and :func:`element_stress_traced` share: the quadrature
@@ -275,7 +346,9 @@ def _complementary_stress(data, point, lr, j, state, work, entry_tol, image):
     it. A ``vertical_form`` source (a vertical rectangle, interfaces between solids) takes
     its triples in closed form (:func:`.vertical3d.vertical_image_stress`) where the
     quadrature would need sub-squares or :data:`VERTICAL_FROM` points per side, the
-    quadrature elsewhere."""
+    quadrature elsewhere. The record, the state and the workspace come as pointers
+    (:func:`hmatddm.kernels.held_function.address_of`)."""
+    data, state, work = dereference(data_at), dereference(state_at), dereference(work_at)
     traced, is_traced, near_only, three, heights = state
     local, gradient, kelvin, ws1, ws, rules, vwork, uniform = work[0], work[2], work[3], work[4], work[5], work[7], \
         work[10], work[11]
@@ -378,7 +451,7 @@ def element_stress_traced(data, point, point_layer, j, state, work, out):
                 for k in range(3):
                     out[q, i, k] += image[q, i, k]
     elif data.interfaces.shape[0] > 0:
-        _complementary_stress(data, point, point_layer, j, state, work, 0.0, image)
+        _image_terms(data, point, point_layer, j, state, work, 0.0, image)
         for q in range(3):
             for i in range(3):
                 for k in range(3):

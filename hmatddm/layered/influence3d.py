@@ -68,13 +68,13 @@ def influence_data(mesh, medium, singular_shift, alpha, near_fraction, n_images,
                 & (medium.method != "quadrature") & (int(n_images) >= 1) & (not is_half_space(medium)))
     if not is_half_space(medium) or medium.method == "quadrature":
         closed[:] = False
-    return with_self_max(images3d.LayeredRectangles(
+    return with_self_max(images3d.with_image_terms(images3d.LayeredRectangles(
         mesh.centers, mesh.frames, mesh.half_a, mesh.half_b, layers, interfaces, g, nu, n_images=int(n_images),
         gauss_points=int(medium.gauss_points), max_subdivisions=int(MAX_SUBDIVISIONS),
         singular_shift=float(singular_shift), near_fraction=float(near_fraction), alpha=float(alpha),
         self_max=np.zeros(mesh.n_elements), entry_tol=float(ENTRY_TOL), entry_scale=float(scale), table=table,
         closed_form=closed, okada=okada, okada_half=half,
-        surface=float(interfaces[0]) if interfaces.shape[0] else 0.0, surface_form=surface, vertical_form=vertical))
+        surface=float(interfaces[0]) if interfaces.shape[0] else 0.0, surface_form=surface, vertical_form=vertical)))
 
 
 def is_half_space(medium):
