@@ -7,9 +7,9 @@ every intact natural element (the rigorous screen of :mod:`.field_bound` holds f
 homogeneous kernel only) with the image terms (:func:`hmatddm.layered.influence3d.stress_at`,
 a direct sum, hundreds of microseconds per point and element), at every growth pass. The
 stress is linear in the DDs and each element's term depends on that element alone, so the
-terms of the elements a check has seen are kept (one (9, 3) block per point and element)
-and a later check computes only the terms of the elements appended since, then contracts
-the kept terms with the current DDs. The stage scene with stiffer bounding layers
+terms of the elements a check has seen are kept (one (6, 3) block per point and element:
+the six components of the symmetric stress) and a later check computes only the terms of
+the elements appended since, then contracts the kept terms with the current DDs. The stage scene with stiffer bounding layers
 (issue 35): every check recomputed 20-500 elements at 2074 points; now each element is
 computed once per run (benchmarks/RESULTS.md, issue 35).
 
