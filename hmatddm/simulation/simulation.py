@@ -397,6 +397,10 @@ class Simulation:
             record.update(solve_seconds=float(time.perf_counter() - clock), step_retries=retries)
             return record
 
+    def splittable(self):
+        """Whether the step being solved may still be redone in shorter steps (:meth:`step`)."""
+        return self.front is None and self._shorter_step() is not None
+
     def _shorter_step(self):
         """Half the step that did not converge, or None when it may not be shorter (see
         :meth:`step`)."""
