@@ -25,11 +25,11 @@ run's CPU (benchmarks/RESULTS.md, issue 33).
 
 A base serves while the changed rows are at most :data:`MAX_RANK_FRACTION` of the unknowns
 and ``K`` is well conditioned (:data:`MIN_RCOND`); otherwise the current rows become the
-new base. The bases are kept per operator (:func:`contact_factor`), so the steps and the
-solves of one mesh share them.
+new base. The bases live with the solver of one step's solve (:class:`ElasticSolver`), not
+with the operator: a run resumed from a checkpoint then makes the same bases, and the same
+round-off, as the run it continues (the project's resumes are bit for bit).
 """
 import itertools
-import weakref
 
 import numpy as np
 import scipy.linalg
@@ -44,16 +44,7 @@ MAX_RANK_FRACTION = 0.2
 #: (1-norm estimate; below it the update would lose digits that a new base keeps)
 MIN_RCOND = 1e-8
 
-_FACTORS = weakref.WeakKeyDictionary()  # operator -> ContactFactor
 _BASE_IDS = itertools.count()
-
-
-def contact_factor(operator):
-    """The :class:`ContactFactor` of a dense ``operator`` (one per operator, kept while it lives)."""
-    factor = _FACTORS.get(operator)
-    if factor is None:
-        factor = _FACTORS[operator] = ContactFactor(operator.to_dense(), operator.dof)
-    return factor
 
 
 def _element_dofs(elements, d):

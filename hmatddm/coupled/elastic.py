@@ -25,7 +25,7 @@ import scipy.sparse.linalg as spla
 
 from ..elasticity.inverse import solve_with_inverse
 from ..hmatrix._threads import single_threaded_blas
-from .contact_factor import contact_factor
+from .contact_factor import ContactFactor
 
 
 class ElasticSolver:
@@ -42,6 +42,7 @@ class ElasticSolver:
         self._modified_inverse = None
         self._modified_factors = None  # (key, dense LU of S A + D) of exact operators, for solve
         self._update = None  # (key, UpdatedFactor) of exact operators (contact_update)
+        self.contact_factor = None  # their ContactFactor (made on first use)
 
     @property
     def shape(self):
@@ -99,7 +100,9 @@ class ElasticSolver:
         solves and ``(S A + D)^-1 S B`` from the operator's factorised base."""
         key = None if rows is None else rows.key
         if self._update is None or self._update[0] != key:
-            self._update = (key, contact_factor(self.operator).update(rows))
+            if self.contact_factor is None:
+                self.contact_factor = ContactFactor(self.operator.to_dense(), self.operator.dof)
+            self._update = (key, self.contact_factor.update(rows))
         return self._update[1]
 
     def exact_inverse_times(self, columns, rows=None):

@@ -240,7 +240,8 @@ def solve_step(problem, settings, dd_guess, p_guess, relaxation, provisional=Fal
     result converged.
 
     ``splittable=True`` (the caller redoes a step that does not converge in shorter steps):
-    a relaxation that does not help is not pursued (:data:`RELAXATION_HELPS`).
+    a relaxation that does not help is not pursued (:data:`RELAXATION_HELPS`; coupled schemes
+    only: the segregated ones converge slowly at small alpha, ref. Fig. 4.10).
     """
     pending = PendingSolve(problem, settings, dd_guess, p_guess, relaxation, splittable=splittable)
     return pending.run(provisional)
@@ -252,7 +253,7 @@ class PendingSolve:
 
     def __init__(self, problem, settings, dd_guess, p_guess, relaxation, splittable=False):
         self.problem, self.settings = problem, settings
-        self.splittable = splittable
+        self.splittable = splittable and settings.scheme in COUPLED_SCHEMES  # segregated ones need the ladder
         self._stalled = None       # the stagnated change of this attempt (None: it did not stagnate)
         self._last_stalled = None  # ... of the attempt before it
         self.dd_guess, self.p_guess = dd_guess, p_guess
