@@ -7,8 +7,10 @@ inverse, warm-started), ``approximate_inverse`` (what the Krylov-accelerated cou
 scheme uses inside its preconditioner: the exact LU solve for ``dense``, one
 application of the near-field preconditioner otherwise, no inner iteration) and
 ``modified_inverse`` for contact rows; with an exact (dense LU) inverse also
-``exact_inverse_times``, the solve of a block of columns (the exact Schur complement of the
-``"krylov"`` preconditioner, :mod:`hmatddm.coupled.scaled_system`).
+``contact_update``, the solves with ``S A + D`` from a low-rank update of a factorised base
+(:mod:`hmatddm.coupled.contact_factor`: the contact statuses of a large network change a few
+at a time), which the preconditioner and the exact Schur complement of the ``"krylov"``
+scheme use (:mod:`hmatddm.coupled.scaled_system`).
 
 Every method takes optional contact ``rows`` (:class:`~hmatddm.coupled.contact.ContactRows`):
 the operator is then ``S A + D`` (closed elements, see :mod:`hmatddm.coupled.contact`),
@@ -23,6 +25,7 @@ import scipy.sparse.linalg as spla
 
 from ..elasticity.inverse import solve_with_inverse
 from ..hmatrix._threads import single_threaded_blas
+from .contact_factor import ContactFactor
 
 
 class ElasticSolver:
@@ -37,7 +40,9 @@ class ElasticSolver:
         self._diagonal_blocks = None
         self._modified_key = None
         self._modified_inverse = None
-        self._modified_factors = None  # dense LU of S A + D (exact operators), for _modified_key
+        self._modified_factors = None  # (key, dense LU of S A + D) of exact operators, for solve
+        self._update = None  # (key, UpdatedFactor) of exact operators (contact_update)
+        self.contact_factor = None  # their ContactFactor (made on first use)
 
     @property
     def shape(self):
@@ -57,8 +62,9 @@ class ElasticSolver:
         if rows is None:
             x, info = self.operator.solve(rhs, **settings)
         else:
-            x, info = solve_with_inverse(self.modified_operator(rows), rhs, self._modified(rows),
-                                         self.operator.inverse_is_exact, **settings)
+            exact = self.operator.inverse_is_exact
+            inverse = self._exact_modified(rows) if exact else self._modified(rows)
+            x, info = solve_with_inverse(self.modified_operator(rows), rhs, inverse, exact, **settings)
         return x, int(info["iterations"])
 
     def approximate_inverse(self, rhs, rows=None):
@@ -68,33 +74,44 @@ class ElasticSolver:
 
     def _modified(self, rows):
         """Approximate inverse of ``S A + D`` for ``rows`` (cached for the last key); for an
-        exact operator the solve with the LU factors of :meth:`exact_inverse_times` (the
-        factorisation of the operator's own ``modified_inverse``, made once for both)."""
+        exact operator the solve with :meth:`contact_update` (exact: a low-rank update of a
+        factorised base, :mod:`hmatddm.coupled.contact_factor`)."""
         if self._modified_key != rows.key or self._modified_inverse is None:
-            self._modified_factors = None
             if self.operator.inverse_is_exact:
-                with single_threaded_blas():  # as the GMRES around it (hmatddm.hmatrix._threads)
-                    factors = scipy.linalg.lu_factor(rows.modify_dense(self.operator.to_dense()), check_finite=False)
-                self._modified_factors = factors
-                inverse = lambda r: scipy.linalg.lu_solve(factors, np.asarray(r, dtype=np.float64).ravel(),  # noqa: E731
-                                                          check_finite=False)
+                inverse = self.contact_update(rows).solve
             else:
                 inverse = self.operator.modified_inverse(rows)
             self._modified_key, self._modified_inverse = rows.key, inverse
         return self._modified_inverse
 
+    def _exact_modified(self, rows):
+        """The dense LU solve of ``S A + D`` (a fresh factorisation, cached for the last key):
+        :meth:`solve`, which answers without an iteration, gets the factors' own accuracy."""
+        if self._modified_factors is None or self._modified_factors[0] != rows.key:
+            with single_threaded_blas():  # as the GMRES around it (hmatddm.hmatrix._threads)
+                factors = scipy.linalg.lu_factor(rows.modify_dense(self.operator.to_dense()), check_finite=False)
+            self._modified_factors = (rows.key, factors)
+        factors = self._modified_factors[1]
+        return lambda r: scipy.linalg.lu_solve(factors, np.asarray(r, dtype=np.float64).ravel(), check_finite=False)
+
+    def contact_update(self, rows):
+        """The :class:`~hmatddm.coupled.contact_factor.UpdatedFactor` of ``S A + D`` (``A``
+        for ``rows`` None) of an exact (dense) operator, cached for the last key: exact
+        solves and ``(S A + D)^-1 S B`` from the operator's factorised base."""
+        key = None if rows is None else rows.key
+        if self._update is None or self._update[0] != key:
+            if self.contact_factor is None:
+                self.contact_factor = ContactFactor(self.operator.to_dense(), self.operator.dof)
+            self._update = (key, self.contact_factor.update(rows))
+        return self._update[1]
+
     def exact_inverse_times(self, columns, rows=None):
         """``A^-1 M`` (``(S A + D)^-1 M`` with ``rows``) for the dense ``(dN, k)`` columns
-        ``M``, from the dense LU factors; None when the operator's inverse is not exact
+        ``M`` (:meth:`contact_update`); None when the operator's inverse is not exact
         (:attr:`inverse_is_exact`: the ``hmatrix`` backend, a grown operator)."""
         if not self.operator.inverse_is_exact:
             return None
-        if rows is None:
-            factors = self.operator.lu()
-        else:
-            self._modified(rows)
-            factors = self._modified_factors
-        return scipy.linalg.lu_solve(factors, columns, check_finite=False)
+        return self.contact_update(rows).solve(columns)
 
     def diagonal_blocks(self, rows=None):
         """(N, d, d) self-influence block of each element (``S_i A_ii + D_i`` with rows)."""

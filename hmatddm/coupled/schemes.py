@@ -202,6 +202,17 @@ def _stagnated(history, left):
     return math.log(recent) / -math.log(rate) > left
 
 
+#: A solve that may be redone in shorter steps (``solve_step(splittable=True)``) is given up
+#: when two attempts in a row stagnate (:func:`_stagnated`) and halving the relaxation cut
+#: the stagnated change by less than this factor (it cuts any change by 2: a mode that the
+#: relaxation does not damp, e.g. a drift or a cycle of the active set whose size follows
+#: alpha). On the dfn-3cluster network at 4x its area, 154-158 s: six steps went down the
+#: whole ladder from alpha 1/2 or 1/4 to 1/256 (~20 iterations an attempt, 800 of 1485
+#: iterations) before their halves converged; no attempt converged below alpha 1/4, and
+#: none after two stagnated attempts.
+RELAXATION_HELPS = 0.25
+
+
 def _products(problem):
     """Products the step problem's elasticity operator has made so far
     (:class:`hmatddm.elasticity.operator.ProductCounter`; 0 for an operator that does not
@@ -209,7 +220,7 @@ def _products(problem):
     return int(getattr(getattr(problem.elastic, "operator", None), "products", 0))
 
 
-def solve_step(problem, settings, dd_guess, p_guess, relaxation, provisional=False):
+def solve_step(problem, settings, dd_guess, p_guess, relaxation, provisional=False, splittable=False):
     """Iterate one time step to convergence (ref. Eqs 4.43-4.44).
 
     Returns ``(dd, p, info)``; ``info`` has ``nonlinear_iterations`` (all attempts),
@@ -227,8 +238,12 @@ def solve_step(problem, settings, dd_guess, p_guess, relaxation, provisional=Fal
     this iterate whether the mesh grows (:mod:`hmatddm.simulation.step_solve`) and pays the
     rest of the iteration only for the mesh it keeps. Otherwise ``pending`` is None and the
     result converged.
+
+    ``splittable=True`` (the caller redoes a step that does not converge in shorter steps):
+    a relaxation that does not help is not pursued (:data:`RELAXATION_HELPS`; coupled schemes
+    only: the segregated ones converge slowly at small alpha, ref. Fig. 4.10).
     """
-    pending = PendingSolve(problem, settings, dd_guess, p_guess, relaxation)
+    pending = PendingSolve(problem, settings, dd_guess, p_guess, relaxation, splittable=splittable)
     return pending.run(provisional)
 
 
@@ -236,8 +251,11 @@ class PendingSolve:
     """The nonlinear iteration of one :func:`solve_step`, which may stop after the first
     (loose) iterate of an attempt and be continued by :meth:`finish`."""
 
-    def __init__(self, problem, settings, dd_guess, p_guess, relaxation):
+    def __init__(self, problem, settings, dd_guess, p_guess, relaxation, splittable=False):
         self.problem, self.settings = problem, settings
+        self.splittable = splittable and settings.scheme in COUPLED_SCHEMES  # segregated ones need the ladder
+        self._stalled = None       # the stagnated change of this attempt (None: it did not stagnate)
+        self._last_stalled = None  # ... of the attempt before it
         self.dd_guess, self.p_guess = dd_guess, p_guess
         self.coupled = settings.scheme in COUPLED_SCHEMES
         self.iterate = _coupled_iteration if self.coupled else _segregated_iteration
@@ -261,6 +279,7 @@ class PendingSolve:
         if self.problem.contact is not None:
             self.problem.contact.reset()
         self.history = []
+        self._stalled = None
         self.iteration = 0
         self.last_change = math.nan
         self.accurate_next = False  # an iterate solved loosely passed the test: the next at linear_rtol
@@ -376,6 +395,7 @@ class PendingSolve:
                     if max(change_p, change_u) > 1e6:
                         raise _Diverged(f"relative change {max(change_p, change_u):.2e}")
                     if _stagnated(history, settings.max_iterations - self.iteration):
+                        self._stalled = min(history[-STAGNATION_WINDOW:])
                         raise _Diverged(f"changes stagnated at {self.last_change:.2e} (no convergence within "
                                         f"{settings.max_iterations} iterations at their rate)")
                     if provisional and loose:
@@ -383,6 +403,14 @@ class PendingSolve:
                 raise _Diverged(f"no convergence in {settings.max_iterations} iterations "
                                 f"(last relative change {self.last_change:.2e})")
             except _Diverged as reason:
+                stalled, last = self._stalled, self._last_stalled
+                self._last_stalled = stalled
+                if (self.splittable and stalled is not None and last is not None
+                        and stalled > RELAXATION_HELPS * last):
+                    raise ConvergenceError(
+                        f"time step did not converge with scheme {settings.scheme!r}: two attempts stagnated, at "
+                        f"relaxation {2.0 * self.alpha:g} and {self.alpha:g}, with changes {last:.3g} and {stalled:.3g} "
+                        "tolerances (a smaller relaxation does not help)", iterations=self.counters["nonlinear"])
                 if self.alpha / 2.0 < settings.min_relaxation:
                     raise ConvergenceError(
                         f"time step did not converge with scheme {settings.scheme!r} down to relaxation "

@@ -126,6 +126,7 @@ class StepProblem:
         self._last_product = (None, None)  # (dd, A dd) of the last elastic product
         self.flow_factor = None  # the last iterate's FlowFactor (hmatddm.coupled.scaled_system)
         self._coupled_compliance = (None, None)  # (rows key, C A^-1 B) of the last active set
+        self._base_compliance = (None, None)  # (X_0, C X_0) of the contact factor's base
 
     def elastic_matvec(self, dd):
         """``A dd``; the last product is kept: an iteration's first residual (and the
@@ -162,24 +163,23 @@ class StepProblem:
     def coupled_compliance(self, rows):
         """The dense ``(N, N)`` matrix ``C A^-1 B`` (``C (S A + D)^-1 S B`` with contact ``rows``):
         how the flow rows see the pressures through the elasticity, whose ``D - C A^-1 B`` is
-        the exact Schur complement of the coupled matrix. Computed from the dense LU of an
-        exact operator for at most :data:`EXACT_SCHUR_MAX_ELEMENTS` elements (else None),
-        kept for the last active set (it changes only with the statuses)."""
+        the exact Schur complement of the coupled matrix. Computed for an exact operator of
+        at most :data:`EXACT_SCHUR_MAX_ELEMENTS` elements (else None) from the low-rank update
+        of a factorised base (:meth:`ElasticSolver.contact_update`): ``C X_0`` once per base,
+        then ``(C W) F`` per set of statuses; kept for the last active set."""
         if self.n > EXACT_SCHUR_MAX_ELEMENTS or not self.elastic.operator.inverse_is_exact:
             return None
         key = None if rows is None else rows.key
         cached_key, value = self._coupled_compliance
         if value is not None and cached_key == key:
             return value
-        n, d = self.n, self.d
-        columns = np.zeros((n, d, n))
-        columns[np.arange(n), :, np.arange(n)] = self.normals  # B: p_i n_i on the rows of element i
-        columns = columns.reshape(n * d, n)
-        if rows is not None:
-            columns = rows.modify_rows(columns, 0)
-        with single_threaded_blas():  # small dense blocks: threads cost more than they save (hmatrix._threads)
-            solved = self.elastic.exact_inverse_times(columns, rows)
-        value = np.asarray(self.coupling @ solved)
+        x0, w, f = self.elastic.contact_update(rows).inverse_times_b(self.normals)
+        if self._base_compliance[0] is not x0:
+            self._base_compliance = (x0, np.asarray(self.coupling @ x0))
+        value = self._base_compliance[1]
+        if w is not None:
+            with single_threaded_blas():  # small dense blocks: threads cost more than they save (hmatrix._threads)
+                value = value + np.asarray(self.coupling @ w) @ f
         self._coupled_compliance = (key, value)
         return value
 

@@ -398,6 +398,13 @@ class Simulation:
             record.update(solve_seconds=float(time.perf_counter() - clock), step_retries=retries)
             return record
 
+    def splittable(self):
+        """Whether the step being solved may still be redone in shorter steps (:meth:`step`),
+        so that its coupled solve may give up early on a hopeless relaxation ladder. Element
+        front only: the asymptotic front's steps are split too, but its solves keep the whole
+        ladder (a trial front's solve that fails changes the front iteration's course)."""
+        return self.front is None and self._shorter_step() is not None
+
     def _shorter_step(self):
         """Half the step that did not converge, or None when it may not be shorter (see
         :meth:`step`)."""

@@ -109,8 +109,9 @@ def solve(simulation, trial, start, t_old, t_new, relaxation, provisional=False)
                           width_old=start.width, pressure_old=start.pressure,
                           leak_off_rate=flow.leak_off_rate(trial.creation_time, t_old, t_new),
                           contact=contact, fixed_pressure=fixed_pressure)
+    # a step that may still be split gives up a relaxation that does not help (solve_step)
     dd, p, info = solve_step(problem, sim.settings, trial.dd.ravel(), pressure_guess, relaxation,
-                             provisional=provisional)
+                             provisional=provisional, splittable=sim.splittable())
     info["drained"] = no_fluid
     return _with_solution(trial, problem, dd, p, info), info, SolvedMesh(edges, faces, flow)
 

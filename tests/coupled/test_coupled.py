@@ -370,3 +370,54 @@ def test_the_exact_schur_complement_gives_the_same_step_in_two_gmres_iterations(
     assert info_diag["linear_iterations"] > 3 * info["linear_iterations"]
     np.testing.assert_allclose(p, p_diag, rtol=1e-8)
     np.testing.assert_allclose(dd, dd_diag, atol=1e-8 * np.abs(dd_diag).max())
+
+
+class _Oscillating:
+    """A stand-in step problem and iteration whose iterates swing about 1 by
+    ``amplitude(alpha)`` (relative), without ever converging: a mode the relaxation damps
+    only as fast as ``amplitude`` falls with alpha."""
+
+    contact = elastic = None
+
+    def __init__(self, amplitude):
+        self.amplitude, self.sign = amplitude, 1.0
+
+    def update_contact(self, dd, p):
+        return 0
+
+    def iterate(self, problem, settings, dd, p, alpha, counters, **kwargs):
+        self.sign = -self.sign
+        return np.full_like(dd, 1.0 + self.sign * self.amplitude(alpha)), p
+
+
+@pytest.mark.parametrize("damped", [False, True])
+def test_a_splittable_solve_gives_up_a_relaxation_that_does_not_help(damped):
+    """With ``splittable=True`` a solve whose stagnated change only halves with alpha (a
+    mode the relaxation does not damp) stops after two stagnated attempts instead of going
+    down to ``min_relaxation``; where halving alpha cuts it by more than RELAXATION_HELPS
+    (here 8x) the ladder goes on as without the flag, to the same converged attempt."""
+    from hmatddm.coupled.schemes import STAGNATION_WINDOW, PendingSolve
+    from hmatddm.errors import ConvergenceError
+
+    settings = SchemeSettings(scheme="krylov", max_iterations=400)
+    counts = {}
+    for splittable in (False, True):
+        model = _Oscillating((lambda a: 1e-2 * a**3) if damped else (lambda a: 1e-2 * a))
+        pending = PendingSolve(model, settings, np.ones(4), np.ones(2), 1.0, splittable=splittable)
+        pending.iterate = model.iterate
+        try:
+            pending.run()
+            message = "converged"
+        except ConvergenceError as error:
+            message = str(error)
+        counts[splittable] = (pending.counters["nonlinear"], pending.alpha, message)
+    segregated = SchemeSettings(scheme="fixed-width")  # its slow convergence at small alpha needs the ladder
+    assert not PendingSolve(_Oscillating(abs), segregated, np.ones(4), np.ones(2), 1.0, splittable=True).splittable
+    ladder = counts[False]
+    if damped:  # converges at a small alpha, the same way with the flag
+        assert ladder[2] == "converged" and ladder[1] <= 1.0 / 16.0
+        assert counts[True] == ladder
+    else:
+        assert ladder[1] == settings.min_relaxation  # the whole ladder, 1 .. 1/256
+        assert counts[True][0] == 2 * 2 * STAGNATION_WINDOW and counts[True][1] == 0.5
+        assert "does not help" in counts[True][2] and ladder[0] > 4 * counts[True][0]

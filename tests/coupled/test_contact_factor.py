@@ -1,0 +1,133 @@
+"""The low-rank (Woodbury) update of the contact-modified dense matrix ``S A + D``
+(hmatddm.coupled.contact_factor) against a fresh dense factorisation of the same rows."""
+import numpy as np
+
+import hmatddm as hd
+from hmatddm.coupled import ElasticSolver, SchemeSettings, solve_step
+from hmatddm.coupled import contact_factor as cf
+from hmatddm.coupled.contact import OPEN, SLIP, STICK, ContactLaw, ContactModel
+
+MATERIAL = hd.Elastic(shear_modulus=10e9, poisson_ratio=0.25)
+
+
+def _model(mesh, elastic, status, seed):
+    n, d = mesh.n_elements, mesh.dim
+    rng = np.random.default_rng(seed)
+    law = ContactLaw(np.ones(n, bool), np.full(n, 0.6), np.full(n, 1e5))
+    direction = np.zeros((n, d))
+    slip = status == SLIP
+    tangent = np.stack([-mesh.normals[:, 1], mesh.normals[:, 0]], axis=1) if d == 2 else None
+    if d == 2:
+        direction[slip] = tangent[slip] * rng.choice([-1.0, 1.0], size=(np.count_nonzero(slip), 1))
+    return ContactModel(law, mesh.normals, rng.normal(scale=1e-4, size=(n, d)), status, direction,
+                        elastic.normal_stiffness(mesh.normals))
+
+
+def _dense_modified(operator, rows):
+    return operator.to_dense() if rows is None else rows.modify_dense(operator.to_dense())
+
+
+def _schur_columns(mesh, rows):
+    n, d = mesh.n_elements, mesh.dim
+    columns = np.zeros((n, d, n))
+    columns[np.arange(n), :, np.arange(n)] = mesh.normals
+    columns = columns.reshape(n * d, n)
+    return columns if rows is None else rows.modify_rows(columns, 0)
+
+
+def test_updated_solves_and_schur_columns_match_a_fresh_factorisation(monkeypatch):
+    """Statuses that change a few elements at a time (the base kept), then many at once
+    (a new base): every solve and ``(S A + D)^-1 S B`` agree with the LU of the same rows."""
+    mesh = hd.mesh.line([-5.0, 0.0], [5.0, 0.0], 40)
+    operator = hd.ElasticityOperator(mesh, MATERIAL, backend="dense")
+    elastic = ElasticSolver(operator)
+    n, d = mesh.n_elements, mesh.dim
+    rng = np.random.default_rng(3)
+    status = np.full(n, OPEN)
+    ranks = []
+    for it in range(12):
+        if it == 8:  # past MAX_RANK_FRACTION: a new base
+            status = rng.choice([OPEN, STICK, SLIP], size=n)
+        else:
+            flip = rng.choice(n, size=3, replace=False)
+            status[flip] = rng.choice([OPEN, STICK, SLIP], size=3)
+        rows = _model(mesh, elastic, status.copy(), it).rows()
+        updated = elastic.contact_update(rows)
+        ranks.append(updated.rank)
+        dense = _dense_modified(operator, rows)
+        r = rng.normal(size=n * d)
+        exact = np.linalg.solve(dense, r)
+        np.testing.assert_allclose(updated.solve(r), exact, rtol=0, atol=1e-9 * np.abs(exact).max())
+        x0, w, f = updated.inverse_times_b(mesh.normals)
+        columns = x0 if w is None else x0 + w @ f
+        expected = np.linalg.solve(dense, _schur_columns(mesh, rows))
+        np.testing.assert_allclose(columns, expected, rtol=0, atol=1e-9 * np.abs(expected).max())
+    assert max(ranks[:8]) > 0           # updates did serve
+    assert elastic.contact_factor.bases_made >= 2        # ... and the big change made a new base
+    assert ranks[8] == 0
+
+
+def test_an_ill_conditioned_update_makes_a_new_base(monkeypatch):
+    """A capacitance matrix below MIN_RCOND is not used: the rows become a new base."""
+    mesh = hd.mesh.line([-5.0, 0.0], [5.0, 0.0], 20)
+    operator = hd.ElasticityOperator(mesh, MATERIAL, backend="dense")
+    elastic = ElasticSolver(operator)
+    n = mesh.n_elements
+    status = np.full(n, OPEN)
+    elastic.contact_update(_model(mesh, elastic, status, 0).rows() if status.any() else None)
+    status[4] = STICK
+    monkeypatch.setattr(cf, "MIN_RCOND", 2.0)  # no capacitance is that well conditioned
+    updated = elastic.contact_update(_model(mesh, elastic, status, 0).rows())
+    assert updated.rank == 0 and elastic.contact_factor.bases_made == 2
+
+
+def _pressurised_step(pressure_peak):
+    """One "krylov" step of an inclined crack, closed and stuck at the start, drained at a
+    pressure that peaks at its centre: its middle opens, its flanks slip or stick, and the
+    statuses settle over several iterations, a few elements at a time."""
+    from test_contact import MATERIAL as material, STRESS_2D, _inclined_crack
+    from hmatddm.coupled import StepProblem
+    from hmatddm.flow import LeakOff, LubricationModel, fracture_compliance
+    from hmatddm.mesh import topology
+
+    mesh, _ = _inclined_crack(n=60)
+    n, d = mesh.n_elements, mesh.dim
+    operator = hd.ElasticityOperator(mesh, material, backend="dense")
+    faces = topology.element_faces(mesh, topology.element_edges(mesh, 1.0))
+    flow = LubricationModel(areas=mesh.areas, normals=mesh.normals, faces=faces, fluid=hd.Fluid(1e-3, 1e-9),
+                            leak_off=LeakOff(), injection_elements=np.array([0]), injection_rates=np.zeros(1),
+                            wellbore_volumes=np.zeros(1), minimum_width=1e-5)
+    elastic = ElasticSolver(operator)
+    s = np.linspace(-1.0, 1.0, n)
+    pressure = 5e6 + pressure_peak * np.exp(-(s / 0.3) ** 2)
+    law = ContactLaw(np.ones(n, bool), np.full(n, 0.6), np.full(n, 1e5))
+    contact = ContactModel(law, mesh.normals, np.zeros((n, d)), np.full(n, STICK), np.zeros((n, d)),
+                           elastic.normal_stiffness(mesh.normals))
+    problem = StepProblem(elastic=elastic, normals=mesh.normals, far_field=-(mesh.normals @ STRESS_2D.T).ravel(),
+                          flow=flow, compliance=fracture_compliance(mesh, material), dt=1.0, width_old=np.zeros(n),
+                          pressure_old=pressure, leak_off_rate=np.zeros(n), contact=contact, fixed_pressure=pressure)
+    settings = SchemeSettings(scheme="krylov", tolerance_pressure=1e-9, tolerance_opening=1e-9, linear_rtol=1e-12)
+    dd, p, info = solve_step(problem, settings, np.zeros(n * d), pressure, 1.0)
+    return dd, p, info, contact, elastic.contact_factor
+
+
+def test_a_step_with_updated_factors_matches_one_with_fresh_factorisations(monkeypatch):
+    """The coupled "krylov" step whose statuses change over its iterations: with updates
+    (the default) and with a new factorisation for every set of statuses
+    (``MAX_RANK_FRACTION`` 0, the path before the updates) the same statuses, DDs and
+    pressures to the solver tolerance, in as many iterations."""
+    results = {}
+    for fraction in (0.0, cf.MAX_RANK_FRACTION):
+        monkeypatch.setattr(cf, "MAX_RANK_FRACTION", fraction)
+        results[fraction] = _pressurised_step(20e6)
+    (dd_fresh, p_fresh, info_fresh, contact_fresh, factor_fresh), (dd, p, info, contact, factor) = results.values()
+    assert info_fresh["contact_changes"] > 0 and info["nonlinear_iterations"] > 2
+    assert 0 < np.count_nonzero(contact.status == OPEN) < contact.n  # a mixed active set
+    np.testing.assert_array_equal(contact.status, contact_fresh.status)
+    assert info["nonlinear_iterations"] == info_fresh["nonlinear_iterations"]
+    # (the all-stuck start and the statuses after its first iterate: two bases either way;
+    # the three sets after them are updates of the second)
+    assert factor_fresh.bases_made >= 4 and factor.bases_made == 2
+    assert info["linear_iterations"] == info_fresh["linear_iterations"]
+    np.testing.assert_allclose(p, p_fresh, rtol=1e-9)
+    np.testing.assert_allclose(dd, dd_fresh, rtol=0, atol=1e-8 * np.abs(dd_fresh).max())
