@@ -321,7 +321,9 @@ CLUSTER = {  # -> hmatddm.flow.fluid.Cluster (ref. Eqs 4.34-4.35)
     "wellbore_volume": Setting("number", 0.0, low=0.0, unit="m^3"),
     # perforations of a cluster on a shared [well] (issue 35, hmatddm.flow.well)
     "perforations": Setting("integer", ABSENT, low=1, doc="number of perforations n (with a [well])"),
-    "perforation_diameter": Setting("number", ABSENT, low=0.0, low_open=True, unit="m",
+    # bounded so that the orifice law's d^4 stays a finite, non-zero float (a perforation is
+    # millimetres to centimetres across)
+    "perforation_diameter": Setting("number", ABSENT, low=1e-4, high=1.0, unit="m",
                                     doc="perforation diameter d (with perforations)"),
     "discharge_coefficient": Setting("number", ABSENT, low=0.0, high=1.0, low_open=True,
                                      doc="C_d of the orifice law, in (0, 1] (default 0.6 with perforations)"),
@@ -337,7 +339,9 @@ WELL = {
     "heel": Setting("point", REQUIRED, length="dim", unit="m", doc="where the pump pressure (heel pressure) is"),
     "direction": Setting("point", REQUIRED, length="dim", doc="the well's direction from the heel to the toe"),
     "volume": Setting("number", 0.0, low=0.0, unit="m^3", doc="wellbore volume storing fluid (c_f V)"),
-    "diameter": Setting("number", ABSENT, low=0.0, low_open=True, unit="m",
+    # bounded so that the Darcy-Weisbach D^5 stays a finite, non-zero float (a casing's inner
+    # diameter is a few centimetres to decimetres)
+    "diameter": Setting("number", ABSENT, low=1e-3, high=10.0, unit="m",
                         doc="inner diameter (needed with friction_factor > 0)"),
     "friction_factor": Setting("number", 0.0, low=0.0,
                                doc="Darcy friction factor f_D of the pipe between clusters (0: no friction)"),
