@@ -7,17 +7,17 @@ every intact natural element (the rigorous screen of :mod:`.field_bound` holds f
 homogeneous kernel only) with the image terms (:func:`hmatddm.layered.influence3d.stress_at`,
 a direct sum, hundreds of microseconds per point and element), at every growth pass. The
 stress is linear in the DDs and each element's term depends on that element alone, so the
-terms of the elements a check has seen are kept (one (6, 3) block per point and element:
-the six components of the symmetric stress) and a later check computes only the terms of
-the elements appended since, then contracts the kept terms with the current DDs. The stage scene with stiffer bounding layers
-(issue 35): every check recomputed 20-500 elements at 2074 points; now each element is
-computed once per run (benchmarks/RESULTS.md, issue 35).
+terms of the elements a check has seen are kept (one (6, 3) block per point and element: the
+stress of a term is symmetric to the bit, the same expression gives ``ik`` and ``ki``, so its
+six components are kept and mirrored) and a later check computes only the terms of the
+elements appended since, then contracts the kept terms with the current DDs. The stage scene
+with stiffer bounding layers (issue 35): every check recomputed 20-500 elements at 2074
+points; now each element is computed once per run (benchmarks/RESULTS.md, issue 35).
 
 The terms are those of the direct sum (:func:`hmatddm.layered.stress3d.stress_columns`,
 the per-pair function :func:`hmatddm.layered.stress3d.stress_points` sums, each source traced
 once, vertical sources in closed form), so the stress is the direct sum's up to the order of
-the additions (1e-16 relative); each term's stress is symmetric to the bit (the same
-expression gives ``ik`` and ``ki``), so six components are kept and mirrored. A mesh that is not the
+the additions (1e-16 relative). A mesh that is not the
 last one plus appended elements (same first elements, bit for bit), another medium, number
 of images, correction or set of points starts again; points outside the first call's set
 start again too (the intact set only shrinks in a run). Above :data:`MEMORY_BUDGET` bytes
