@@ -105,14 +105,6 @@ class ElasticSolver:
             self._update = (key, self.contact_factor.update(rows))
         return self._update[1]
 
-    def exact_inverse_times(self, columns, rows=None):
-        """``A^-1 M`` (``(S A + D)^-1 M`` with ``rows``) for the dense ``(dN, k)`` columns
-        ``M`` (:meth:`contact_update`); None when the operator's inverse is not exact
-        (:attr:`inverse_is_exact`: the ``hmatrix`` backend, a grown operator)."""
-        if not self.operator.inverse_is_exact:
-            return None
-        return self.contact_update(rows).solve(columns)
-
     def diagonal_blocks(self, rows=None):
         """(N, d, d) self-influence block of each element (``S_i A_ii + D_i`` with rows)."""
         if self._diagonal_blocks is None:
