@@ -88,8 +88,20 @@ near ribbon to a fracture too long and thin (R +0.06 / +0.30%, w0 -0.12 / -0.33%
 m); with the far ribbon -0.36 / -0.10%, +0.35 / +0.05% (benchmarks/RESULTS.md, issue 39, "the far
 ribbon in 3D"). At a toughness tip (by ``toughness_share``: radial-k and radial-km) 3D keeps
 ``s_r >= h/2``: there the far ribbon moved radial-k (K_m 4-6, 0.5 m) from R -0.23% / w0 +0.54%
-to -0.37% / +1.10% against the K vertex (Dontsov's transition: -0.10% / +0.50%), for a reason
-not found.
+to -0.37% / +1.10% against the K vertex (Dontsov's transition: -0.10% / +0.50%). Why, measured
+(benchmarks/bench_ribbon_curvature.py; RESULTS.md, issue 39, "why the far ribbon fails at a 3D
+toughness tip"): not the front's curvature in the asymptote (the finite-fracture factor inverts
+Sneddon's opening exactly at any ``s``; without it the far band would read the front 0.10 h too
+near at R = 20 h) but in the level set. First-order fast marching from ribbon centres ``s_r``
+behind a convex front puts the front too near by ~0.25 ``s_r h / R`` (-0.015 h from the near
+ribbon, -0.024 h from the far one at R = 20 h); the filled band's prescribed openings follow
+it, so the far ribbon of Sneddon's crack reads 0.7 / 0.6 / 0.5% narrow (against its centre) at
+R = 20 / 30 / 40 h, 0.3% with the exact openings in the band: a toughness read ~0.5% high, a
+run shorter and wider by an error that falls only as ``h / R``. With the level set replaced by
+the front interpolated in angle from the ribbons (an experiment, radial fronts only) the far
+ribbon's radial-k gives R -0.19 / -0.15%, w0 +0.66 / +0.56% at 0.5 / 0.25 m, converging to
+Dontsov's; the near ribbon reads ~1% wide, which cancels the level set's error in the default.
+A second-order level set would let 3D toughness tips take the far ribbon (not built).
 
 **Carter leak-off** (a Newtonian fluid): the tip asymptote with leak-off, the elements the
 front crosses leaking point by point, and the front iteration bracketed --

@@ -96,3 +96,28 @@ def test_planar_grid_maps_cells_and_rejects_other_meshes():
     line = hd.mesh.line([-1.5, 0.0], [1.5, 0.0], 3)
     grid = PlanarGrid(line)
     assert grid.k == 1 and grid.h == pytest.approx(1.0)
+
+
+def _circle_front_error(radius, depth):
+    """Mean radius of the marched front of a circle of ``radius`` (h = 1) from the exact
+    distances of the ribbon: channel cells at least ``depth`` behind the front."""
+    axes = [np.arange(-int(radius) - 4, int(radius) + 5)] * 2
+    cells = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 2)
+    s = radius - np.linalg.norm(cells, axis=1)
+    channel = cells[s >= depth]
+    keys = {tuple(c) for c in channel.tolist()}
+    ribbon = np.array([c for c in channel.tolist() if not all(
+        (c[0] + a, c[1] + b) in keys for a, b in ((1, 0), (-1, 0), (0, 1), (0, -1)))])
+    distance = radius - np.linalg.norm(ribbon, axis=1)
+    field = FrontField(ribbon, distance, np.zeros(len(ribbon)), channel, 1.0, margin=int(depth) + 4)
+    return float(np.mean(front_radii(np.zeros(2), field, n_rays=360))) - radius, float(np.mean(distance))
+
+
+def test_marched_front_of_a_circle_is_too_near_by_its_first_order_error():
+    # issue 39 (benchmarks/bench_ribbon_curvature.py, table 2): first-order fast marching from
+    # exact ribbon distances s_r puts a convex front too near by ~0.25 s_r h / R -- more from a
+    # ribbon 2 h behind the front than from one 1 h behind, and half as much at twice the radius
+    (near, s_near), (far, s_far) = _circle_front_error(20.3, 0.5), _circle_front_error(20.3, 1.5)
+    far_large, _ = _circle_front_error(40.3, 1.5)
+    assert -0.5 * s_near / 20.3 < near < 0.0 and -0.5 * s_far / 20.3 < far < 1.3 * near < 0.0
+    assert far_large / far == pytest.approx(20.3 / 40.3, rel=0.25)
