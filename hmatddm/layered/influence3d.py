@@ -8,7 +8,7 @@ import numpy as np
 from .._validation import finite_array
 from ..errors import InputError
 from ..kernels.drivers import with_self_max
-from . import images3d, okada3d, remainder_build3d, remainder_table3d, stress3d, vertical3d
+from . import images3d, okada3d, okada_point3d, remainder_build3d, remainder_table3d, stress3d, vertical3d
 from .image_tracer3d import trace_points
 from .influence2d import choose_images as _choose_images
 from .influence2d import layers_of_extents, with_images
@@ -47,7 +47,8 @@ def influence_data(mesh, medium, singular_shift, alpha, near_fraction, n_images,
     :data:`TABLE_MIN_ELEMENTS` elements, the layered remainder's table
     (:func:`remainder_table`). In a half-space (:func:`is_half_space`) with ``medium.method``
     other than ``"quadrature"``, the elements with a horizontal side take their image and
-    surface terms in closed form (:mod:`.okada3d`; ``closed_form``), the others by quadrature.
+    surface terms in closed form (:mod:`.okada3d`; ``closed_form``), the others by the image
+    quadrature's rule of Okada's point source (:mod:`.okada_point3d`; ``point_form``).
     With two or more solid layers under a void (:func:`surface_form`), the elements of the
     top solid layer with a horizontal side take their reflection in the free surface in
     closed form (``surface_form``) and their other triples by quadrature. Vertical
@@ -68,13 +69,22 @@ def influence_data(mesh, medium, singular_shift, alpha, near_fraction, n_images,
                 & (medium.method != "quadrature") & (int(n_images) >= 1) & (not is_half_space(medium)))
     if not is_half_space(medium) or medium.method == "quadrature":
         closed[:] = False
+    # a half-space source without a horizontal side: Okada's point source at the Gauss points
+    point = np.zeros(mesh.n_elements, dtype=np.bool_)
+    if is_half_space(medium) and medium.method != "quadrature":
+        for e in np.flatnonzero(~closed):
+            rows = okada_point3d.point_frame(mesh.frames[e, 2])
+            if rows is not None:
+                okada[e] = rows
+                point[e] = True
     return with_self_max(images3d.with_image_terms(images3d.LayeredRectangles(
         mesh.centers, mesh.frames, mesh.half_a, mesh.half_b, layers, interfaces, g, nu, n_images=int(n_images),
         gauss_points=int(medium.gauss_points), max_subdivisions=int(MAX_SUBDIVISIONS),
         singular_shift=float(singular_shift), near_fraction=float(near_fraction), alpha=float(alpha),
         self_max=np.zeros(mesh.n_elements), entry_tol=float(ENTRY_TOL), entry_scale=float(scale), table=table,
         closed_form=closed, okada=okada, okada_half=half,
-        surface=float(interfaces[0]) if interfaces.shape[0] else 0.0, surface_form=surface, vertical_form=vertical)))
+        surface=float(interfaces[0]) if interfaces.shape[0] else 0.0, surface_form=surface, vertical_form=vertical,
+        point_form=point)))
 
 
 def is_half_space(medium):

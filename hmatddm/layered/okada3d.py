@@ -33,8 +33,8 @@ of an edge) ``X11 = X32 = 0`` (``Y11 = Y32 = 0``), the limits whose differences 
 corners are finite; ``|cos(dip)| < COS_ZERO`` takes the vertical forms of part B.
 
 Where the closed form does not apply: a rectangle with no horizontal edge (neither
-``e1`` nor ``e2`` horizontal) has no strike in Okada's sense; such elements keep the
-image quadrature (:mod:`.images3d`). Beyond the half-space it gives the top layer's
+``e1`` nor ``e2`` horizontal) has no strike in Okada's sense; such elements take Okada's
+point source at Gauss points (:mod:`.okada_point3d`). Beyond the half-space it gives the top layer's
 reflection in the free surface exactly (``real=False``; :mod:`.images3d` ``surface_form``);
 a reflection in an interface between solids is no reweighting of these terms
 (``_derive_closed_form3d.py``; vertical rectangles: :mod:`.vertical3d`).
@@ -43,6 +43,8 @@ import math
 
 import numpy as np
 from numba import njit
+
+from .okada_stress3d import global_stress, global_traction
 
 #: Coordinates ``xi``, ``eta``, ``q`` smaller than this fraction of the rectangle's size
 #: are set to zero (Okada 1992 sets them below 1e-6 of its unit).
@@ -440,33 +442,7 @@ def okada_stress(point, center, okada, hs, hd, surface, shear_modulus, poisson_r
     the image and surface terms) through Hooke's law, turned from Okada's frame (``x`` =
     strike, ``y = z x strike``, ``z``) to the global one. ``work``: (5, 3, 3, 3), ``c4``: (30, 4) scratch."""
     s0, s1, lam = _gradient(point, center, okada, hs, hd, surface, shear_modulus, poisson_ratio, real, image, work, c4)
-    # Hooke's law into work[4], then about z to the global frame: R^T sigma R, R rows the
-    # (x, y, z) axes of Okada's frame, each step through the other slot
-    for k in range(3):
-        tr = lam * (work[3, k, 0, 0] + work[3, k, 1, 1] + work[3, k, 2, 2])
-        for i in range(3):
-            for j in range(3):
-                work[4, k, i, j] = shear_modulus * (work[3, k, i, j] + work[3, k, j, i])
-            work[4, k, i, i] += tr
-        for i in range(3):
-            a0 = work[4, k, i, 0] * s0 - work[4, k, i, 1] * s1
-            a1 = work[4, k, i, 0] * s1 + work[4, k, i, 1] * s0
-            work[3, k, i, 0] = a0
-            work[3, k, i, 1] = a1
-            work[3, k, i, 2] = work[4, k, i, 2]
-        for j in range(3):
-            b0 = work[3, k, 0, j] * s0 - work[3, k, 1, j] * s1
-            b1 = work[3, k, 0, j] * s1 + work[3, k, 1, j] * s0
-            work[4, k, 0, j] = b0
-            work[4, k, 1, j] = b1
-            work[4, k, 2, j] = work[3, k, 2, j]
-    for q in range(3):
-        f0 = okada[0, q]
-        f1 = okada[1, q]
-        f2 = okada[2, q]
-        for i in range(3):
-            for j in range(3):
-                out[q, i, j] = f0 * work[4, 0, i, j] + f1 * work[4, 1, i, j] + f2 * work[4, 2, i, j]
+    global_stress(work, s0, s1, lam, shear_modulus, okada, out)
 
 
 @njit(cache=True)
@@ -477,23 +453,4 @@ def okada_traction(point, normal, center, okada, hs, hd, surface, shear_modulus,
     through the traction in Okada's frame: the normal turned into it once, no stress
     tensor turned back."""
     s0, s1, lam = _gradient(point, center, okada, hs, hd, surface, shear_modulus, poisson_ratio, real, image, work, c4)
-    n0 = s0 * normal[0] + s1 * normal[1]
-    n1 = -s1 * normal[0] + s0 * normal[1]
-    n2 = normal[2]
-    for k in range(3):
-        tr = lam * (work[3, k, 0, 0] + work[3, k, 1, 1] + work[3, k, 2, 2])
-        t0 = (shear_modulus * (2.0 * work[3, k, 0, 0] * n0 + (work[3, k, 0, 1] + work[3, k, 1, 0]) * n1
-                               + (work[3, k, 0, 2] + work[3, k, 2, 0]) * n2) + tr * n0)
-        t1 = (shear_modulus * ((work[3, k, 1, 0] + work[3, k, 0, 1]) * n0 + 2.0 * work[3, k, 1, 1] * n1
-                               + (work[3, k, 1, 2] + work[3, k, 2, 1]) * n2) + tr * n1)
-        t2 = (shear_modulus * ((work[3, k, 2, 0] + work[3, k, 0, 2]) * n0 + (work[3, k, 2, 1] + work[3, k, 1, 2]) * n1
-                               + 2.0 * work[3, k, 2, 2] * n2) + tr * n2)
-        work[4, k, 0, 0] = t0 * s0 - t1 * s1
-        work[4, k, 0, 1] = t0 * s1 + t1 * s0
-        work[4, k, 0, 2] = t2
-    for q in range(3):
-        f0 = okada[0, q]
-        f1 = okada[1, q]
-        f2 = okada[2, q]
-        for p in range(3):
-            block[p, q] += f0 * work[4, 0, 0, p] + f1 * work[4, 1, 0, p] + f2 * work[4, 2, 0, p]
+    global_traction(work, s0, s1, lam, shear_modulus, okada, normal, block)

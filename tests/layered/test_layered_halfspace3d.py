@@ -105,6 +105,8 @@ RECTANGLES = {  # center, frame, half sizes: a 0.8 x 0.6 m rectangle 0.7-1.5 m b
     "horizontal": ([0.3, -0.2, -0.9], _frame([1, 0, 0], [0, 1, 0]), 0.4, 0.3),
     "vertical": ([0.0, 0.1, -1.2], _frame([0, 1, 0], [0, 0, 1]), 0.4, 0.3),
     "tilted": ([0.2, 0.0, -1.1], _frame([1, 1, 0], [-0.5, 0.5, 1.0]), 0.4, 0.3),
+    # no horizontal side: Okada's point source at the Gauss points (okada_point3d)
+    "skewed": ([0.1, 0.2, -1.3], _frame([1, 0, 0.5], [-0.2, 1, 0.4]), 0.4, 0.3),
 }
 OFFSETS = np.array([[0.0, 0.0, 0.35], [0.55, -0.3, 0.2], [-0.2, 0.6, -0.4],  # near field (in the element frame)
                     [2.5, 1.0, -0.6], [-3.0, -2.0, -2.5]])                      # far field

@@ -159,11 +159,14 @@ def test_equal_layers_under_a_surface_are_the_half_space():
     # receivers of the top layer from sources with the surface in closed form: the other
     # triples vanish (no contrast); the other entries (a receiver in the second layer, whose
     # surface triple is transmitted, a source without a horizontal side or in the second
-    # layer) are the quadrature against the half-space's closed form
+    # layer) are the quadrature against the half-space's closed form, or, for a source
+    # without a horizontal side, against Okada's point source on the finer rule of
+    # okada_point3d.point_rule (8 points per side where the image method takes 4): the
+    # difference is the image method's own quadrature error
     closed = np.repeat(data.surface_form, 3)
     top = np.repeat(data.layer == 1, 3)
     assert np.abs(got - want)[np.ix_(top, closed)].max() <= 1e-13 * np.abs(want).max()
-    assert np.abs(got - want).max() <= 1e-10 * np.abs(want).max()
+    assert np.abs(got - want).max() <= 1e-9 * np.abs(want).max()
 
 
 def test_surface_form_is_off_for_the_cross_check_and_without_images():

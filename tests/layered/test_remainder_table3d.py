@@ -181,15 +181,23 @@ def test_interface_conditions_on_the_table_path_are_those_of_the_quadrature():
                          ids=["half-space", "bi-material"])
 def test_media_without_far_triples_build_no_table_and_equal_the_quadrature(medium, mesh):
     """A half-space or a bi-material (one interface: every image is a first reflection or
-    the transmitted source): no far triple, so no table, and the same entries bit for bit
-    as the quadrature path."""
+    the transmitted source): no far triple, so no table, and the same entries as the
+    quadrature path, bit for bit, in the bi-material. In the half-space the images are
+    Okada's forms (okada3d, okada_point3d), within issue 32's 1e-8 of the largest entry of
+    the converged quadrature (16 points on up to 64 x 64 sub-squares), which the default
+    quadrature, 4.3e-8 away next to the surface here, is not."""
     shallow = _random_mesh(5, [c for c in CENTERS if c[2] > -1.5], 0.15)
     fields = dict(interfaces=medium.interfaces, shear_modulus=medium.shear_modulus,
                   poisson_ratio=medium.poisson_ratio, images=medium.images)
     table = influence_data(shallow, LayeredMedium(**fields, method="table"), 0.0, 0.0, 0.0, medium.images)
     quadrature = influence_data(shallow, LayeredMedium(**fields, method="quadrature"), 0.0, 0.0, 0.0, medium.images)
     assert np.all(table.table.pair_index < 0)
-    assert np.array_equal(_matrix(table), _matrix(quadrature))
+    got = _matrix(table)
+    if table.point_form.any() or table.closed_form.any():
+        converged = _matrix(quadrature._replace(gauss_points=16, max_subdivisions=64, far_tol=0.0, entry_tol=0.0))
+        assert np.abs(got - converged).max() <= 1e-8 * np.abs(converged).max()
+    else:
+        assert np.array_equal(got, _matrix(quadrature))
 
 
 def test_equal_layers_reproduce_uniform_rock_on_the_table_path(mesh):

@@ -1,0 +1,70 @@
+"""From Okada's (1992) displacement gradients to the global stress and traction: Hooke's
+law in Okada's frame (``x`` along the strike, ``z`` up), turned about ``z`` to the global
+frame, and the unit dislocations (strike, up-dip, tensile) mapped to the global DD by the
+rows ``(strike, up-dip, normal)``. Shared by the finite rectangle (:mod:`.okada3d`) and the
+point source (:mod:`.okada_point3d`)."""
+from numba import njit
+
+
+@njit(cache=True, inline="always")
+def global_stress(work, s0, s1, lam, shear_modulus, okada, out):
+    """``out[q, i, j]``: the global stress of a unit global DD ``q`` from the displacement
+    gradient ``work[3, k, i, j]`` (Okada's frame, unit dislocation ``k``: strike, up-dip,
+    tensile) through Hooke's law, turned about ``z`` by the strike ``(s0, s1)`` to the
+    global frame and mapped by the rows ``okada`` (strike, up-dip, normal) to the global
+    DD; ``work[4]`` scratch."""
+    # Hooke's law into work[4], then about z to the global frame: R^T sigma R, R rows the
+    # (x, y, z) axes of Okada's frame, each step through the other slot
+    for k in range(3):
+        tr = lam * (work[3, k, 0, 0] + work[3, k, 1, 1] + work[3, k, 2, 2])
+        for i in range(3):
+            for j in range(3):
+                work[4, k, i, j] = shear_modulus * (work[3, k, i, j] + work[3, k, j, i])
+            work[4, k, i, i] += tr
+        for i in range(3):
+            a0 = work[4, k, i, 0] * s0 - work[4, k, i, 1] * s1
+            a1 = work[4, k, i, 0] * s1 + work[4, k, i, 1] * s0
+            work[3, k, i, 0] = a0
+            work[3, k, i, 1] = a1
+            work[3, k, i, 2] = work[4, k, i, 2]
+        for j in range(3):
+            b0 = work[3, k, 0, j] * s0 - work[3, k, 1, j] * s1
+            b1 = work[3, k, 0, j] * s1 + work[3, k, 1, j] * s0
+            work[4, k, 0, j] = b0
+            work[4, k, 1, j] = b1
+            work[4, k, 2, j] = work[3, k, 2, j]
+    for q in range(3):
+        f0 = okada[0, q]
+        f1 = okada[1, q]
+        f2 = okada[2, q]
+        for i in range(3):
+            for j in range(3):
+                out[q, i, j] = f0 * work[4, 0, i, j] + f1 * work[4, 1, i, j] + f2 * work[4, 2, i, j]
+
+
+@njit(cache=True, inline="always")
+def global_traction(work, s0, s1, lam, shear_modulus, okada, normal, block):
+    """``block[p, q] +=`` the global traction ``sigma . normal`` (component ``p``) of a unit
+    global DD ``q`` from the displacement gradient ``work[3, k, i, j]`` of
+    :func:`global_stress`: the normal turned into Okada's frame once, no stress tensor turned
+    back; ``work[4]`` scratch."""
+    n0 = s0 * normal[0] + s1 * normal[1]
+    n1 = -s1 * normal[0] + s0 * normal[1]
+    n2 = normal[2]
+    for k in range(3):
+        tr = lam * (work[3, k, 0, 0] + work[3, k, 1, 1] + work[3, k, 2, 2])
+        t0 = (shear_modulus * (2.0 * work[3, k, 0, 0] * n0 + (work[3, k, 0, 1] + work[3, k, 1, 0]) * n1
+                               + (work[3, k, 0, 2] + work[3, k, 2, 0]) * n2) + tr * n0)
+        t1 = (shear_modulus * ((work[3, k, 1, 0] + work[3, k, 0, 1]) * n0 + 2.0 * work[3, k, 1, 1] * n1
+                               + (work[3, k, 1, 2] + work[3, k, 2, 1]) * n2) + tr * n1)
+        t2 = (shear_modulus * ((work[3, k, 2, 0] + work[3, k, 0, 2]) * n0 + (work[3, k, 2, 1] + work[3, k, 1, 2]) * n1
+                               + 2.0 * work[3, k, 2, 2] * n2) + tr * n2)
+        work[4, k, 0, 0] = t0 * s0 - t1 * s1
+        work[4, k, 0, 1] = t0 * s1 + t1 * s0
+        work[4, k, 0, 2] = t2
+    for q in range(3):
+        f0 = okada[0, q]
+        f1 = okada[1, q]
+        f2 = okada[2, q]
+        for p in range(3):
+            block[p, q] += f0 * work[4, 0, 0, p] + f1 * work[4, 1, 0, p] + f2 * work[4, 2, 0, p]
