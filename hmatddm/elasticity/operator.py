@@ -85,6 +85,11 @@ class ElasticityOperator(ProductCounter, LinearOperator):
         If given (>= 1), blocks whose largest entry exceeds ``alpha`` times the largest
         entry of the source element's self block are scaled down (ref. Eq. 6.11).
         Applied entry-wise in the kernel, so both backends see the same matrix.
+    n_images : int or None
+        A :class:`hmatddm.LayeredMedium` with ``images="auto"``: this number of images
+        instead of the choice made on ``mesh`` (a growing run's rebuilds keep their choice
+        while the mesh stays within twice its extent:
+        :class:`hmatddm.simulation.growing_operator.GrowingOperator`); >= 0.
 
     Warns
     -----
@@ -95,7 +100,7 @@ class ElasticityOperator(ProductCounter, LinearOperator):
     """
 
     def __init__(self, mesh, material, backend="dense", eps=DEFAULT_EPS, eta=DEFAULT_ETA,
-                 leaf_size=DEFAULT_LEAF_SIZE, singular_correction="none", alpha=None):
+                 leaf_size=DEFAULT_LEAF_SIZE, singular_correction="none", alpha=None, n_images=None):
         if not isinstance(mesh, (Mesh2D, Mesh3D)):
             raise InputError(f"mesh must be a Mesh2D or Mesh3D, got {type(mesh).__name__}")
         if not isinstance(material, (Elastic, LayeredMedium)):
@@ -118,7 +123,13 @@ class ElasticityOperator(ProductCounter, LinearOperator):
         n = mesh.n_elements * self.dof
         super().__init__(dtype=np.float64, shape=(n, n))
 
-        self.data = influence_data(mesh, material, singular_correction, alpha)
+        if n_images is not None and (isinstance(n_images, bool) or not isinstance(n_images, (int, np.integer))
+                                     or n_images < 0):
+            raise InputError(f"n_images must be an integer >= 0 or None, got {n_images!r}")
+        if n_images is not None and not (isinstance(material, LayeredMedium) and material.images == "auto"):
+            n_images = None  # a fixed number of images, or no layers: the medium's own
+        self.data = influence_data(mesh, material, singular_correction, alpha,
+                                   None if n_images is None else int(n_images))
 
         t0 = time.perf_counter()
         if backend == "dense":

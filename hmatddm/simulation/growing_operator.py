@@ -8,6 +8,14 @@ in its plane (:mod:`hmatddm.elasticity.planar`; the same matrix, ~7x faster prod
 crack loaded in opening) unless :data:`SPLIT_PLANAR_MODES` is False; and a planar lattice
 mesh gets the FFT operator of :mod:`hmatddm.elasticity.lattice` unless
 :data:`LATTICE_PLANAR` is False.
+
+In a :class:`~hmatddm.LayeredMedium` with ``images = "auto"`` a build chooses its number of
+images by sampling the influence block with more and more images (:func:`hmatddm.layered.
+influence2d.choose_images`): in 3D that sampling cost 84% of the `layered-3d` scene's run (2.4 s
+a build, eight builds; benchmarks/RESULTS.md, issue 32). A rebuild keeps the last choice while
+the mesh spans the same layers and stays within :data:`IMAGES_KEPT_WITHIN` times the extent it
+was chosen on (``image_choice``, saved in checkpoints so that a resumed run builds the same
+operators).
 """
 import warnings
 from dataclasses import asdict
@@ -16,6 +24,7 @@ import numpy as np
 
 from ..errors import MeshQualityWarning
 from ..elasticity.extended import ExtendedElasticityOperator, compresses_borders
+from ..layered import LayeredMedium
 from ..material import Elastic
 from ..elasticity.operator import ElasticityOperator
 from ..elasticity.lattice import LatticePlanarOperator, lattice_of
@@ -29,6 +38,10 @@ SPLIT_PLANAR_MODES = True
 #: products, no H-matrix, no border blocks, a new kernel table only when the crack
 #: outgrows its box.
 LATTICE_PLANAR = True
+
+#: A rebuild keeps the number of images chosen on an earlier mesh (module docstring) while
+#: the mesh's extent along every axis is at most this many times that mesh's.
+IMAGES_KEPT_WITHIN = 2.0
 
 
 class GrowingOperator:
@@ -44,6 +57,9 @@ class GrowingOperator:
         self._mesh = None    # the mesh of the last operator handed out
         self._operator = None
         self._mesh_quality_warned = False
+        #: the last choice of images (``"auto"`` media): ``dict(n_images, extent, layers)``
+        #: of the mesh it was made on, or None (module docstring)
+        self.image_choice = None
 
     def __call__(self, mesh):
         """The elasticity operator of ``mesh``: the last one if the mesh is unchanged, the
@@ -111,7 +127,11 @@ class GrowingOperator:
             settings = asdict(self.operator_settings)
             split = (SPLIT_PLANAR_MODES and settings["backend"] == "hmatrix" and isinstance(self.material, Elastic)
                      and is_planar(mesh))
-            self.base = (PlanarElasticityOperator if split else ElasticityOperator)(mesh, self.material, **settings)
+            if split:
+                self.base = PlanarElasticityOperator(mesh, self.material, **settings)
+            else:
+                self.base = ElasticityOperator(mesh, self.material, n_images=self._kept_images(mesh), **settings)
+                self._remember_images(mesh)
         for warning in caught:
             if issubclass(warning.category, MeshQualityWarning):
                 if not self._mesh_quality_warned:
@@ -123,16 +143,49 @@ class GrowingOperator:
         self.builds += 1
         return self.base
 
+    def _chooses_images(self):
+        material = self.material
+        return isinstance(material, LayeredMedium) and material.images == "auto" and not material.is_homogeneous
+
+    def _extent_and_layers(self, mesh):
+        extent = np.ptp(mesh.centers, axis=0) + 2.0 * np.max(np.maximum(mesh.half_a, mesh.half_b)) \
+            if mesh.dim == 3 else np.ptp(mesh.centers, axis=0) + 2.0 * np.max(mesh.half_length)
+        height = mesh.centers[:, -1]
+        return extent, sorted({int(k) for k in np.unique(self.material.layer_of(height))})
+
+    def _kept_images(self, mesh):
+        """The number of images of the last choice if it still holds for ``mesh`` (module
+        docstring), else None (choose on ``mesh``)."""
+        if not self._chooses_images() or self.image_choice is None:
+            return None
+        extent, layers = self._extent_and_layers(mesh)
+        kept = self.image_choice
+        if layers != kept["layers"] or np.any(extent > IMAGES_KEPT_WITHIN * np.asarray(kept["extent"]) + 1e-12):
+            return None
+        return int(kept["n_images"])
+
+    def _remember_images(self, mesh):
+        if not self._chooses_images():
+            return
+        n_images = int(self.base.stats.get("n_images", 0))
+        if self.image_choice is not None and n_images == self.image_choice["n_images"] and \
+                self._kept_images(mesh) is not None:
+            return  # kept: the extent it was chosen on stays the reference
+        extent, layers = self._extent_and_layers(mesh)
+        self.image_choice = dict(n_images=n_images, extent=[float(v) for v in extent], layers=layers)
+
     def reset(self, base):
         """Go back to ``base`` (an earlier :attr:`base`, or None), forgetting the operators
         made since: a step tried again starts from the operator it started from, as a run
         resumed from that step's checkpoint would."""
         self.base, self._mesh, self._operator = base, None, None
 
-    def restore(self, mesh, compressed_elements):
+    def restore(self, mesh, compressed_elements, image_choice=None):
         """Rebuild the base an interrupted run had (its first ``compressed_elements``
-        elements of ``mesh``), so that a resumed run applies the same operator, bit for bit."""
+        elements of ``mesh``, with the run's ``image_choice``), so that a resumed run applies
+        the same operator, bit for bit."""
         self.base = self._mesh = self._operator = None
+        self.image_choice = None if image_choice is None else dict(image_choice)
         if 0 < compressed_elements <= mesh.n_elements:
             self.build(mesh.subset(np.arange(compressed_elements)))
 

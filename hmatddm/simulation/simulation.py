@@ -596,7 +596,7 @@ class Simulation:
     def save_checkpoint(self):
         s = self.state
         metadata = dict(s.scalars(), records=self.records, fingerprint=self.fingerprint(),
-                        compressed_elements=self.compressed_elements)
+                        compressed_elements=self.compressed_elements, image_choice=self.operators.image_choice)
         checkpoint.save(self.checkpoint_dir, s.step, s.arrays(), metadata,
                         keep=self.checkpoint_settings.keep_checkpoints)
 
@@ -612,7 +612,8 @@ class Simulation:
         self.records = list(metadata["records"])
         # rebuild the compressed base exactly as the interrupted run had it, so the
         # resumed run applies the same operator (bit for bit)
-        self.operators.restore(self.state.mesh, int(metadata.get("compressed_elements", 0)))
+        self.operators.restore(self.state.mesh, int(metadata.get("compressed_elements", 0)),
+                               metadata.get("image_choice"))
         return self.state
 
 
