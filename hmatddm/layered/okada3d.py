@@ -44,13 +44,11 @@ import math
 import numpy as np
 from numba import njit
 
-from .okada_stress3d import global_stress, global_traction
+from .okada_stress3d import COS_ZERO, dip_and_medium, global_stress, global_traction  # noqa: F401 (COS_ZERO: re-exported)
 
 #: Coordinates ``xi``, ``eta``, ``q`` smaller than this fraction of the rectangle's size
 #: are set to zero (Okada 1992 sets them below 1e-6 of its unit).
 SNAP = 1e-9
-#: ``|cos(dip)|`` below this is vertical (Okada 1992's 1e-6).
-COS_ZERO = 1e-6
 #: ``|e_z|`` below this makes an element's side horizontal (as ``engine._has_horizontal_edge``).
 HORIZONTAL = 1e-9
 
@@ -418,16 +416,7 @@ def _gradient(point, center, okada, hs, hd, surface, shear_modulus, poisson_rati
     y = -s1 * dx + s0 * dy
     z = point[2] - surface
     depth = surface - center[2]
-    t1 = -s1 * okada[1, 0] + s0 * okada[1, 1]
-    t2 = okada[1, 2]
-    norm = math.sqrt(t1 * t1 + t2 * t2)
-    cd = t1 / norm
-    sd = t2 / norm
-    if abs(cd) < COS_ZERO:
-        cd = 0.0
-        sd = 1.0
-    lam = 2.0 * shear_modulus * poisson_ratio / (1.0 - 2.0 * poisson_ratio)
-    alpha = (lam + shear_modulus) / (lam + 2.0 * shear_modulus)
+    sd, cd, lam, alpha = dip_and_medium(s0, s1, okada, shear_modulus, poisson_ratio)
     gradient(x, y, z, depth, sd, cd, -hs, hs, -hd, hd, alpha, real, image, work, c4)
     return s0, s1, lam
 

@@ -30,8 +30,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .okada3d import COS_ZERO
-from .okada_stress3d import global_stress, global_traction
+from .okada_stress3d import dip_and_medium, global_stress, global_traction
 from .rectangle_quadrature import entry_order, far_order, nearest_singularity, square_rule
 
 _INV_2PI = 1.0 / (2.0 * math.pi)
@@ -276,16 +275,7 @@ def _point_gradient(point, center, frame, a, b, okada, surface, shear_modulus, p
     strike's ``(s_x, s_y)`` and Lame's lambda, as :func:`.okada_stress3d.global_stress` takes them."""
     s0 = okada[0, 0]
     s1 = okada[0, 1]
-    t1 = -s1 * okada[1, 0] + s0 * okada[1, 1]
-    t2 = okada[1, 2]
-    norm = math.sqrt(t1 * t1 + t2 * t2)
-    cd = t1 / norm
-    sd = t2 / norm
-    if abs(cd) < COS_ZERO:
-        cd = 0.0
-        sd = 1.0
-    lam = 2.0 * shear_modulus * poisson_ratio / (1.0 - 2.0 * poisson_ratio)
-    alpha = (lam + shear_modulus) / (lam + 2.0 * shear_modulus)
+    sd, cd, lam, alpha = dip_and_medium(s0, s1, okada, shear_modulus, poisson_ratio)
     for k in range(3):
         for i in range(3):
             for j in range(3):

@@ -3,7 +3,30 @@ law in Okada's frame (``x`` along the strike, ``z`` up), turned about ``z`` to t
 frame, and the unit dislocations (strike, up-dip, tensile) mapped to the global DD by the
 rows ``(strike, up-dip, normal)``. Shared by the finite rectangle (:mod:`.okada3d`) and the
 point source (:mod:`.okada_point3d`)."""
+import math
+
 from numba import njit
+
+#: ``|cos(dip)|`` below this is vertical (Okada 1992's 1e-6).
+COS_ZERO = 1e-6
+
+
+@njit(cache=True, inline="always")
+def dip_and_medium(s0, s1, okada, shear_modulus, poisson_ratio):
+    """``(sin dip, cos dip, lambda, alpha)``: the dip of the up-dip row of ``okada`` seen
+    along the strike ``(s0, s1)`` (``|cos| <`` :data:`COS_ZERO`: vertical, Okada's own
+    rule), Lame's lambda and Okada's medium constant ``alpha = (lambda + mu) / (lambda + 2
+    mu)``."""
+    t1 = -s1 * okada[1, 0] + s0 * okada[1, 1]
+    t2 = okada[1, 2]
+    norm = math.sqrt(t1 * t1 + t2 * t2)
+    cd = t1 / norm
+    sd = t2 / norm
+    if abs(cd) < COS_ZERO:
+        cd = 0.0
+        sd = 1.0
+    lam = 2.0 * shear_modulus * poisson_ratio / (1.0 - 2.0 * poisson_ratio)
+    return sd, cd, lam, (lam + shear_modulus) / (lam + 2.0 * shear_modulus)
 
 
 @njit(cache=True, inline="always")
