@@ -8,7 +8,6 @@ import pytest
 import hmatddm as hd
 from hmatddm.layered import LayeredMedium
 from hmatddm.layered import influence2d
-from hmatddm.simulation import growing_operator
 from hmatddm.simulation.growing_operator import GrowingOperator
 from hmatddm.simulation.settings import OperatorSettings, RebuildSettings
 
@@ -71,4 +70,5 @@ def test_a_fixed_number_of_images_is_never_sampled_nor_remembered(counted):
 def test_elasticity_operator_refuses_a_negative_number_of_images():
     with pytest.raises(hd.InputError, match="n_images"):
         hd.ElasticityOperator(_crack(2.0, 2), MEDIUM, n_images=-1)
-    assert growing_operator.IMAGES_KEPT_WITHIN == 2.0
+    with pytest.raises(hd.InputError, match="n_images"):
+        hd.ElasticityOperator(_crack(2.0, 2), MEDIUM, n_images=1.5)
