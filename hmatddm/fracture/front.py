@@ -23,6 +23,7 @@ import numpy as np
 from ..errors import InputError
 from ..mesh import Mesh2D, Mesh3D
 from .fast_marching import first_nearest, interpolate, march, nearest_circle
+from .front_fit import FrontReconstruction
 
 CHANNEL, TIP, EMPTY, FILLED = 0, 1, 2, 3  # FILLED: fully fractured during the last step
 
@@ -126,9 +127,12 @@ class FrontField:
     cells : (R, k) int, the ribbon cells;  distances : (R,) ``s_r``;  velocities : (R,)
     channel : (C, k) int, the fully fractured cells (the ribbon among them or not)
     h : cell size;  margin : cells marched beyond the ribbon (>= the farthest front + 2)
+    order : 1, the first-order march, bilinear between cell centres; 2 (3D only): the front
+    reconstructed from the ribbon to second order (:mod:`.front_fit`), evaluated at the points
+    themselves and at the cell centres (``phi``) wherever the march reached (elsewhere its +-inf)
     """
 
-    def __init__(self, cells, distances, velocities, channel, h, margin):
+    def __init__(self, cells, distances, velocities, channel, h, margin, order=1):
         cells = np.asarray(cells, np.int64)
         self.k = cells.shape[1]
         self.h = float(h)
@@ -154,6 +158,15 @@ class FrontField:
         phi[inside & ~known] = -inward[inside & ~known]
         unreached = ~np.isfinite(phi)
         phi[unreached & inside] = -np.inf
+        self._front = None
+        if order == 2 and self.k == 2 and len(cells):
+            self._front = FrontReconstruction(self.ribbon_points, self.distances, phi, cells - self.low, self.h)
+            finite = np.isfinite(phi)
+            index = np.argwhere(finite)
+            phi[finite] = self._front((index + self.low) * self.h)
+        elif order not in (1, 2):
+            raise ValueError(f"FrontField order must be 1 or 2, got {order}")
+        self.order = order
         self.phi = phi  # +inf: beyond the march (outside), -inf: inside, unreached
         self._tree = None  # a k-d tree of the ribbon points (velocity), made on first use
 
@@ -175,6 +188,9 @@ class FrontField:
             points = np.column_stack([points, np.zeros(len(points))])
         out = np.empty(len(points))
         interpolate(phi, low, self.h, np.ascontiguousarray(points), out)
+        if self._front is not None:  # order 2: the reconstruction where the march reached
+            finite = np.isfinite(out)
+            out[finite] = self._front(points[finite])
         return out
 
     def velocity(self, points):

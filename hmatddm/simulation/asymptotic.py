@@ -187,6 +187,12 @@ class AsymptoticFront:
     # ... and in 3D at such a (not toughness-dominated) tip once the radius is resolved_tip elements
     # (issue 39, "the far ribbon in 3D"); False: 3D keeps the ribbon next to the front everywhere
     far_ribbon_3d = True
+    # ... and in 3D at a toughness-dominated tip too, by the 2D rule (c grows as (L/h)^(1/2));
+    # False: 3D toughness tips keep the ribbon next to the front (module docstring)
+    far_ribbon_3d_toughness = False
+    # the level set of the 3D front (FrontField order): 1 first-order fast marching, bilinear
+    # between cell centres; 2 the front reconstructed to second order (hmatddm.fracture.front_fit)
+    level_set_order = 1
     # Anderson acceleration of the front iteration, 3D only (hmatddm.simulation.front_acceleration):
     # a 0.5 m radial K-vertex run takes half the front iterations with the same errors to 0.07
     # points; a plane-strain run's errors, 0.1-0.3 % and falling with h, moved by up to 0.08
@@ -246,7 +252,8 @@ class AsymptoticFront:
     def field(self, cells, distance, velocity, channel):
         """The :class:`~hmatddm.fracture.front.FrontField` of ribbon ``cells`` at ``distance``."""
         margin = int(np.ceil(np.max(distance) / self.grid.h)) + 3
-        return FrontField(cells, distance, velocity, channel, self.grid.h, margin)
+        return FrontField(cells, distance, velocity, channel, self.grid.h, margin,
+                          order=self.level_set_order if self.grid.k == 2 else 1)
 
     # -- one step ------------------------------------------------------------------------
     def inner_settings(self, settings, change, front_tolerance):
@@ -332,8 +339,8 @@ class AsymptoticFront:
         toughness_tip = self.toughness_share(begin, size) >= self.toughness_tip
         resolved = size >= self.resolved_tip * h
         # 3D: at a resolved tip that is not toughness-dominated (module docstring)
-        far_ribbon = (toughness_tip or resolved) if grid.k == 1 else \
-            (self.far_ribbon_3d and resolved and not toughness_tip)
+        far_ribbon = (toughness_tip or resolved) if grid.k == 1 else self.far_ribbon_3d and (
+            (resolved and not toughness_tip) or (toughness_tip and self.far_ribbon_3d_toughness))
         if far_ribbon:  # a filled element joins the channel c h behind the front
             filled_old &= old.at_cells(cells) <= -self.ribbon_distance(size, toughness_tip) * h
         channel = (begin.front_class == CHANNEL) | filled_old
