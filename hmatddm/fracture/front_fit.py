@@ -86,26 +86,52 @@ def ribbon_normals(phi, index, h):
 
 
 @njit(cache=True)
+def _solve3(m, v):
+    """``m^-1 v`` of a symmetric 3x3 by Cramer's rule; ``ok`` False when nearly singular."""
+    c00 = m[1, 1] * m[2, 2] - m[1, 2] * m[2, 1]
+    c01 = m[1, 2] * m[2, 0] - m[1, 0] * m[2, 2]
+    c02 = m[1, 0] * m[2, 1] - m[1, 1] * m[2, 0]
+    det = m[0, 0] * c00 + m[0, 1] * c01 + m[0, 2] * c02
+    out = np.zeros(3)
+    if not abs(det) > 1e-9 * m[0, 0] * m[1, 1] * m[2, 2]:
+        return out, False
+    c11 = m[0, 0] * m[2, 2] - m[0, 2] * m[2, 0]
+    c12 = m[0, 1] * m[2, 0] - m[0, 0] * m[2, 1]
+    c22 = m[0, 0] * m[1, 1] - m[0, 1] * m[1, 0]
+    # the inverse of a symmetric matrix is symmetric: its cofactors c_ij = c_ji
+    out[0] = (c00 * v[0] + c01 * v[1] + c02 * v[2]) / det
+    out[1] = (c01 * v[0] + c11 * v[1] + c12 * v[2]) / det
+    out[2] = (c02 * v[0] + c12 * v[1] + c22 * v[2]) / det
+    return out, True
+
+
+@njit(cache=True)
 def fit_front(centres, distances, normals, neighbours, h):
     """Front points, normals and curvatures (R, 2), (R, 2), (R,) of ribbons at ``centres``
     (R, 2) with ``distances`` (R,), from first ``normals`` and ``neighbours`` (R, m; -1:
-    none): the local graph fit of the module docstring, :data:`FIT_PASSES` passes."""
+    none): the local quadratic regression of the module docstring, :data:`FIT_PASSES` passes."""
     m = neighbours.shape[1]
     count = centres.shape[0]
     n = normals.copy()
     kappa = np.zeros(count)
+    shift = np.zeros(count)
     points = np.empty((count, 2))
     radius2 = (FIT_RADIUS * h) ** 2
     limit = 1.0 / (MIN_RADIUS * h)
     for r in range(count):
         points[r, 0] = centres[r, 0] + distances[r] * n[r, 0]
         points[r, 1] = centres[r, 1] + distances[r] * n[r, 1]
+    matrix = np.empty((3, 3))
+    rhs = np.empty(3)
     for _ in range(FIT_PASSES):
         turned = np.empty((count, 2))
         for r in range(count):
             nx, ny = n[r, 0], n[r, 1]
             tx, ty = -ny, nx
-            s11 = s12 = s22 = b1 = b2 = 0.0
+            matrix[:] = 0.0
+            rhs[:] = 0.0
+            matrix[0, 0] = 1.0  # the point itself: t = u = 0, weight 1
+            used = 0
             for c in range(m):
                 j = neighbours[r, c]
                 if j < 0 or j == r or n[j, 0] * nx + n[j, 1] * ny < 0.5:
@@ -118,28 +144,38 @@ def fit_front(centres, distances, normals, neighbours, h):
                 w = (1.0 - d2 / radius2) ** 2
                 t = (dx * tx + dy * ty) / h
                 u = (dx * nx + dy * ny) / h
-                s11 += w * t * t
-                s12 += w * t * t * t
-                s22 += w * t * t * t * t
-                b1 += w * t * u
-                b2 += w * t * t * u
-            det = s11 * s22 - s12 * s12
-            if s11 > 0.0 and det > 1e-8 * s11 * s22:
-                b = (b1 * s22 - b2 * s12) / det
-                a = (s11 * b2 - s12 * b1) / det  # u = b t + a t^2 (in cells)
-            elif s11 > 0.0:
-                b, a = b1 / s11, 0.0
+                basis = (1.0, t, t * t)
+                for a in range(3):
+                    rhs[a] += w * basis[a] * u
+                    for b in range(3):
+                        matrix[a, b] += w * basis[a] * basis[b]
+                used += 1
+            coefficients, ok = _solve3(matrix, rhs)  # u = c0 + c1 t + c2 t^2 (cells)
+            if ok and used >= 3:
+                c0, b, a = coefficients[0], coefficients[1], coefficients[2]
+            elif used >= 2 and matrix[1, 1] * matrix[2, 2] - matrix[1, 2] ** 2 > 1e-9 * matrix[1, 1] * matrix[2, 2]:
+                # two neighbours: the graph through the point itself, u = b t + a t^2
+                det = matrix[1, 1] * matrix[2, 2] - matrix[1, 2] ** 2
+                c0 = 0.0
+                b = (rhs[1] * matrix[2, 2] - rhs[2] * matrix[1, 2]) / det
+                a = (matrix[1, 1] * rhs[2] - matrix[1, 2] * rhs[1]) / det
+            elif matrix[1, 1] > 0.0:  # one: the line u = b t through the point
+                c0, b, a = 0.0, rhs[1] / matrix[1, 1], 0.0
             else:
-                b, a = 0.0, 0.0
+                c0, b, a = 0.0, 0.0, 0.0
             scale = math.sqrt(1.0 + b * b)
             k = -2.0 * a / (h * scale ** 3)
             kappa[r] = min(max(k, -limit), limit)
+            shift[r] = c0 * h / scale  # the graph at t = 0, along the turned normal
             turned[r, 0] = (nx - b * tx) / scale
             turned[r, 1] = (ny - b * ty) / scale
         n = turned
         for r in range(count):
             points[r, 0] = centres[r, 0] + distances[r] * n[r, 0]
             points[r, 1] = centres[r, 1] + distances[r] * n[r, 1]
+    for r in range(count):  # the regression's front point (smoothed), not the ribbon's own
+        points[r, 0] += shift[r] * n[r, 0]
+        points[r, 1] += shift[r] * n[r, 1]
     return points, n, kappa
 
 
