@@ -23,7 +23,7 @@ import numpy as np
 from ..errors import InputError
 from ..mesh import Mesh2D, Mesh3D
 from .fast_marching import first_nearest, interpolate, march, nearest_circle
-from .front_fit import FrontReconstruction
+from .front_fit import MIN_RIBBON, FrontReconstruction
 
 CHANNEL, TIP, EMPTY, FILLED = 0, 1, 2, 3  # FILLED: fully fractured during the last step
 
@@ -159,7 +159,7 @@ class FrontField:
         unreached = ~np.isfinite(phi)
         phi[unreached & inside] = -np.inf
         self._front = None
-        if order == 2 and self.k == 2 and len(cells):
+        if order == 2 and self.k == 2 and len(cells) >= MIN_RIBBON:  # else the march (MIN_RIBBON)
             self._front = FrontReconstruction(self.ribbon_points, self.distances, phi, cells - self.low, self.h)
             finite = np.isfinite(phi)
             index = np.argwhere(finite)

@@ -16,12 +16,17 @@ tip"). Here, for any smooth front:
    section on building extension velocities from the front).
 2. **Normals and curvatures** (:func:`fit_front`): the first normals are the first-order field's
    gradient at the ribbon centres (:func:`ribbon_normals`, central differences); then, in the
-   frame ``(n_r, t_r)`` of each front point, the neighbouring front points (within
+   frame ``(n_r, t_r)`` of each front point, the point itself and its neighbours (within
    ``FIT_RADIUS`` and facing the same way) are fitted in weighted least squares by the graph
-   ``u = b t - (kappa/2) t^2``; ``b`` turns the normal, ``kappa`` is the curvature of the graph
-   (``kappa / (1 + b^2)^(3/2)`` in the turned frame), and the front points are placed again
-   (``FIT_PASSES`` passes). The graph's ``t^3`` term is the error: ``O(h / R^2)`` in the
-   curvature, ``O(h^2 / R^2)`` in the normal.
+   ``u = c + b t - (kappa/2) t^2`` (a local quadratic regression, as in moving least squares);
+   ``b`` turns the normal, ``kappa`` is the curvature of the graph (``kappa / (1 + b^2)^(3/2)``
+   in the turned frame), the front points are placed again (``FIT_PASSES`` passes) and finally
+   moved by ``c`` onto the graph. The graph's ``t^3`` term is the error: ``O(h / R^2)`` in the
+   curvature, ``O(h^2 / R^2)`` in the normal. Why a regression and not a graph through each
+   point: the curvature of a graph pinned at a point follows that point's noise (the simulator's
+   ``s_r`` carry a few 0.01 h from the ribbon's inversion), and the 0.25 m radial-k run's front
+   iteration stalled at 0.1-0.3 elements; with the point among its neighbours it converges.
+   With fewer than three neighbours: the graph through the point (two), a line (one).
 3. **The signed distance** at a point ``y`` (:func:`blend`): the exact signed distance to
    each of the ``BLEND`` nearest front points' osculating circles,
 
@@ -35,8 +40,8 @@ tip"). Here, for any smooth front:
    other side of a narrow fracture) are left out. The error: the curve against its osculating
    circle over ``~h``, ``O(h^3 / R^2)``, second order in ``h / R`` in elements.
 
-For a circle with exact ``s_r`` the front is then within ~1e-4 h at R = 10 h
-(tests/fracture/test_front.py). The front of a plane-strain fracture (one point per tip) is
+For a circle with exact ``s_r`` the front is then within ~1e-3 h at R = 10 h, ~1e-5 h at 40 h
+(the first-order march: 0.04-0.09 h, 0.01-0.02 h; tests/fracture/test_front.py). The front of a plane-strain fracture (one point per tip) is
 exact with the first-order march, so only 3D uses this.
 """
 import math
@@ -52,6 +57,11 @@ FIT_RADIUS = 3.0
 FIT_PASSES = 3
 #: The curvature is held to 1/(MIN_RADIUS h): a front bent tighter than that is not resolved.
 MIN_RADIUS = 0.5
+#: Fewer ribbon cells than this: the front is not resolved (a radius below ~3.5 h, a curvature
+#: radius within the fit's reach); FrontField keeps the first-order march. The radial-k run at
+#: 1 m starts from 3 x 3 elements (8 ribbon cells): reconstructed, its front jumped to 419
+#: elements by 5 s (the first-order march: ~150) and stalled there.
+MIN_RIBBON = 20
 #: Front points blended per evaluation point (and the one beyond them that sets the weights).
 BLEND = 4
 
