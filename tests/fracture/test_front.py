@@ -200,11 +200,12 @@ def test_second_order_front_of_an_ellipse_and_a_rounded_square(a, b, p):
 @pytest.mark.parametrize("angle", [0.0, np.pi / 8, 0.3])
 def test_second_order_front_is_exact_for_a_straight_front(angle):
     h, s = 0.5, 0.7
-    n = 12
+    n = 20  # at least MIN_RIBBON ribbon cells (fewer: the first-order march)
     cells = np.stack(np.meshgrid(*[np.arange(-n, n + 1)] * 2, indexing="ij"), axis=-1).reshape(-1, 2)
     normal = np.array([np.cos(angle), np.sin(angle)])
     ribbon, distance, channel = _ribbon_of(cells, s - cells @ normal * h, s)
     near = distance < 2.0 * h  # not the channel's edge on the box's border
     field = FrontField(ribbon[near], distance[near], np.zeros(np.count_nonzero(near)), channel, h, margin=4, order=2)
+    assert field._front is not None
     points = np.random.default_rng(0).uniform(-2.0, 2.0, (200, 2))
     np.testing.assert_allclose(field(points), points @ normal - s, atol=1e-6)
