@@ -9,7 +9,10 @@ is ``-s_r`` at the ribbon centres and solves the eikonal equation ``|grad phi| =
 elsewhere (:class:`FrontField`: first-order fast marching on the cell centres (:mod:`.fast_marching`), outward
 through the cells that are not fully fractured and inward through those that are; the
 upwind update is exact for a straight front in any direction, so the front does not
-favour the grid axes), bilinear between the centres. A *tip* element is crossed by the
+favour the grid axes), bilinear between the centres; or, in 3D with ``order = 2``, the front
+reconstructed from the ribbon to second order (:mod:`.front_fit`: the ribbon's tangent points,
+local curvatures, blended osculating circles; the first-order march puts a convex front
+~0.25 ``s_r h / R`` too near, issue 39). A *tip* element is crossed by the
 front: its filled fraction and its mean opening (the asymptote ``w(-phi, V)`` averaged
 over the whole element, zero outside the front; ``V`` of the nearest ribbon) come from
 ``n_sub^k`` sample points (``k`` = 2 in 3D, 1 in 2D). Its fluid volume is that mean opening times its area, and its flow faces carry

@@ -209,3 +209,14 @@ def test_second_order_front_is_exact_for_a_straight_front(angle):
     assert field._front is not None
     points = np.random.default_rng(0).uniform(-2.0, 2.0, (200, 2))
     np.testing.assert_allclose(field(points), points @ normal - s, atol=1e-6)
+
+
+def test_second_order_leaves_a_plane_strain_front_to_the_march():
+    # 2D (k = 1): the march is exact, order 2 is not built there (the 2D runs stay bit-identical)
+    cells = np.arange(-30, 31)[:, None]
+    channel = cells[np.abs(cells[:, 0]) <= 20]
+    ribbon = np.array([[-20], [20]])
+    first = FrontField(ribbon, [0.7, 0.4], [0.0, 0.0], channel, 0.5, margin=4)
+    second = FrontField(ribbon, [0.7, 0.4], [0.0, 0.0], channel, 0.5, margin=4, order=2)
+    points = np.linspace(-12.0, 12.0, 97)[:, None]
+    assert second._front is None and np.array_equal(first(points), second(points))
