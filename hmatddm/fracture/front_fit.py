@@ -20,12 +20,17 @@ tip"). Here, for any smooth front:
    ``FIT_RADIUS`` and facing the same way) are fitted in weighted least squares by the graph
    ``u = c + b t - (kappa/2) t^2`` (a local quadratic regression, as in moving least squares);
    ``b`` turns the normal, ``kappa`` is the curvature of the graph (``kappa / (1 + b^2)^(3/2)``
-   in the turned frame), the front points are placed again (``FIT_PASSES`` passes) and finally
-   moved by ``c`` onto the graph. The graph's ``t^3`` term is the error: ``O(h / R^2)`` in the
-   curvature, ``O(h^2 / R^2)`` in the normal. Why a regression and not a graph through each
-   point: the curvature of a graph pinned at a point follows that point's noise (the simulator's
-   ``s_r`` carry a few 0.01 h from the ribbon's inversion), and the 0.25 m radial-k run's front
-   iteration stalled at 0.1-0.3 elements; with the point among its neighbours it converges.
+   in the turned frame) and the front points are placed again (``FIT_PASSES`` passes); each
+   front point stays on its own ribbon's circle (``c`` is not applied: ``SMOOTH_POINTS``). The
+   graph's ``t^3`` term is the error: ``O(h / R^2)`` in the curvature, ``O(h^2 / R^2)`` in the
+   normal. Why a regression, and why the points are not moved by it (both measured on radial
+   runs, issue 39): the curvature of a graph pinned at a point through its neighbours follows
+   that point's noise (the simulator's ``s_r`` carry a few 0.01 h from the ribbon's
+   inversion) and the 0.25 m radial-k front iteration stalled at 0.1-0.3 elements for 40
+   iterations; with the points moved onto the regression a ribbon's own ``s_r`` barely moves
+   the front (the regression averages it out), the zigzag of the ribbon's distances is left
+   free, and the 0.5 m radial-km run took minutes of front iterations instead of 15 s. Each
+   point on its own circle, the curvature and normal from the regression: both converge.
    With fewer than three neighbours: the graph through the point (two), a line (one).
 3. **The signed distance** at a point ``y`` (:func:`blend`): the exact signed distance to
    each of the ``BLEND`` nearest front points' osculating circles,
@@ -57,6 +62,9 @@ FIT_RADIUS = 3.0
 FIT_PASSES = 3
 #: The curvature is held to 1/(MIN_RADIUS h): a front bent tighter than that is not resolved.
 MIN_RADIUS = 0.5
+#: Move each front point onto its regression (False: the point stays on its own ribbon's circle,
+#: only the normal and curvature are the regression's; module docstring).
+SMOOTH_POINTS = False
 #: Fewer ribbon cells than this: the front is not resolved (a radius below ~3.5 h, a curvature
 #: radius within the fit's reach); FrontField keeps the first-order march. The radial-k run at
 #: 1 m starts from 3 x 3 elements (8 ribbon cells): reconstructed, its front jumped to 419
@@ -183,9 +191,10 @@ def fit_front(centres, distances, normals, neighbours, h):
         for r in range(count):
             points[r, 0] = centres[r, 0] + distances[r] * n[r, 0]
             points[r, 1] = centres[r, 1] + distances[r] * n[r, 1]
-    for r in range(count):  # the regression's front point (smoothed), not the ribbon's own
-        points[r, 0] += shift[r] * n[r, 0]
-        points[r, 1] += shift[r] * n[r, 1]
+    if SMOOTH_POINTS:  # the regression's front point (smoothed), not the ribbon's own
+        for r in range(count):
+            points[r, 0] += shift[r] * n[r, 0]
+            points[r, 1] += shift[r] * n[r, 1]
     return points, n, kappa
 
 

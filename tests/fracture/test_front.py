@@ -173,7 +173,7 @@ def _superellipse_front_error(a, b, p, depth, order, centre=(0.17, 0.41), n_rays
 def test_second_order_front_of_a_circle(depth):
     # issue 39: the reconstructed front (order 2, hmatddm.fracture.front_fit) of a circle from
     # the exact ribbon distances: its error in elements falls like (h/R)^2 or faster (measured
-    # ~(h/R)^3: 5e-4, 6e-5, 1e-5 h at R = 10, 20, 40 h), the first-order march's like h/R
+    # ~(h/R)^3: 6-8e-4, 7-8e-5, 1e-5 h at R = 10, 20, 40 h), the first-order march's like h/R
     first = [_superellipse_front_error(radius, radius, 2, depth, 1) for radius in (10.3, 20.3, 40.3)]
     second = [_superellipse_front_error(radius, radius, 2, depth, 2) for radius in (10.3, 20.3, 40.3)]
     for (mean, worst), radius in zip(second, (10.3, 20.3, 40.3)):
@@ -188,13 +188,15 @@ def test_second_order_front_of_a_circle(depth):
 def test_second_order_front_of_an_ellipse_and_a_rounded_square(a, b, p):
     # not circle-specific: an ellipse (axes 5:3) and a superellipse |x|^4 + |y/0.8|^4 = 1,
     # scaled 10.3, 20.3, 40.3 h: the largest error along rays falls like (h/L)^2 or faster
-    # and stays below the first-order march's mean error at the coarsest
+    # (measured 0.016-0.018 -> 0.003-0.004 -> 0.0006 h and 0.015-0.023 -> 0.004-0.007 ->
+    # 0.0008-0.0009 h: the curvature of the rounded square varies within a few cells), and
+    # stays below the first-order march's mean error at the coarsest
     for depth in (0.5, 1.5):
         errors = [_superellipse_front_error(a * scale, b * scale, p, depth, 2) for scale in (10.3, 20.3, 40.3)]
         first, _ = _superellipse_front_error(a * 10.3, b * 10.3, p, depth, 1)
-        assert errors[0][1] < abs(first)
+        assert errors[0][1] < abs(first) and errors[2][1] < errors[0][1] / 14.0
         for coarse, fine in zip(errors, errors[1:]):
-            assert fine[1] < coarse[1] / 3.5 and abs(fine[0]) < 0.25 * abs(first)
+            assert fine[1] < coarse[1] / 3.0 and abs(fine[0]) < 0.25 * abs(first)
 
 
 @pytest.mark.parametrize("angle", [0.0, np.pi / 8, 0.3])
