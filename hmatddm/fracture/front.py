@@ -26,7 +26,7 @@ import numpy as np
 from ..errors import InputError
 from ..mesh import Mesh2D, Mesh3D
 from .fast_marching import first_nearest, interpolate, march, nearest_circle
-from .front_fit import MIN_RIBBON, FrontReconstruction
+from .front_fit import BAND, MIN_RIBBON, FrontReconstruction
 
 CHANNEL, TIP, EMPTY, FILLED = 0, 1, 2, 3  # FILLED: fully fractured during the last step
 
@@ -132,7 +132,8 @@ class FrontField:
     h : cell size;  margin : cells marched beyond the ribbon (>= the farthest front + 2)
     order : 1, the first-order march, bilinear between cell centres; 2 (3D only): the front
     reconstructed from the ribbon to second order (:mod:`.front_fit`), evaluated at the points
-    themselves and at the cell centres (``phi``) wherever the march reached (elsewhere its +-inf)
+    themselves and at the cell centres (``phi``) within ``BAND`` cells of the front (beyond: the
+    march; the bilinear march selects)
     """
 
     def __init__(self, cells, distances, velocities, channel, h, margin, order=1):
@@ -164,9 +165,9 @@ class FrontField:
         self._front = None
         if order == 2 and self.k == 2 and len(cells) >= MIN_RIBBON:  # else the march (MIN_RIBBON)
             self._front = FrontReconstruction(self.ribbon_points, self.distances, phi, cells - self.low, self.h)
-            finite = np.isfinite(phi)
-            index = np.argwhere(finite)
-            phi[finite] = self._front((index + self.low) * self.h)
+            near = np.abs(phi) < BAND * self.h  # the march beyond (front_fit.BAND)
+            index = np.argwhere(near)
+            phi[near] = self._front((index + self.low) * self.h)
         elif order not in (1, 2):
             raise ValueError(f"FrontField order must be 1 or 2, got {order}")
         self.order = order
@@ -191,9 +192,9 @@ class FrontField:
             points = np.column_stack([points, np.zeros(len(points))])
         out = np.empty(len(points))
         interpolate(phi, low, self.h, np.ascontiguousarray(points), out)
-        if self._front is not None:  # order 2: the reconstruction where the march reached
-            finite = np.isfinite(out)
-            out[finite] = self._front(points[finite])
+        if self._front is not None:  # order 2: the reconstruction near the front (front_fit.BAND)
+            near = np.abs(out) < BAND * self.h
+            out[near] = self._front(points[near])
         return out
 
     def velocity(self, points):

@@ -60,8 +60,14 @@ FIT_NEIGHBOURS = 12
 FIT_RADIUS = 3.0
 #: Passes of the fit (normals turned, front points placed again).
 FIT_PASSES = 3
-#: The curvature is held to 1/(MIN_RADIUS h): a front bent tighter than that is not resolved.
-MIN_RADIUS = 0.5
+#: The curvature is held to 1/(MIN_RADIUS h): a front bent tighter than that is not resolved,
+#: and a concave circle's far side (2 MIN_RADIUS h from the front) stays beyond BAND.
+MIN_RADIUS = 2.0
+#: The reconstruction applies within BAND cells of the front (by the first-order field); beyond,
+#: the march. Why: the signed distance to a concave circle turns negative again past its
+#: centre, and the 0.25 m radial-m run (noisy early curvatures) found hundreds of spurious
+#: tip elements outside its front and grew to 2046 elements in 2 s.
+BAND = 3.0
 #: Move each front point onto its regression (False: the point stays on its own ribbon's circle,
 #: only the normal and curvature are the regression's; module docstring).
 SMOOTH_POINTS = False

@@ -101,7 +101,17 @@ run shorter and wider by an error that falls only as ``h / R``. With the level s
 the front interpolated in angle from the ribbons (an experiment, radial fronts only) the far
 ribbon's radial-k gives R -0.19 / -0.15%, w0 +0.66 / +0.56% at 0.5 / 0.25 m, converging to
 Dontsov's; the near ribbon reads ~1% wide, which cancels the level set's error in the default.
-A second-order level set would let 3D toughness tips take the far ribbon (not built).
+The general remedy is built as an option: ``AsymptoticFront.level_set_order = 2`` (3D only) takes
+the front reconstructed from the ribbon to second order (:mod:`hmatddm.fracture.front_fit`; a
+circle from exact ``s_r`` within 1e-3 h at R = 10 h, the march 0.04-0.09 h) and
+``far_ribbon_3d_toughness = True`` the far ribbon at 3D toughness tips by the 2D rule. With both,
+radial-k against Dontsov's transition: R -0.15 / -0.10 / -0.05%, w0 +0.35 / +0.18 / +0.06% at
+1 / 0.5 / 0.25 m (the default: -0.44 / -0.13 / -0.03%, +0.55 / +0.03 / -0.05%, its RMS over the
+second half 2-5x the option's); radial-km 0.5 m R -0.38%, w0 -0.03% (default -0.40 / -0.14%);
+radial-m 0.5 m R -0.60%, w0 +0.46% (default -0.75 / +0.60%). Not the default: at 0.25 m the
+radial-m and radial-km runs took 4x and more the CPU of the default (front iterations; not
+resolved in that session), and the default's 0.5 m radial-k w0 is nearer Dontsov's (by the
+cancellation above) (benchmarks/RESULTS.md, issue 39, "a second-order level set").
 
 **Carter leak-off** (a Newtonian fluid): the tip asymptote with leak-off, the elements the
 front crosses leaking point by point, and the front iteration bracketed --
