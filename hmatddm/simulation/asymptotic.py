@@ -105,13 +105,14 @@ The general remedy is built as an option: ``AsymptoticFront.level_set_order = 2`
 the front reconstructed from the ribbon to second order (:mod:`hmatddm.fracture.front_fit`; a
 circle from exact ``s_r`` within 1e-3 h at R = 10 h, the march 0.04-0.09 h) and
 ``far_ribbon_3d_toughness = True`` the far ribbon at 3D toughness tips by the 2D rule. With both,
-radial-k against Dontsov's transition: R -0.15 / -0.10 / -0.05%, w0 +0.35 / +0.18 / +0.06% at
-1 / 0.5 / 0.25 m (the default: -0.44 / -0.13 / -0.03%, +0.55 / +0.03 / -0.05%, its RMS over the
-second half 2-5x the option's); radial-km 0.5 m R -0.38%, w0 -0.03% (default -0.40 / -0.14%);
-radial-m 0.5 m R -0.60%, w0 +0.46% (default -0.75 / +0.60%). Not the default: at 0.25 m the
-radial-m and radial-km runs took 4x and more the CPU of the default (front iterations; not
-resolved in that session), and the default's 0.5 m radial-k w0 is nearer Dontsov's (by the
-cancellation above) (benchmarks/RESULTS.md, issue 39, "a second-order level set").
+radial-k against Dontsov's transition: R -0.11 / -0.07%, w0 +0.18 / +0.12% at 0.5 / 0.25 m, RMS
+over the second half 0.10 / 0.07% and 0.18 / 0.11% (the default: -0.13 / -0.03%, +0.03 /
+-0.05%, RMS 0.28 / 0.06% and 0.41 / 0.20%). The build before ``front_fit.BAND``: radial-k 1 m
+-0.15%, +0.35% (default -0.44%, +0.55%); radial-km 0.5 m R -0.38%, w0 -0.03% (default -0.40 /
+-0.14%); radial-m 0.5 m R -0.60%, w0 +0.46% (default -0.75 / +0.60%). Not the default: the
+0.25 m radial-m run took more than 4x the default's CPU (front iterations; not resolved), and
+the default's final 0.5 m radial-k w0 is nearer Dontsov's, by the cancellation above
+(benchmarks/RESULTS.md, issue 39, "a second-order level set").
 
 **Carter leak-off** (a Newtonian fluid): the tip asymptote with leak-off, the elements the
 front crosses leaking point by point, and the front iteration bracketed --
