@@ -3,6 +3,8 @@
     python benchmarks/bench_convergence.py                          # h = 1, 0.5 m (0.25 m where it fits)
     python benchmarks/bench_convergence.py --cases kgd,radial-k --sizes 1,0.5,0.25
     python benchmarks/bench_convergence.py --max-elements 20000     # let h/4 of the 3D scenes run too
+    python benchmarks/bench_convergence.py --cases radial-k --front level_set_order=2 \
+        --front far_ribbon_3d_toughness=True                        # a variant of the asymptotic front
 
 Cases, each against the closed form that applies to it (hmatddm.analytical.regimes):
 
@@ -49,11 +51,18 @@ VARIANTS = {"kgd-element": ("kgd", ['propagation.front="element"']),
                               'numerics.backend="dense"'])}
 
 _CHILD = """
-import json, sys, time
+import json, os, sys, time
 import hmatddm.scene as hs
 from hmatddm.scene import apply_override
 
 name, out, overrides = sys.argv[1], sys.argv[2], sys.argv[3:]
+if os.environ.get("BENCH_FRONT"):  # --front: attributes of AsymptoticFront (variants of the front)
+    import ast
+    from hmatddm.simulation.asymptotic import AsymptoticFront
+    for assignment in os.environ["BENCH_FRONT"].split(";"):
+        key, value = assignment.split("=", 1)
+        assert hasattr(AsymptoticFront, key), key
+        setattr(AsymptoticFront, key, ast.literal_eval(value))
 raw = hs.parse_scene(hs.embedded_text(name)).data
 for assignment in overrides:
     apply_override(raw, assignment)
@@ -100,11 +109,13 @@ def mesh_overrides(name, h):
     return sets
 
 
-def run(name, h, folder, extra=()):
+def run(name, h, folder, extra=(), front=()):
     """One run in a child process: final values, errors, RMS errors over the second half
-    (``extra``: more ``--set`` assignments, e.g. ``numerics.time_step=0.5``)."""
+    (``extra``: more ``--set`` assignments, e.g. ``numerics.time_step=0.5``; ``front``:
+    ``attribute=value`` of :class:`hmatddm.simulation.asymptotic.AsymptoticFront` set in the child)."""
     out = os.path.join(folder, f"{name}-{h}.json")
-    environment = dict(os.environ, PYTHONPATH=os.pathsep.join([ROOT, os.environ.get("PYTHONPATH", "")]))
+    environment = dict(os.environ, PYTHONPATH=os.pathsep.join([ROOT, os.environ.get("PYTHONPATH", "")]),
+                       BENCH_FRONT=";".join(front))
     scene = VARIANTS.get(name, (name,))[0]
     subprocess.run([sys.executable, "-c", _CHILD, scene, out, *mesh_overrides(name, h), *extra], env=environment,
                    check=True)
@@ -161,6 +172,8 @@ def main():
     parser.add_argument("--json", default=None, help="also write the rows to this file")
     parser.add_argument("--set", action="append", default=[],
                         help="another scene assignment for every run (repeatable), e.g. numerics.time_step=0.5")
+    parser.add_argument("--front", action="append", default=[],
+                        help="an AsymptoticFront class attribute for every run (repeatable), e.g. level_set_order=2")
     parser.add_argument("--report", default=None,
                         help="no runs: print the tables and plot of earlier --json files (comma separated)")
     args = parser.parse_args()
@@ -185,7 +198,7 @@ def main():
                     skipped.append(f"{name} at h = {h:g} m (~{needed} elements > --max-elements {args.max_elements})")
                     print(f"skipped {skipped[-1]}", flush=True)
                     continue
-                rows.append(run(name, h, folder, args.set))
+                rows.append(run(name, h, folder, args.set, args.front))
                 print(json.dumps(rows[-1]), flush=True)
     if args.json:
         json.dump(dict(rows=rows, skipped=skipped, machine=machine()), open(args.json, "w"), indent=1)

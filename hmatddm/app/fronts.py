@@ -3,8 +3,8 @@ tracks and the closed form's.
 
 * The tracked front: with ``propagation.front = "asymptotic"``, the zero level of the
   signed distance ``phi`` that the ribbon elements' front distances define
-  (:class:`hmatddm.fracture.front.FrontField`, bilinear between the cell centres; Peirce and
-  Detournay 2008), as a curve in the fracture's plane; with the element front (the
+  (:class:`hmatddm.fracture.front.FrontField` of the solver's order, drawn through its cell
+  centres; Peirce and Detournay 2008), as a curve in the fracture's plane; with the element front (the
   reference's switch, ref. Sec. 4.2.2), the outer edges of the hydraulic elements.
 * The closed form's front (the scene's ``[reference]``): the circle of radius ``R(t)``
   round the injection point (radial solutions) or the tips ``+-l(t)`` of a plane-strain
@@ -35,6 +35,7 @@ def asymptotic_front(mesh, front_distance, front_velocity, front_class):
     """The front of a state with the asymptotic front's arrays: a list of (n, 3) polylines
     (3D; [] for a 2D mesh, whose front is two points)."""
     from ..fracture.front import CHANNEL, FrontField, PlanarGrid
+    from ..simulation.asymptotic import AsymptoticFront
 
     if not isinstance(mesh, Mesh3D):
         return []
@@ -46,7 +47,8 @@ def asymptotic_front(mesh, front_distance, front_velocity, front_class):
     distance = np.asarray(front_distance, float)[ribbon]
     margin = int(np.ceil(np.max(distance) / grid.h)) + 3  # as AsymptoticFront.field
     field = FrontField(cells[ribbon], distance, np.asarray(front_velocity, float)[ribbon],
-                       cells[np.asarray(front_class) == CHANNEL], grid.h, margin)
+                       cells[np.asarray(front_class) == CHANNEL], grid.h, margin,
+                       order=AsymptoticFront.level_set_order)  # the solver's level set
     return [grid.origin + line @ grid.axes for line in _contour(field.phi, field.low, grid.h) if len(line) >= 2]
 
 

@@ -9,7 +9,10 @@ is ``-s_r`` at the ribbon centres and solves the eikonal equation ``|grad phi| =
 elsewhere (:class:`FrontField`: first-order fast marching on the cell centres (:mod:`.fast_marching`), outward
 through the cells that are not fully fractured and inward through those that are; the
 upwind update is exact for a straight front in any direction, so the front does not
-favour the grid axes), bilinear between the centres. A *tip* element is crossed by the
+favour the grid axes), bilinear between the centres; or, in 3D with ``order = 2``, the front
+reconstructed from the ribbon to second order (:mod:`.front_fit`: the ribbon's tangent points,
+local curvatures, blended osculating circles; the first-order march puts a convex front
+~0.25 ``s_r h / R`` too near, issue 39). A *tip* element is crossed by the
 front: its filled fraction and its mean opening (the asymptote ``w(-phi, V)`` averaged
 over the whole element, zero outside the front; ``V`` of the nearest ribbon) come from
 ``n_sub^k`` sample points (``k`` = 2 in 3D, 1 in 2D). Its fluid volume is that mean opening times its area, and its flow faces carry
@@ -23,6 +26,7 @@ import numpy as np
 from ..errors import InputError
 from ..mesh import Mesh2D, Mesh3D
 from .fast_marching import first_nearest, interpolate, march, nearest_circle
+from .front_fit import BAND, MIN_RIBBON, FrontReconstruction
 
 CHANNEL, TIP, EMPTY, FILLED = 0, 1, 2, 3  # FILLED: fully fractured during the last step
 
@@ -126,9 +130,13 @@ class FrontField:
     cells : (R, k) int, the ribbon cells;  distances : (R,) ``s_r``;  velocities : (R,)
     channel : (C, k) int, the fully fractured cells (the ribbon among them or not)
     h : cell size;  margin : cells marched beyond the ribbon (>= the farthest front + 2)
+    order : 1, the first-order march, bilinear between cell centres; 2 (3D only): the front
+    reconstructed from the ribbon to second order (:mod:`.front_fit`), evaluated at the points
+    themselves and at the cell centres (``phi``) within ``BAND`` cells of the front (beyond: the
+    march; the bilinear march selects)
     """
 
-    def __init__(self, cells, distances, velocities, channel, h, margin):
+    def __init__(self, cells, distances, velocities, channel, h, margin, order=1):
         cells = np.asarray(cells, np.int64)
         self.k = cells.shape[1]
         self.h = float(h)
@@ -154,6 +162,15 @@ class FrontField:
         phi[inside & ~known] = -inward[inside & ~known]
         unreached = ~np.isfinite(phi)
         phi[unreached & inside] = -np.inf
+        self._front = None
+        if order == 2 and self.k == 2 and len(cells) >= MIN_RIBBON:  # else the march (MIN_RIBBON)
+            self._front = FrontReconstruction(self.ribbon_points, self.distances, phi, cells - self.low, self.h)
+            near = np.abs(phi) < BAND * self.h  # the march beyond (front_fit.BAND)
+            index = np.argwhere(near)
+            phi[near] = self._front((index + self.low) * self.h)
+        elif order not in (1, 2):
+            raise ValueError(f"FrontField order must be 1 or 2, got {order}")
+        self.order = order
         self.phi = phi  # +inf: beyond the march (outside), -inf: inside, unreached
         self._tree = None  # a k-d tree of the ribbon points (velocity), made on first use
 
@@ -175,6 +192,9 @@ class FrontField:
             points = np.column_stack([points, np.zeros(len(points))])
         out = np.empty(len(points))
         interpolate(phi, low, self.h, np.ascontiguousarray(points), out)
+        if self._front is not None:  # order 2: the reconstruction near the front (front_fit.BAND)
+            near = np.abs(out) < BAND * self.h
+            out[near] = self._front(points[near])
         return out
 
     def velocity(self, points):

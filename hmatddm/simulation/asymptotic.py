@@ -101,7 +101,18 @@ run shorter and wider by an error that falls only as ``h / R``. With the level s
 the front interpolated in angle from the ribbons (an experiment, radial fronts only) the far
 ribbon's radial-k gives R -0.19 / -0.15%, w0 +0.66 / +0.56% at 0.5 / 0.25 m, converging to
 Dontsov's; the near ribbon reads ~1% wide, which cancels the level set's error in the default.
-A second-order level set would let 3D toughness tips take the far ribbon (not built).
+The general remedy is built as an option: ``AsymptoticFront.level_set_order = 2`` (3D only) takes
+the front reconstructed from the ribbon to second order (:mod:`hmatddm.fracture.front_fit`; a
+circle from exact ``s_r`` within 1e-3 h at R = 10 h, the march 0.04-0.09 h) and
+``far_ribbon_3d_toughness = True`` the far ribbon at 3D toughness tips by the 2D rule. With both,
+radial-k against Dontsov's transition: R -0.11 / -0.07%, w0 +0.18 / +0.12% at 0.5 / 0.25 m, RMS
+over the second half 0.10 / 0.07% and 0.18 / 0.11% (the default: -0.13 / -0.03%, +0.03 /
+-0.05%, RMS 0.28 / 0.06% and 0.41 / 0.20%). The build before ``front_fit.BAND``: radial-k 1 m
+-0.15%, +0.35% (default -0.44%, +0.55%); radial-km 0.5 m R -0.38%, w0 -0.03% (default -0.40 /
+-0.14%); radial-m 0.5 m R -0.60%, w0 +0.46% (default -0.75 / +0.60%). Not the default: the
+0.25 m radial-m run took more than 4x the default's CPU (front iterations; not resolved), and
+the default's final 0.5 m radial-k w0 is nearer Dontsov's, by the cancellation above
+(benchmarks/RESULTS.md, issue 39, "a second-order level set").
 
 **Carter leak-off** (a Newtonian fluid): the tip asymptote with leak-off, the elements the
 front crosses leaking point by point, and the front iteration bracketed --
@@ -187,6 +198,12 @@ class AsymptoticFront:
     # ... and in 3D at such a (not toughness-dominated) tip once the radius is resolved_tip elements
     # (issue 39, "the far ribbon in 3D"); False: 3D keeps the ribbon next to the front everywhere
     far_ribbon_3d = True
+    # ... and in 3D at a toughness-dominated tip too, by the 2D rule (c grows as (L/h)^(1/2));
+    # False: 3D toughness tips keep the ribbon next to the front (module docstring)
+    far_ribbon_3d_toughness = False
+    # the level set of the 3D front (FrontField order): 1 first-order fast marching, bilinear
+    # between cell centres; 2 the front reconstructed to second order (hmatddm.fracture.front_fit)
+    level_set_order = 1
     # Anderson acceleration of the front iteration, 3D only (hmatddm.simulation.front_acceleration):
     # a 0.5 m radial K-vertex run takes half the front iterations with the same errors to 0.07
     # points; a plane-strain run's errors, 0.1-0.3 % and falling with h, moved by up to 0.08
@@ -246,7 +263,8 @@ class AsymptoticFront:
     def field(self, cells, distance, velocity, channel):
         """The :class:`~hmatddm.fracture.front.FrontField` of ribbon ``cells`` at ``distance``."""
         margin = int(np.ceil(np.max(distance) / self.grid.h)) + 3
-        return FrontField(cells, distance, velocity, channel, self.grid.h, margin)
+        return FrontField(cells, distance, velocity, channel, self.grid.h, margin,
+                          order=self.level_set_order if self.grid.k == 2 else 1)
 
     # -- one step ------------------------------------------------------------------------
     def inner_settings(self, settings, change, front_tolerance):
@@ -332,8 +350,8 @@ class AsymptoticFront:
         toughness_tip = self.toughness_share(begin, size) >= self.toughness_tip
         resolved = size >= self.resolved_tip * h
         # 3D: at a resolved tip that is not toughness-dominated (module docstring)
-        far_ribbon = (toughness_tip or resolved) if grid.k == 1 else \
-            (self.far_ribbon_3d and resolved and not toughness_tip)
+        far_ribbon = (toughness_tip or resolved) if grid.k == 1 else self.far_ribbon_3d and (
+            (resolved and not toughness_tip) or (toughness_tip and self.far_ribbon_3d_toughness))
         if far_ribbon:  # a filled element joins the channel c h behind the front
             filled_old &= old.at_cells(cells) <= -self.ribbon_distance(size, toughness_tip) * h
         channel = (begin.front_class == CHANNEL) | filled_old
