@@ -12,10 +12,11 @@ mesh gets the FFT operator of :mod:`hmatddm.elasticity.lattice` unless
 In a :class:`~hmatddm.LayeredMedium` with ``images = "auto"`` a build chooses its number of
 images by sampling the influence block with more and more images (:func:`hmatddm.layered.
 influence2d.choose_images`): in 3D that sampling cost 84% of the `layered-3d` scene's run (2.4 s
-a build, eight builds; benchmarks/RESULTS.md, issue 32). A rebuild keeps the last choice while
-the mesh spans the same layers and stays within :data:`IMAGES_KEPT_WITHIN` times the extent it
-was chosen on (``image_choice``, saved in checkpoints so that a resumed run builds the same
-operators).
+a build, eight builds; benchmarks/RESULTS.md, issue 32). A 3D rebuild keeps the last choice
+while the mesh spans the same layers and stays within :data:`IMAGES_KEPT_WITHIN` times the
+extent it was chosen on (``image_choice``: kept with the base it was made for, so that a step
+tried again from an earlier base starts from that base's choice, and saved in checkpoints, so
+that a resumed run builds the same operators). 2D chooses at every build (cheap there).
 """
 import warnings
 from dataclasses import asdict
@@ -132,6 +133,7 @@ class GrowingOperator:
             else:
                 self.base = ElasticityOperator(mesh, self.material, n_images=self._kept_images(mesh), **settings)
                 self._remember_images(mesh)
+                self.base.image_choice = self.image_choice  # the choice this base was made with (reset)
         for warning in caught:
             if issubclass(warning.category, MeshQualityWarning):
                 if not self._mesh_quality_warned:
@@ -143,20 +145,19 @@ class GrowingOperator:
         self.builds += 1
         return self.base
 
-    def _chooses_images(self):
+    def _chooses_images(self, mesh):
         material = self.material
-        return isinstance(material, LayeredMedium) and material.images == "auto" and not material.is_homogeneous
+        return (mesh.dim == 3 and isinstance(material, LayeredMedium) and material.images == "auto"
+                and not material.is_homogeneous)
 
     def _extent_and_layers(self, mesh):
-        extent = np.ptp(mesh.centers, axis=0) + 2.0 * np.max(np.maximum(mesh.half_a, mesh.half_b)) \
-            if mesh.dim == 3 else np.ptp(mesh.centers, axis=0) + 2.0 * np.max(mesh.half_length)
-        height = mesh.centers[:, -1]
-        return extent, sorted({int(k) for k in np.unique(self.material.layer_of(height))})
+        extent = np.ptp(mesh.centers, axis=0) + 2.0 * np.max(np.maximum(mesh.half_a, mesh.half_b))
+        return extent, sorted({int(k) for k in np.unique(self.material.layer_of(mesh.centers[:, 2]))})
 
     def _kept_images(self, mesh):
         """The number of images of the last choice if it still holds for ``mesh`` (module
         docstring), else None (choose on ``mesh``)."""
-        if not self._chooses_images() or self.image_choice is None:
+        if not self._chooses_images(mesh) or self.image_choice is None:
             return None
         extent, layers = self._extent_and_layers(mesh)
         kept = self.image_choice
@@ -165,7 +166,7 @@ class GrowingOperator:
         return int(kept["n_images"])
 
     def _remember_images(self, mesh):
-        if not self._chooses_images():
+        if not self._chooses_images(mesh):
             return
         n_images = int(self.base.stats.get("n_images", 0))
         if self.image_choice is not None and n_images == self.image_choice["n_images"] and \
@@ -177,8 +178,10 @@ class GrowingOperator:
     def reset(self, base):
         """Go back to ``base`` (an earlier :attr:`base`, or None), forgetting the operators
         made since: a step tried again starts from the operator it started from, as a run
-        resumed from that step's checkpoint would."""
+        resumed from that step's checkpoint would (with the choice of images ``base`` was
+        made with)."""
         self.base, self._mesh, self._operator = base, None, None
+        self.image_choice = None if base is None else getattr(base, "image_choice", None)
 
     def restore(self, mesh, compressed_elements, image_choice=None):
         """Rebuild the base an interrupted run had (its first ``compressed_elements``

@@ -72,3 +72,22 @@ def test_elasticity_operator_refuses_a_negative_number_of_images():
         hd.ElasticityOperator(_crack(2.0, 2), MEDIUM, n_images=-1)
     with pytest.raises(hd.InputError, match="n_images"):
         hd.ElasticityOperator(_crack(2.0, 2), MEDIUM, n_images=1.5)
+
+
+def test_a_step_tried_again_from_an_earlier_base_starts_from_its_choice(counted):
+    operators = GrowingOperator(MEDIUM, OperatorSettings(backend="dense"), RebuildSettings())
+    first = operators.build(_crack(2.0, 2))
+    chosen_first = dict(operators.image_choice)
+    operators.build(_crack(8.0, 8))  # chosen again, across the interfaces
+    assert operators.image_choice["layers"] == [0, 1, 2]
+    operators.reset(first)
+    assert operators.image_choice == chosen_first
+    operators.reset(None)
+    assert operators.image_choice is None
+
+
+def test_2d_chooses_at_every_build():
+    medium = LayeredMedium([1.0], [2e10, 1e10], [0.25, 0.25], images="auto")
+    operators = GrowingOperator(medium, OperatorSettings(backend="dense"), RebuildSettings())
+    operators.build(hd.mesh.line([0.0, -2.0], [0.0, 0.0], 8))
+    assert operators.image_choice is None
