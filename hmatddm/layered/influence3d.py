@@ -72,11 +72,9 @@ def influence_data(mesh, medium, singular_shift, alpha, near_fraction, n_images,
     # a half-space source without a horizontal side: Okada's point source at the Gauss points
     point = np.zeros(mesh.n_elements, dtype=np.bool_)
     if is_half_space(medium) and medium.method != "quadrature":
-        for e in np.flatnonzero(~closed):
-            rows = okada_point3d.point_frame(mesh.frames[e, 2])
-            if rows is not None:
-                okada[e] = rows
-                point[e] = True
+        rows, has_strike = okada_point3d.point_frames(mesh.frames[:, 2])
+        point = has_strike & ~closed
+        okada[point] = rows[point]
     return with_self_max(images3d.with_image_terms(images3d.LayeredRectangles(
         mesh.centers, mesh.frames, mesh.half_a, mesh.half_b, layers, interfaces, g, nu, n_images=int(n_images),
         gauss_points=int(medium.gauss_points), max_subdivisions=int(MAX_SUBDIVISIONS),

@@ -256,17 +256,25 @@ def point_rule(dmin, a, b, max_sub, far_tol, entry_tol):
     return POINT_GAUSS_POINTS, n_sub
 
 
+def point_frames(normals):
+    """Okada's rows ``(strike, up-dip, normal)`` of planes from their unit ``normals`` (N, 3)
+    alone: ``(rows (N, 3, 3), has_strike (N,) bool)``, the strike ``e_z x n`` (horizontal),
+    the up-dip ``n x strike`` (``z >= 0``); a horizontal plane has no strike (such a rectangle
+    has horizontal sides, :mod:`.okada3d`): its rows are zeros."""
+    n = np.asarray(normals, dtype=float).reshape(-1, 3)
+    strike = np.stack([-n[:, 1], n[:, 0], np.zeros(len(n))], axis=1)
+    size = np.linalg.norm(strike, axis=1)
+    has_strike = size > 1e-12
+    strike[has_strike] /= size[has_strike, None]
+    rows = np.stack([strike, np.cross(n, strike), n], axis=1)
+    rows[~has_strike] = 0.0
+    return rows, has_strike
+
+
 def point_frame(normal):
-    """Okada's rows ``(strike, up-dip, normal)`` of a plane from its unit ``normal`` alone:
-    the strike ``e_z x n`` (horizontal), the up-dip ``n x strike`` (``z >= 0``); None for a
-    horizontal plane (no strike: such a rectangle has horizontal sides, :mod:`.okada3d`)."""
-    n = np.asarray(normal, dtype=float)
-    strike = np.array([-n[1], n[0], 0.0])
-    size = np.linalg.norm(strike)
-    if size <= 1e-12:
-        return None
-    strike /= size
-    return np.stack([strike, np.cross(n, strike), n])
+    """:func:`point_frames` of one plane: its rows, or None for a horizontal plane."""
+    rows, has_strike = point_frames(normal)
+    return rows[0] if has_strike[0] else None
 
 
 @njit(cache=True, inline="always")
