@@ -58,9 +58,6 @@ class GrowingOperator:
         self._mesh = None    # the mesh of the last operator handed out
         self._operator = None
         self._mesh_quality_warned = False
-        #: the last choice of images (``"auto"`` media): ``dict(n_images, extent, layers)``
-        #: of the mesh it was made on, or None (module docstring)
-        self.image_choice = None
 
     def __call__(self, mesh):
         """The elasticity operator of ``mesh``: the last one if the mesh is unchanged, the
@@ -118,8 +115,15 @@ class GrowingOperator:
             return last.chunk_bytes / last.n_new
         return 2.0 * base.stats["memory_bytes"] / base.mesh.n_elements
 
-    def build(self, mesh):
-        """A full build of the operator of ``mesh``, which becomes the base."""
+    @property
+    def image_choice(self):
+        """The base's choice of images (``"auto"`` media, 3D): ``dict(n_images, extent,
+        layers)`` of the mesh it was made on, or None (module docstring)."""
+        return getattr(self.base, "image_choice", None)
+
+    def build(self, mesh, image_choice=None):
+        """A full build of the operator of ``mesh``, which becomes the base; ``image_choice``:
+        the choice of images to start from (default: the base's)."""
         if self._on_lattice(mesh):
             return self._lattice_operator(mesh)
         # the mesh-quality check runs at every build of a growing mesh: warn once per run
@@ -131,9 +135,10 @@ class GrowingOperator:
             if split:
                 self.base = PlanarElasticityOperator(mesh, self.material, **settings)
             else:
-                self.base = ElasticityOperator(mesh, self.material, n_images=self._kept_images(mesh), **settings)
-                self._remember_images(mesh)
-                self.base.image_choice = self.image_choice  # the choice this base was made with (reset)
+                previous = self.image_choice if image_choice is None else image_choice
+                self.base = ElasticityOperator(mesh, self.material, n_images=self._kept_images(mesh, previous),
+                                               **settings)
+                self.base.image_choice = self._remembered_images(mesh, previous)
         for warning in caught:
             if issubclass(warning.category, MeshQualityWarning):
                 if not self._mesh_quality_warned:
@@ -154,26 +159,26 @@ class GrowingOperator:
         extent = np.ptp(mesh.centers, axis=0) + 2.0 * np.max(np.maximum(mesh.half_a, mesh.half_b))
         return extent, sorted({int(k) for k in np.unique(self.material.layer_of(mesh.centers[:, 2]))})
 
-    def _kept_images(self, mesh):
-        """The number of images of the last choice if it still holds for ``mesh`` (module
+    def _kept_images(self, mesh, kept):
+        """The number of images of the choice ``kept`` if it still holds for ``mesh`` (module
         docstring), else None (choose on ``mesh``)."""
-        if not self._chooses_images(mesh) or self.image_choice is None:
+        if not self._chooses_images(mesh) or kept is None:
             return None
         extent, layers = self._extent_and_layers(mesh)
-        kept = self.image_choice
         if layers != kept["layers"] or np.any(extent > IMAGES_KEPT_WITHIN * np.asarray(kept["extent"]) + 1e-12):
             return None
         return int(kept["n_images"])
 
-    def _remember_images(self, mesh):
+    def _remembered_images(self, mesh, previous):
+        """The choice of images of the base just built on ``mesh`` from ``previous``."""
         if not self._chooses_images(mesh):
-            return
+            return None
         n_images = int(self.base.stats.get("n_images", 0))
-        if self.image_choice is not None and n_images == self.image_choice["n_images"] and \
-                self._kept_images(mesh) is not None:
-            return  # kept: the extent it was chosen on stays the reference
+        if previous is not None and n_images == previous["n_images"] and \
+                self._kept_images(mesh, previous) is not None:
+            return previous  # kept: the extent it was chosen on stays the reference
         extent, layers = self._extent_and_layers(mesh)
-        self.image_choice = dict(n_images=n_images, extent=[float(v) for v in extent], layers=layers)
+        return dict(n_images=n_images, extent=[float(v) for v in extent], layers=layers)
 
     def reset(self, base):
         """Go back to ``base`` (an earlier :attr:`base`, or None), forgetting the operators
@@ -181,16 +186,14 @@ class GrowingOperator:
         resumed from that step's checkpoint would (with the choice of images ``base`` was
         made with)."""
         self.base, self._mesh, self._operator = base, None, None
-        self.image_choice = None if base is None else getattr(base, "image_choice", None)
 
     def restore(self, mesh, compressed_elements, image_choice=None):
         """Rebuild the base an interrupted run had (its first ``compressed_elements``
         elements of ``mesh``, with the run's ``image_choice``), so that a resumed run applies
         the same operator, bit for bit."""
         self.base = self._mesh = self._operator = None
-        self.image_choice = None if image_choice is None else dict(image_choice)
         if 0 < compressed_elements <= mesh.n_elements:
-            self.build(mesh.subset(np.arange(compressed_elements)))
+            self.build(mesh.subset(np.arange(compressed_elements)), image_choice)
 
     @property
     def compressed_elements(self):
