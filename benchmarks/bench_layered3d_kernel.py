@@ -14,8 +14,18 @@ allowed relative to the largest entry) and of the relative-error rule of issue 1
 ``--error-rows`` receivers), for ``gauss_points`` 4 (the default) and 6; the three-layer
 timings on ``--rows3`` receivers (all 576 sources).
 
-Run: ``NUMBA_NUM_THREADS=1 python benchmarks/bench_layered3d_kernel.py [--issue32]``."""
+``--whole``: the same mesh, the *whole* 576 x 576 matrix of each medium after a warm-up (so a
+source's tracing is shared by all 576 receivers, as in a real assembly), uniform rock the best
+of five, the three-layer error on ``--error-rows`` receivers against 8 points per side
+everywhere; ``--compare TREE`` runs the same in a child process on another source tree (e.g.
+a worktree of the previous commit) and prints both, one after the other.
+
+Run: ``NUMBA_NUM_THREADS=1 python benchmarks/bench_layered3d_kernel.py [--issue32 | --whole [--compare TREE]]``."""
 import argparse
+import json
+import os
+import subprocess
+import sys
 import time
 
 import numpy as np
@@ -113,13 +123,66 @@ def issue32(args):
     print(machine())
 
 
+def whole(error_rows):
+    """``{medium: (CPU s, wall s, CPU us / pair, error)}`` of the whole issue-32 matrix."""
+    grid = issue32_mesh()
+    every = np.arange(grid.n_elements, dtype=np.int64)
+    g = 1.0
+    media = {"uniform": hd.Elastic(g, 0.25),
+             "half-space, images=1": LayeredMedium([0.0], [0.0, g], [0.25, 0.25], images=1),
+             "surface + 2 interfaces, images=4": LayeredMedium([0.0, -10.0, -20.0], [0.0, g, 2 * g, g], [0.25] * 4,
+                                                               images=4)}
+    found = {}
+    for name, medium in media.items():
+        data = operators.influence_data(grid, medium)  # the three layers' table is built here
+        runs = [_timed(data, every, every) for _ in range(5 if name == "uniform" else 1)]
+        out, cpu, wall = min(runs, key=lambda run: run[1])
+        error = "-"
+        if name.startswith("surface"):
+            rows = every[::len(every) // error_rows][:error_rows]
+            reference, *_ = _timed(data._replace(gauss_points=8, far_tol=0.0, entry_tol=0.0), rows, every)
+            error = f"{np.abs(out[_dof(rows)] - reference).max() / np.abs(reference).max():.1e}"
+        found[name] = (cpu, wall, cpu / len(every) ** 2 * 1e6, error)
+    return found
+
+
+def _dof(rows):
+    return (3 * rows[:, None] + np.arange(3)).ravel()
+
+
+def print_whole(label, found):
+    base = found["uniform"][2]
+    print(markdown_table(["tree", "medium", "CPU s (576 x 576)", "wall s", "CPU us / pair", "x uniform",
+                          "max error / max entry (vs 8 points)"],
+                         [[label, name, f"{cpu:.2f}", f"{wall:.2f}", f"{per:.2f}", f"{per / base:.0f}", error]
+                          for name, (cpu, wall, per, error) in found.items()]))
+
+
 def main():
     parser = argparse.ArgumentParser()
+    parser.add_argument("--whole", action="store_true")
+    parser.add_argument("--compare", default=None, help="another source tree, run in a child process (--whole)")
+    parser.add_argument("--json", action="store_true", help=argparse.SUPPRESS)
     parser.add_argument("--quick", action="store_true")
     parser.add_argument("--issue32", action="store_true")
     parser.add_argument("--rows3", type=int, default=48)
     parser.add_argument("--error-rows", type=int, default=12)
     args = parser.parse_args()
+    if args.whole:
+        if args.json:
+            print(json.dumps(whole(args.error_rows)))
+            return
+        print(machine(), flush=True)
+        found = whole(args.error_rows)
+        print_whole("this", found)
+        if args.compare:
+            env = dict(os.environ, PYTHONPATH=os.path.abspath(args.compare))
+            child = subprocess.run([sys.executable, os.path.abspath(__file__), "--whole", "--json",
+                                    "--error-rows", str(args.error_rows)], env=env, capture_output=True,
+                                   text=True, check=True, cwd=os.path.abspath(args.compare))
+            print_whole(args.compare, json.loads(child.stdout.strip().splitlines()[-1]))
+        print(machine())
+        return
     if args.issue32:
         issue32(args)
         return

@@ -190,12 +190,12 @@ def _point_tables(r1, r2, r3, sigma, n_c=10):
     """``(base, sf, sl)`` of :mod:`.potentials3d` at ``r`` for gauge ``sigma``:
     ``base[kind, a, b, c]`` the derivatives of F (0) and L (1), ``sf, sl`` the horizontal
     ones of the gauge +1 functions at ``(r1, r2, sigma r3)``."""
-    from .potentials3d import _base_table, base_derivatives
+    from .potentials3d import _base_table, base_derivatives, inverse_distance_scratch
     sf, sl, ser = np.empty((6, 6)), np.empty((6, 6)), np.empty((4, 6))
     q = np.empty((6, 6, n_c - 1))
     base = np.empty((2, 6, 6, n_c))
-    base_derivatives(r1, r2, sigma * r3, sf, sl, q, ser)
-    _base_table(sigma, n_c, sf, sl, q, base)
+    base_derivatives(r1, r2, sigma * r3, sf, sl, q, ser, inverse_distance_scratch(n_c - 1), 6 + n_c)
+    _base_table(sigma, n_c, sf, sl, q, base, 6 + n_c)
     return base, sf, sl
 
 
@@ -225,7 +225,7 @@ def _strike_primitive_difference(kind, b, m, ends, r2, r3, sigma):
     ``m >= 2`` (``d3^2 F = -1/r``), L ``m >= 1`` (``d3 L = sigma / r``). ``d1^-1 (1/r)``:
     ``log(r + r1)``, or ``-log(r - r1)`` when both ends are negative (no cancellation); the
     same branch at both ends."""
-    from .potentials3d import base_derivatives
+    from .potentials3d import base_derivatives, inverse_distance_scratch
     if kind == 0 and m < 2 or kind == 1 and m < 1:
         raise ValueError(f"d1^-1 of d3^{m} of {'FL'[kind]}: not a derivative of 1/r")
     k = m - 2 if kind == 0 else m - 1
@@ -235,7 +235,7 @@ def _strike_primitive_difference(kind, b, m, ends, r2, r3, sigma):
     for r1 in ends:
         sf, sl, ser = np.empty((6, 6)), np.empty((6, 6)), np.empty((4, 6))
         q = np.empty((6, 6, 2))  # sl's second index uses d_r1 (1/r) (Laplace)
-        base_derivatives(r2, r3, -r1 if flip else r1, sf, sl, q, ser)  # axes turned: (r2, r3, r1)
+        base_derivatives(r2, r3, -r1 if flip else r1, sf, sl, q, ser, inverse_distance_scratch(2), 8)  # axes turned: (r2, r3, r1)
         # d3^k of a function of (r2, r3, -r1) is the u2 derivative; flipping r1 changes no sign here
         values.append(-sl[b, k] if flip else sl[b, k])
     return scale * (values[1] - values[0])

@@ -108,7 +108,7 @@ from .image_tracer import trace_capacity
 from .images2d import _lame, zero_in_void
 from .image_tracer3d import _trace_range, _traced_buffer, drop_surface_range, trace, trace_points
 from .remainder_table3d import keep_near_range, rectangle_covered, remainder_rectangle_stress
-from .potentials3d import Workspace, base_derivatives, inverse_distance_derivatives
+from .potentials3d import Workspace, base_derivatives, inverse_distance_derivatives, inverse_distance_scratch
 from .vertical3d import vertical_image_stress, vertical_workspace
 from .rectangle_quadrature import (FAR_TOL, _cached_rules, _image_order, _integrate, far_order, image_rectangle_stress,
                                    image_rectangle_stress_without, remainder_order,
@@ -116,7 +116,7 @@ from .rectangle_quadrature import (FAR_TOL, _cached_rules, _image_order, _integr
 
 __all__ = ["LayeredRectangles", "with_image_terms", "workspace", "source_state", "element_traction", "element_stress", "element_stress_traced",
            # re-exported from the parts (module docstring)
-           "base_derivatives", "inverse_distance_derivatives", "Workspace", "trace", "trace_points",
+           "base_derivatives", "inverse_distance_derivatives", "inverse_distance_scratch", "Workspace", "trace", "trace_points",
            "kelvin_point_stress", "image_point_stress", "kelvin_point_displacement", "image_point_displacement",
            "square_rule", "nearest_singularity", "subdivisions", "FAR_TOL", "far_order", "image_rectangle_stress"]
 

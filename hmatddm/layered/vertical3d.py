@@ -27,7 +27,8 @@ import numpy as np
 from numba import njit
 
 from .potentials3d import (Workspace, _axis_series, _base_table, _contract, _pair_stress_gradient, _stress,
-                           base_derivatives, inverse_distance_step, potential_base)
+                           base_derivatives, inverse_distance_scratch, inverse_distance_step,
+                           potential_base)
 from .rectangle_quadrature import entry_order, far_order
 from .segment_quadrature import gauss_legendre
 
@@ -134,13 +135,14 @@ def _edge_table(ends, r2, r3, sigma, sj, work):
     """``sj[kind, a, b, m + 1]``: the strike integral (``r1`` from ``ends[0]`` to
     ``ends[1]``) of ``d1^a d2^b d3^m B`` along one edge (height ``r3``) for ``m`` from -1,
     ``a + b <= 5``; NaN where the reduction does not reach (never read by the stress)."""
-    sf, sl, ser, q, base, logs, qlog, serlog = work
+    sf, sl, ser, q, base, logs, qlog, serlog, pad = work
     n_m = sj.shape[3]
     sj[:] = 0.0
     for e in range(2):
         sign = 1.0 if e == 1 else -1.0
-        base_derivatives(ends[e], r2, sigma * r3, sf, sl, q, ser)
-        _base_table(sigma, base.shape[3], sf, sl, q, base)
+        full = q.shape[0] + q.shape[2]  # every entry of q
+        base_derivatives(ends[e], r2, sigma * r3, sf, sl, q, ser, pad, full)
+        _base_table(sigma, base.shape[3], sf, sl, q, base, full)
         for kind in range(2):
             for a in range(1, 6):
                 for b in range(6 - a):
@@ -266,7 +268,7 @@ def vertical_workspace(n_orders):
     n_log = M_MAX - 1
     edge = (np.empty((6, 6)), np.empty((6, 6)), np.empty((4, 6)), np.empty((6, 6, M_MAX - 2)),
             np.empty((2, 6, 6, M_MAX - 1)), np.empty((n_log, n_log)), np.empty((2, n_log - 1, n_log - 1)),
-            np.empty((4, n_log + 1)))
+            np.empty((4, n_log + 1)), inverse_distance_scratch(M_MAX - 2))
     tables = (np.empty((2, 6, 6, M_MAX)), np.empty((2, 6, 6, M_MAX)), np.zeros((2, 4, 3, 3, 6, 6, 6)))
     return (edge, tables, np.zeros((3, 3, 3, 3)), np.zeros((3, 3)), np.zeros((3, 3)), np.zeros((3, 3, 3)), np.zeros(3),
             Workspace(n_orders), np.zeros((3, 3, n_orders)), np.zeros((3, 3, n_orders)))

@@ -41,7 +41,8 @@ def test_base_function_derivatives_are_harmonic_and_closed_form():
     r1, r2, r3 = 0.3, -0.4, 0.7
     r = np.sqrt(r1 * r1 + r2 * r2 + r3 * r3)
     sf, sl = np.zeros((6, 6)), np.zeros((6, 6))
-    images3d.base_derivatives(r1, r2, r3, sf, sl, np.zeros((6, 6, 4)), np.zeros((4, 6)))
+    images3d.base_derivatives(r1, r2, r3, sf, sl, np.zeros((6, 6, 4)), np.zeros((4, 6)),
+                                  images3d.inverse_distance_scratch(4), 10)
     assert sf[0, 0] == pytest.approx(r - r3 * np.log(r + r3), rel=1e-14)
     assert sf[1, 0] == pytest.approx(r1 / (r + r3), rel=1e-13)  # d1 F (ref. Eq. 3.24 gauge +1)
     assert sl[0, 1] == pytest.approx(r2 / (r * (r + r3)), rel=1e-13)
@@ -52,15 +53,17 @@ def test_base_function_derivatives_are_harmonic_and_closed_form():
         step = np.array([h, 0.0]) if var == 0 else np.array([0.0, h])
         plus, minus = (np.zeros((6, 6)) for _ in range(2))
         sfp, sfm = np.zeros((6, 6)), np.zeros((6, 6))
-        images3d.base_derivatives(r1 + step[0], r2 + step[1], r3, sfp, plus, np.zeros((6, 6, 4)), np.zeros((4, 6)))
-        images3d.base_derivatives(r1 - step[0], r2 - step[1], r3, sfm, minus, np.zeros((6, 6, 4)), np.zeros((4, 6)))
+        images3d.base_derivatives(r1 + step[0], r2 + step[1], r3, sfp, plus, np.zeros((6, 6, 4)), np.zeros((4, 6)),
+                                  images3d.inverse_distance_scratch(4), 10)
+        images3d.base_derivatives(r1 - step[0], r2 - step[1], r3, sfm, minus, np.zeros((6, 6, 4)), np.zeros((4, 6)),
+                                  images3d.inverse_distance_scratch(4), 10)
         for a in range(5):
             b = 4 - a
             da, db = (a + 1, b) if var == 0 else (a, b + 1)
             assert sl[da, db] == pytest.approx((plus[a, b] - minus[a, b]) / (2 * h), rel=1e-6, abs=1e-6)
             assert sf[da, db] == pytest.approx((sfp[a, b] - sfm[a, b]) / (2 * h), rel=1e-6, abs=1e-6)
     q = np.zeros((6, 6, 24))
-    images3d.inverse_distance_derivatives(r1, r2, r3, q)
+    images3d.inverse_distance_derivatives(r1, r2, r3, q, images3d.inverse_distance_scratch(q.shape[2]), 30)
     # (d11 + d22)^2 = d3^4 on harmonic functions; d3 L = 1/r, d3^2 F = -1/r
     assert sl[4, 0] + 2 * sl[2, 2] + sl[0, 4] == pytest.approx(q[0, 0, 3], rel=1e-11)
     assert sf[5, 0] + 2 * sf[3, 2] + sf[1, 4] == pytest.approx(-q[1, 0, 2], rel=1e-11)
