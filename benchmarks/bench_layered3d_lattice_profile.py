@@ -3,7 +3,7 @@ oriented 0.5 m squares 3 m apart (``bench_layered3d_kernel.issue32_mesh``) in a 
 over two interfaces (``images=4``, the default table path). Prints the dense per-pair CPU
 against uniform rock (one run, after a warm-up), the rules the kernel picks per pair
 (counted with its own functions: table coverage, ``_image_order`` with the operator's
-``entry_tol``, ``remainder_order``), the near triples kept per source, and the cost per
+``entry_tol``, ``one_square_order``), the near triples kept per source, and the cost per
 point of the near-triple quadrature (``_integrate``) and of the table's interpolation
 (``remainder_rectangle_stress``) on three pairs.
 
@@ -21,7 +21,7 @@ from hmatddm.elasticity import operator as operators
 from hmatddm.kernels import drivers
 from hmatddm.layered import LayeredMedium
 from hmatddm.layered.remainder_table3d import remainder_rectangle_stress
-from hmatddm.layered.rectangle_quadrature import _image_order, _integrate, remainder_order, square_rule
+from hmatddm.layered.rectangle_quadrature import _image_order, _integrate, one_square_order, square_rule
 from hmatddm.layered.image_tracer3d import _trace_range, _traced_buffer, trace_points
 from hmatddm.layered.remainder_table3d import keep_near, keep_near_range, rectangle_covered
 from hmatddm.layered.image_tracer import trace_capacity
@@ -55,7 +55,7 @@ def comp(data, i, j, n, R, which):
         if which == 0:
             remainder_rectangle_stress(data.table, data.centers[i], lr, data.centers[j], data.frames[j], data.half_a[j], data.half_b[j], ls, g[ls], _lame(g[ls], nu[ls]), xi, eta, wt, image)
         else:
-            _integrate(data.centers[i], lr, data.centers[j], data.frames[j], data.half_a[j], data.half_b[j], ls, g, nu, xi, eta, wt, traced, 0, image, grad, ws, ws1, kel)
+            _integrate(data.centers[i], lr, data.centers[j], data.frames[j], data.half_a[j], data.half_b[j], ls, g, nu, xi, eta, wt, traced, 0, image, grad, ws, ws1, kel, -np.inf, np.inf)
     return traced[0][0]
 # pick pairs: same layer 1 (i, j both at depth -3..-9), and layer 2
 depth = grid.centers[:, 2]
@@ -83,7 +83,7 @@ def stats(data, out):
                 r1 = point[0] - data.centers[j, 0]; r2 = point[1] - data.centers[j, 1]
                 beside = max(0.0, np.sqrt(r1*r1 + r2*r2) - data.half_a[j] - data.half_b[j])
                 cl = data.table.clearance[ls, lr]
-                nr = remainder_order(np.sqrt(cl*cl + beside*beside), data.half_a[j], data.half_b[j], data.gauss_points, data.far_tol, et)
+                nr = one_square_order(np.sqrt(cl*cl + beside*beside), data.half_a[j], data.half_b[j], data.gauss_points, data.far_tol, et)
             quad = not (tab and abs(lr - ls) >= 2)
             out[i, j, 0] = lr; out[i, j, 1] = ls; out[i, j, 2] = tab; out[i, j, 3] = ng if quad else 0
             out[i, j, 4] = ns if quad else 0; out[i, j, 5] = nr

@@ -23,15 +23,17 @@ from .potentials3d import (Workspace, _contract, _contract_vector, _original, _p
 
 @njit(cache=True, inline="always")
 def _complementary_gradient(y, receiver_layer, x, n_pairs, source_layer, pair_layer, pair_z, pair_eps, pair_sigma,
-                            pair_coef, pair_dcoef, shear_modulus, poisson_ratio, gradient, work, work1, kelvin):
+                            pair_coef, pair_dcoef, shear_modulus, poisson_ratio, gradient, work, work1, kelvin,
+                            z_lo=-np.inf, z_hi=np.inf):
     """``gradient[f, q, i, k]`` of the complementary field at receiver ``y`` from the
     traced triples of the source point ``x`` (see :mod:`.images2d` for the bookkeeping);
     ``work``: a :func:`Workspace` of the triples' order, ``work1`` one of order 1,
-    ``kelvin`` (2, 3, 3, 1) scratch."""
+    ``kelvin`` (2, 3, 3, 1) scratch; ``z_lo <= z < z_hi``: the triples' heights taken (a
+    group of triples with its own rule, :func:`.images3d._complementary_stress`)."""
     gradient[:] = 0.0
     g_r, delta_r, lame_r = receiver_constants(shear_modulus, poisson_ratio, receiver_layer)
     for k in range(n_pairs):
-        if pair_layer[k] == receiver_layer:
+        if pair_layer[k] == receiver_layer and z_lo <= pair_z[k] < z_hi:
             _pair_stress_gradient(y[0] - x[0], y[1] - x[1], y[2] - pair_z[k], pair_eps[k], pair_sigma[k],
                                   pair_coef[k], pair_dcoef[k], delta_r, g_r, lame_r, gradient, work)
     if receiver_layer != source_layer:

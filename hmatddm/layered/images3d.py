@@ -106,12 +106,13 @@ from .okada_point3d import point_form_terms
 from .image_points3d import image_point_displacement, image_point_stress, kelvin_point_displacement, kelvin_point_stress
 from .image_tracer import trace_capacity
 from .images2d import _lame, zero_in_void
-from .image_tracer3d import _trace_range, _traced_buffer, drop_surface_range, trace, trace_points
-from .remainder_table3d import keep_near_range, rectangle_covered, remainder_rectangle_stress
+from .image_tracer3d import _traced_buffer, trace, trace_points
+from .source_traces3d import three_heights, traced_slot
+from .remainder_table3d import rectangle_covered, remainder_rectangle_stress
 from .potentials3d import Workspace, base_derivatives, inverse_distance_derivatives, inverse_distance_scratch
 from .vertical3d import vertical_image_stress, vertical_workspace
 from .rectangle_quadrature import (FAR_TOL, _cached_rules, _image_order, _integrate, far_order, image_rectangle_stress,
-                                   image_rectangle_stress_without, remainder_order,
+                                   image_rectangle_stress_without, mirror_distance, one_square_order,
                                    nearest_singularity, square_rule, subdivisions)
 
 __all__ = ["LayeredRectangles", "with_image_terms", "workspace", "source_state", "element_traction", "element_stress", "element_stress_traced",
@@ -249,41 +250,9 @@ def _source_state(data_at, j, work_at):
         return (_traced_buffer(one, one, one), np.zeros(start.shape[0] - 1, dtype=np.bool_), near_only,
                 _traced_buffer(np.int64(3), one, one), np.zeros(3))
     cap, n_orders = max(room[ls, 0], 1), max(room[ls, 1], 1)
-    three, heights = _three_heights(data, j, near_only, cap, n_orders)
+    three, heights = three_heights(data, j, near_only, cap, n_orders)
     return (_traced_buffer(start[-1], cap, n_orders), np.zeros(start.shape[0] - 1, dtype=np.bool_), near_only,
             three, heights)
-
-
-@njit(cache=True)
-def _three_heights(data, j, near_only, cap, n_orders):
-    """``(traced, heights)``: the triples of a ``vertical_form`` source at its bottom,
-    middle and top heights (:mod:`.vertical3d`), near ones only with a table, without the
-    free surface's when it is in closed form; one empty point otherwise."""
-    heights = np.zeros(3)
-    if not data.vertical_form[j]:
-        return _traced_buffer(np.int64(3), np.int64(1), np.int64(1)), heights
-    ls = data.layer[j]
-    center = data.centers[j]
-    frame = data.frames[j]
-    a = data.half_a[j]
-    b = data.half_b[j]
-    xi = np.zeros(3)
-    eta = np.zeros(3)
-    for p in range(3):
-        if abs(frame[1, 2]) > abs(frame[0, 2]):
-            eta[p] = (p - 1.0) * frame[1, 2]
-        else:
-            xi[p] = (p - 1.0) * frame[0, 2]
-        heights[p] = center[2] + xi[p] * a * frame[0, 2] + eta[p] * b * frame[1, 2]
-    three = _traced_buffer(np.int64(3), cap, n_orders)
-    first, last = np.int64(0), np.int64(3)  # not literals: the same compiled functions as element_traction's
-    _trace_range(center, frame, a, b, ls, data.interfaces, data.shear_modulus, data.poisson_ratio, data.n_images, xi,
-                 eta, first, last, three)
-    if near_only:
-        keep_near_range(three, first, last, center, frame, a, b, xi, eta, ls, data.table.bottoms, data.table.tops)
-    if data.surface_form[j]:
-        drop_surface_range(three, first, last, center, frame, a, b, xi, eta, ls, data.surface)
-    return three, heights
 
 
 @njit(cache=True)
@@ -402,18 +371,27 @@ def _complementary_stress(data_at, point, lr, j, state_at, work_at, entry_tol, i
                     for p in range(3):
                         for kk in range(3):
                             image[q, p, kk] -= uniform[q, p, kk]
-        if not closed and n_sub <= 2:
+        if not closed and n_sub == 1 and near_only and lr == ls:
+            # the near triples of the receiver's own layer are its first reflections in the
+            # layer's top (above it) and bottom (below it): each takes the rule of its own
+            # mirror, not both the nearer one's
+            bottom, top = table.bottoms[ls], table.tops[ls]
+            split = 0.5 * (bottom + top) if math.isfinite(bottom + top) else (top if math.isfinite(top) else bottom)
+            for side in range(2):
+                k = ls - 1 if side == 0 else ls
+                if k < 0 or k >= interfaces.shape[0] or k == skip:
+                    continue
+                n = one_square_order(mirror_distance(point, interfaces[k], center, frame, a, b), a, b,
+                                     data.gauss_points, data.far_tol, entry_tol)
+                lo, hi = traced_slot(data, j, n - 1, state, rules)
+                _integrate(point, lr, center, frame, a, b, ls, g, nu, xi[lo:hi], eta[lo:hi], wt[lo:hi], traced, lo,
+                           image, gradient, ws, ws1, kelvin, split if side == 0 else -np.inf,
+                           np.inf if side == 0 else split)
+        elif not closed and n_sub <= 2:
             slot = n_gauss - 1 if n_sub == 1 else data.gauss_points
-            lo, hi = start[slot], start[slot + 1]
-            if not is_traced[slot]:
-                _trace_range(center, frame, a, b, ls, interfaces, g, nu, data.n_images, xi, eta, lo, hi, traced)
-                if near_only:
-                    keep_near_range(traced, lo, hi, center, frame, a, b, xi, eta, ls, table.bottoms, table.tops)
-                if surface_form:
-                    drop_surface_range(traced, lo, hi, center, frame, a, b, xi, eta, ls, data.surface)
-                is_traced[slot] = True
+            lo, hi = traced_slot(data, j, slot, state, rules)
             _integrate(point, lr, center, frame, a, b, ls, g, nu, xi[lo:hi], eta[lo:hi], wt[lo:hi], traced, lo,
-                       image, gradient, ws, ws1, kelvin)
+                       image, gradient, ws, ws1, kelvin, -np.inf, np.inf)
         elif not closed:
             image_rectangle_stress_without(point, lr, center, frame, a, b, ls, interfaces, g, nu, data.n_images,
                                            n_gauss, n_sub, image, near_only, table.bottoms, table.tops, surface_form,
@@ -425,7 +403,7 @@ def _complementary_stress(data_at, point, lr, j, state_at, work_at, entry_tol, i
         r2 = point[1] - center[1]
         beside = max(0.0, math.sqrt(r1 * r1 + r2 * r2) - a - b)
         clearance = table.clearance[ls, lr]
-        n = remainder_order(math.sqrt(clearance * clearance + beside * beside), a, b, data.gauss_points, data.far_tol,
+        n = one_square_order(math.sqrt(clearance * clearance + beside * beside), a, b, data.gauss_points, data.far_tol,
                             entry_tol)
         lo, hi = start[n - 1], start[n]
         remainder_rectangle_stress(table, point, lr, center, frame, a, b, ls, g[ls], _lame(g[ls], nu[ls]),

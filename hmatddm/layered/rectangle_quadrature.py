@@ -157,9 +157,10 @@ def entry_scale(half_a, half_b, layer, shear_modulus, poisson_ratio):
 
 @njit(cache=True)
 def _integrate(y, receiver_layer, center, frame, a, b, source_layer, shear_modulus, poisson_ratio, xi, eta, wt,
-               traced, offset, out, gradient, work, work1, kelvin):
+               traced, offset, out, gradient, work, work1, kelvin, z_lo, z_hi):
     """``out[b, i, k] +=`` the Gauss sum of the complementary stress over the rectangle
-    with the triples traced at the points ``offset ... offset + len(xi)`` of ``traced``."""
+    with the triples traced at the points ``offset ... offset + len(xi)`` of ``traced``
+    whose heights are in ``[z_lo, z_hi)``."""
     n_pairs, layer, z, eps, sigma, coef, dcoef = traced
     normal = frame[2]
     g_s = shear_modulus[source_layer]
@@ -171,7 +172,8 @@ def _integrate(y, receiver_layer, center, frame, a, b, source_layer, shear_modul
             x[c] = center[c] + xi[g] * a * frame[0, c] + eta[g] * b * frame[1, c]
         k = offset + g
         _complementary_gradient(y, receiver_layer, x, n_pairs[k], source_layer, layer[k], z[k], eps[k], sigma[k],
-                                coef[k], dcoef[k], shear_modulus, poisson_ratio, gradient, work, work1, kelvin)
+                                coef[k], dcoef[k], shear_modulus, poisson_ratio, gradient, work, work1, kelvin, z_lo,
+                                z_hi)
         _contract(gradient, normal, g_s, lame_s, wt[g] * jac, out)
 
 
@@ -206,7 +208,7 @@ def image_rectangle_stress_without(y, receiver_layer, center, frame, a, b, sourc
     out[:] = 0.0
     _integrate(y, receiver_layer, center, frame, a, b, source_layer, shear_modulus, poisson_ratio, xi, eta, wt,
                traced, first, out, np.empty((3, 3, 3, 3)), Workspace(n_orders), Workspace(1),
-               np.zeros((2, 3, 3, 1)))
+               np.zeros((2, 3, 3, 1)), -np.inf, np.inf)
 
 
 @njit(cache=True)
@@ -221,22 +223,26 @@ def _image_order(y, receiver_layer, center, frame, a, b, source_layer, interface
     dmin = nearest_singularity(y, receiver_layer, center, frame, a, b, source_layer, interfaces, skip)
     n_sub = 2 ** subdivision_level(_sub_count(dmin, a, b, max_sub))
     if n_sub == 1:
-        n = far_order(dmin / max(a, b), gauss_points, far_tol)
-        if entry_tol > 0.0:
-            n = min(n, entry_order(dmin, a, b, gauss_points, entry_tol))
-        return n, 1
+        return one_square_order(dmin, a, b, gauss_points, far_tol, entry_tol), 1
     return gauss_points, n_sub
 
 
 @njit(cache=True)
-def remainder_order(clearance, a, b, gauss_points, far_tol, entry_tol):
-    """Gauss points per side of one square for the tabulated layered remainder
-    (:mod:`.remainder_table3d`), whose singular points stay ``clearance`` away from the
-    receiver: :func:`entry_order` when ``entry_tol > 0``, else :func:`far_order`."""
-    n = far_order(clearance / max(a, b), gauss_points, far_tol)
+def one_square_order(dmin, a, b, gauss_points, far_tol, entry_tol):
+    """Gauss points per side on one square (no sub-squares) whose nearest singular point is
+    ``dmin`` away: :func:`far_order`, or fewer by :func:`entry_order` when ``entry_tol > 0``
+    (a receiver's rule, a group of its triples', the tabulated remainder's)."""
+    n = far_order(dmin / max(a, b), gauss_points, far_tol)
     if entry_tol > 0.0:
-        n = min(n, entry_order(clearance, a, b, gauss_points, entry_tol))
+        n = min(n, entry_order(dmin, a, b, gauss_points, entry_tol))
     return n
+
+
+@njit(cache=True)
+def mirror_distance(y, interface, center, frame, a, b):
+    """Distance from ``y`` to the rectangle's mirror image in the plane ``z = interface``
+    (the receiver's mirror to the rectangle): the singular points of a first reflection."""
+    return _distance(y[0], y[1], 2.0 * interface - y[2], center, frame, a, b)
 
 
 @njit(cache=True)

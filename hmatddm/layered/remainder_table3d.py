@@ -76,7 +76,9 @@ class RemainderTable(NamedTuple):
     of the layers, sparser far away, where it varies on the scale of ``rho``),
     ``t = t0 + i h_t`` (source height), ``y3 = y0 + i h_y`` (receiver height); its values
     ``values[offset[k] + ((i_u n_t + i_t) n_y + i_y) 20 + c]``. ``clearance[ls, lr]``: the
-    smallest distance of a far triple's point to the receiver's layer."""
+    smallest distance of a far triple's point to the receiver's layer; ``near_images``: the
+    reflections a source's near triples are traced with (1 where no deeper image merges with
+    a near one, :func:`.remainder_build3d.near_images`)."""
 
     pair_index: np.ndarray  #: (L, L) int64, -1: no table (all triples by quadrature)
     grid: np.ndarray  #: (P, 9)
@@ -85,6 +87,9 @@ class RemainderTable(NamedTuple):
     clearance: np.ndarray  #: (L, L)
     bottoms: np.ndarray  #: (L,) layer bottoms (-inf for the lowest)
     tops: np.ndarray  #: (L,) layer tops (+inf for the highest)
+    #: reflections to trace for a source's near triples (:func:`.remainder_build3d.near_images`;
+    #: 0: the medium's own ``images``)
+    near_images: int = 0
 
 
 def empty_table(n_layers):

@@ -243,3 +243,35 @@ def test_a_table_depends_on_the_domain_not_on_the_history(mesh):
     influence3d._TABLES.clear()
     b = influence_data(grown, _medium(), 0.0, 0.0, 0.0, 2).table
     assert np.array_equal(a.values, b.values) and np.array_equal(a.grid, b.grid)
+
+
+def test_near_triples_are_traced_with_one_reflection_and_give_the_same_entries(mesh):
+    """A table's sources trace their near triples with one reflection
+    (remainder_build3d.near_images, ~6x cheaper than the medium's images): no deeper image of
+    this stack merges with a near triple, and the entries equal those of the near triples
+    taken from the trace with every reflection (near_images 0: the medium's own) to round-off."""
+    data = influence_data(mesh, _medium(images=3), 0.0, 0.0, 0.0, 3)
+    assert data.table.near_images == 1
+    every = _matrix(data._replace(table=data.table._replace(near_images=0)))
+    assert np.abs(_matrix(data) - every).max() <= 1e-13 * np.abs(every).max()
+
+
+def test_near_images_keep_every_reflection_where_a_deeper_image_merges(monkeypatch):
+    """Where the trace with every reflection holds a near triple that the one-reflection trace
+    lacks or holds otherwise (a deeper image merged into it), the near triples keep every
+    reflection: a deeper contribution is imitated on the first near triple of the full trace."""
+    medium = _medium()
+    interfaces, g, nu = medium.arrays()
+    bottoms, tops = rt.layer_bounds(interfaces)
+    ranges = [(0.0, 0.0), (-1.5, 0.0), (-3.0, -1.5), (-6.0, -3.0)]
+    assert build.near_images(interfaces, g, nu, 3, ranges, bottoms, tops, [1, 2, 3]) == 1
+    traced = build.trace
+
+    def merged(t, ls, interfaces, g, nu, images, layer, z, eps, sigma, coef, dcoef):
+        n = traced(t, ls, interfaces, g, nu, images, layer, z, eps, sigma, coef, dcoef)
+        if images > 1:
+            coef[0] *= 1.0 + 1e-9
+        return n
+
+    monkeypatch.setattr(build, "trace", merged)
+    assert build.near_images(interfaces, g, nu, 3, ranges, bottoms, tops, [1, 2, 3]) == 3
