@@ -23,16 +23,24 @@ def traced_slot(data, j, slot, state, rules):
     xi, eta, start = rules[0], rules[1], rules[3]
     lo, hi = start[slot], start[slot + 1]
     if not is_traced[slot]:
-        ls = data.layer[j]
-        center, frame, a, b = data.centers[j], data.frames[j], data.half_a[j], data.half_b[j]
-        _trace_range(center, frame, a, b, ls, data.interfaces, data.shear_modulus, data.poisson_ratio,
-                     traced_images(data, near_only), xi, eta, lo, hi, traced)
-        if near_only:
-            keep_near_range(traced, lo, hi, center, frame, a, b, xi, eta, ls, data.table.bottoms, data.table.tops)
-        if data.surface_form[j]:
-            drop_surface_range(traced, lo, hi, center, frame, a, b, xi, eta, ls, data.surface)
+        _trace_kept(data, j, near_only, xi, eta, lo, hi, traced)
         is_traced[slot] = True
     return lo, hi
+
+
+@njit(cache=True)
+def _trace_kept(data, j, near_only, xi, eta, lo, hi, traced):
+    """Trace source ``j`` at the points ``lo ... hi`` of the rule ``(xi, eta)`` into
+    ``traced`` and keep what its receivers integrate: the near triples only with a table,
+    without the free surface's reflection when it is in closed form."""
+    ls = data.layer[j]
+    center, frame, a, b = data.centers[j], data.frames[j], data.half_a[j], data.half_b[j]
+    _trace_range(center, frame, a, b, ls, data.interfaces, data.shear_modulus, data.poisson_ratio,
+                 traced_images(data, near_only), xi, eta, lo, hi, traced)
+    if near_only:
+        keep_near_range(traced, lo, hi, center, frame, a, b, xi, eta, ls, data.table.bottoms, data.table.tops)
+    if data.surface_form[j]:
+        drop_surface_range(traced, lo, hi, center, frame, a, b, xi, eta, ls, data.surface)
 
 
 @njit(cache=True, inline="always")
@@ -52,7 +60,6 @@ def three_heights(data, j, near_only, cap, n_orders):
     heights = np.zeros(3)
     if not data.vertical_form[j]:
         return _traced_buffer(np.int64(3), np.int64(1), np.int64(1)), heights
-    ls = data.layer[j]
     center = data.centers[j]
     frame = data.frames[j]
     a = data.half_a[j]
@@ -66,11 +73,6 @@ def three_heights(data, j, near_only, cap, n_orders):
             xi[p] = (p - 1.0) * frame[0, 2]
         heights[p] = center[2] + xi[p] * a * frame[0, 2] + eta[p] * b * frame[1, 2]
     three = _traced_buffer(np.int64(3), cap, n_orders)
-    first, last = np.int64(0), np.int64(3)  # not literals: the same compiled functions as element_traction's
-    _trace_range(center, frame, a, b, ls, data.interfaces, data.shear_modulus, data.poisson_ratio,
-                 traced_images(data, near_only), xi, eta, first, last, three)
-    if near_only:
-        keep_near_range(three, first, last, center, frame, a, b, xi, eta, ls, data.table.bottoms, data.table.tops)
-    if data.surface_form[j]:
-        drop_surface_range(three, first, last, center, frame, a, b, xi, eta, ls, data.surface)
+    # not literals: the same compiled functions as element_traction's
+    _trace_kept(data, j, near_only, xi, eta, np.int64(0), np.int64(3), three)
     return three, heights
