@@ -35,7 +35,9 @@ its iterate is never accepted (a guess whose residual is already below that tole
 comes back unchanged: the next iteration checks it at ``linear_rtol``).
 
 Segregated schemes relax (ref. Eq. 4.47) with ``alpha``; when an iteration diverges
-or does not converge, ``alpha`` is halved and the step restarted (ref. Fig. 4.10).
+or does not converge, ``alpha`` is halved and the step restarted (ref. Fig. 4.10). The
+coupled schemes' iterates are Anderson-accelerated while the contact active set stands
+still and the changes fall slowly (:mod:`hmatddm.coupled.acceleration`, ``ANDERSON_*``).
 
 Closed elements (:mod:`hmatddm.coupled.contact`): with a ``contact`` model the
 elasticity rows of closed elements become ``S (A DD + B p - f) + D DD = g`` (stick or
@@ -64,6 +66,7 @@ import scipy.sparse.linalg as spla
 
 from ..errors import ConvergenceError
 from ..hmatrix.solvers import PausableGmres
+from .acceleration import IterateMixing
 from .paused import PausedIterate, pause_levels
 from .scaled_system import _CoupledLinearSystem
 from .step_problem import COUPLED_SCHEMES
@@ -212,6 +215,16 @@ def _stagnated(history, left):
 #: none after two stagnated attempts.
 RELAXATION_HELPS = 0.25
 
+#: Iterates combined by the Anderson acceleration of a coupled attempt
+#: (:mod:`hmatddm.coupled.acceleration`); 0: the plain relaxed iteration
+ANDERSON_MEMORY = 5
+#: ... from the iterate after this many in a row without a status change
+ANDERSON_STILL = 1
+#: ... where the changes fell slower than this per iteration (a fast contraction, e.g. the
+#: radial K-vertex scene's ~1e-3 per iteration, keeps its plain iterates and the
+#: "contraction" stopping rule, which an accelerated iterate gives up)
+ANDERSON_RATE = 0.3
+
 
 def _products(problem):
     """Products the step problem's elasticity operator has made so far
@@ -265,6 +278,8 @@ class PendingSolve:
         self.alpha = relaxation
         self.restarts = 0
         self.contact_changes = 0
+        self.mixing = (IterateMixing(settings.tolerance_opening, settings.tolerance_pressure, ANDERSON_MEMORY)
+                       if self.coupled and ANDERSON_MEMORY > 0 else None)
         self._start_attempt()
 
     @property
@@ -280,6 +295,10 @@ class PendingSolve:
             self.problem.contact.reset()
         self.history = []
         self._stalled = None
+        self._still = 0      # iterations since the active set last changed
+        self._mixed = False  # the current iterate is an accelerated one (hmatddm.coupled.acceleration)
+        if self.mixing is not None:
+            self.mixing.reset()
         self.iteration = 0
         self.last_change = math.nan
         self.accurate_next = False  # an iterate solved loosely passed the test: the next at linear_rtol
@@ -370,6 +389,7 @@ class PendingSolve:
                         raise _Diverged("non-finite iterate")
                     change_p = _relative_change(p_new, self.p)
                     change_u = _relative_change(dd_new, self.dd)
+                    dd_old, p_old, mixed = self.dd, self.p, self._mixed
                     self.dd, self.p = dd_new, p_new
                     self.last_change = max(change_p, change_u)
                     changed = problem.update_contact(self.dd, self.p)
@@ -380,7 +400,9 @@ class PendingSolve:
                     # below first_linear_rtol): only a full-accuracy iterate can be accepted
                     loose = iteration == 0 and self.loose_first
                     forced = self.last_rtol is not None and self.last_rtol > settings.linear_rtol
-                    if _converged(settings.stopping, change, self.history) and changed == 0:
+                    # after an accelerated iterate the rate of the changes is not the map's: no extrapolation
+                    stopping = "change" if mixed else settings.stopping
+                    if _converged(stopping, change, self.history) and changed == 0:
                         if not (loose or forced):
                             return self.dd, self.p, self._finished(pending=False)
                         self.accurate_next = True  # the next at linear_rtol (SchemeSettings.linear_forcing)
@@ -398,6 +420,7 @@ class PendingSolve:
                         self._stalled = min(history[-STAGNATION_WINDOW:])
                         raise _Diverged(f"changes stagnated at {self.last_change:.2e} (no convergence within "
                                         f"{settings.max_iterations} iterations at their rate)")
+                    self._accelerate(dd_old, p_old, changed)  # (never on a first iterate)
                     if provisional and loose:
                         return self.dd.copy(), self.p.copy(), self._finished(pending=True)
                 raise _Diverged(f"no convergence in {settings.max_iterations} iterations "
@@ -418,6 +441,25 @@ class PendingSolve:
                 self.alpha /= 2.0
                 self.restarts += 1
                 self._start_attempt()
+
+    def _accelerate(self, dd, p, changed):
+        """Replace the relaxed iterate ``G(x_k)`` (``self.dd``, ``self.p``) after ``x_k = (dd, p)``
+        by the Anderson combination (:mod:`hmatddm.coupled.acceleration`) while the active set
+        stands still (``changed`` 0 for :data:`ANDERSON_STILL` iterates; a change restarts the
+        history) and the changes fall slower than :data:`ANDERSON_RATE` per iterate."""
+        self._mixed = False
+        if self.mixing is None:
+            return
+        self._still = 0 if changed else self._still + 1
+        if self._still < ANDERSON_STILL:
+            self.mixing.reset()
+            return
+        history = self.history
+        slow = len(history) >= 2 and history[-2] > 0.0 and history[-1] > ANDERSON_RATE * history[-2]
+        mixed = self.mixing.next(dd, p, self.dd, self.p, combine=slow)
+        if mixed is not None:
+            self.dd, self.p = mixed
+            self._mixed = True
 
     def _iterate(self, iteration, provisional):
         """The next iterate from ``(self.dd, self.p)``: the paused first GMRES solve

@@ -1,0 +1,89 @@
+"""Anderson acceleration of the coupled schemes' nonlinear (Picard) iteration
+(:mod:`hmatddm.coupled.schemes`), beyond the reference (its Sec. 4.5 relaxes, ref. Eq. 4.47).
+
+The iteration of one attempt is the fixed point ``x = G(x)`` of the relaxed map
+``G(x) = x + alpha (F(x) - x)``, ``x = (DD, p)`` and ``F`` one coupled linear solve with the
+widths (and the contact rows) lagged at ``x``. Anderson acceleration (type II; Walker and
+Ni 2011, SIAM J. Numer. Anal. 49:1715) takes the combination of the last ``memory`` iterates
+whose residuals ``f = G(x) - x`` cancel best::
+
+    gamma = argmin || f_k - dF gamma ||,    x_(k+1) = x_k + f_k - (dX + dF) gamma
+
+with ``dX``, ``dF`` the differences of consecutive iterates and residuals, in units of the
+tolerances of ref. Eqs 4.43-4.44 (DDs over ``tolerance_opening max|DD|``, pressures over
+``tolerance_pressure max|p|``, the scales fixed when the history starts).
+
+Why (issue 33, benchmarks/RESULTS.md): on the dfn-3cluster network at 4x its area the
+iteration at ``alpha = 1`` falls into a period-2 cycle of constant amplitude (a Picard
+eigenvalue at -1), the relaxation ladder halves alpha, and at ``alpha = 1/2`` every other
+mode contracts by exactly 1/2 per iteration: ~18 of a solve's ~30 iterations, once the
+contact active set has settled, were that contraction; other solves crept at a rate of
+0.8-0.93 on one slow mode (an element that fills through a throttled face). Both are what
+a least-squares combination of a few iterates removes.
+
+The combination is used only while the active set stands still: the map ``G`` changes with
+the contact rows, so the history restarts at every status change (and the plain relaxed
+step is taken), and at every iterate whose residual does not fall (the safeguard of
+:class:`hmatddm.simulation.front_acceleration.AndersonMixing`, which this follows). The
+convergence test of :mod:`hmatddm.coupled.schemes` is unchanged: an iterate is accepted on
+its own relaxed change ``G(x_k) - x_k`` (below the tolerances, no status change), and the
+accepted state is ``G(x_k)``, as without acceleration. Conventions: docs/conventions.md.
+"""
+import numpy as np
+
+#: Iterates kept (the columns of dX and dF).
+MEMORY = 5
+#: Singular values of dF below this share of the largest are dropped from the fit (nearly
+#: parallel residual differences would amplify round-off into the combination).
+RCOND = 1e-6
+
+
+class IterateMixing:
+    """The accelerated iterates of one attempt of a coupled solve (:meth:`reset` at its start)."""
+
+    def __init__(self, tolerance_opening, tolerance_pressure, memory=MEMORY):
+        self.tolerance_opening, self.tolerance_pressure = float(tolerance_opening), float(tolerance_pressure)
+        self.memory = int(memory)
+        self.steps = 0     # accelerated iterates made (combinations returned)
+        self.restarts = 0  # histories dropped by the safeguard
+        self.reset()
+
+    def reset(self):
+        """Forget the history (a new attempt, or a change of the active set)."""
+        self._points, self._residuals = [], []
+        self._scale = None
+
+    def _scaled(self, dd, p):
+        scale_u, scale_p = self._scale
+        return np.concatenate([dd / scale_u, p / scale_p])
+
+    def next(self, dd, p, dd_new, p_new, combine=True):
+        """The next iterate ``(dd, p)`` after ``x_k = (dd, p)`` whose relaxed map gave
+        ``G(x_k) = (dd_new, p_new)``, or None: take ``G(x_k)`` (the first iterate of a
+        history, any whose residual did not fall, which restarts it, and any with
+        ``combine`` False, which only joins the history)."""
+        if self._scale is None:
+            self._scale = (self.tolerance_opening * max(float(np.max(np.abs(dd_new))), 1e-30),
+                           self.tolerance_pressure * max(float(np.max(np.abs(p_new))), 1e-30))
+        point = self._scaled(dd, p)
+        residual = self._scaled(dd_new, p_new) - point
+        if self._residuals and np.linalg.norm(residual) >= np.linalg.norm(self._residuals[-1]):
+            self._points, self._residuals = [], []
+            self.restarts += 1
+        self._points.append(point)
+        self._residuals.append(residual)
+        if len(self._points) > self.memory + 1:
+            self._points.pop(0)
+            self._residuals.pop(0)
+        if len(self._points) < 2 or not combine:
+            return None
+        points, residuals = np.array(self._points), np.array(self._residuals)
+        d_points, d_residuals = np.diff(points, axis=0).T, np.diff(residuals, axis=0).T
+        gamma = np.linalg.lstsq(d_residuals, residual, rcond=RCOND)[0]
+        mixed = point + residual - (d_points + d_residuals) @ gamma
+        if not np.all(np.isfinite(mixed)):
+            return None
+        self.steps += 1
+        nd = dd.size
+        scale_u, scale_p = self._scale
+        return mixed[:nd] * scale_u, mixed[nd:] * scale_p
