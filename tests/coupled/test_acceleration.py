@@ -2,10 +2,9 @@
 on linear maps whose fixed point is known, and on a coupled step with contact, where the
 accelerated solve must reach the plain solve's answer within the nonlinear tolerance."""
 import numpy as np
-import pytest
 
 import hmatddm as hd
-from hmatddm.coupled import SchemeSettings, schemes, solve_step
+from hmatddm.coupled import SchemeSettings, schemes
 from hmatddm.coupled.acceleration import IterateMixing
 from hmatddm.coupled.contact import OPEN
 
@@ -97,4 +96,13 @@ def test_an_accelerated_contact_run_reaches_the_plain_answer(monkeypatch):
     scale = np.max(np.abs(opening))
     assert np.all(opening[natural] >= -1e-3 * scale)
     closed = natural & (s.contact_status != OPEN)
+    assert np.any(closed)
     assert np.all(np.abs(opening[closed]) <= 1e-3 * scale)
+    operator = fast.operator(s.mesh)
+    traction = operator.matvec(s.dd.ravel()) + (s.mesh.normals * s.pressure[:, None]).ravel()
+    c = (traction - fast.far_field_traction(s.mesh)).reshape(-1, 2)
+    c_n = np.sum(c * s.mesh.normals, axis=1)
+    tau = np.abs(np.sum(c * np.stack([-s.mesh.normals[:, 1], s.mesh.normals[:, 0]], axis=1), axis=1))
+    band = 1e-3 * np.max(np.abs(c_n[closed]))
+    assert np.all(c_n[closed] <= band)  # compressive contact
+    assert np.all(tau[closed] <= -fast.network.properties.friction * c_n[closed] + band)  # inside the cone
