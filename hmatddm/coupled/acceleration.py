@@ -33,6 +33,18 @@ import numpy as np
 
 #: Iterates kept (the columns of dX and dF).
 MEMORY = 5
+#: Combinations start after this many iterates in a row without a status change
+STILL = 1
+#: ... where the changes fell slower than this per iterate (a fast contraction, e.g. the
+#: radial K-vertex scene's ~1e-3 per iterate, keeps its plain iterates and the
+#: "contraction" stopping rule, which an accelerated iterate gives up)
+RATE = 0.3
+#: An iterate after an accelerated one is accepted when its change is below this share of
+#: the tolerances: the change of ``G(x)`` bounds its error only through the contraction
+#: ``rho`` of the plain map (``rho / (1 - rho)`` times the change), unknown here; 0.1 keeps
+#: the error within the tolerance up to rho = 0.9 (the slow fill mode of the dfn-3cluster
+#: network at 4x its area: 0.8-0.93)
+ACCEPT = 0.1
 #: Singular values of dF below this share of the largest are dropped from the fit (nearly
 #: parallel residual differences would amplify round-off into the combination).
 RCOND = 1e-6
@@ -52,6 +64,20 @@ class IterateMixing:
         """Forget the history (a new attempt, or a change of the active set)."""
         self._points, self._residuals = [], []
         self._scale = None
+        self._still = 0  # iterates since the active set last changed
+
+    def iterate(self, dd, p, dd_new, p_new, changed, history):
+        """The iterate to continue from after ``x_k = (dd, p)`` whose relaxed map gave
+        ``G(x_k) = (dd_new, p_new)`` and changed ``changed`` contact statuses, the attempt's
+        changes (in tolerances) being ``history``: a combination (:meth:`next`) while the
+        active set stood still for :data:`STILL` iterates and the changes fall slower than
+        :data:`RATE`, else None (take ``G(x_k)``; a status change restarts the history)."""
+        self._still = 0 if changed else self._still + 1
+        if self._still < STILL:
+            self._points, self._residuals, self._scale = [], [], None
+            return None
+        slow = len(history) >= 2 and history[-2] > 0.0 and history[-1] > RATE * history[-2]
+        return self.next(dd, p, dd_new, p_new, combine=slow)
 
     def _scaled(self, dd, p):
         scale_u, scale_p = self._scale

@@ -6,7 +6,7 @@ import pytest
 import hmatddm as hd
 from hmatddm.mesh import topology
 from hmatddm.coupled import ElasticSolver, SchemeSettings, StepProblem, solve_step
-from hmatddm.coupled import schemes, step_problem
+from hmatddm.coupled import step_problem
 from hmatddm.coupled.scaled_system import FlowFactor, _CoupledLinearSystem
 from hmatddm.flow import LeakOff, LubricationModel, fracture_compliance
 
@@ -115,7 +115,6 @@ def test_contraction_stopping_matches_the_change_rule_within_the_tolerance(schem
     # Each iterate factors its own flow block, so that the GMRES counts compare the rules
     # alone (a reused factor is tested below).
     monkeypatch.setattr(FlowFactor, "REUSE_LIMIT", 0)
-    monkeypatch.setattr(schemes, "ANDERSON_MEMORY", 0)  # the plain iterates (acceleration: test_acceleration.py)
     mesh = hd.mesh.rectangle([0, 0, 0], [1, 0, 0], [0, 1, 0], 8.0, 8.0, 8, 8)
     tight = SchemeSettings(scheme="krylov", tolerance_pressure=1e-10, tolerance_opening=1e-10, linear_rtol=1e-12,
                            stopping="change")
