@@ -27,7 +27,9 @@ step is taken), and at every iterate whose residual does not fall (the safeguard
 :class:`hmatddm.simulation.front_acceleration.AndersonMixing`, which this follows). The
 convergence test of :mod:`hmatddm.coupled.schemes` is unchanged: an iterate is accepted on
 its own relaxed change ``G(x_k) - x_k`` (below the tolerances, no status change), and the
-accepted state is ``G(x_k)``, as without acceleration. Conventions: docs/conventions.md.
+accepted state is ``G(x_k)``, as without acceleration. "ref." is the reference
+(``../shared/reference/hirose-2019-ddm-hydraulic-fracturing.md``); conventions:
+docs/conventions.md.
 """
 import numpy as np
 
