@@ -35,7 +35,10 @@ its iterate is never accepted (a guess whose residual is already below that tole
 comes back unchanged: the next iteration checks it at ``linear_rtol``).
 
 Segregated schemes relax (ref. Eq. 4.47) with ``alpha``; when an iteration diverges
-or does not converge, ``alpha`` is halved and the step restarted (ref. Fig. 4.10).
+or does not converge, ``alpha`` is halved and the step restarted (ref. Fig. 4.10). The
+coupled schemes' iterates may be Anderson-accelerated while the contact active set stands
+still and the changes fall slowly (``solve_step(accelerate=True)``, the element front's
+steps; :mod:`hmatddm.coupled.acceleration`).
 
 Closed elements (:mod:`hmatddm.coupled.contact`): with a ``contact`` model the
 elasticity rows of closed elements become ``S (A DD + B p - f) + D DD = g`` (stick or
@@ -64,6 +67,7 @@ import scipy.sparse.linalg as spla
 
 from ..errors import ConvergenceError
 from ..hmatrix.solvers import PausableGmres
+from .acceleration import ACCEPT, IterateMixing
 from .paused import PausedIterate, pause_levels
 from .scaled_system import _CoupledLinearSystem
 from .step_problem import COUPLED_SCHEMES
@@ -212,6 +216,10 @@ def _stagnated(history, left):
 #: none after two stagnated attempts.
 RELAXATION_HELPS = 0.25
 
+#: Iterates combined by the Anderson acceleration of a coupled attempt
+#: (:mod:`hmatddm.coupled.acceleration`, ``solve_step(accelerate=True)``); 0: the plain iteration
+ANDERSON_MEMORY = 5
+
 
 def _products(problem):
     """Products the step problem's elasticity operator has made so far
@@ -220,7 +228,8 @@ def _products(problem):
     return int(getattr(getattr(problem.elastic, "operator", None), "products", 0))
 
 
-def solve_step(problem, settings, dd_guess, p_guess, relaxation, provisional=False, splittable=False):
+def solve_step(problem, settings, dd_guess, p_guess, relaxation, provisional=False, splittable=False,
+               accelerate=False):
     """Iterate one time step to convergence (ref. Eqs 4.43-4.44).
 
     Returns ``(dd, p, info)``; ``info`` has ``nonlinear_iterations`` (all attempts),
@@ -242,8 +251,15 @@ def solve_step(problem, settings, dd_guess, p_guess, relaxation, provisional=Fal
     ``splittable=True`` (the caller redoes a step that does not converge in shorter steps):
     a relaxation that does not help is not pursued (:data:`RELAXATION_HELPS`; coupled schemes
     only: the segregated ones converge slowly at small alpha, ref. Fig. 4.10).
+
+    ``accelerate=True`` (coupled schemes): Anderson-accelerated iterates while the contact
+    active set stands still (:mod:`hmatddm.coupled.acceleration`; the element front's steps,
+    :mod:`hmatddm.simulation.step_solve`). Not the asymptotic front's solves: its front
+    iteration converges to ``front_tolerance`` around them, and an accelerated inner path
+    moved its answer within that tolerance but by more than its tests' 2e-6.
     """
-    pending = PendingSolve(problem, settings, dd_guess, p_guess, relaxation, splittable=splittable)
+    pending = PendingSolve(problem, settings, dd_guess, p_guess, relaxation, splittable=splittable,
+                           accelerate=accelerate)
     return pending.run(provisional)
 
 
@@ -251,7 +267,7 @@ class PendingSolve:
     """The nonlinear iteration of one :func:`solve_step`, which may stop after the first
     (loose) iterate of an attempt and be continued by :meth:`finish`."""
 
-    def __init__(self, problem, settings, dd_guess, p_guess, relaxation, splittable=False):
+    def __init__(self, problem, settings, dd_guess, p_guess, relaxation, splittable=False, accelerate=False):
         self.problem, self.settings = problem, settings
         self.splittable = splittable and settings.scheme in COUPLED_SCHEMES  # segregated ones need the ladder
         self._stalled = None       # the stagnated change of this attempt (None: it did not stagnate)
@@ -265,6 +281,8 @@ class PendingSolve:
         self.alpha = relaxation
         self.restarts = 0
         self.contact_changes = 0
+        self.mixing = (IterateMixing(settings.tolerance_opening, settings.tolerance_pressure, ANDERSON_MEMORY)
+                       if accelerate and self.coupled and ANDERSON_MEMORY > 0 else None)
         self._start_attempt()
 
     @property
@@ -280,6 +298,9 @@ class PendingSolve:
             self.problem.contact.reset()
         self.history = []
         self._stalled = None
+        self._mixed = False  # the current iterate is an accelerated one (hmatddm.coupled.acceleration)
+        if self.mixing is not None:
+            self.mixing.reset()
         self.iteration = 0
         self.last_change = math.nan
         self.accurate_next = False  # an iterate solved loosely passed the test: the next at linear_rtol
@@ -370,6 +391,7 @@ class PendingSolve:
                         raise _Diverged("non-finite iterate")
                     change_p = _relative_change(p_new, self.p)
                     change_u = _relative_change(dd_new, self.dd)
+                    dd_old, p_old, mixed = self.dd, self.p, self._mixed
                     self.dd, self.p = dd_new, p_new
                     self.last_change = max(change_p, change_u)
                     changed = problem.update_contact(self.dd, self.p)
@@ -380,7 +402,10 @@ class PendingSolve:
                     # below first_linear_rtol): only a full-accuracy iterate can be accepted
                     loose = iteration == 0 and self.loose_first
                     forced = self.last_rtol is not None and self.last_rtol > settings.linear_rtol
-                    if _converged(settings.stopping, change, self.history) and changed == 0:
+                    # after an accelerated iterate the rate of the changes is not the map's: no
+                    # extrapolation, and a change within acceleration.ACCEPT of the tolerances
+                    accepted = change < ACCEPT if mixed else _converged(settings.stopping, change, self.history)
+                    if accepted and changed == 0:
                         if not (loose or forced):
                             return self.dd, self.p, self._finished(pending=False)
                         self.accurate_next = True  # the next at linear_rtol (SchemeSettings.linear_forcing)
@@ -398,6 +423,7 @@ class PendingSolve:
                         self._stalled = min(history[-STAGNATION_WINDOW:])
                         raise _Diverged(f"changes stagnated at {self.last_change:.2e} (no convergence within "
                                         f"{settings.max_iterations} iterations at their rate)")
+                    self._accelerate(dd_old, p_old, changed)  # (never on a first iterate)
                     if provisional and loose:
                         return self.dd.copy(), self.p.copy(), self._finished(pending=True)
                 raise _Diverged(f"no convergence in {settings.max_iterations} iterations "
@@ -418,6 +444,14 @@ class PendingSolve:
                 self.alpha /= 2.0
                 self.restarts += 1
                 self._start_attempt()
+
+    def _accelerate(self, dd, p, changed):
+        """Continue from the Anderson combination (:meth:`IterateMixing.iterate`) instead of the
+        relaxed iterate ``G(x_k)`` (``self.dd``, ``self.p``) after ``x_k = (dd, p)``, if any."""
+        mixed = None if self.mixing is None else self.mixing.iterate(dd, p, self.dd, self.p, changed, self.history)
+        self._mixed = mixed is not None
+        if self._mixed:
+            self.dd, self.p = mixed
 
     def _iterate(self, iteration, provisional):
         """The next iterate from ``(self.dd, self.p)``: the paused first GMRES solve

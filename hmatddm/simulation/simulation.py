@@ -386,7 +386,10 @@ class Simulation:
             try:
                 record = self._step(end_time) if self.front is None else self.front.step(self, end_time)
             except ConvergenceError:
-                shorter = self._shorter_step()
+                # half the step that was tried: one cut to end at end_time is shorter than
+                # time_step, and half of time_step could be that same step again
+                t_old, t_new = self.step_times(end_time)
+                shorter = self._shorter_step(min(self.state.time_step, t_new - t_old))
                 if shorter is None:
                     raise
                 self.state = replace(self.state, time_step=shorter)
@@ -405,10 +408,10 @@ class Simulation:
         ladder (a trial front's solve that fails changes the front iteration's course)."""
         return self.front is None and self._shorter_step() is not None
 
-    def _shorter_step(self):
-        """Half the step that did not converge, or None when it may not be shorter (see
-        :meth:`step`)."""
-        step = self.state.time_step
+    def _shorter_step(self, step=None):
+        """Half the step ``step`` (default ``state.time_step``) that did not converge, or None
+        when it may not be shorter (see :meth:`step`)."""
+        step = self.state.time_step if step is None else step
         if self.step_control is not None:
             shorter = max(0.5 * step, self.step_control.minimum)
             return shorter if shorter < step else None

@@ -109,9 +109,10 @@ def solve(simulation, trial, start, t_old, t_new, relaxation, provisional=False)
                           width_old=start.width, pressure_old=start.pressure,
                           leak_off_rate=flow.leak_off_rate(trial.creation_time, t_old, t_new),
                           contact=contact, fixed_pressure=fixed_pressure)
-    # a step that may still be split gives up a relaxation that does not help (solve_step)
+    # a step that may still be split gives up a relaxation that does not help; accelerated
+    # iterates while the active set stands still (solve_step)
     dd, p, info = solve_step(problem, sim.settings, trial.dd.ravel(), pressure_guess, relaxation,
-                             provisional=provisional, splittable=sim.splittable())
+                             provisional=provisional, splittable=sim.splittable(), accelerate=True)
     info["drained"] = no_fluid
     return _with_solution(trial, problem, dd, p, info), info, SolvedMesh(edges, faces, flow)
 

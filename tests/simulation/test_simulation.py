@@ -181,7 +181,8 @@ def test_relaxation_grows_back_after_an_easy_step_in_the_coupled_schemes(monkeyp
     solve = step_solve.solve_step
     calls = []
 
-    def solve_halving_once(problem, settings, dd, p, relaxation, provisional=False, splittable=False):
+    def solve_halving_once(problem, settings, dd, p, relaxation, provisional=False, splittable=False,
+                           accelerate=False):
         calls.append(relaxation)
         dd, p, info = solve(problem, settings, dd, p, relaxation)  # converged: no pending part
         if len(calls) == 1:  # pretend the first solve needed one halving

@@ -202,6 +202,29 @@ def test_a_fixed_step_that_does_not_converge_is_split_and_the_run_stays_on_its_g
         kgd(time_step=1.0).step()
 
 
+def test_a_failing_step_cut_to_end_at_end_time_is_halved_from_its_own_length(monkeypatch):
+    """A step cut to end at ``end_time`` (0.4 s of a 1 s fixed step) that does not converge
+    is tried again at half of itself, not at half the fixed step (0.5 s, cut to the same
+    0.4 s: the identical solves again, seen on runs resumed to an end off their grid)."""
+    from hmatddm.errors import ConvergenceError
+    from hmatddm.simulation import step_solve
+
+    original = step_solve.solve
+    tried = []
+
+    def refuses_long_steps(simulation, trial, start, t_old, t_new, *args):
+        tried.append(round(t_new - t_old, 12))
+        if t_new - t_old > 0.15:
+            raise ConvergenceError("too long a step for this test", iterations=1)
+        return original(simulation, trial, start, t_old, t_new, *args)
+
+    monkeypatch.setattr(step_solve, "solve", refuses_long_steps)
+    simulation = kgd(time_step=1.0)
+    record = simulation.step(end_time=0.4)
+    assert tried[:3] == [0.4, 0.2, 0.1]
+    assert record["step_retries"] == 2 and record["time"] == pytest.approx(0.1)
+
+
 def test_operators_count_each_product_once():
     """``products`` of an elasticity operator: one per matvec, one per column of a matmat,
     for the dense, H-matrix and grown operators alike."""
