@@ -44,10 +44,10 @@ round-off when an element sits at the boundary between two states (fluid pressur
 to the normal stress): the error it allows is ``tol_w`` of displacement, a
 ``relative_tolerance`` (1e-3) of the largest DD. A step has converged only when no
 status changed and no slip direction turned. An element
-that changes status more than ``max_flips`` times in one step keeps its last status (and
-is counted in :attr:`ContactModel.frozen`) so the active set cannot cycle forever.
-An element held like this is closed and stuck from then on in the step: its DDs are
-bounded and its friction law is violated at most by the traction of the last cycle.
+that changes status more than ``max_flips`` times in one step is held closed and stuck
+from then on in the step (and counted in :attr:`ContactModel.frozen`), so the active set
+cannot cycle forever: its DDs are bounded and its friction law is violated at most by the
+traction of the last cycle.
 """
 from dataclasses import dataclass
 

@@ -3,10 +3,8 @@ on linear maps whose fixed point is known, and on a coupled step with contact, w
 accelerated solve must reach the plain solve's answer within the nonlinear tolerance."""
 import numpy as np
 
-import hmatddm as hd
 from hmatddm.coupled import SchemeSettings, schemes
 from hmatddm.coupled.acceleration import IterateMixing
-from hmatddm.coupled.contact import OPEN
 
 
 def _iterate_linear(matrix, shift, alpha, mixing, iterations, n_u):
@@ -50,33 +48,21 @@ def test_the_mixing_restarts_when_a_residual_grows():
     assert mixing.restarts == 1
 
 
-def _contact_run(memory, monkeypatch):
-    """A 2D hydraulic fracture meeting an inclined natural fracture (elements fail remotely,
-    join closed and slip: the contact active set of tests/coupled/test_contact.py) at a
-    relaxation of 1/2, where the plain iteration contracts by 1/2 per iterate."""
-    from hmatddm.fracture import NaturalFractureProperties
-
+def _contact_run(memory, monkeypatch, network_simulation):
+    """The network case of conftest.py (elements fail remotely, join closed and slip: the
+    contact active set of tests/coupled/test_contact.py) at a relaxation of 1/2, where the
+    plain iteration contracts by 1/2 per iterate."""
     monkeypatch.setattr(schemes, "ANDERSON_MEMORY", memory)
-    mat = hd.Elastic(3.415e9, 0.23)
-    hf = hd.mesh.line([-0.075, 0], [0.075, 0], 3)
-    a = np.deg2rad(60.0)
-    center, tangent = np.array([0.2, 0.0]), np.array([np.cos(a), np.sin(a)])
-    nf = hd.mesh.line(center - 0.15 * tangent, center + 0.15 * tangent, 6)
-    props = NaturalFractureProperties(friction=0.38, cohesion=0.0, tensile_strength=5e6, toughness=0.5e6,
-                                      critical_radius=0.005, crossing="mohr-coulomb")
-    sim = hd.Simulation(hf, mat, hd.Fluid(0.135, 4.545e-10), [hd.Cluster((0, 0), 4e-6, 1e-5)],
-                        far_field_stress=np.diag([-6e6, -3e6]), time_step=1.0,
-                        propagation=hd.Propagation(toughness=2e6), initial_pressure=3.5e6, initial_opening=1e-5,
-                        backend="dense", natural_fractures=nf, natural=props, singular_correction="average",
-                        alpha=1.0)
+    sim = network_simulation("dense")
     sim.settings = SchemeSettings(**{**sim.settings.__dict__, "relaxation": 0.5, "relaxation_growth": 1.0})
     records = sim.run(12.0)
     return sim, records
 
 
-def test_an_accelerated_contact_run_reaches_the_plain_answer(monkeypatch):
-    plain, plain_records = _contact_run(0, monkeypatch)
-    fast, fast_records = _contact_run(schemes.ANDERSON_MEMORY or 5, monkeypatch)
+def test_an_accelerated_contact_run_reaches_the_plain_answer(monkeypatch, network_simulation,
+                                                             check_contact_conditions):
+    plain, plain_records = _contact_run(0, monkeypatch, network_simulation)
+    fast, fast_records = _contact_run(schemes.ANDERSON_MEMORY or 5, monkeypatch, network_simulation)
     assert [r["n_elements"] for r in fast_records] == [r["n_elements"] for r in plain_records]
     assert plain_records[-1]["natural_active"] + plain_records[-1]["natural_failed"] >= 1
     assert plain_records[-1]["closed_elements"] >= 1
@@ -89,20 +75,5 @@ def test_an_accelerated_contact_run_reaches_the_plain_answer(monkeypatch):
     # ... in fewer nonlinear iterations
     total = [sum(r["nonlinear_iterations"] for r in rs[1:]) for rs in (plain_records, fast_records)]
     assert total[1] < total[0]
-    # the accelerated answer satisfies the contact conditions (test_contact.py's checks)
-    s = fast.state
-    natural = s.origin >= 1
-    opening = np.sum(s.dd * s.mesh.normals, axis=1)
-    scale = np.max(np.abs(opening))
-    assert np.all(opening[natural] >= -1e-3 * scale)
-    closed = natural & (s.contact_status != OPEN)
-    assert np.any(closed)
-    assert np.all(np.abs(opening[closed]) <= 1e-3 * scale)
-    operator = fast.operator(s.mesh)
-    traction = operator.matvec(s.dd.ravel()) + (s.mesh.normals * s.pressure[:, None]).ravel()
-    c = (traction - fast.far_field_traction(s.mesh)).reshape(-1, 2)
-    c_n = np.sum(c * s.mesh.normals, axis=1)
-    tau = np.abs(np.sum(c * np.stack([-s.mesh.normals[:, 1], s.mesh.normals[:, 0]], axis=1), axis=1))
-    band = 1e-3 * np.max(np.abs(c_n[closed]))
-    assert np.all(c_n[closed] <= band)  # compressive contact
-    assert np.all(tau[closed] <= -fast.network.properties.friction * c_n[closed] + band)  # inside the cone
+    # the accelerated answer satisfies the contact conditions
+    check_contact_conditions(fast)

@@ -168,56 +168,23 @@ def test_bad_contact_law():
                       np.diag([-1e6, -1e6]), 1.0, contact="sometimes")
 
 
-def _network_run(backend, end_time=12.0):
-    """A 2D hydraulic fracture growing towards an inclined natural fracture under a low
-    stress contrast: elements of the natural fracture fail remotely, join closed and slip."""
-    mat = hd.Elastic(3.415e9, 0.23)
-    hf = hd.mesh.line([-0.075, 0], [0.075, 0], 3)
-    a = np.deg2rad(60.0)
-    center, tangent = np.array([0.2, 0.0]), np.array([np.cos(a), np.sin(a)])
-    nf = hd.mesh.line(center - 0.15 * tangent, center + 0.15 * tangent, 6)
-    props = NaturalFractureProperties(friction=0.38, cohesion=0.0, tensile_strength=5e6, toughness=0.5e6,
-                                      critical_radius=0.005, crossing="mohr-coulomb")
-    sim = hd.Simulation(hf, mat, hd.Fluid(0.135, 4.545e-10), [hd.Cluster((0, 0), 4e-6, 1e-5)],
-                        far_field_stress=np.diag([-6e6, -3e6]), time_step=1.0,
-                        propagation=hd.Propagation(toughness=2e6), initial_pressure=3.5e6, initial_opening=1e-5,
-                        backend=backend, natural_fractures=nf, natural=props, singular_correction="average",
-                        alpha=1.0)
-    return sim, sim.run(end_time)
-
-
-def test_activated_natural_elements_never_interpenetrate_and_obey_coulomb():
-    sim, records = _network_run("dense")
-    s = sim.state
-    natural = s.origin >= 1
+def test_activated_natural_elements_never_interpenetrate_and_obey_coulomb(network_simulation,
+                                                                          check_contact_conditions):
+    """The network case (conftest.py): a hydraulic fracture growing towards an inclined
+    natural fracture whose elements fail remotely, join closed and slip."""
+    sim = network_simulation("dense")
+    records = sim.run(12.0)
     assert records[-1]["natural_active"] + records[-1]["natural_failed"] >= 1
     assert records[-1]["closed_elements"] >= 1 and records[-1]["slipping_elements"] >= 1
-    opening = np.sum(s.dd * s.mesh.normals, axis=1)
-    scale = np.max(np.abs(opening))
-    assert np.all(opening[natural] >= -1e-3 * scale)
-    closed = natural & (s.contact_status != OPEN)
-    assert np.all(np.abs(opening[closed]) <= 1e-3 * scale)
-    # Coulomb: the contact traction c = A dd + B p - f of closed elements is compressive
-    # and within the friction cone (slipping ones on it)
-    operator = sim.operator(s.mesh)
-    traction = operator.matvec(s.dd.ravel()) + (s.mesh.normals * s.pressure[:, None]).ravel()
-    c = (traction - sim.far_field_traction(s.mesh)).reshape(-1, 2)
-    c_n = np.sum(c * s.mesh.normals, axis=1)
-    tau = np.abs(np.sum(c * np.stack([-s.mesh.normals[:, 1], s.mesh.normals[:, 0]], axis=1), axis=1))
-    strength = -sim.network.properties.friction * c_n
-    band = 1e-3 * np.max(np.abs(c_n[closed]))
-    assert np.all(c_n[closed] <= band)
-    assert np.all(tau[closed] <= strength[closed] + band)
-    slipping = natural & (s.contact_status == SLIP)
-    np.testing.assert_allclose(tau[slipping], strength[slipping], atol=band)
+    check_contact_conditions(sim)
     for key in ("closed_elements", "slipping_elements", "max_slip", "contact_changes"):
         assert key in records[-1]
 
 
 @pytest.mark.slow  # two network runs end to end (issue 18 item 8); the dense run is checked by the test above
-def test_network_run_dense_and_hmatrix_take_the_same_path():
-    dense, dense_records = _network_run("dense", end_time=12.0)
-    fast, fast_records = _network_run("hmatrix", end_time=12.0)
+def test_network_run_dense_and_hmatrix_take_the_same_path(network_simulation):
+    dense, fast = network_simulation("dense"), network_simulation("hmatrix")
+    dense_records, fast_records = dense.run(12.0), fast.run(12.0)
     assert [r["n_elements"] for r in dense_records] == [r["n_elements"] for r in fast_records]
     np.testing.assert_array_equal(dense.state.contact_status, fast.state.contact_status)
     scale = np.max(np.abs(dense.state.dd))
