@@ -371,10 +371,10 @@ def _complementary_stress(data_at, point, lr, j, state_at, work_at, entry_tol, i
                     for p in range(3):
                         for kk in range(3):
                             image[q, p, kk] -= uniform[q, p, kk]
-        if not closed and n_sub == 1 and near_only and lr == ls:
-            # the near triples of the receiver's own layer are its first reflections in the
-            # layer's top (above it) and bottom (below it): each takes the rule of its own
-            # mirror, not both the nearer one's
+        if not closed and n_sub == 1 and tabulated and lr == ls:
+            # with the rest tabulated, the near triples of the receiver's own layer are its
+            # first reflections in the layer's top (above it) and bottom (below it): each
+            # takes the rule of its own mirror, not both the nearer one's
             bottom, top = table.bottoms[ls], table.tops[ls]
             split = 0.5 * (bottom + top) if math.isfinite(bottom + top) else (top if math.isfinite(top) else bottom)
             for side in range(2):

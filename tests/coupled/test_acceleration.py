@@ -5,6 +5,7 @@ import numpy as np
 
 from hmatddm.coupled import SchemeSettings, schemes
 from hmatddm.coupled.acceleration import IterateMixing
+from network_case import check_contact_conditions, network_simulation
 
 
 def _iterate_linear(matrix, shift, alpha, mixing, iterations, n_u):
@@ -48,8 +49,8 @@ def test_the_mixing_restarts_when_a_residual_grows():
     assert mixing.restarts == 1
 
 
-def _contact_run(memory, monkeypatch, network_simulation):
-    """The network case of conftest.py (elements fail remotely, join closed and slip: the
+def _contact_run(memory, monkeypatch):
+    """The network case of network_case.py (elements fail remotely, join closed and slip: the
     contact active set of tests/coupled/test_contact.py) at a relaxation of 1/2, where the
     plain iteration contracts by 1/2 per iterate."""
     monkeypatch.setattr(schemes, "ANDERSON_MEMORY", memory)
@@ -59,10 +60,9 @@ def _contact_run(memory, monkeypatch, network_simulation):
     return sim, records
 
 
-def test_an_accelerated_contact_run_reaches_the_plain_answer(monkeypatch, network_simulation,
-                                                             check_contact_conditions):
-    plain, plain_records = _contact_run(0, monkeypatch, network_simulation)
-    fast, fast_records = _contact_run(schemes.ANDERSON_MEMORY or 5, monkeypatch, network_simulation)
+def test_an_accelerated_contact_run_reaches_the_plain_answer(monkeypatch):
+    plain, plain_records = _contact_run(0, monkeypatch)
+    fast, fast_records = _contact_run(schemes.ANDERSON_MEMORY or 5, monkeypatch)
     assert [r["n_elements"] for r in fast_records] == [r["n_elements"] for r in plain_records]
     assert plain_records[-1]["natural_active"] + plain_records[-1]["natural_failed"] >= 1
     assert plain_records[-1]["closed_elements"] >= 1

@@ -16,6 +16,7 @@ from hmatddm.coupled.contact import OPEN, SLIP, STICK, ContactLaw, ContactModel
 from hmatddm.errors import InputError
 from hmatddm.flow import LeakOff, LubricationModel, fracture_compliance
 from hmatddm.fracture import NaturalFractureProperties
+from network_case import check_contact_conditions, network_simulation
 
 G, NU = 10e9, 0.25
 MATERIAL = hd.Elastic(shear_modulus=G, poisson_ratio=NU)
@@ -168,9 +169,8 @@ def test_bad_contact_law():
                       np.diag([-1e6, -1e6]), 1.0, contact="sometimes")
 
 
-def test_activated_natural_elements_never_interpenetrate_and_obey_coulomb(network_simulation,
-                                                                          check_contact_conditions):
-    """The network case (conftest.py): a hydraulic fracture growing towards an inclined
+def test_activated_natural_elements_never_interpenetrate_and_obey_coulomb():
+    """The network case (tests/network_case.py): a hydraulic fracture growing towards an inclined
     natural fracture whose elements fail remotely, join closed and slip."""
     sim = network_simulation("dense")
     records = sim.run(12.0)
@@ -182,7 +182,7 @@ def test_activated_natural_elements_never_interpenetrate_and_obey_coulomb(networ
 
 
 @pytest.mark.slow  # two network runs end to end (issue 18 item 8); the dense run is checked by the test above
-def test_network_run_dense_and_hmatrix_take_the_same_path(network_simulation):
+def test_network_run_dense_and_hmatrix_take_the_same_path():
     dense, fast = network_simulation("dense"), network_simulation("hmatrix")
     dense_records, fast_records = dense.run(12.0), fast.run(12.0)
     assert [r["n_elements"] for r in dense_records] == [r["n_elements"] for r in fast_records]

@@ -1,15 +1,16 @@
-"""Shared cases of the coupled tests: a 2D hydraulic fracture growing towards an inclined
-natural fracture under a low stress contrast (its elements fail remotely, join closed and
-slip), and the contact conditions its answer must meet (test_contact.py, test_acceleration.py)."""
+"""A shared case of the coupled tests (tests/coupled/test_contact.py, test_acceleration.py):
+a 2D hydraulic fracture growing towards an inclined natural fracture under a low stress
+contrast (its elements fail remotely, join closed and slip), and the contact conditions its
+answer must meet. Imported by name (tests/ is on the path: tests/conftest.py)."""
 import numpy as np
-import pytest
 
 import hmatddm as hd
 from hmatddm.coupled.contact import OPEN, SLIP
 from hmatddm.fracture import NaturalFractureProperties
 
 
-def _network_simulation(backend="dense"):
+def network_simulation(backend="dense"):
+    """The network case's :class:`hmatddm.Simulation`, not run."""
     mat = hd.Elastic(3.415e9, 0.23)
     hf = hd.mesh.line([-0.075, 0], [0.075, 0], 3)
     a = np.deg2rad(60.0)
@@ -24,7 +25,7 @@ def _network_simulation(backend="dense"):
                          alpha=1.0)
 
 
-def _check_contact_conditions(sim):
+def check_contact_conditions(sim):
     """Activated natural elements do not interpenetrate; the contact traction ``c = A dd + B p
     - f`` of closed ones is compressive and within the friction cone, slipping ones on it
     (bands of 1e-3 of the largest opening and closed normal traction)."""
@@ -47,15 +48,3 @@ def _check_contact_conditions(sim):
     assert np.all(tau[closed] <= strength[closed] + band)
     slipping = natural & (s.contact_status == SLIP)
     np.testing.assert_allclose(tau[slipping], strength[slipping], atol=band)
-
-
-@pytest.fixture
-def network_simulation():
-    """``make(backend="dense")``: the network case's :class:`hmatddm.Simulation`, not run."""
-    return _network_simulation
-
-
-@pytest.fixture
-def check_contact_conditions():
-    """``check(sim)``: assert the contact conditions on ``sim``'s state."""
-    return _check_contact_conditions
