@@ -24,7 +24,7 @@ a least-squares combination of a few iterates removes.
 The combination is used only while the active set stands still: the map ``G`` changes with
 the contact rows, so the history restarts at every status change (and the plain relaxed
 step is taken), and at every iterate whose residual does not fall (the safeguard of
-:class:`hmatddm.simulation.front_acceleration.AndersonMixing`, which this follows). The
+:class:`AndersonMixing`, the history shared with the asymptotic front's iteration). The
 convergence test of :mod:`hmatddm.coupled.schemes` is unchanged: an iterate is accepted on
 its own relaxed change ``G(x_k) - x_k`` (below the tolerances, no status change), and the
 accepted state is ``G(x_k)``, as without acceleration. "ref." is the reference
@@ -52,6 +52,52 @@ ACCEPT = 0.1
 RCOND = 1e-6
 
 
+class AndersonMixing:
+    """The history of a fixed-point iteration ``x = g(x)`` and its Anderson (type II)
+    correction: the last ``memory + 1`` iterates and residuals ``f = g(x) - x``, restarted
+    when a residual does not fall. Shared by the coupled iterates (:class:`IterateMixing`)
+    and the asymptotic front's ribbon distances (:mod:`hmatddm.simulation.front_acceleration`)."""
+
+    def __init__(self, memory=MEMORY, rcond=RCOND):
+        self.memory, self.rcond = int(memory), float(rcond)
+        self._points, self._residuals = [], []
+        self.restarts = 0  # histories dropped by the safeguard
+
+    def clear(self):
+        """Forget the history (not counted as a restart)."""
+        self._points, self._residuals = [], []
+
+    def correction(self, point, residual, combine=True):
+        """``(dX + dF) gamma``, the accelerated iterate being ``point + residual - correction``,
+        or None when the caller takes its plain step: the first iterate of a history, one
+        whose residual did not fall (the history then restarts from it) and, with ``combine``
+        False, any (it only joins the history)."""
+        point, residual = np.asarray(point, float), np.asarray(residual, float)
+        if self._residuals and np.linalg.norm(residual) >= np.linalg.norm(self._residuals[-1]):
+            self._points, self._residuals = [], []
+            self.restarts += 1
+        self._points.append(point.copy())
+        self._residuals.append(residual.copy())
+        if len(self._points) > self.memory + 1:
+            self._points.pop(0)
+            self._residuals.pop(0)
+        if len(self._points) < 2 or not combine:
+            return None
+        points, residuals = np.array(self._points), np.array(self._residuals)
+        d_points, d_residuals = np.diff(points, axis=0).T, np.diff(residuals, axis=0).T
+        gamma = np.linalg.lstsq(d_residuals, residual, rcond=self.rcond)[0]
+        return (d_points + d_residuals) @ gamma
+
+    def step(self, point, residual):
+        """The step to add to ``point`` (``residual - correction``), or None (see
+        :meth:`correction`; also when it is not finite)."""
+        correction = self.correction(point, residual)
+        if correction is None:
+            return None
+        step = residual - correction
+        return step if np.all(np.isfinite(step)) else None
+
+
 class IterateMixing:
     """The accelerated iterates of one attempt of a coupled solve (:meth:`reset` at its start)."""
 
@@ -59,12 +105,17 @@ class IterateMixing:
         self.tolerance_opening, self.tolerance_pressure = float(tolerance_opening), float(tolerance_pressure)
         self.memory = int(memory)
         self.steps = 0     # accelerated iterates made (combinations returned)
-        self.restarts = 0  # histories dropped by the safeguard
+        self._history = AndersonMixing(memory, RCOND)
         self.reset()
+
+    @property
+    def restarts(self):
+        """Histories dropped by the safeguard (:class:`AndersonMixing`)."""
+        return self._history.restarts
 
     def reset(self):
         """Forget the history (a new attempt, or a change of the active set)."""
-        self._points, self._residuals = [], []
+        self._history.clear()
         self._scale = None
         self._still = 0  # iterates since the active set last changed
 
@@ -76,7 +127,8 @@ class IterateMixing:
         :data:`RATE`, else None (take ``G(x_k)``; a status change restarts the history)."""
         self._still = 0 if changed else self._still + 1
         if self._still < STILL:
-            self._points, self._residuals, self._scale = [], [], None
+            self._history.clear()
+            self._scale = None
             return None
         slow = len(history) >= 2 and history[-2] > 0.0 and history[-1] > RATE * history[-2]
         return self.next(dd, p, dd_new, p_new, combine=slow)
@@ -95,20 +147,10 @@ class IterateMixing:
                            self.tolerance_pressure * max(float(np.max(np.abs(p_new))), 1e-30))
         point = self._scaled(dd, p)
         residual = self._scaled(dd_new, p_new) - point
-        if self._residuals and np.linalg.norm(residual) >= np.linalg.norm(self._residuals[-1]):
-            self._points, self._residuals = [], []
-            self.restarts += 1
-        self._points.append(point)
-        self._residuals.append(residual)
-        if len(self._points) > self.memory + 1:
-            self._points.pop(0)
-            self._residuals.pop(0)
-        if len(self._points) < 2 or not combine:
+        correction = self._history.correction(point, residual, combine)
+        if correction is None:
             return None
-        points, residuals = np.array(self._points), np.array(self._residuals)
-        d_points, d_residuals = np.diff(points, axis=0).T, np.diff(residuals, axis=0).T
-        gamma = np.linalg.lstsq(d_residuals, residual, rcond=RCOND)[0]
-        mixed = point + residual - (d_points + d_residuals) @ gamma
+        mixed = point + residual - correction
         if not np.all(np.isfinite(mixed)):
             return None
         self.steps += 1

@@ -136,7 +136,7 @@ from ..analytical.power_law_tip import tip_asymptote
 from ..analytical.tip_asymptote import finite_fracture_factor
 from ..analytical.tip_leak_off import LeakOffTipAsymptote
 from . import proppant_step
-from .front_acceleration import AndersonMixing
+from .front_acceleration import front_mixing
 from .front_leak_off import MAX_RETREATS, crossing_times, starved, tip_leak_off_rate
 from .records import StepTally, step_record
 from .step_solve import mesh_topology
@@ -373,7 +373,7 @@ class AsymptoticFront:
         relaxation = starting = begin.relaxation  # the last solve's alpha; the next one's (module docstring)
         change, iterations, weight = np.inf, 0, 1.0
         last_update = np.zeros(len(ribbon))
-        mixing = AndersonMixing()  # hmatddm.simulation.front_acceleration
+        mixing = front_mixing()  # hmatddm.simulation.front_acceleration
         filled = np.zeros(mesh.n_elements, bool)  # filled once in this step: stays filled (no tip/filled cycling)
         retreats = 0  # failed coupled solves in a row (leak-off: the trial front's advance halved each time)
         ceiling = np.full(len(ribbon), np.inf)  # leak-off: the nearest trial front too far (solve failed or

@@ -13,8 +13,11 @@ cancel best,
 with ``dS``, ``dF`` the differences of consecutive iterates and residuals. Safeguard: when
 a residual is not smaller than the last one (a new element joined, a clip bit, or the
 combination overshot), the history restarts and the caller takes its own relaxed step.
+
+The history and the combination are :class:`hmatddm.coupled.acceleration.AndersonMixing`,
+which the coupled schemes' iterates share.
 """
-import numpy as np
+from ..coupled.acceleration import AndersonMixing
 
 #: Iterates kept (the columns of dS and dF).
 MEMORY = 4
@@ -24,34 +27,12 @@ MEMORY = 4
 RCOND = 1e-3
 
 
-class AndersonMixing:
-    """The accelerated steps of one time step's front iteration (a new one each step)."""
-
-    def __init__(self, memory=MEMORY):
-        self.memory = int(memory)
-        self._points, self._residuals = [], []
-        self.restarts = 0
-
-    def step(self, point, residual):
-        """The step to add to ``point`` given its residual ``g(point) - point``, or None
-        when the caller should take its plain (relaxed) step: the first iterate, and any
-        whose residual did not fall (the history then restarts from it)."""
-        point, residual = np.asarray(point, float), np.asarray(residual, float)
-        if self._residuals and np.linalg.norm(residual) >= np.linalg.norm(self._residuals[-1]):
-            self._points, self._residuals = [], []
-            self.restarts += 1
-        self._points.append(point.copy())
-        self._residuals.append(residual.copy())
-        if len(self._points) > self.memory + 1:
-            self._points.pop(0)
-            self._residuals.pop(0)
-        if len(self._points) < 2:
-            return None
-        points, residuals = np.array(self._points), np.array(self._residuals)
-        d_points, d_residuals = np.diff(points, axis=0).T, np.diff(residuals, axis=0).T
-        gamma = np.linalg.lstsq(d_residuals, residual, rcond=RCOND)[0]
-        step = residual - (d_points + d_residuals) @ gamma
-        return step if np.all(np.isfinite(step)) else None
+def front_mixing():
+    """The Anderson history of one time step's front iteration (a new one each step): the
+    shared :class:`hmatddm.coupled.acceleration.AndersonMixing` with this module's
+    :data:`MEMORY` and :data:`RCOND`; its ``step(point, residual)`` is the step to add to
+    ``point``, or None for the caller's own relaxed step."""
+    return AndersonMixing(MEMORY, RCOND)
 
 
-__all__ = ["AndersonMixing", "MEMORY", "RCOND"]
+__all__ = ["front_mixing", "MEMORY", "RCOND"]

@@ -6,11 +6,11 @@ import pytest
 
 import hmatddm.scene as hs
 from hmatddm.simulation.asymptotic import AsymptoticFront
-from hmatddm.simulation.front_acceleration import AndersonMixing
+from hmatddm.simulation.front_acceleration import front_mixing
 
 
 def _iterate(g, x, accelerate, tolerance=1e-10, limit=500):
-    mixing = AndersonMixing()
+    mixing = front_mixing()
     for iteration in range(1, limit + 1):
         residual = g(x) - x
         if np.max(np.abs(residual)) < tolerance:
@@ -37,7 +37,7 @@ def test_anderson_reaches_the_fixed_point_of_a_slow_contraction_in_few_iteration
 
 
 def test_a_residual_that_grows_restarts_the_history():
-    mixing = AndersonMixing()
+    mixing = front_mixing()
     assert mixing.step(np.zeros(3), np.ones(3)) is None  # the first iterate: the caller's step
     assert mixing.step(np.ones(3), 0.5 * np.ones(3)) is not None
     assert mixing.step(np.full(3, 1.5), 2.0 * np.ones(3)) is None and mixing.restarts == 1
