@@ -27,9 +27,8 @@ step is taken), and at every iterate whose residual does not fall (the safeguard
 :class:`AndersonMixing`, the history shared with the asymptotic front's iteration). The
 convergence test of :mod:`hmatddm.coupled.schemes` is unchanged: an iterate is accepted on
 its own relaxed change ``G(x_k) - x_k`` (below the tolerances, no status change), and the
-accepted state is ``G(x_k)``, as without acceleration. "ref." is the reference
-(``../shared/reference/hirose-2019-ddm-hydraulic-fracturing.md``); conventions:
-docs/conventions.md.
+accepted state is ``G(x_k)``, as without acceleration. "ref." is S. Hirose's 2019
+dissertation (README); conventions: docs/conventions.md.
 """
 import numpy as np
 
