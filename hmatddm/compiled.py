@@ -15,6 +15,12 @@ from types import FunctionType
 import numba
 from numba import njit, types
 
+#: Floating-point flags (numba's ``fastmath``) of the loops that are vectorised: LLVM may
+#: reassociate sums (dot products, Gauss sums) while NaN and inf keep their meaning, so
+#: finiteness checks stay meaningful. Used by the H-matrix engine's ACA, recompression and
+#: matvec, and by the half-space point source's Gauss sum (:mod:`hmatddm.layered.okada_point3d`).
+FAST = {"reassoc", "contract", "nsz", "arcp"}
+
 #: Element indices, as the block generators take them.
 INDEX = types.int64[::1]
 

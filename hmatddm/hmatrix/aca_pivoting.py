@@ -24,7 +24,7 @@ contiguous row; residual updates as BLAS products on one BLAS thread) are those 
 import numpy as np
 from numba import njit
 
-from .fastmath import FAST
+from ..compiled import FAST
 
 
 # Pivot singular values below PIVOT_RTOL * largest are dropped (numerical rank).

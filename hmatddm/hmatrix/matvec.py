@@ -7,8 +7,7 @@ on one thread (:func:`_matmat_serial`).
 import numpy as np
 from numba import njit, prange
 
-from ..compiled import serial_twin
-from .fastmath import FAST
+from ..compiled import FAST, serial_twin
 
 
 @njit(parallel=True, cache=True, fastmath=FAST)

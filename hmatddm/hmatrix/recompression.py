@@ -18,8 +18,8 @@ depend on the BLAS thread count.
 import numpy as np
 from numba import njit
 
+from ..compiled import FAST
 from ._threads import single_threaded_blas
-from .fastmath import FAST
 
 
 # Vectors per panel of the blocked Gram-Schmidt (:func:`_orthonormalize`): the

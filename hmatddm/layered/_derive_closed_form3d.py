@@ -84,7 +84,8 @@ def _okada_groups():
                     source)
     lines, inside = [], False
     for line in source.split("\n"):
-        inside = line.strip().startswith("_store(c4") or (inside and not lines[-1].rstrip().endswith(")"))
+        inside = re.match(r"v\d = _turned\(", line.strip()) is not None or (
+            inside and not lines[-1].rstrip().endswith(")"))
         if inside:
             line = re.sub(r"a\[(\d+)\]", r"k_a * a[\1]", line)
             line = re.sub(r"\bB(\d{3})\b", r"k_b * B\1", line)

@@ -231,7 +231,8 @@ def source_state(data, j, work):
     the near triples only (the source's layer has a tabulated remainder), and, for a
     ``vertical_form`` source, those triples traced at its bottom, middle and top heights
     (:func:`.vertical3d.vertical_image_stress`). A source whose images are in closed form
-    (``closed_form``) traces nothing: its room is one point. :func:`_source_state` through
+    (``closed_form``) or by Okada's point source (``point_form``) traces nothing: its room is
+    one point. :func:`_source_state` through
     ``data.source_tracer`` (:func:`with_image_terms`)."""
     return data.source_tracer(address_of(without_functions(data)), np.int64(j), address_of(work))
 
@@ -246,7 +247,7 @@ def _source_state(data_at, j, work_at):
     ls = data.layer[j]
     near_only = data.table.pair_index[ls].max() >= 0
     one = np.int64(1)  # not literals: one compiled _traced_buffer (module docstring)
-    if data.closed_form[j]:
+    if data.closed_form[j] or data.point_form[j]:
         return (_traced_buffer(one, one, one), np.zeros(start.shape[0] - 1, dtype=np.bool_), near_only,
                 _traced_buffer(np.int64(3), one, one), np.zeros(3))
     cap, n_orders = max(room[ls, 0], 1), max(room[ls, 1], 1)

@@ -44,7 +44,8 @@ import math
 import numpy as np
 from numba import njit
 
-from .okada_stress3d import COS_ZERO, dip_and_medium, global_stress, global_traction  # noqa: F401 (COS_ZERO: re-exported)
+from ..compiled import FAST
+from .okada_stress3d import COS_ZERO, accumulate, add_gradient, dip_and_medium, global_stress, global_traction  # noqa: F401 (COS_ZERO: re-exported)
 
 #: Coordinates ``xi``, ``eta``, ``q`` smaller than this fraction of the rectangle's size
 #: are set to zero (Okada 1992 sets them below 1e-6 of its unit).
@@ -156,24 +157,24 @@ def _real_corners(xs, p, q, aw1, aw2, snap, sd, cd, alpha, s):
 
 
 @njit(cache=True, inline="always")
-def _store(c4, m, c, sign, cd, sd, ab0, ab1, ab2, zc0, zc1, zc2):
-    """Image source at corner ``c``: ``A + B`` (``ab``) and ``z C`` (``zc``, with C's own
+def _turned(cd, sd, ab0, ab1, ab2, zc0, zc1, zc2):
+    """Image source at one corner: ``A + B`` (``ab``) and ``z C`` (``zc``, with C's own
     displacement in the z-derivatives: d(z C)/dz = C + z dC/dz) turned from the fault's
-    ``(x, y', z')`` to Okada's frame (``z C`` flips in the vertical turn), times
-    Chinnery's ``sign``, into rows ``m .. m + 2`` of ``c4``."""
-    c4[m, c] = sign * (ab0 + zc0)
-    c4[m + 1, c] = sign * ((ab1 + zc1) * cd - (ab2 + zc2) * sd)
-    c4[m + 2, c] = sign * ((ab1 - zc1) * sd + (ab2 - zc2) * cd)
+    ``(x, y', z')`` to Okada's frame (``z C`` flips in the vertical turn): three of the 27
+    values of :func:`.okada_stress3d.accumulate`'s order."""
+    return (ab0 + zc0, (ab1 + zc1) * cd - (ab2 + zc2) * sd, (ab1 - zc1) * sd + (ab2 - zc2) * cd)
 
 
-@njit(cache=True, fastmath={"contract", "arcp"})
+@njit(cache=True, fastmath=FAST, error_model="numpy")
 def _image_corners(q, z, sd, cd, alpha, c4):
-    """Parts A + B + z C of the image source (Okada 1992, finite source) at the four
-    corners ``(c4[27, c], c4[28, c])`` with Chinnery's signs ``c4[29, c]`` (0: skipped),
-    into ``c4[9 k + 3 j + i, c]`` (``du_i / dx_j``, Okada's frame, dislocation ``k``); the
-    caller sums the corners. One straight loop without branches or calls, so that it could
-    be vectorized over the corners; LLVM does not (checked in the assembly: scalar
-    ``divsd``/``sqrtsd`` only), so the loop costs what four scalar corners cost."""
+    """Parts A + B + z C of the image source (Okada 1992, finite source) summed over the
+    four corners ``(c4[27, c], c4[28, c])`` with Chinnery's signs ``c4[29, c]`` (0:
+    skipped): 27 values ``9 k + 3 j + i`` (``du_i / dx_j``, Okada's frame, dislocation
+    ``k``), times ``2 pi``. One straight loop without branches or calls, its sum carried in
+    registers (:func:`.okada_stress3d.accumulate`) and divisions without Python's zero
+    check (numpy's error model), so that LLVM vectorises it over the corners (it did not
+    while the corners were stored to an array and divisions checked: scalar
+    ``divsd``/``sqrtsd`` only)."""
     a1 = 0.5 * (1.0 - alpha)
     a2 = 0.5 * alpha
     a3 = (1.0 - alpha) / alpha
@@ -184,6 +185,7 @@ def _image_corners(q, z, sd, cd, alpha, c4):
     sdcd = sd * cd
     sdsd = sd * sd
     cdcd = cd * cd
+    acc = (0.0,) * 27
     for corner in range(4):
         xi = c4[27, corner]
         eta = c4[28, corner]
@@ -291,24 +293,17 @@ def _image_corners(q, z, sd, cd, alpha, c4):
         U20 = -a4 * (sd * ir + qy * cd) - a5 * (z * y11 - q2 * z32)
         U21 = a4 * 2.0 * xy * sd + d * x11 - a5 * c * (x11 - q2 * x32)
         U22 = a4 * (y * x11 + xy * cd) + a5 * q * (c * eta * x32 + xi * z32)
-        _store(c4, 0, corner, sign, cd, sd, a[0] + B000, a[3] + B010, a[6] + B020,
-               z * W000, z * W010, z * W020)
-        _store(c4, 3, corner, sign, cd, sd, a[1] + B001, a[4] + B011, a[7] + B021,
-               z * W001, z * W011, z * W021)
-        _store(c4, 6, corner, sign, cd, sd, a[2] + B002, a[5] + B012, a[8] + B022,
-               z * W002 + U00, z * W012 + U01, z * W022 + U02)
-        _store(c4, 9, corner, sign, cd, sd, a[9] + B100, a[12] + B110, a[15] + B120,
-               z * W100, z * W110, z * W120)
-        _store(c4, 12, corner, sign, cd, sd, a[10] + B101, a[13] + B111, a[16] + B121,
-               z * W101, z * W111, z * W121)
-        _store(c4, 15, corner, sign, cd, sd, a[11] + B102, a[14] + B112, a[17] + B122,
-               z * W102 + U10, z * W112 + U11, z * W122 + U12)
-        _store(c4, 18, corner, sign, cd, sd, a[18] + B200, a[21] + B210, a[24] + B220,
-               z * W200, z * W210, z * W220)
-        _store(c4, 21, corner, sign, cd, sd, a[19] + B201, a[22] + B211, a[25] + B221,
-               z * W201, z * W211, z * W221)
-        _store(c4, 24, corner, sign, cd, sd, a[20] + B202, a[23] + B212, a[26] + B222,
-               z * W202 + U20, z * W212 + U21, z * W222 + U22)
+        v0 = _turned(cd, sd, a[0] + B000, a[3] + B010, a[6] + B020, z * W000, z * W010, z * W020)
+        v1 = _turned(cd, sd, a[1] + B001, a[4] + B011, a[7] + B021, z * W001, z * W011, z * W021)
+        v2 = _turned(cd, sd, a[2] + B002, a[5] + B012, a[8] + B022, z * W002 + U00, z * W012 + U01, z * W022 + U02)
+        v3 = _turned(cd, sd, a[9] + B100, a[12] + B110, a[15] + B120, z * W100, z * W110, z * W120)
+        v4 = _turned(cd, sd, a[10] + B101, a[13] + B111, a[16] + B121, z * W101, z * W111, z * W121)
+        v5 = _turned(cd, sd, a[11] + B102, a[14] + B112, a[17] + B122, z * W102 + U10, z * W112 + U11, z * W122 + U12)
+        v6 = _turned(cd, sd, a[18] + B200, a[21] + B210, a[24] + B220, z * W200, z * W210, z * W220)
+        v7 = _turned(cd, sd, a[19] + B201, a[22] + B211, a[25] + B221, z * W201, z * W211, z * W221)
+        v8 = _turned(cd, sd, a[20] + B202, a[23] + B212, a[26] + B222, z * W202 + U20, z * W212 + U21, z * W222 + U22)
+        acc = accumulate(acc, sign, v0 + v1 + v2 + v3 + v4 + v5 + v6 + v7 + v8)
+    return acc
 
 
 @njit(cache=True)
@@ -349,12 +344,7 @@ def gradient(x, y, z, depth, sd, cd, al1, al2, aw1, aw2, alpha, real, image, s, 
                 c4[27, c] = xi
                 c4[28, c] = eta
                 c4[29, c] = sign
-        _image_corners(q, z, sd, cd, alpha, c4)
-        for k in range(3):
-            for j in range(3):
-                for i in range(3):
-                    m = 9 * k + 3 * j + i
-                    s[3, k, i, j] += (c4[m, 0] + c4[m, 1]) + (c4[m, 2] + c4[m, 3])
+        add_gradient(_image_corners(q, z, sd, cd, alpha, c4), s[3])
     for k in range(3):
         for i in range(3):
             for j in range(3):

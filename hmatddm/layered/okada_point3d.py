@@ -30,7 +30,8 @@ import math
 import numpy as np
 from numba import njit
 
-from .okada_stress3d import dip_and_medium, global_stress, global_traction
+from ..compiled import FAST
+from .okada_stress3d import accumulate, add_gradient, dip_and_medium, global_stress, global_traction
 from .rectangle_quadrature import entry_order, far_order, nearest_singularity, square_rule
 
 _INV_2PI = 1.0 / (2.0 * math.pi)
@@ -45,11 +46,13 @@ POINT_NEAR_RATIO = 2.5
 
 
 @njit(cache=True, inline="always")
-def _point_image(x, y, z, depth, sd, cd, alpha, weight, s):
-    """``s[k, i, j] += weight * du_i / dx_j`` at ``(x, y, z)`` (Okada's frame, ``z <= 0``) of
-    the image source's parts A + B + z C (Okada 1992, point source, ``d = depth - z``) for
-    a unit potency ``k`` (strike, dip, tensile) at depth ``depth``; ``weight`` includes
-    Okada's ``1 / (2 pi)``. ``d > 0`` (the source below the surface) keeps ``R + d > 0``."""
+def _point_image(x, y, z, depth, sd, cd, alpha):
+    """The 27 values ``du_i / dx_j`` at ``(x, y, z)`` (Okada's frame, ``z <= 0``) of the image
+    source's parts A + B + z C (Okada 1992, point source, ``d = depth - z``) for a unit
+    potency ``k`` (strike, dip, tensile) at depth ``depth``, times ``2 pi``: ``9 k + m``,
+    ``m = 3 j + i`` in Okada's order (:func:`_combined`, :func:`.okada_stress3d.accumulate`). ``d > 0`` (the source below the
+    surface) keeps ``R + d > 0``. Returned, not stored, so that the Gauss sum of
+    :func:`_point_gradient` stays in registers and is vectorised over its points."""
     alp1 = 0.5 * (1.0 - alpha)
     alp2 = 0.5 * alpha
     alp3 = (1.0 - alpha) / alpha
@@ -141,8 +144,8 @@ def _point_image(x, y, z, depth, sd, cd, alpha, weight, s):
     sc6 = 3.0 * ir5 * (-alp4 * d * a5 * cd + alp5 * c * (a5 * cd + d * qr5 * a7))
     sc7 = 15.0 * x * ir7 * (alp4 * y * d * cd + alp5 * c * (d * b7 * sd - y * c7 * cd))
     sc8 = 15.0 * x * ir7 * (-alp4 * y * d * sd + alp5 * c * (2.0 * d * cd - q * c7))
-    _add(s, 0, weight, z, sa0 + sb0, sa1 + sb1, sa2 + sb2, sa3 + sb3, sa4 + sb4, sa5 + sb5, sa6 + sb6,
-         sa7 + sb7, sa8 + sb8, sc0, sc1, sc2, sc3, sc4, sc5, sc6, sc7, sc8, su0, su1, su2)
+    strike = _combined(z, sa0 + sb0, sa1 + sb1, sa2 + sb2, sa3 + sb3, sa4 + sb4, sa5 + sb5, sa6 + sb6,
+                      sa7 + sb7, sa8 + sb8, sc0, sc1, sc2, sc3, sc4, sc5, sc6, sc7, sc8, su0, su1, su2)
 
     # dip
     da0 = alp2 * p * qr * a5
@@ -175,8 +178,8 @@ def _point_image(x, y, z, depth, sd, cd, alpha, weight, s):
     dc6 = x3r5 * (-alp4 * (s2d - t * dr5) - alp5 * 5.0 * c * ir2 * (t + d * p * qr7))
     dc7 = 3.0 * ir5 * (-alp4 * (d * b5 * c2d + y * c5 * s2d) - alp5 * c * ((3.0 + a5) * c2d + y * p * dr5 * qr7))
     dc8 = 3.0 * ir5 * (-alp4 * d * a5 * sdcd - alp5 * c * (s2d - 10.0 * d * t * ir2 + p * qr5 * c7))
-    _add(s, 1, weight, z, da0 + db0, da1 + db1, da2 + db2, da3 + db3, da4 + db4, da5 + db5, da6 + db6,
-         da7 + db7, da8 + db8, dc0, dc1, dc2, dc3, dc4, dc5, dc6, dc7, dc8, du0, du1, du2)
+    dip = _combined(z, da0 + db0, da1 + db1, da2 + db2, da3 + db3, da4 + db4, da5 + db5, da6 + db6,
+                   da7 + db7, da8 + db8, dc0, dc1, dc2, dc3, dc4, dc5, dc6, dc7, dc8, du0, du1, du2)
 
     # tensile
     ta0 = alp1 * a3 * ir3 - alp2 * q * qr * a5
@@ -212,25 +215,18 @@ def _point_image(x, y, z, depth, sd, cd, alpha, weight, s):
                        + alp5 * (c * ((3.0 + a5) * s2d - y * dr5 * d7) - y * (1.0 + z * dr5)))
     tc8 = 3.0 * ir5 * (-alp4 * d * (1.0 - a5 * sdsd)
                        - alp5 * (c * (c2d + 10.0 * d * (ss - d) * ir2 - q * qr5 * c7) + z * (1.0 + c5)))
-    _add(s, 2, weight, z, ta0 + tb0, ta1 + tb1, ta2 + tb2, ta3 + tb3, ta4 + tb4, ta5 + tb5, ta6 + tb6,
-         ta7 + tb7, ta8 + tb8, tc0, tc1, tc2, tc3, tc4, tc5, tc6, tc7, tc8, tu0, tu1, tu2)
+    tensile = _combined(z, ta0 + tb0, ta1 + tb1, ta2 + tb2, ta3 + tb3, ta4 + tb4, ta5 + tb5, ta6 + tb6,
+                       ta7 + tb7, ta8 + tb8, tc0, tc1, tc2, tc3, tc4, tc5, tc6, tc7, tc8, tu0, tu1, tu2)
+    return strike + dip + tensile
 
 
 @njit(cache=True, inline="always")
-def _add(s, k, weight, z, ab0, ab1, ab2, ab3, ab4, ab5, ab6, ab7, ab8, c0, c1, c2, c3, c4, c5, c6, c7, c8,
-         u0, u1, u2):
-    """``s[k, i, j] += weight * (A + B + z C)_{i,j}``, ``m = 3 j + i`` in Okada's order
-    (``u_x,x u_y,x u_z,x u_x,y ... u_z,z``); the ``z`` derivatives add ``C``'s displacement
-    (``d(z C)/dz = C + z dC/dz``)."""
-    s[k, 0, 0] += weight * (ab0 + z * c0)
-    s[k, 1, 0] += weight * (ab1 + z * c1)
-    s[k, 2, 0] += weight * (ab2 + z * c2)
-    s[k, 0, 1] += weight * (ab3 + z * c3)
-    s[k, 1, 1] += weight * (ab4 + z * c4)
-    s[k, 2, 1] += weight * (ab5 + z * c5)
-    s[k, 0, 2] += weight * (ab6 + z * c6 + u0)
-    s[k, 1, 2] += weight * (ab7 + z * c7 + u1)
-    s[k, 2, 2] += weight * (ab8 + z * c8 + u2)
+def _combined(z, ab0, ab1, ab2, ab3, ab4, ab5, ab6, ab7, ab8, c0, c1, c2, c3, c4, c5, c6, c7, c8, u0, u1, u2):
+    """``(A + B + z C)_{i,j}``, ``m = 3 j + i`` in Okada's order (``u_x,x u_y,x u_z,x u_x,y
+    ... u_z,z``); the ``z`` derivatives add ``C``'s displacement (``d(z C)/dz = C + z
+    dC/dz``)."""
+    return (ab0 + z * c0, ab1 + z * c1, ab2 + z * c2, ab3 + z * c3, ab4 + z * c4, ab5 + z * c5,
+            ab6 + z * c6 + u0, ab7 + z * c7 + u1, ab8 + z * c8 + u2)
 
 
 @njit(cache=True)
@@ -280,27 +276,39 @@ def point_frame(normal):
 @njit(cache=True, inline="always")
 def _point_gradient(point, center, frame, a, b, okada, surface, shear_modulus, poisson_ratio, xi, eta, wt, work):
     """The Gauss sum of :func:`_point_image` into ``work[3]`` (Okada's frame); returns the
-    strike's ``(s_x, s_y)`` and Lame's lambda, as :func:`.okada_stress3d.global_stress` takes them."""
+    strike's ``(s_x, s_y)`` and Lame's lambda, as :func:`.okada_stress3d.global_stress` takes them.
+    Its callers compile with :data:`FAST` and numpy's error model: the sum over the points is
+    then a vectorised loop (2.7x cheaper a point at 4 points, benchmarks/RESULTS.md, issue 32)."""
     s0 = okada[0, 0]
     s1 = okada[0, 1]
     sd, cd, lam, alpha = dip_and_medium(s0, s1, okada, shear_modulus, poisson_ratio)
+    z = point[2] - surface
+    jac = a * b * _INV_2PI
+    # the receiver from the rectangle's centre, in Okada's frame; each point moves it
+    rx = point[0] - center[0]
+    ry = point[1] - center[1]
+    x0 = s0 * rx + s1 * ry
+    y0 = -s1 * rx + s0 * ry
+    depth0 = surface - center[2]
+    ax = s0 * frame[0, 0] + s1 * frame[0, 1]
+    ay = -s1 * frame[0, 0] + s0 * frame[0, 1]
+    bx = s0 * frame[1, 0] + s1 * frame[1, 1]
+    by = -s1 * frame[1, 0] + s0 * frame[1, 1]
+    acc = (0.0,) * 27
+    for g in range(xi.shape[0]):
+        ua = xi[g] * a
+        ub = eta[g] * b
+        acc = accumulate(acc, wt[g] * jac, _point_image(x0 - ua * ax - ub * bx, y0 - ua * ay - ub * by, z,
+                                                         depth0 - ua * frame[0, 2] - ub * frame[1, 2], sd, cd, alpha))
     for k in range(3):
         for i in range(3):
             for j in range(3):
                 work[3, k, i, j] = 0.0
-    z = point[2] - surface
-    jac = a * b * _INV_2PI
-    for g in range(xi.shape[0]):
-        ua = xi[g] * a
-        ub = eta[g] * b
-        dx = point[0] - (center[0] + ua * frame[0, 0] + ub * frame[1, 0])
-        dy = point[1] - (center[1] + ua * frame[0, 1] + ub * frame[1, 1])
-        depth = surface - (center[2] + ua * frame[0, 2] + ub * frame[1, 2])
-        _point_image(s0 * dx + s1 * dy, -s1 * dx + s0 * dy, z, depth, sd, cd, alpha, wt[g] * jac, work[3])
+    add_gradient(acc, work[3])
     return s0, s1, lam
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath=FAST, error_model="numpy")
 def point_image_stress(point, center, frame, a, b, okada, surface, shear_modulus, poisson_ratio, xi, eta, wt,
                        work, out):
     """``out[q, i, j]``: the image and surface terms of the global stress at ``point`` (below
@@ -313,7 +321,7 @@ def point_image_stress(point, center, frame, a, b, okada, surface, shear_modulus
     global_stress(work, s0, s1, lam, shear_modulus, okada, out)
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath=FAST, error_model="numpy")
 def point_image_traction(point, normal, center, frame, a, b, okada, surface, shear_modulus, poisson_ratio, xi, eta,
                          wt, work, block):
     """``block[p, q] +=`` the traction ``sigma . normal`` (global component ``p``) of the terms

@@ -19,14 +19,61 @@ def dip_and_medium(s0, s1, okada, shear_modulus, poisson_ratio):
     mu)``."""
     t1 = -s1 * okada[1, 0] + s0 * okada[1, 1]
     t2 = okada[1, 2]
-    norm = math.sqrt(t1 * t1 + t2 * t2)
-    cd = t1 / norm
-    sd = t2 / norm
+    inverse = 1.0 / math.sqrt(t1 * t1 + t2 * t2)
+    cd = t1 * inverse
+    sd = t2 * inverse
     if abs(cd) < COS_ZERO:
         cd = 0.0
         sd = 1.0
     lam = 2.0 * shear_modulus * poisson_ratio / (1.0 - 2.0 * poisson_ratio)
-    return sd, cd, lam, (lam + shear_modulus) / (lam + 2.0 * shear_modulus)
+    return sd, cd, lam, 0.5 / (1.0 - poisson_ratio)  # (lambda + mu) / (lambda + 2 mu)
+
+
+@njit(cache=True, inline="always")
+def accumulate(acc, w, v):
+    """``acc + w v`` of two 27-tuples of displacement derivatives (``9 k + 3 j + i``:
+    ``du_i / dx_j`` of dislocation ``k``), written out: a Gauss or corner sum carried in a
+    tuple stays in registers, where stores to an array would stop LLVM from vectorising the
+    loop (the point source's points, the finite source's corners)."""
+    return (acc[0] + w * v[0], acc[1] + w * v[1], acc[2] + w * v[2], acc[3] + w * v[3], acc[4] + w * v[4],
+            acc[5] + w * v[5], acc[6] + w * v[6], acc[7] + w * v[7], acc[8] + w * v[8], acc[9] + w * v[9],
+            acc[10] + w * v[10], acc[11] + w * v[11], acc[12] + w * v[12], acc[13] + w * v[13], acc[14] + w * v[14],
+            acc[15] + w * v[15], acc[16] + w * v[16], acc[17] + w * v[17], acc[18] + w * v[18], acc[19] + w * v[19],
+            acc[20] + w * v[20], acc[21] + w * v[21], acc[22] + w * v[22], acc[23] + w * v[23], acc[24] + w * v[24],
+            acc[25] + w * v[25], acc[26] + w * v[26])
+
+
+@njit(cache=True, inline="always")
+def add_gradient(acc, gradient):
+    """``gradient[k, i, j] += acc[9 k + 3 j + i]`` (:func:`accumulate`'s order), each index a
+    constant (a tuple indexed by a variable is copied to memory first)."""
+    gradient[0, 0, 0] += acc[0]
+    gradient[0, 1, 0] += acc[1]
+    gradient[0, 2, 0] += acc[2]
+    gradient[0, 0, 1] += acc[3]
+    gradient[0, 1, 1] += acc[4]
+    gradient[0, 2, 1] += acc[5]
+    gradient[0, 0, 2] += acc[6]
+    gradient[0, 1, 2] += acc[7]
+    gradient[0, 2, 2] += acc[8]
+    gradient[1, 0, 0] += acc[9]
+    gradient[1, 1, 0] += acc[10]
+    gradient[1, 2, 0] += acc[11]
+    gradient[1, 0, 1] += acc[12]
+    gradient[1, 1, 1] += acc[13]
+    gradient[1, 2, 1] += acc[14]
+    gradient[1, 0, 2] += acc[15]
+    gradient[1, 1, 2] += acc[16]
+    gradient[1, 2, 2] += acc[17]
+    gradient[2, 0, 0] += acc[18]
+    gradient[2, 1, 0] += acc[19]
+    gradient[2, 2, 0] += acc[20]
+    gradient[2, 0, 1] += acc[21]
+    gradient[2, 1, 1] += acc[22]
+    gradient[2, 2, 1] += acc[23]
+    gradient[2, 0, 2] += acc[24]
+    gradient[2, 1, 2] += acc[25]
+    gradient[2, 2, 2] += acc[26]
 
 
 @njit(cache=True, inline="always")

@@ -63,6 +63,8 @@ def nearest_singularity(y, receiver_layer, center, frame, a, b, source_layer, in
         for k in (layer - 1, layer):
             if 0 <= k < n_if and k != skip:
                 dmin = min(dmin, _distance(y[0], y[1], 2.0 * interfaces[k] - y[2], center, frame, a, b))
+        if receiver_layer == source_layer:  # the same interfaces: once
+            break
     return dmin
 
 
@@ -98,9 +100,21 @@ def far_order(ratio, n_max, tol):
     ``n`` = 1-4 (``ratio`` 8-128; the error of a Gauss rule on a function regular within
     a distance ``d`` falls like ``(a / d)^(2n)``). Thresholds at :data:`FAR_TOL`: 4 points
     from ratio 10.6, 3 from 22.3, 2 from 95."""
+    return _bounded_order(ratio, 1.0, n_max, tol)
+
+
+@njit(cache=True, inline="always")
+def _bounded_order(ratio, size, n_max, tol):
+    """The smallest ``n < n_max`` with ``40 n ratio^(-2n) size <= tol``, else ``n_max``: the
+    powers by products (a ``pow`` a term cost more than the rest of a far pair's rule)."""
+    if ratio <= 0.0:
+        return n_max
+    step = 1.0 / (ratio * ratio)
+    power = step
     for n in range(1, n_max):
-        if 40.0 * n * ratio ** (-2.0 * n) <= tol:
+        if 40.0 * n * power * size <= tol:
             return n
+        power *= step
     return n_max
 
 
@@ -129,11 +143,7 @@ def entry_order(dmin, a, b, n_max, tol):
     if tol <= 0.0 or dmin <= 0.0:
         return n_max
     ratio = dmin / max(a, b)
-    size = IMAGE_BOUND * 4.0 * a * b / (dmin * dmin * dmin)
-    for n in range(1, n_max):
-        if 40.0 * n * ratio ** (-2.0 * n) * size <= tol:
-            return n
-    return n_max
+    return _bounded_order(ratio, IMAGE_BOUND * 4.0 * a * b / (dmin * dmin * dmin), n_max, tol)
 
 
 @njit(cache=True)
