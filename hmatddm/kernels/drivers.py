@@ -285,7 +285,10 @@ def traction_block(data, rows, cols, out):
     n_inner = rows_.shape[0] if by_source else cols_.shape[0]
     for outer in range(n_outer):
         if by_source:
-            state = _source_state(data_, cols_[outer], work)
+            # the state's arrays borrowed in the pair loop (each pair counted references to
+            # them: 10-15% of a half-space entry, benchmarks/RESULTS.md, issue 32), held below
+            owner = _source_state(data_, cols_[outer], work)
+            state = borrowed(owner)
         for inner in range(n_inner):
             ia = inner if by_source else outer
             jb = outer if by_source else inner
@@ -299,6 +302,8 @@ def traction_block(data, rows, cols, out):
             for p in range(dof):
                 for q in range(dof):
                     out_[dof * ia + p, dof * jb + q] = block[p, q]
+        if by_source:
+            _hold(owner)
     _hold(scratch)
 
 

@@ -15,7 +15,7 @@ outside, both by quadrature; ``benchmarks/bench_layered3d_stress.py``, benchmark
 import numpy as np
 from numba import njit
 
-from ..kernels.drivers import _in_parts
+from ..kernels.drivers import _hold, _in_parts, borrowed
 from .images3d import element_stress_traced, source_state, workspace
 
 __all__ = ["stress_points", "stress_sum", "stress_columns_points", "stress_columns"]
@@ -33,7 +33,8 @@ def stress_points(data, points, point_layer, dd, out):
             for k in range(3):
                 out[m, i, k] = 0.0
     for j in range(data.centers.shape[0]):
-        state = source_state(data, j, work)
+        owner = source_state(data, j, work)
+        state = borrowed(owner)  # no reference counts per point (kernels.drivers.traction_block)
         for m in range(points.shape[0]):
             element_stress_traced(data, points[m], point_layer[m], j, state, work, pair)
             for i in range(3):
@@ -42,6 +43,7 @@ def stress_points(data, points, point_layer, dd, out):
                     for q in range(3):
                         acc += pair[q, i, k] * dd[j, q]
                     out[m, i, k] += acc
+        _hold(owner)
 
 
 def stress_sum(data, points, dd, point_layer):
@@ -69,10 +71,12 @@ def stress_columns_points(data, points, point_layer, out):
     work = workspace(data)
     pair = np.empty((3, 3, 3))
     for j in range(data.centers.shape[0]):
-        state = source_state(data, j, work)
+        owner = source_state(data, j, work)
+        state = borrowed(owner)
         for m in range(points.shape[0]):
             element_stress_traced(data, points[m], point_layer[m], j, state, work, pair)
             out[m, j] = pair
+        _hold(owner)
 
 
 def stress_columns(data, points, point_layer):
