@@ -210,7 +210,8 @@ def workspace(data):
     of any source layer's triples, the tracer's room per layer ``(cap, n_orders)``, the
     :func:`_cached_rules`, the scratch of :func:`.okada3d.okada_stress` and of
     :func:`.vertical3d.vertical_image_stress`, the whole-space stress and the receiver point
-    of :func:`_complementary_stress`."""
+    of :func:`_complementary_stress`, and the arrays of the state of a source that traces
+    nothing (:func:`_untraced_state`: made once a block, not once a source)."""
     n_layers = data.shear_modulus.shape[0]
     room = np.zeros((n_layers, 2), dtype=np.int64)
     n_orders = 1
@@ -221,7 +222,16 @@ def workspace(data):
                 n_orders = max(n_orders, room[layer, 1])
     return (np.empty((3, 3, 3)), np.zeros((3, 3, 3)), np.empty((3, 3, 3, 3)), np.zeros((2, 3, 3, 1)), Workspace(1),
             Workspace(n_orders), room, _cached_rules(data.gauss_points), np.empty((5, 3, 3, 3)), np.empty((30, 4)),
-            vertical_workspace(n_orders), np.empty((3, 3, 3)), np.empty(3))
+            vertical_workspace(n_orders), np.empty((3, 3, 3)), np.empty(3), _untraced_state(data.gauss_points))
+
+
+@njit(cache=True)
+def _untraced_state(gauss_points):
+    """The arrays of :func:`source_state` for a source that traces nothing (closed form or
+    point source): one empty point, no rule traced, three empty heights."""
+    one = np.int64(1)
+    return (_traced_buffer(one, one, one), np.zeros(gauss_points + 1, dtype=np.bool_),
+            _traced_buffer(np.int64(3), one, one), np.zeros(3))
 
 
 @njit(cache=True)
@@ -231,8 +241,8 @@ def source_state(data, j, work):
     the near triples only (the source's layer has a tabulated remainder), and, for a
     ``vertical_form`` source, those triples traced at its bottom, middle and top heights
     (:func:`.vertical3d.vertical_image_stress`). A source whose images are in closed form
-    (``closed_form``) or by Okada's point source (``point_form``) traces nothing: its room is
-    one point. :func:`_source_state` through
+    (``closed_form``) or by Okada's point source (``point_form``) traces nothing: its state
+    is the workspace's (:func:`_untraced_state`). :func:`_source_state` through
     ``data.source_tracer`` (:func:`with_image_terms`)."""
     return data.source_tracer(address_of(without_functions(data)), np.int64(j), address_of(work))
 
@@ -246,10 +256,11 @@ def _source_state(data_at, j, work_at):
     start = work[7][3]
     ls = data.layer[j]
     near_only = data.table.pair_index[ls].max() >= 0
-    one = np.int64(1)  # not literals: one compiled _traced_buffer (module docstring)
     if data.closed_form[j] or data.point_form[j]:
-        return (_traced_buffer(one, one, one), np.zeros(start.shape[0] - 1, dtype=np.bool_), near_only,
-                _traced_buffer(np.int64(3), one, one), np.zeros(3))
+        # the workspace's arrays: nothing allocated a source (16 arrays a source made the
+        # half-space's H-matrix rows cost as much again as their entries)
+        traced, is_traced, three, heights = work[13]
+        return traced, is_traced, near_only, three, heights
     cap, n_orders = max(room[ls, 0], 1), max(room[ls, 1], 1)
     three, heights = three_heights(data, j, near_only, cap, n_orders)
     return (_traced_buffer(start[-1], cap, n_orders), np.zeros(start.shape[0] - 1, dtype=np.bool_), near_only,
