@@ -298,7 +298,17 @@ class ContactModel:
 
     def update(self, dd, contact_traction):
         """Update the statuses from the iterate ``dd`` (N*d,) and the contact traction
-        ``c = A dd + B p - f`` (N*d,); returns the number of elements that changed."""
+        ``c = A dd + B p - f`` (N*d,); returns the number of elements that changed.
+
+        The statuses are those of the complementarity functions (module docstring), read at
+        the iterate whatever the element's status, with a band ``tol_c = k tol_w`` around
+        each switch that the status must cross to change:
+
+        * closed where the normal indicator ``lambda~ = -c_n - k (w - w_p)`` is positive;
+        * a closed element sticks where its tangential trial traction
+          ``t = c_s + k (s - s^n)`` is within the friction bound
+          ``C_0 + mu lambda~``, and slips along ``t`` where it is beyond it.
+        """
         n, d = self.n, self.d
         dd = np.asarray(dd).reshape(n, d)
         c = np.asarray(contact_traction).reshape(n, d)
@@ -306,38 +316,39 @@ class ContactModel:
         opening = np.sum(dd * normals, axis=1)
         c_n = np.sum(c * normals, axis=1)
         c_s = c - c_n[:, None] * normals
-        tau = np.linalg.norm(c_s, axis=1)
-        strength = self.law.cohesion - self.law.friction * c_n
         increment = dd - opening[:, None] * normals - self.shear_start
-        new_status = self.status.copy()
-        new_direction = self.direction.copy()
+        k = self.stiffness
         enabled = self.law.enabled
         scale = np.max(np.linalg.norm(dd, axis=1)) if n else 0.0  # the largest DD (opening or slip)
         tol_w = self.relative_tolerance * max(scale, 1e-30)
-        tol_c = self.stiffness * tol_w
-        is_open, closed, slip = self.status == OPEN, self.status != OPEN, self.status == SLIP
-        # open -> stick when the faces interpenetrate
-        close = enabled & is_open & (opening < self.propped_width - tol_w)
-        new_status[close] = STICK
-        # closed -> open when the contact traction turns tensile
-        release = enabled & closed & (c_n > tol_c)
-        new_status[release] = OPEN
-        # stick -> slip when the shear exceeds the strength
-        stay = enabled & closed & ~release
-        to_slip = stay & (self.status == STICK) & (tau > strength + tol_c)
-        new_status[to_slip] = SLIP
-        new_direction[to_slip] = c_s[to_slip] / tau[to_slip, None]
-        # slip: follow the slip increment; stick again if it reverses
-        slipping = stay & slip
-        along = np.sum(increment * self.direction, axis=1)
-        increment_norm = np.linalg.norm(increment, axis=1)
-        reverse = slipping & (along < -tol_w)
-        new_status[reverse] = STICK
-        follow = slipping & ~reverse & (increment_norm > 0.0)
+        tol_c = k * tol_w
+        was_closed, was_slip = self.status != OPEN, self.status == SLIP
+        # normal: closed where lambda~ > 0 (a status crosses the band to change)
+        pressure = -c_n - k * (opening - self.propped_width)
+        closed = enabled & np.where(was_closed, pressure >= -tol_c, pressure > tol_c)
+        # tangential: stick within the bound, slip along the trial traction beyond it
+        trial = c_s + k[:, None] * increment
+        trial_norm = np.linalg.norm(trial, axis=1)
+        bound = self.law.cohesion + self.law.friction * np.maximum(pressure, 0.0)
+        frictionless = (self.law.cohesion == 0.0) & (self.law.friction == 0.0)
+        slip = closed & np.where(was_slip, trial_norm >= bound - tol_c, trial_norm > bound + tol_c)
+        new_status = np.where(closed, np.where(slip, SLIP, STICK), OPEN).astype(np.int64)
+        new_direction = self.direction.copy()
+        starts = slip & ~was_slip
+        new_direction[starts] = trial[starts] / trial_norm[starts, None]
         turned = np.zeros(n, dtype=bool)
-        if d == 3 and np.any(follow):
-            turned, directions = self._turn(follow, increment, increment_norm, tol_w)
-            new_direction[turned] = directions
+        stays = slip & was_slip
+        if d == 2:
+            # the trial traction against the slip: it slips the other way (a frictionless
+            # element's rows are the same both ways: it keeps its direction)
+            along = np.sum(trial * self.direction, axis=1)
+            turned = stays & ~frictionless & (along < -tol_c)
+            new_direction[turned] = -self.direction[turned]
+        else:
+            follow = stays & (np.linalg.norm(increment, axis=1) > 0.0)
+            if np.any(follow):
+                turned, directions = self._turn(follow, increment, np.linalg.norm(increment, axis=1), tol_w)
+                new_direction[turned] = directions
         new_direction[new_status != SLIP] = 0.0
         # elements that flipped too often are held closed and stuck (the most constrained
         # state: bounded DDs, a friction law violated at most by the last oscillation)

@@ -145,11 +145,12 @@ def test_slip_direction_settles_when_the_increment_overshoots(gain):
     start = 0.3
     model = ContactModel(law, [[0.0, 0.0, 1.0]], np.zeros((1, 3)), np.array([SLIP]),
                          [[np.cos(start), np.sin(start), 0.0]], np.ones(1))
-    traction = np.array([0.0, 0.0, -1e6])  # closed, compressive
     changes = []
     for _ in range(60):
         tilt = np.arctan2(model.direction[0, 1], model.direction[0, 0])
         increment = 2e-7 * np.array([np.cos(gain * tilt), np.sin(gain * tilt), 0.0])
+        # closed, compressive, the shear traction on the friction bound along m (its slip rows)
+        traction = np.array([0.0, 0.0, -1e6]) + 0.3e6 * model.direction[0]
         changes.append(model.update(increment, traction))
     tilt = np.arctan2(model.direction[0, 1], model.direction[0, 0])
     assert model.status[0] == SLIP and model.frozen == 0
