@@ -197,6 +197,7 @@ class ContactModel:
         self.status = self.initial_status.copy()
         self.direction = self.initial_direction.copy()
         self.flips = np.zeros(self.n, dtype=np.int64)
+        self.inconsistent = np.zeros(self.n, dtype=bool)  # held elements the last update would change
         self.direction_damping = np.ones(self.n)          # 3D slip-direction step, per element
         self._last_turn = np.zeros(self.n)                 # the last rotation applied (signed, rad)
         self._rows = None
@@ -205,6 +206,12 @@ class ContactModel:
     def frozen(self):
         """Elements whose status stopped changing because they flipped too often."""
         return int(np.count_nonzero(self.flips > self.max_flips))
+
+    @property
+    def violated(self):
+        """Held elements whose contact conditions fail (beyond the band) at the last update:
+        at a converged iterate, the elements whose conditions the answer violates."""
+        return int(np.count_nonzero(self.inconsistent))
 
     @property
     def closed(self):
@@ -351,12 +358,12 @@ class ContactModel:
                 new_direction[turned] = directions
         new_direction[new_status != SLIP] = 0.0
         # elements that flipped too often are held closed and stuck (the most constrained
-        # state: bounded DDs, a friction law violated at most by the last oscillation)
-        changed = new_status != self.status
-        self.flips += changed
-        frozen = self.flips > self.max_flips
-        new_status[frozen] = STICK
-        new_direction[frozen] = 0.0
+        # state: bounded DDs); those whose conditions fail there are counted (:attr:`violated`)
+        self.flips += new_status != self.status
+        held = self.flips > self.max_flips
+        self.inconsistent = held & (new_status != STICK)
+        new_status[held] = STICK
+        new_direction[held] = 0.0
         changed = (new_status != self.status) | (turned & (new_status == SLIP))
         self.status, self.direction = new_status, new_direction
         n_changed = int(np.count_nonzero(changed))
