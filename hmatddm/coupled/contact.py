@@ -32,22 +32,38 @@ diagonal blocks (for the scaling of the fully coupled system) are ``S`` times th
 ``A`` plus ``D``.
 
 The status is an active set updated once per nonlinear iteration
-(:meth:`ContactModel.update`): an open element with ``w < -tol_w`` closes (stick); a
-closed element whose contact traction turns tensile by more than ``k tol_w`` opens; a
-stuck element whose shear exceeds its strength by more than ``k tol_w`` slips along its
-shear traction; a slipping element whose slip increment reverses by more than ``tol_w``
-sticks; a slipping element turns its slip direction toward its slip increment (3D,
-damped, see :meth:`ContactModel._turn`). The band ``tol_w = relative_tolerance * max|DD|``
-(the largest DD of the mesh, opening or slip; ``k`` the element's own stiffness, so
-``k tol_w`` is the traction of that much opening) keeps the active set from flipping on
-round-off when an element sits at the boundary between two states (fluid pressure equal
-to the normal stress): the error it allows is ``tol_w`` of displacement, a
-``relative_tolerance`` (1e-3) of the largest DD. A step has converged only when no
-status changed and no slip direction turned. An element
+(:meth:`ContactModel.update`) from the complementarity functions of the conditions above
+(a primal-dual active set, the semismooth Newton method of Hüeber & Wohlmuth for contact
+with Coulomb friction), read at the iterate whatever the element's status. With
+``lambda~ = -c_n - k (w - w_p)`` (``k`` the element's own normal stiffness)::
+
+    closed  where  lambda~ > 0                        (else open)
+    slip    where  |c_s + k (s - s^n)| > C_0 + mu lambda~   (a closed element; else stick)
+
+a slipping element slipping along ``c_s + k (s - s^n)`` (2D: the other way when that
+turns against its direction; frictionless elements keep theirs: their rows are the same;
+3D: it turns toward its slip increment, damped, see :meth:`ContactModel._turn`). At an
+iterate that solves its rows (``w = w_p`` closed, ``c = 0`` open) these are the plain
+tests: an open element closes when it interpenetrates, a closed one opens when its contact
+traction turns tensile, a stuck one slips when its shear exceeds the strength, a slipping
+one sticks when its slip reverses. At a relaxed or accelerated iterate (neither) each
+test weighs the traction and the displacement together, so a closed element still
+interpenetrating does not open on a tensile traction, and a stuck one does not slip on the
+shear that a reversal of its slip explains (measured on the dfn-3cluster network at 4x
+its area, t = 152-154 s: 4373 status changes and 345 held elements with the tests of one
+status at a time, 802 and 17 with these; benchmarks/RESULTS.md). Every switch has a band
+``k tol_w`` that a status must cross to change, ``tol_w = relative_tolerance * max|DD|``
+(the largest DD of the mesh, opening or slip; ``k tol_w`` the traction of that much
+opening): it keeps the active set from flipping on round-off when an element sits at the
+boundary between two states (fluid pressure equal to the normal stress), and the error it
+allows is ``tol_w`` of displacement, a ``relative_tolerance`` (1e-3) of the largest DD. A
+step has converged only when no status changed and no slip direction turned. An element
 that changes status more than ``max_flips`` times in one step is held closed and stuck
 from then on in the step (and counted in :attr:`ContactModel.frozen`), so the active set
-cannot cycle forever: its DDs are bounded and its friction law is violated at most by the
-traction of the last cycle.
+cannot cycle forever: its DDs are bounded. Some elements have no status that meets their
+conditions with the others' (a closed one tensile, open it interpenetrates: seen next to
+junctions of the network); those the answer violates are counted in
+:attr:`ContactModel.violated`.
 """
 from dataclasses import dataclass
 
