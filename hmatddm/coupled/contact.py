@@ -61,9 +61,9 @@ step has converged only when no status changed and no slip direction turned. An 
 that changes status more than ``max_flips`` times in one step is held closed and stuck
 from then on in the step (and counted in :attr:`ContactModel.frozen`), so the active set
 cannot cycle forever: its DDs are bounded. Some elements have no status that meets their
-conditions with the others' (a closed one tensile, open it interpenetrates: seen next to
-junctions of the network); those the answer violates are counted in
-:attr:`ContactModel.violated`.
+conditions with the others' (closed it is tensile, open it interpenetrates: seen at the
+unresolved near pairs and acute junctions of a network, whose contact matrix is not a
+P-matrix); those the answer violates are counted in :attr:`ContactModel.violated`.
 """
 from dataclasses import dataclass
 
@@ -368,7 +368,8 @@ class ContactModel:
             turned = stays & ~frictionless & (along < -tol_c)
             new_direction[turned] = -self.direction[turned]
         else:
-            follow = stays & (np.linalg.norm(increment, axis=1) > 0.0)
+            # (a frictionless element's rows do not depend on its direction: it keeps it)
+            follow = stays & ~frictionless & (np.linalg.norm(increment, axis=1) > 0.0)
             if np.any(follow):
                 turned, directions = self._turn(follow, increment, np.linalg.norm(increment, axis=1), tol_w)
                 new_direction[turned] = directions
