@@ -32,22 +32,38 @@ diagonal blocks (for the scaling of the fully coupled system) are ``S`` times th
 ``A`` plus ``D``.
 
 The status is an active set updated once per nonlinear iteration
-(:meth:`ContactModel.update`): an open element with ``w < -tol_w`` closes (stick); a
-closed element whose contact traction turns tensile by more than ``k tol_w`` opens; a
-stuck element whose shear exceeds its strength by more than ``k tol_w`` slips along its
-shear traction; a slipping element whose slip increment reverses by more than ``tol_w``
-sticks; a slipping element turns its slip direction toward its slip increment (3D,
-damped, see :meth:`ContactModel._turn`). The band ``tol_w = relative_tolerance * max|DD|``
-(the largest DD of the mesh, opening or slip; ``k`` the element's own stiffness, so
-``k tol_w`` is the traction of that much opening) keeps the active set from flipping on
-round-off when an element sits at the boundary between two states (fluid pressure equal
-to the normal stress): the error it allows is ``tol_w`` of displacement, a
-``relative_tolerance`` (1e-3) of the largest DD. A step has converged only when no
-status changed and no slip direction turned. An element
+(:meth:`ContactModel.update`) from the complementarity functions of the conditions above
+(a primal-dual active set, the semismooth Newton method of Hüeber & Wohlmuth for contact
+with Coulomb friction), read at the iterate whatever the element's status. With
+``lambda~ = -c_n - k (w - w_p)`` (``k`` the element's own normal stiffness)::
+
+    closed  where  lambda~ > 0                        (else open)
+    slip    where  |c_s + k (s - s^n)| > C_0 + mu lambda~   (a closed element; else stick)
+
+a slipping element slipping along ``c_s + k (s - s^n)`` (2D: the other way when that
+turns against its direction; frictionless elements keep theirs: their rows are the same;
+3D: it turns toward its slip increment, damped, see :meth:`ContactModel._turn`). At an
+iterate that solves its rows (``w = w_p`` closed, ``c = 0`` open) these are the plain
+tests: an open element closes when it interpenetrates, a closed one opens when its contact
+traction turns tensile, a stuck one slips when its shear exceeds the strength, a slipping
+one sticks when its slip reverses. At a relaxed or accelerated iterate (neither) each
+test weighs the traction and the displacement together, so a closed element still
+interpenetrating does not open on a tensile traction, and a stuck one does not slip on the
+shear that a reversal of its slip explains (measured on the dfn-3cluster network at 4x
+its area, t = 152-154 s: 4373 status changes and 345 held elements with the tests of one
+status at a time, 802 and 17 with these; benchmarks/RESULTS.md). Every switch has a band
+``k tol_w`` that a status must cross to change, ``tol_w = relative_tolerance * max|DD|``
+(the largest DD of the mesh, opening or slip; ``k tol_w`` the traction of that much
+opening): it keeps the active set from flipping on round-off when an element sits at the
+boundary between two states (fluid pressure equal to the normal stress), and the error it
+allows is ``tol_w`` of displacement, a ``relative_tolerance`` (1e-3) of the largest DD. A
+step has converged only when no status changed and no slip direction turned. An element
 that changes status more than ``max_flips`` times in one step is held closed and stuck
 from then on in the step (and counted in :attr:`ContactModel.frozen`), so the active set
-cannot cycle forever: its DDs are bounded and its friction law is violated at most by the
-traction of the last cycle.
+cannot cycle forever: its DDs are bounded. Some elements have no status that meets their
+conditions with the others' (closed it is tensile, open it interpenetrates: seen at the
+unresolved near pairs and acute junctions of a network, whose contact matrix is not a
+P-matrix); those the answer violates are counted in :attr:`ContactModel.violated`.
 """
 from dataclasses import dataclass
 
@@ -197,6 +213,7 @@ class ContactModel:
         self.status = self.initial_status.copy()
         self.direction = self.initial_direction.copy()
         self.flips = np.zeros(self.n, dtype=np.int64)
+        self.inconsistent = np.zeros(self.n, dtype=bool)  # held elements the last update would change
         self.direction_damping = np.ones(self.n)          # 3D slip-direction step, per element
         self._last_turn = np.zeros(self.n)                 # the last rotation applied (signed, rad)
         self._rows = None
@@ -205,6 +222,12 @@ class ContactModel:
     def frozen(self):
         """Elements whose status stopped changing because they flipped too often."""
         return int(np.count_nonzero(self.flips > self.max_flips))
+
+    @property
+    def violated(self):
+        """Held elements whose contact conditions fail (beyond the band) at the last update:
+        at a converged iterate, the elements whose conditions the answer violates."""
+        return int(np.count_nonzero(self.inconsistent))
 
     @property
     def closed(self):
@@ -298,7 +321,17 @@ class ContactModel:
 
     def update(self, dd, contact_traction):
         """Update the statuses from the iterate ``dd`` (N*d,) and the contact traction
-        ``c = A dd + B p - f`` (N*d,); returns the number of elements that changed."""
+        ``c = A dd + B p - f`` (N*d,); returns the number of elements that changed.
+
+        The statuses are those of the complementarity functions (module docstring), read at
+        the iterate whatever the element's status, with a band ``tol_c = k tol_w`` around
+        each switch that the status must cross to change:
+
+        * closed where the normal indicator ``lambda~ = -c_n - k (w - w_p)`` is positive;
+        * a closed element sticks where its tangential trial traction
+          ``t = c_s + k (s - s^n)`` is within the friction bound
+          ``C_0 + mu lambda~``, and slips along ``t`` where it is beyond it.
+        """
         n, d = self.n, self.d
         dd = np.asarray(dd).reshape(n, d)
         c = np.asarray(contact_traction).reshape(n, d)
@@ -306,46 +339,48 @@ class ContactModel:
         opening = np.sum(dd * normals, axis=1)
         c_n = np.sum(c * normals, axis=1)
         c_s = c - c_n[:, None] * normals
-        tau = np.linalg.norm(c_s, axis=1)
-        strength = self.law.cohesion - self.law.friction * c_n
         increment = dd - opening[:, None] * normals - self.shear_start
-        new_status = self.status.copy()
-        new_direction = self.direction.copy()
+        k = self.stiffness
         enabled = self.law.enabled
         scale = np.max(np.linalg.norm(dd, axis=1)) if n else 0.0  # the largest DD (opening or slip)
         tol_w = self.relative_tolerance * max(scale, 1e-30)
-        tol_c = self.stiffness * tol_w
-        is_open, closed, slip = self.status == OPEN, self.status != OPEN, self.status == SLIP
-        # open -> stick when the faces interpenetrate
-        close = enabled & is_open & (opening < self.propped_width - tol_w)
-        new_status[close] = STICK
-        # closed -> open when the contact traction turns tensile
-        release = enabled & closed & (c_n > tol_c)
-        new_status[release] = OPEN
-        # stick -> slip when the shear exceeds the strength
-        stay = enabled & closed & ~release
-        to_slip = stay & (self.status == STICK) & (tau > strength + tol_c)
-        new_status[to_slip] = SLIP
-        new_direction[to_slip] = c_s[to_slip] / tau[to_slip, None]
-        # slip: follow the slip increment; stick again if it reverses
-        slipping = stay & slip
-        along = np.sum(increment * self.direction, axis=1)
-        increment_norm = np.linalg.norm(increment, axis=1)
-        reverse = slipping & (along < -tol_w)
-        new_status[reverse] = STICK
-        follow = slipping & ~reverse & (increment_norm > 0.0)
+        tol_c = k * tol_w
+        was_closed, was_slip = self.status != OPEN, self.status == SLIP
+        # normal: closed where lambda~ > 0 (a status crosses the band to change)
+        pressure = -c_n - k * (opening - self.propped_width)
+        closed = enabled & np.where(was_closed, pressure >= -tol_c, pressure > tol_c)
+        # tangential: stick within the bound, slip along the trial traction beyond it
+        trial = c_s + k[:, None] * increment
+        trial_norm = np.linalg.norm(trial, axis=1)
+        bound = self.law.cohesion + self.law.friction * np.maximum(pressure, 0.0)
+        frictionless = (self.law.cohesion == 0.0) & (self.law.friction == 0.0)
+        slip = closed & np.where(was_slip, trial_norm >= bound - tol_c, trial_norm > bound + tol_c)
+        new_status = np.where(closed, np.where(slip, SLIP, STICK), OPEN).astype(np.int64)
+        new_direction = self.direction.copy()
+        starts = slip & ~was_slip
+        new_direction[starts] = trial[starts] / trial_norm[starts, None]
         turned = np.zeros(n, dtype=bool)
-        if d == 3 and np.any(follow):
-            turned, directions = self._turn(follow, increment, increment_norm, tol_w)
-            new_direction[turned] = directions
+        stays = slip & was_slip
+        if d == 2:
+            # the trial traction against the slip: it slips the other way (a frictionless
+            # element's rows are the same both ways: it keeps its direction)
+            along = np.sum(trial * self.direction, axis=1)
+            turned = stays & ~frictionless & (along < -tol_c)
+            new_direction[turned] = -self.direction[turned]
+        else:
+            # (a frictionless element's rows do not depend on its direction: it keeps it)
+            follow = stays & ~frictionless & (np.linalg.norm(increment, axis=1) > 0.0)
+            if np.any(follow):
+                turned, directions = self._turn(follow, increment, np.linalg.norm(increment, axis=1), tol_w)
+                new_direction[turned] = directions
         new_direction[new_status != SLIP] = 0.0
         # elements that flipped too often are held closed and stuck (the most constrained
-        # state: bounded DDs, a friction law violated at most by the last oscillation)
-        changed = new_status != self.status
-        self.flips += changed
-        frozen = self.flips > self.max_flips
-        new_status[frozen] = STICK
-        new_direction[frozen] = 0.0
+        # state: bounded DDs); those whose conditions fail there are counted (:attr:`violated`)
+        self.flips += new_status != self.status
+        held = self.flips > self.max_flips
+        self.inconsistent = held & (new_status != STICK)
+        new_status[held] = STICK
+        new_direction[held] = 0.0
         changed = (new_status != self.status) | (turned & (new_status == SLIP))
         self.status, self.direction = new_status, new_direction
         n_changed = int(np.count_nonzero(changed))

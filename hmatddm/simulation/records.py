@@ -44,6 +44,7 @@ class StepTally:
         for key in _SOLVE_COUNTS:
             setattr(self, key, getattr(self, key) + info.get(key, 0))
         self.events.contact_frozen = max(self.events.contact_frozen, info.get("contact_frozen", 0))
+        self.events.contact_violated = max(self.events.contact_violated, info.get("contact_violated", 0))
 
 
 def step_record(simulation, flow, width, tally, relaxation, seconds, start=None):

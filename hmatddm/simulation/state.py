@@ -99,6 +99,7 @@ class StepEvents:
     natural_deflected: int = 0     # tips deflected into (activating) a natural element
     natural_newly_failed: int = 0  # intact natural elements that failed remotely
     contact_frozen: int = 0        # contact elements frozen by the contact iterations (largest)
+    contact_violated: int = 0      # ... of them violating their contact conditions at convergence (largest)
     junctions: int = 0             # tips stopped at another hydraulic fracture
 
 

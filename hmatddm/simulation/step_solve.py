@@ -81,7 +81,7 @@ def solve(simulation, trial, start, t_old, t_new, relaxation, provisional=False)
     :class:`~hmatddm.simulation.state.StepStart`) to ``t_new`` on the mesh of ``trial``
     (a :class:`~hmatddm.simulation.state.State`), from its DD and pressure with
     relaxation ``relaxation``: ``(trial with the solution, info, SolvedMesh)``;
-    ``info`` is :func:`hmatddm.coupled.solve_step`'s plus ``contact_frozen`` and
+    ``info`` is :func:`hmatddm.coupled.solve_step`'s plus ``contact_frozen``, ``contact_violated`` and
     ``drained`` (the remotely failed elements no fluid reaches).
 
     ``provisional=True``: the solution may be the first (loose) iterate, with
@@ -139,10 +139,11 @@ def finish(trial, info):
 
 def _with_solution(trial, problem, dd, p, info):
     """``trial`` holding the solution ``dd``, ``p`` of ``problem`` (and its contact
-    statuses); adds ``contact_frozen`` to ``info``."""
+    statuses); adds ``contact_frozen`` and ``contact_violated`` to ``info``."""
     contact = problem.contact
     solution = dict(dd=dd.reshape(trial.mesh.n_elements, trial.mesh.dim), pressure=p)
     if contact is not None:
         solution.update(contact_status=contact.status.copy(), slip_direction=contact.direction.copy())
     info["contact_frozen"] = 0 if contact is None else contact.frozen
+    info["contact_violated"] = getattr(contact, "violated", 0)
     return replace(trial, **solution)

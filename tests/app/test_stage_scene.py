@@ -84,11 +84,13 @@ def test_limited_entry_feeds_the_interior_clusters_the_stress_shadow_starves(tmp
 def test_the_bounding_layers_hold_the_middle_fractures_height(tmp_path):
     """The middle cluster's fracture with limited entry in the three-layer stack, against the
     same run with the bounding layers' stress and modulus equal to the pay zone's (uniform rock),
-    after the scene's 70 s (benchmarks/RESULTS.md, issue 35: 16 m against 22 m)."""
+    after the scene's 70 s: 14 m against 16 m, at least one row of 2 m elements taller in uniform
+    rock (benchmarks/RESULTS.md, issue 33, eighth session: the 22 m of issue 35's uniform run came
+    on a path that held one element violating its contact conditions in 60 of its 84 solves)."""
     run(tmp_path / "layers", "well.perforations=1", "output.snapshots=false")
     run(tmp_path / "uniform", "well.perforations=1", "output.snapshots=false", "layer[0].s_hmin=35.85e6",
         "layer[2].s_hmin=35.85e6", "layer[0].shear_modulus=6.62e9", "layer[2].shear_modulus=6.62e9")
     _, held = fracture_extent(tmp_path / "layers", 2)
     _, free = fracture_extent(tmp_path / "uniform", 2)
     assert held <= 12.0 + 4.0  # the pay zone, and at most one row of 2 m elements into each bounding layer
-    assert free > held + 2.0
+    assert free >= held + 2.0

@@ -133,6 +133,48 @@ def test_active_set_stops_cycling():
     for k in range(10):  # alternately interpenetrating and tensile: an inconsistent pair
         model.update(closing, np.zeros(2)) if model.status[0] == OPEN else model.update(np.zeros(2), opening)
     assert model.frozen == 1 and model.status[0] == STICK
+    # held: counted as violating while its conditions fail there, not where they hold
+    assert model.update(np.zeros(2), opening) == 0 and model.violated == 1
+    assert model.update(np.zeros(2), -opening) == 0 and model.violated == 0
+
+
+def _one_element(status, friction=0.0, direction=(0.0, 0.0)):
+    law = ContactLaw(np.ones(1, bool), np.full(1, friction), np.zeros(1))
+    return ContactModel(law, [[0.0, 1.0]], np.zeros((1, 2)), np.array([status]), [direction], np.full(1, 1e9))
+
+
+def test_a_closed_element_still_interpenetrating_does_not_open_on_a_smaller_tension():
+    """At a relaxed iterate a closed element is neither at w = 0 nor free of traction: the
+    normal complementarity function ``-c_n - k w`` keeps it closed while it interpenetrates
+    by more than its tension over ``k`` (the test of one status at a time opened it)."""
+    model = _one_element(STICK)
+    assert model.update(np.array([0.0, -1e-5]), np.array([0.0, 5e3])) == 0  # k w = -1e4 Pa beyond 5e3 Pa
+    assert model.status[0] == STICK
+    assert model.update(np.array([0.0, -1e-5]), np.array([0.0, 2e4])) == 1  # the tension wins
+    assert model.status[0] == OPEN
+    assert model.violated == 0
+
+
+def test_a_frictionless_element_whose_slip_reverses_keeps_slipping():
+    """Without friction or cohesion a closed element carries no shear: a reversed slip
+    increment does not make it stick (it cycled stick <-> slip on the 4x network), and its
+    direction, whose rows are the same both ways, stays."""
+    model = _one_element(SLIP, direction=(1.0, 0.0))
+    assert model.update(np.array([-1e-3, 0.0]), np.array([0.0, -1e6])) == 0  # k ds = -1e6 Pa
+    assert model.status[0] == SLIP and model.direction[0, 0] == 1.0
+
+
+def test_a_frictional_slip_that_reverses_sticks_or_slips_the_other_way():
+    """Coulomb: a slipping element on its bound (c_s = mu |c_n| m) whose trial traction
+    ``c_s + k ds`` falls inside the bound sticks; beyond the bound the other way it slips
+    the other way."""
+    model = _one_element(SLIP, friction=0.5, direction=(1.0, 0.0))
+    traction = np.array([0.5e6, -1e6])  # on the bound along +x
+    assert model.update(np.array([-4e-4, 0.0]), traction) == 1  # |0.5e6 - 0.4e6| < 0.5e6 Pa
+    assert model.status[0] == STICK
+    model = _one_element(SLIP, friction=0.5, direction=(1.0, 0.0))
+    assert model.update(np.array([-1.5e-3, 0.0]), traction) == 1  # 0.5e6 - 1.5e6 beyond -0.5e6 Pa
+    assert model.status[0] == SLIP and model.direction[0, 0] == -1.0
 
 
 @pytest.mark.parametrize("gain", [-1.2, -1.8, 0.5])
@@ -145,11 +187,12 @@ def test_slip_direction_settles_when_the_increment_overshoots(gain):
     start = 0.3
     model = ContactModel(law, [[0.0, 0.0, 1.0]], np.zeros((1, 3)), np.array([SLIP]),
                          [[np.cos(start), np.sin(start), 0.0]], np.ones(1))
-    traction = np.array([0.0, 0.0, -1e6])  # closed, compressive
     changes = []
     for _ in range(60):
         tilt = np.arctan2(model.direction[0, 1], model.direction[0, 0])
         increment = 2e-7 * np.array([np.cos(gain * tilt), np.sin(gain * tilt), 0.0])
+        # closed, compressive, the shear traction on the friction bound along m (its slip rows)
+        traction = np.array([0.0, 0.0, -1e6]) + 0.3e6 * model.direction[0]
         changes.append(model.update(increment, traction))
     tilt = np.arctan2(model.direction[0, 1], model.direction[0, 0])
     assert model.status[0] == SLIP and model.frozen == 0
@@ -179,6 +222,8 @@ def test_activated_natural_elements_never_interpenetrate_and_obey_coulomb():
     check_contact_conditions(sim)
     for key in ("closed_elements", "slipping_elements", "max_slip", "contact_changes"):
         assert key in records[-1]
+    # every step's active set converged without holding an element (none violated)
+    assert all(r["contact_frozen"] == 0 and r["contact_violated"] == 0 for r in records[1:])
 
 
 @pytest.mark.slow  # two network runs end to end (issue 18 item 8); the dense run is checked by the test above
