@@ -50,9 +50,10 @@ def _point_image(x, y, z, depth, sd, cd, alpha):
     """The 27 values ``du_i / dx_j`` at ``(x, y, z)`` (Okada's frame, ``z <= 0``) of the image
     source's parts A + B + z C (Okada 1992, point source, ``d = depth - z``) for a unit
     potency ``k`` (strike, dip, tensile) at depth ``depth``, times ``2 pi``: ``9 k + m``,
-    ``m = 3 j + i`` in Okada's order (:func:`_combined`, :func:`.okada_stress3d.accumulate`). ``d > 0`` (the source below the
-    surface) keeps ``R + d > 0``. Returned, not stored, so that the Gauss sum of
-    :func:`_point_gradient` stays in registers and is vectorised over its points."""
+    ``m = 3 j + i`` in Okada's order (:func:`_combined`, :func:`.okada_stress3d.accumulate`).
+    ``d > 0`` (the source below the surface) keeps ``R + d > 0``. Returned, not stored, so
+    that the Gauss sum of :func:`_point_gradient` stays in registers and is vectorised over
+    its points."""
     alp1 = 0.5 * (1.0 - alpha)
     alp2 = 0.5 * alpha
     alp3 = (1.0 - alpha) / alpha
@@ -278,7 +279,7 @@ def _point_gradient(point, center, frame, a, b, okada, surface, shear_modulus, p
     """The Gauss sum of :func:`_point_image` into ``work[3]`` (Okada's frame); returns the
     strike's ``(s_x, s_y)`` and Lame's lambda, as :func:`.okada_stress3d.global_stress` takes them.
     Its callers compile with :data:`FAST` and numpy's error model: the sum over the points is
-    then a vectorised loop (2.7x cheaper a point at 4 points, benchmarks/RESULTS.md, issue 32)."""
+    then a vectorised loop (a 2 x 2 sum 2.3x cheaper, benchmarks/RESULTS.md, issue 32)."""
     s0 = okada[0, 0]
     s1 = okada[0, 1]
     sd, cd, lam, alpha = dip_and_medium(s0, s1, okada, shear_modulus, poisson_ratio)
