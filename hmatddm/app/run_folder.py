@@ -60,8 +60,41 @@ def _json_safe(value):
     return value
 
 
-def write_json(path, document):
-    text = json.dumps(_json_safe(document), indent=1, allow_nan=False)
+def _compact(value):
+    return json.dumps(_json_safe(value), allow_nan=False)
+
+
+def json_text(document, encoded=None):
+    """The text of a JSON document (a dict): indented, except that each entry of a list
+    of dicts at the top level (summary.json's ``steps`` and ``reference``) takes one compact
+    line. json's indenting encoder is pure Python, ~3x slower than its compact one, and
+    summary.json is written after every step: re-encoding every record each time made its
+    cost grow as the steps squared (2 s of CPU in a 200-step run, 6% of a 600-step one's).
+    ``encoded`` (a dict the caller keeps between writes): the text of each record of
+    ``steps`` already encoded, by identity; only for records that no longer change once
+    written (the ``reference`` entries are made anew each time and encoded each time)."""
+    parts = []
+    for key, value in document.items():
+        if isinstance(value, list) and value and all(isinstance(entry, dict) for entry in value):
+            lines = []
+            for entry in value:
+                if encoded is None or key != "steps":
+                    lines.append(_compact(entry))
+                    continue
+                known = encoded.get(id(entry))
+                if known is None or known[0] is not entry:  # the record itself is held: no id reused
+                    known = encoded[id(entry)] = (entry, _compact(entry))
+                lines.append(known[1])
+            body = "[\n  " + ",\n  ".join(lines) + "\n ]"
+        else:
+            body = json.dumps(_json_safe(value), indent=1, allow_nan=False)
+        parts.append(f" {json.dumps(str(key))}: {body}")
+    return "{\n" + ",\n".join(parts) + "\n}" if parts else "{}"
+
+
+def write_json(path, document, encoded=None):
+    """Write ``document`` (a dict) as plain JSON (:func:`json_text`), atomically."""
+    text = json_text(document, encoded)
     with atomic_output(path) as temporary:
         temporary.write_text(text + "\n", encoding="utf-8")
 
@@ -390,7 +423,7 @@ def render_folder(out, movie=False):
 
 
 __all__ = ["SUMMARY", "SCENE_FILE", "PVD", "VTU_DIR", "CHECKPOINT_DIR", "SNAPSHOT_DIR", "HISTORY", "SUMMARY_KEYS",
-           "versions", "write_json", "read_summary", "vtu_name", "vtu_steps", "cell_fields", "snapshot_views",
+           "versions", "write_json", "json_text", "read_summary", "vtu_name", "vtu_steps", "cell_fields", "snapshot_views",
            "snapshot_title", "layer_interfaces", "write_snapshots", "write_history", "mesh_from_vtu", "latest_state",
            "read_pvd_entries", "render_folder", "saved_states", "write_profiles", "write_movie", "MOVIE",
            "PROPPANT_HISTORY", "RATE_SPLIT"]

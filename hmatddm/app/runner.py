@@ -109,6 +109,7 @@ class SceneRun:
         self.resumed = False  # whether this session continued a run from a checkpoint
         self._plotter = None  # the ProfilePlotter of the profile pictures, made at the first
         self.profile_seconds = 0.0  # CPU seconds spent on the profile pictures of this session
+        self._encoded_records = {}  # summary.json's step records, encoded once (_write_summary)
 
     # -- public -----------------------------------------------------------------------
     @property
@@ -345,9 +346,11 @@ class SceneRun:
         return {"scene": self.scene.to_dict(), "versions": versions(), "steps": self.steps,
                 "reference": reference, "wall_seconds": wall}
 
-    def _write_summary(self):
+    def _write_summary(self, final=False):
+        """summary.json after a step, each record encoded once (:func:`.run_folder.json_text`:
+        a record does not change once its step is accepted); the final one from scratch."""
         document = self.summary()
-        write_json(self.out / SUMMARY, document)
+        write_json(self.out / SUMMARY, document, None if final else self._encoded_records)
         return document
 
     # -- the end -------------------------------------------------------------------------
@@ -399,7 +402,7 @@ class SceneRun:
                 raise
             except HmatddmError as error:  # e.g. a receiver on an event: the run itself is fine
                 self.note(f"hmatddm: warning: no microseismic catalogue written: {error}")
-        return self._write_summary()
+        return self._write_summary(final=True)
 
 
 def run_scene(scene, out, resume=False, overwrite=False, quiet=False, stream=None):

@@ -28,3 +28,22 @@ def test_vtu_files_are_named_and_found_by_step(tmp_path):
         (tmp_path / run_folder.vtu_name(step)).write_text("")
     (tmp_path / run_folder.VTU_DIR / "notes.txt").write_text("")
     assert list(run_folder.vtu_steps(tmp_path)) == [3, 7, 12]
+
+
+def test_json_text_encodes_each_step_record_once_and_reads_back_as_plain_json():
+    import json
+
+    steps = [{"step": k, "time": np.float64(0.5 * k), "bad": math.nan} for k in range(3)]
+    document = {"scene": {"name": "x", "list": [1, 2]}, "steps": steps, "reference": [{"time": 1.0}], "empty": []}
+    encoded = {}
+    plain = json.loads(run_folder.json_text(document))
+    assert plain == {"scene": {"name": "x", "list": [1, 2]}, "reference": [{"time": 1.0}], "empty": [],
+                     "steps": [{"step": k, "time": 0.5 * k, "bad": None} for k in range(3)]}
+    assert json.loads(run_folder.json_text(document, encoded)) == plain
+    assert len(encoded) == 3  # the step records only, not the reference's entries
+    steps.append({"step": 3, "time": 1.5, "bad": 0.0})
+    steps[0]["time"] = 99.0  # a written record is not encoded again: its first text stays
+    again = json.loads(run_folder.json_text(document, encoded))
+    assert len(encoded) == 4 and again["steps"][0]["time"] == 0.0 and again["steps"][3]["time"] == 1.5
+    assert json.loads(run_folder.json_text(document))["steps"][0]["time"] == 99.0
+    assert run_folder.json_text({}) == "{}"
