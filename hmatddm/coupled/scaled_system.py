@@ -39,9 +39,18 @@ class _CoupledLinearSystem:
         self.s_u = _power_of_two(max(float(np.max(np.abs(dd))), 1e-12))
         self.s_p = _power_of_two(max(float(np.max(np.abs(p))), 1.0))
         self.rows = problem.rows()
-        self.blocks = blocks = problem.elastic.diagonal_blocks(self.rows)
-        self.block_inverse = np.linalg.inv(blocks)  # (N, d, d), M_u^-1 without s_u
+        # (N, d, d) blocks and M_u^-1 without s_u: the same for every iterate of one set of
+        # contact statuses, kept with the problem for the last one
+        key = None if self.rows is None else self.rows.key
+        kept = problem._scaling_blocks
+        if kept is None or kept[0] != key or kept[1] is not problem.elastic.operator:
+            blocks = problem.elastic.diagonal_blocks(self.rows)
+            kept = problem._scaling_blocks = (key, problem.elastic.operator, blocks, np.linalg.inv(blocks))
+        self.blocks, self.block_inverse = kept[2], kept[3]
         self.flow_diagonal = self.flow_matrix.diagonal()
+        #: whether :meth:`compliance_preconditioner` inverts the system to round-off (the
+        #: exact Schur complement with an exact elasticity solve)
+        self.exact_preconditioner = False
 
     @property
     def operator(self):
@@ -80,16 +89,24 @@ class _CoupledLinearSystem:
         :class:`FlowFactor` it uses. The flow block is ``D + omega C'`` (ref. Eq. 4.50), its
         factor ``previous``'s when it may serve again (:meth:`FlowFactor.reusable`), else a
         new factorisation of this iterate's flow block; or, with an exact elasticity solve,
-        the exact Schur complement ``D - C A^-1 B`` (:meth:`StepProblem.coupled_compliance`;
-        the split is then the exact block-triangular factor, GMRES needs ~2 iterations, and
-        no factor is kept: None)."""
+        the exact Schur complement ``S = D - C A^-1 B`` (:meth:`StepProblem.coupled_compliance`;
+        no factor is kept: None) and the whole block LU, ``p = S^-1 (r_p - C A^-1 r_u)``,
+        ``dd = A^-1 (r_u - B p)``: the inverse of the system to round-off
+        (``exact_preconditioner``), which :class:`hmatddm.hmatrix.solvers.ExactPreconditionerSolve`
+        applies once and checks, with no Krylov cycle. (The block-triangular factor alone, one
+        elasticity solve fewer, left GMRES ~1.3 iterations, three products with ``A`` and
+        three applications a solve: 11% more CPU on the dfn-3cluster network at 4x its area.)"""
         problem = self.problem
         coupled = problem.coupled_compliance(self.rows)
         if coupled is not None:
-            with single_threaded_blas():  # an N x N block of a small mesh (hmatddm.hmatrix._threads)
-                factors = scipy.linalg.lu_factor(self.flow_matrix.toarray() - coupled, check_finite=False)
-            flow_solve = lambda r: scipy.linalg.lu_solve(factors, r, check_finite=False)  # noqa: E731
+            schur = self.flow_matrix.toarray() - coupled
+            kept = problem._schur_factor
+            if kept is None or not kept.serves(coupled):
+                kept = problem._schur_factor = SchurFactor(coupled)
+            kept.use(schur)
+            flow_solve = kept.solve
             factor = None
+            self.exact_preconditioner = True
         else:
             leaking = bool(np.any(problem.leak_off_rate))  # see FlowFactor: not kept with leak-off
             if previous is not None and not leaking and previous.reusable(omega, problem.n):
@@ -103,6 +120,8 @@ class _CoupledLinearSystem:
 
         def apply(z):
             r_u, r_p = self.unscale_left(np.asarray(z).ravel())
+            if self.exact_preconditioner:  # the whole block LU: r_p - C A^-1 r_u first
+                r_p = r_p - problem.coupling @ problem.elastic.approximate_inverse(r_u, self.rows)
             p = flow_solve(r_p)
             b_p = problem.b_times(p)
             dd = problem.elastic.approximate_inverse(r_u - (b_p if self.rows is None else self.rows.select_rows(b_p)),
@@ -143,3 +162,57 @@ class FlowFactor:
         if omega != self.omega or n != self.n or self.uses >= self.REUSE_LIMIT or self.fresh_iterations is None:
             return False
         return self.last_iterations <= self.REUSE_ITERATIONS * self.fresh_iterations + 2
+
+
+class SchurFactor:
+    """The LU of the exact Schur complement ``S = D - C A^-1 B`` of one set of contact
+    statuses (one ``C A^-1 B``, :meth:`StepProblem.coupled_compliance`), kept for the next
+    iterates: theirs differ only in the flow block ``D`` of the lagged widths. A solve takes
+    the kept LU with iterative refinement against the iterate's own ``S`` (a product with
+    the dense ``N x N`` complement and an LU solve a sweep) while that reaches
+    :data:`REFINED` of the right-hand side within :data:`MAX_SWEEPS` sweeps, and factorises
+    ``S`` anew otherwise. A factorisation costs ``2/3 N`` times a sweep: on the dfn-3cluster
+    network at 4x its area (~470 cells) the new complement of every iterate took 17% of the
+    run (benchmarks/RESULTS.md, issue 33)."""
+
+    #: Relative residual at which a refined solve is as good as a fresh LU's
+    REFINED = 1e-13
+    #: Refinement sweeps before the complement is factorised anew
+    MAX_SWEEPS = 3
+
+    def __init__(self, coupled):
+        self.coupled = coupled  # the C A^-1 B of its statuses (identity: the cache's array)
+        self.schur = self.factored = self.lu = None
+        self.factorisations = 0
+
+    def serves(self, coupled):
+        """Whether the complement of ``coupled`` may take this LU."""
+        return self.coupled is coupled
+
+    def use(self, schur):
+        """The complement ``S`` of the current iterate (dense ``(N, N)``)."""
+        self.schur = schur
+        if self.lu is None:
+            self._factorise()
+
+    def _factorise(self):
+        with single_threaded_blas():  # an N x N block of a small mesh (hmatddm.hmatrix._threads)
+            self.lu = scipy.linalg.lu_factor(self.schur, check_finite=False)
+        self.factored = self.schur
+        self.factorisations += 1
+
+    def solve(self, r):
+        """``S^-1 r`` to round-off (see the class docstring)."""
+        p = scipy.linalg.lu_solve(self.lu, r, check_finite=False)
+        if self.schur is self.factored:
+            return p
+        target = self.REFINED * float(np.linalg.norm(r))
+        for _ in range(self.MAX_SWEEPS):
+            residual = r - self.schur @ p
+            if not float(np.linalg.norm(residual)) > target:  # NaN: not converged
+                return p
+            p = p + scipy.linalg.lu_solve(self.lu, residual, check_finite=False)
+        if float(np.linalg.norm(r - self.schur @ p)) <= target:
+            return p
+        self._factorise()
+        return scipy.linalg.lu_solve(self.lu, r, check_finite=False)

@@ -66,7 +66,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..errors import ConvergenceError
-from ..hmatrix.solvers import PausableGmres
+from ..hmatrix.solvers import ExactPreconditionerSolve, PausableGmres
 from .acceleration import ACCEPT, IterateMixing
 from .paused import PausedIterate, pause_levels
 from .scaled_system import _CoupledLinearSystem
@@ -132,9 +132,11 @@ def _coupled_iteration(problem, settings, dd, p, alpha, counters, first=False, p
     elif rtol is None:
         rtol = settings.linear_rtol
     levels = pause_levels(settings) if pause is not None else None
-    solver = PausableGmres(system.operator, system.rhs(flow_rhs), M=preconditioner, rtol=rtol,
-                           restart=settings.linear_restart, maxiter=settings.linear_maxiter, x0=guess,
-                           pause_rtol=levels or None)
+    # an exact preconditioner solves the system: checked by its residual, no Krylov cycle
+    method = ExactPreconditionerSolve if system.exact_preconditioner else PausableGmres
+    solver = method(system.operator, system.rhs(flow_rhs), M=preconditioner, rtol=rtol,
+                    restart=settings.linear_restart, maxiter=settings.linear_maxiter, x0=guess,
+                    pause_rtol=levels or None)
     paused = PausedIterate(solver, system.split, dd, p, alpha, counters)
     linear = counters["linear"]
     iterate = _continued(paused.advance)

@@ -127,6 +127,10 @@ class StepProblem:
         self.flow_factor = None  # the last iterate's FlowFactor (hmatddm.coupled.scaled_system)
         self._coupled_compliance = (None, None)  # (rows key, C A^-1 B) of the last active set
         self._base_compliance = (None, None)  # (X_0, C X_0) of the contact factor's base
+        # (rows key, operator, blocks, their inverses) of the coupled system's scaling, for the
+        # last set of statuses (hmatddm.coupled.scaled_system)
+        self._scaling_blocks = None
+        self._schur_factor = None  # the kept LU of the exact Schur complement (scaled_system.SchurFactor)
 
     def elastic_matvec(self, dd):
         """``A dd``; the last product is kept: an iteration's first residual (and the
@@ -195,9 +199,17 @@ class StepProblem:
         matrix, rhs = self.flow.assemble(self.width(dd), self.width_old, self.pressure_old, self.dt,
                                          self.leak_off_rate, pressure_iterate=p)
         if np.any(self.fixed):  # drained elements: p_i = p_fixed, scaled like the other rows
+            matrix = matrix.tocsr()
             diagonal = matrix.diagonal()
             scale = float(np.mean(np.abs(diagonal[~self.fixed]))) if np.any(~self.fixed) else 1.0
-            free = (~self.fixed).astype(np.float64)
-            matrix = (sp.diags(free) @ matrix + sp.diags(scale * self.fixed)).tocsr()
+            row = np.repeat(np.arange(self.n), np.diff(matrix.indptr))
+            on_diagonal = np.flatnonzero(matrix.indices == row)
+            if on_diagonal.size == self.n:  # every diagonal stored: the rows rescaled in place
+                matrix = matrix.copy()
+                matrix.data[self.fixed[row]] = 0.0
+                matrix.data[on_diagonal] += scale * self.fixed[row[on_diagonal]]
+            else:
+                free = (~self.fixed).astype(np.float64)
+                matrix = (sp.diags(free) @ matrix + sp.diags(scale * self.fixed)).tocsr()
             rhs = np.where(self.fixed, scale * np.nan_to_num(self.fixed_pressure), rhs)
         return matrix, rhs

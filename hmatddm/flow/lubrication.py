@@ -231,10 +231,9 @@ class LubricationModel:
         diagonal = storage + leak
         np.add.at(diagonal, f.first, k)
         np.add.at(diagonal, f.second, k)
-        rows = np.concatenate([np.arange(n), f.first, f.second])
-        cols = np.concatenate([np.arange(n), f.second, f.first])
-        values = np.concatenate([diagonal, -k, -k])
-        matrix = sp.csr_matrix((values, (rows, cols)), shape=(n, n))
+        indices, indptr, slot = self._pattern()
+        data = np.bincount(slot, weights=np.concatenate([diagonal, -k, -k]), minlength=indices.size)
+        matrix = sp.csr_matrix((data, indices.copy(), indptr.copy()), shape=(n, n))
         rhs = (self.injection() + storage * pressure_old + self.areas * width_old / dt
                + leak * self.leak_off.pore_pressure)
         if correction is not None:  # the linearised power-law flux: F_e = k_e dp_e - r_e
@@ -246,6 +245,23 @@ class LubricationModel:
             matrix = (matrix + well_matrix).tocsr()
             rhs = rhs + well_rhs
         return matrix, rhs
+
+    def _pattern(self):
+        """The CSR pattern of ``D`` (each cell's diagonal, the two entries of each face) and
+        the slot of each assembled value in it, ``(indices, indptr, slot)``: made once per
+        model (mesh), not sorted again at every nonlinear iterate as a COO matrix's would be."""
+        n, f = self.n_elements, self.faces
+        cached = getattr(self, "_csr_pattern", None)
+        if cached is not None and cached[0] is f and cached[1] == n:
+            return cached[2]
+        rows = np.concatenate([np.arange(n), f.first, f.second]).astype(np.int64)
+        cols = np.concatenate([np.arange(n), f.second, f.first]).astype(np.int64)
+        unique, slot = np.unique(rows * n + cols, return_inverse=True)
+        indptr = np.zeros(n + 1, dtype=np.int32)
+        np.cumsum(np.bincount(unique // n, minlength=n), out=indptr[1:])
+        pattern = ((unique % n).astype(np.int32), indptr, slot.ravel())
+        self._csr_pattern = (f, n, pattern)
+        return pattern
 
     def cluster_rates(self, pressure):
         """The rate into each cluster (m^3/s) at the element pressures ``pressure``: the fixed

@@ -238,6 +238,54 @@ class PausableGmres:
         return self.result
 
 
+class ExactPreconditionerSolve:
+    """A solve with a preconditioner ``M`` that inverts ``A`` to round-off (e.g. the exact
+    Schur complement of a small coupled system, :mod:`hmatddm.coupled.scaled_system`):
+    ``x = M b``, accepted when its true residual meets ``rtol``; otherwise a
+    :class:`PausableGmres` continues from it (the same arguments, ``x0`` replaced by ``M b``).
+    One product with ``M`` and one with ``A``, where GMRES with such an ``M`` makes three of
+    each (the initial and final residuals, ``M b`` for its inner test, one iteration). The
+    interface of :class:`PausableGmres`: :meth:`pause` and :meth:`finish` return the solution
+    at once (``iterations`` 0) when the check passed."""
+
+    def __init__(self, A, b, M, rtol=1e-8, restart=50, maxiter=20, x0=None, max_restart=None, pause_rtol=None):
+        self.result = None
+        self.level = None
+        self._rtol = rtol
+        self._gmres = None
+        b = np.asarray(b, dtype=np.float64).reshape(-1)
+        with single_threaded_blas():
+            x = np.asarray(spla.aslinearoperator(M).matvec(b), dtype=np.float64).reshape(-1)
+            b_norm = float(np.linalg.norm(b))
+            residual = math.inf
+            if np.all(np.isfinite(x)) and b_norm > 0.0:
+                residual = float(np.linalg.norm(b - np.asarray(spla.aslinearoperator(A).matvec(x)).reshape(-1)))
+                residual /= b_norm
+        if b_norm == 0.0 or residual <= rtol:
+            self.result = (x if b_norm > 0.0 else np.zeros_like(b),
+                           {"iterations": 0, "residual": 0.0 if b_norm == 0.0 else residual, "converged": True,
+                            "restart": 0, "cycles": 0})
+        else:  # not exact after all (round-off of an ill-conditioned M): iterate from M b
+            start = x if np.all(np.isfinite(x)) else x0
+            self._gmres = PausableGmres(A, b, M, rtol, restart, maxiter, start, max_restart, pause_rtol)
+
+    def pause(self):
+        """As :meth:`PausableGmres.pause`."""
+        if self._gmres is None:
+            self.level = self._rtol
+            return self.result[0], self.result[1]["iterations"]
+        x, iterations = self._gmres.pause()
+        self.result, self.level = self._gmres.result, self._gmres.level
+        return x, iterations
+
+    def finish(self):
+        """As :meth:`PausableGmres.finish`."""
+        if self._gmres is not None:
+            self.result = self._gmres.finish()
+        self.level = self._rtol
+        return self.result
+
+
 def _gmres_steps(A, b, M, rtol, restart, maxiter, x0, max_restart, pauses):
     """The iteration of :class:`PausableGmres` as a generator: yields ``(x, iterations,
     level)`` at the pauses (``pauses``: decreasing relative residuals), returns ``(x, info)``. The caller limits BLAS to one thread

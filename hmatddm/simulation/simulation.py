@@ -232,6 +232,7 @@ class Simulation:
                                                                                              max_elements)
         self.proppant, self.pump_schedule = _checked_proppant(proppant, pump_schedule)
         self.records = []
+        self._encoded_records = {}  # the records' checkpoint text, encoded once (checkpoint.metadata_text)
         self.front = None  # propagation.front == "asymptotic": its AsymptoticFront (raises for unsupported setups)
         if propagation is not None and propagation.front == "asymptotic":
             from .asymptotic import AsymptoticFront
@@ -601,7 +602,7 @@ class Simulation:
         metadata = dict(s.scalars(), records=self.records, fingerprint=self.fingerprint(),
                         compressed_elements=self.compressed_elements, image_choice=self.operators.image_choice)
         checkpoint.save(self.checkpoint_dir, s.step, s.arrays(), metadata,
-                        keep=self.checkpoint_settings.keep_checkpoints)
+                        keep=self.checkpoint_settings.keep_checkpoints, encoded=self._encoded_records)
 
     def load_checkpoint(self):
         arrays, metadata = checkpoint.load_latest(self.checkpoint_dir)

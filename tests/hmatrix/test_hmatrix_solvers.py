@@ -280,3 +280,28 @@ def test_a_paused_gmres_finishes_bit_for_bit_as_an_unpaused_one(spd_problem):
     assert solver.result is not None and iterations == solver.result[1]["iterations"]
     with pytest.raises(InputError, match="pause_rtol"):
         PausableGmres(h, b, rtol=1e-6, pause_rtol=1e-8).pause()
+
+
+def test_an_exact_preconditioner_solves_at_once_and_an_inexact_one_falls_back_to_gmres(spd_problem):
+    # ExactPreconditionerSolve: M = A^-1 (dense LU) gives M b, checked by its residual, with no
+    # iteration; an M that is not exact (block Jacobi) leaves the check failing and GMRES
+    # continues from M b to the same tolerance as a plain solve.
+    import scipy.linalg
+
+    from hmatddm.hmatrix.solvers import ExactPreconditionerSolve
+
+    h, dense, b = spd_problem
+    lu = scipy.linalg.lu_factor(dense)
+    exact = spla.LinearOperator(dense.shape, matvec=lambda v: scipy.linalg.lu_solve(lu, v), dtype=np.float64)
+    solver = ExactPreconditionerSolve(h, b, exact, rtol=1e-8, pause_rtol=1e-4)
+    x, iterations = solver.pause()
+    assert iterations == 0 and solver.result is not None and solver.level == 1e-8
+    x_dense = np.linalg.solve(dense, b)
+    assert np.linalg.norm(x - x_dense) <= 1e-7 * np.linalg.norm(x_dense)
+    assert solver.finish()[1]["residual"] <= 1e-8
+    inexact = default_preconditioner(h)
+    solver = ExactPreconditionerSolve(h, b, inexact, rtol=1e-10, restart=50, maxiter=10)
+    x, info = solver.finish()
+    assert info["iterations"] > 0 and np.linalg.norm(b - dense @ x) <= 1e-9 * np.linalg.norm(b)
+    zero = ExactPreconditionerSolve(h, np.zeros_like(b), exact)
+    assert not zero.finish()[0].any()

@@ -202,3 +202,21 @@ def test_relaxation_grows_back_after_an_easy_step_in_the_coupled_schemes(monkeyp
     assert hd.SchemeSettings(scheme=scheme).relaxation_growth == (2.0 if scheme == "krylov" else 1.0)
     with pytest.raises(InputError, match="relaxation_growth"):
         hd.SchemeSettings(scheme=scheme, relaxation_growth=0.5)
+
+
+def test_checkpoint_metadata_encodes_each_record_once_and_reads_back(tmp_path):
+    records = [{"step": k, "time": 0.5 * k, "b": [1, 2]} for k in range(3)]
+    document = {"time": 1.5, "records": records, "fingerprint": "x"}
+    encoded = {}
+    text = checkpoints.metadata_text(document, encoded)
+    assert json.loads(text) == document == json.loads(checkpoints.metadata_text(document))
+    assert len(encoded) == 3
+    records.append({"step": 3, "time": 1.5, "b": []})
+    records[0]["time"] = 99.0  # an encoded record is not encoded again
+    again = json.loads(checkpoints.metadata_text(document, encoded))
+    assert len(encoded) == 4 and again["records"][0]["time"] == 0.0 and again["records"][3]["step"] == 3
+    assert json.loads(checkpoints.metadata_text({"records": []})) == {"records": []}
+    assert json.loads(checkpoints.metadata_text({"a": 1})) == {"a": 1}
+    checkpoints.save(tmp_path, 4, {"x": np.arange(3)}, document, encoded=encoded)
+    arrays, metadata = checkpoints.load(tmp_path, 4)
+    assert metadata["records"][3] == records[3] and list(arrays["x"]) == [0, 1, 2]
