@@ -84,18 +84,21 @@ class _CoupledLinearSystem:
     def rhs(self, flow_rhs):
         return self.left_scale(self.problem.elastic_rhs(self.rows), flow_rhs)
 
-    def compliance_preconditioner(self, omega, previous=None):
+    def compliance_preconditioner(self, omega, previous=None, rtol=None):
         """Inverse of the scaled fracture-compliance split, as a LinearOperator, and the
         :class:`FlowFactor` it uses. The flow block is ``D + omega C'`` (ref. Eq. 4.50), its
         factor ``previous``'s when it may serve again (:meth:`FlowFactor.reusable`), else a
         new factorisation of this iterate's flow block; or, with an exact elasticity solve,
         the exact Schur complement ``S = D - C A^-1 B`` (:meth:`StepProblem.coupled_compliance`;
         no factor is kept: None) and the whole block LU, ``p = S^-1 (r_p - C A^-1 r_u)``,
-        ``dd = A^-1 (r_u - B p)``: the inverse of the system to round-off
+        ``dd = A^-1 r_u - (A^-1 B) p`` (:meth:`StepProblem.inverse_b_times`): the inverse of
+        the system to round-off
         (``exact_preconditioner``), which :class:`hmatddm.hmatrix.solvers.ExactPreconditionerSolve`
         applies once and checks, with no Krylov cycle. (The block-triangular factor alone, one
         elasticity solve fewer, left GMRES ~1.3 iterations, three products with ``A`` and
-        three applications a solve: 11% more CPU on the dfn-3cluster network at 4x its area.)"""
+        three applications a solve: 11% more CPU on the dfn-3cluster network at 4x its area.)
+        ``rtol``: the relative residual the solve asks for (the kept Schur LU refines its
+        solves to :data:`SchurFactor.ACCURACY` of it; None: to round-off)."""
         problem = self.problem
         coupled = problem.coupled_compliance(self.rows)
         if coupled is not None:
@@ -103,7 +106,8 @@ class _CoupledLinearSystem:
             kept = problem._schur_factor
             if kept is None or not kept.serves(coupled):
                 kept = problem._schur_factor = SchurFactor(coupled)
-            kept.use(schur)
+            kept.use(schur, SchurFactor.REFINED if rtol is None else max(SchurFactor.REFINED,
+                                                                        SchurFactor.ACCURACY * rtol))
             flow_solve = kept.solve
             factor = None
             self.exact_preconditioner = True
@@ -120,8 +124,10 @@ class _CoupledLinearSystem:
 
         def apply(z):
             r_u, r_p = self.unscale_left(np.asarray(z).ravel())
-            if self.exact_preconditioner:  # the whole block LU: r_p - C A^-1 r_u first
-                r_p = r_p - problem.coupling @ problem.elastic.approximate_inverse(r_u, self.rows)
+            if self.exact_preconditioner:  # the whole block LU, A^-1 B p from C A^-1 B's terms
+                y = problem.elastic.approximate_inverse(r_u, self.rows)
+                p = flow_solve(r_p - problem.coupling @ y)
+                return np.concatenate([(y - problem.inverse_b_times(p, self.rows)) / self.s_u, p / self.s_p])
             p = flow_solve(r_p)
             b_p = problem.b_times(p)
             dd = problem.elastic.approximate_inverse(r_u - (b_p if self.rows is None else self.rows.select_rows(b_p)),
@@ -169,29 +175,34 @@ class SchurFactor:
     statuses (one ``C A^-1 B``, :meth:`StepProblem.coupled_compliance`), kept for the next
     iterates: theirs differ only in the flow block ``D`` of the lagged widths. A solve takes
     the kept LU with iterative refinement against the iterate's own ``S`` (a product with
-    the dense ``N x N`` complement and an LU solve a sweep) while that reaches
-    :data:`REFINED` of the right-hand side within :data:`MAX_SWEEPS` sweeps, and factorises
-    ``S`` anew otherwise. A factorisation costs ``2/3 N`` times a sweep: on the dfn-3cluster
-    network at 4x its area (~470 cells) the new complement of every iterate took 17% of the
-    run (benchmarks/RESULTS.md, issue 33)."""
+    the dense ``N x N`` complement and an LU solve a sweep) to the iterate's target (at
+    least :data:`REFINED`, :data:`ACCURACY` of the solve's tolerance) within
+    :data:`MAX_SWEEPS` sweeps, and factorises ``S`` anew as soon as the sweeps' contraction
+    says they will not get there. A factorisation costs ``~N / 5`` sweeps: on the
+    dfn-3cluster network at 4x its area (~470 cells) the new complement of every iterate
+    took 17% of the run (benchmarks/RESULTS.md, issue 33)."""
 
-    #: Relative residual at which a refined solve is as good as a fresh LU's
+    #: Relative residual of a refined solve that needs no better (round-off of a fresh LU's)
     REFINED = 1e-13
-    #: Refinement sweeps before the complement is factorised anew
-    MAX_SWEEPS = 3
+    #: ... and the fraction of the coupled solve's tolerance a refined flow solve reaches
+    ACCURACY = 1e-2
+    #: Refinement sweeps at most before the complement is factorised anew
+    MAX_SWEEPS = 8
 
     def __init__(self, coupled):
         self.coupled = coupled  # the C A^-1 B of its statuses (identity: the cache's array)
         self.schur = self.factored = self.lu = None
+        self.target = self.REFINED
         self.factorisations = 0
 
     def serves(self, coupled):
         """Whether the complement of ``coupled`` may take this LU."""
         return self.coupled is coupled
 
-    def use(self, schur):
-        """The complement ``S`` of the current iterate (dense ``(N, N)``)."""
-        self.schur = schur
+    def use(self, schur, target=REFINED):
+        """The complement ``S`` of the current iterate (dense ``(N, N)``) and the relative
+        residual its solves reach."""
+        self.schur, self.target = schur, target
         if self.lu is None:
             self._factorise()
 
@@ -202,17 +213,24 @@ class SchurFactor:
         self.factorisations += 1
 
     def solve(self, r):
-        """``S^-1 r`` to round-off (see the class docstring)."""
+        """``S^-1 r`` to the target (see the class docstring)."""
         p = scipy.linalg.lu_solve(self.lu, r, check_finite=False)
         if self.schur is self.factored:
             return p
-        target = self.REFINED * float(np.linalg.norm(r))
-        for _ in range(self.MAX_SWEEPS):
+        target = self.target * float(np.linalg.norm(r))
+        previous = None
+        for sweep in range(self.MAX_SWEEPS + 1):
             residual = r - self.schur @ p
-            if not float(np.linalg.norm(residual)) > target:  # NaN: not converged
+            size = float(np.linalg.norm(residual))
+            if size <= target:
                 return p
+            if not math.isfinite(size) or sweep == self.MAX_SWEEPS:
+                break
+            if previous is not None:  # the contraction so far: give up early when it cannot reach the target
+                rate = size / previous
+                if rate >= 1.0 or size * rate ** (self.MAX_SWEEPS - sweep) > target:
+                    break
+            previous = size
             p = p + scipy.linalg.lu_solve(self.lu, residual, check_finite=False)
-        if float(np.linalg.norm(r - self.schur @ p)) <= target:
-            return p
         self._factorise()
         return scipy.linalg.lu_solve(self.lu, r, check_finite=False)

@@ -118,19 +118,19 @@ def _coupled_iteration(problem, settings, dd, p, alpha, counters, first=False, p
     matrix, flow_rhs = problem.flow_matrices(dd, p)
     if not (np.all(np.isfinite(matrix.data)) and np.all(np.isfinite(flow_rhs))):
         raise _Diverged("non-finite flow matrix")
-    try:
-        system = _CoupledLinearSystem(problem, matrix, dd, p)
-        preconditioner = factor = None
-        if settings.scheme == "krylov":
-            preconditioner, factor = system.compliance_preconditioner(settings.omega, problem.flow_factor)
-            problem.flow_factor = factor
-    except (RuntimeError, np.linalg.LinAlgError) as error:  # singular flow or diagonal blocks
-        raise _Diverged(f"singular coupled system: {error}") from None
-    guess = np.concatenate([dd / system.s_u, p / system.s_p])
     if first:
         rtol = max(settings.linear_rtol, settings.first_linear_rtol)
     elif rtol is None:
         rtol = settings.linear_rtol
+    try:
+        system = _CoupledLinearSystem(problem, matrix, dd, p)
+        preconditioner = factor = None
+        if settings.scheme == "krylov":
+            preconditioner, factor = system.compliance_preconditioner(settings.omega, problem.flow_factor, rtol)
+            problem.flow_factor = factor
+    except (RuntimeError, np.linalg.LinAlgError) as error:  # singular flow or diagonal blocks
+        raise _Diverged(f"singular coupled system: {error}") from None
+    guess = np.concatenate([dd / system.s_u, p / system.s_p])
     levels = pause_levels(settings) if pause is not None else None
     # an exact preconditioner solves the system: checked by its residual, no Krylov cycle
     method = ExactPreconditionerSolve if system.exact_preconditioner else PausableGmres

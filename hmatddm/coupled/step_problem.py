@@ -16,10 +16,11 @@ from ..settings import SCHEME  # (ranges and units of the fields)
 COUPLED_SCHEMES = ("fully-coupled", "krylov")
 
 #: The ``"krylov"`` preconditioner uses the exact Schur complement ``D - C A^-1 B`` (a dense
-#: ``N x N`` LU per iteration, :meth:`StepProblem.coupled_compliance`) when the elasticity
-#: solve is exact (the dense LU) and the mesh has at most this many elements; the diagonal
-#: compliance ``C'`` of ref. Eq. 4.49 otherwise. (dfn-3cluster, ~300 elements: 24-50 GMRES
-#: iterations per nonlinear iteration with ``C'``, 2-3 with the exact complement.)
+#: ``N x N`` LU, kept across iterates with refinement: :class:`.scaled_system.SchurFactor`;
+#: :meth:`StepProblem.coupled_compliance`) when the elasticity solve is exact (the dense LU)
+#: and the mesh has at most this many elements; the diagonal compliance ``C'`` of ref. Eq.
+#: 4.49 otherwise. (dfn-3cluster, ~300 elements: 24-50 GMRES iterations per nonlinear
+#: iteration with ``C'``; the exact complement's block LU solves with none.)
 EXACT_SCHUR_MAX_ELEMENTS = 1500
 
 
@@ -126,6 +127,7 @@ class StepProblem:
         self._last_product = (None, None)  # (dd, A dd) of the last elastic product
         self.flow_factor = None  # the last iterate's FlowFactor (hmatddm.coupled.scaled_system)
         self._coupled_compliance = (None, None)  # (rows key, C A^-1 B) of the last active set
+        self._inverse_b = None  # (rows key, X_0, W, F): A^-1 B = X_0 + W F of that set (coupled_compliance)
         self._base_compliance = (None, None)  # (X_0, C X_0) of the contact factor's base
         # (rows key, operator, blocks, their inverses) of the coupled system's scaling, for the
         # last set of statuses (hmatddm.coupled.scaled_system)
@@ -178,6 +180,7 @@ class StepProblem:
         if value is not None and cached_key == key:
             return value
         x0, w, f = self.elastic.contact_update(rows).inverse_times_b(self.normals)
+        self._inverse_b = (key, x0, w, f)
         if self._base_compliance[0] is not x0:
             self._base_compliance = (x0, np.asarray(self.coupling @ x0))
         value = self._base_compliance[1]
@@ -186,6 +189,16 @@ class StepProblem:
                 value = value + np.asarray(self.coupling @ w) @ f
         self._coupled_compliance = (key, value)
         return value
+
+    def inverse_b_times(self, p, rows):
+        """``A^-1 B p`` (``(S A + D)^-1 S B p`` with contact ``rows``) from the ``X_0 + W F`` of
+        :meth:`coupled_compliance` (called first for these rows): a product with the dense
+        ``(dN, N)`` ``X_0``, a quarter of an elasticity solve's work."""
+        key, x0, w, f = self._inverse_b
+        if key != (None if rows is None else rows.key):
+            raise RuntimeError("inverse_b_times before coupled_compliance for these contact rows")
+        value = x0 @ p
+        return value if w is None else value + w @ (f @ p)
 
     def width(self, dd):
         return np.sum(dd.reshape(self.n, self.d) * self.normals, axis=1)

@@ -447,3 +447,30 @@ def test_drained_rows_of_the_flow_matrix_are_the_scaled_identity_rows():
     np.testing.assert_array_equal(rhs[free], plain_rhs[free])
     np.testing.assert_allclose(rhs[problem.fixed], scale * fixed_pressure[problem.fixed], rtol=1e-15)
     assert matrix.has_canonical_format and not np.shares_memory(matrix.data, plain.data)
+
+
+def test_a_kept_schur_factor_refines_to_round_off_and_factorises_anew_when_refinement_fails():
+    # SchurFactor: the LU of one complement serves a nearby one through iterative refinement
+    # (same answer as a fresh solve to REFINED), and a complement too far from it for
+    # MAX_SWEEPS sweeps is factorised anew; a different C A^-1 B array is not served.
+    from hmatddm.coupled.scaled_system import SchurFactor
+
+    rng = np.random.default_rng(3)
+    n = 40
+    coupled = rng.standard_normal((n, n)) * 0.1
+    first = np.diag(rng.uniform(1.0, 2.0, n)) - coupled
+    factor = SchurFactor(coupled)
+    factor.use(first)
+    r = rng.standard_normal(n)
+    np.testing.assert_allclose(first @ factor.solve(r), r, rtol=0, atol=1e-12 * np.linalg.norm(r))
+    near = first + np.diag(rng.uniform(0.0, 1e-5, n))  # the flow block of the next iterate
+    factor.use(near)
+    p = factor.solve(r)
+    assert factor.factorisations == 1
+    assert np.linalg.norm(r - near @ p) <= SchurFactor.REFINED * np.linalg.norm(r)
+    far = first + np.diag(rng.uniform(5.0, 10.0, n))  # refinement cannot converge from the first LU
+    factor.use(far)
+    p = factor.solve(r)
+    assert factor.factorisations == 2 and factor.factored is far
+    np.testing.assert_allclose(far @ p, r, rtol=0, atol=1e-12 * np.linalg.norm(r))
+    assert factor.serves(coupled) and not factor.serves(coupled.copy())
