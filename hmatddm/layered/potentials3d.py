@@ -206,33 +206,6 @@ def potential_base(f, j):
     return 0, 0, 1
 
 
-@njit(cache=True, inline="always")
-def _potential_order(cf, n0, m, scale, h, ia, ib, ic, tf, o):
-    """``tf[a, b, c] = sum_n scale cf[n0 + n] h[a + ia, b + ib, c + ic + n0 + n]`` (``n <
-    m``) for ``a + b + c = o``: one order of :func:`_potential_table`, the sum written out
-    for the ``m`` of 1 to 3 terms that most triples have. (Skipping the entries of order
-    ``o + 1`` that the stress never reads, ``c = 0``, by a run-time lower bound measured
-    1.7x slower: LLVM no longer unrolls the loops.)"""
-    k0 = scale * cf[n0] if m >= 1 else 0.0
-    k1 = scale * cf[n0 + 1] if m >= 2 else 0.0
-    k2 = scale * cf[n0 + 2] if m >= 3 else 0.0
-    for a in range(o + 1):
-        for b in range(o + 1 - a):
-            c = o - a - b + n0 + ic
-            row = h[a + ia, b + ib]
-            if m == 1:
-                s = k0 * row[c]
-            elif m == 2:
-                s = k0 * row[c] + k1 * row[c + 1]
-            elif m == 3:
-                s = k0 * row[c] + k1 * row[c + 1] + k2 * row[c + 2]
-            else:
-                s = 0.0
-                for n in range(m):
-                    s += scale * cf[n0 + n] * row[c + n]
-            tf[a, b, o - a - b] = s
-
-
 @njit(cache=True, fastmath=FAST, error_model="numpy", inline="always")
 def _potential_table(coef, h, sigma, order, used, table):
     """``table[f, j, a, b, c] = d1^a d2^b d3^c phi_j`` of force ``f`` for the triple
@@ -240,44 +213,51 @@ def _potential_table(coef, h, sigma, order, used, table):
     or ``L = -sigma D F``, from the gauge table ``h`` of :func:`gauge_table`; ``used``:
     :func:`.image_tracer.orders_used`): the orders the stress needs, ``a + b + c =
     order``, and ``order + 1`` for ``phi_2``, the only one with the ``s`` term of ref. Eq.
-    3.22. The number of terms is dispatched to literal 1, 2 or
-    3 (:func:`_potential_order`): LLVM then unrolls the sums, 1.4x faster than one loop
-    of run-time length."""
+    3.22. The up to three terms of most triples (near ones: 1 to 3) are written out, the
+    missing ones with a zero coefficient: ``h``'s entries past those computed are zero or
+    left by an earlier triple, finite (:func:`Workspace`), so the sum is the same; LLVM
+    unrolls it (a loop of run-time length was 1.4x slower)."""
     for f in range(3):
         for j in range(3):
             if f == 2 and j == 2:
                 continue
             kind, ia, ib = potential_base(f, j)
-            cf = coef[f, j]
             n0 = 0
-            while n0 < used and cf[n0] == 0.0:
+            while n0 < used and coef[f, j, n0] == 0.0:
                 n0 += 1
             n1 = used
-            while n1 > n0 and cf[n1 - 1] == 0.0:
+            while n1 > n0 and coef[f, j, n1 - 1] == 0.0:
                 n1 -= 1
             m = n1 - n0
-            ic = kind  # L = -sigma D F
+            ic = kind + n0  # L = -sigma D F
             scale = -sigma if kind == 1 else 1.0
-            tf = table[f, j]
+            k0 = scale * coef[f, j, n0] if m >= 1 else 0.0
+            k1 = scale * coef[f, j, n0 + 1] if m >= 2 else 0.0
+            k2 = scale * coef[f, j, n0 + 2] if m >= 3 else 0.0
             top = order + 1 if j == 1 else order
             for o in range(order, top + 1):
-                if m == 1:
-                    _potential_order(cf, n0, 1, scale, h, ia, ib, ic, tf, o)
-                elif m == 2:
-                    _potential_order(cf, n0, 2, scale, h, ia, ib, ic, tf, o)
-                elif m == 3:
-                    _potential_order(cf, n0, 3, scale, h, ia, ib, ic, tf, o)
-                else:  # more terms, or none (a zero potential)
-                    _potential_order(cf, n0, m, scale, h, ia, ib, ic, tf, o)
+                for a in range(o + 1):
+                    for b in range(o + 1 - a):
+                        c = o - a - b
+                        e = c + ic
+                        if m <= 3:
+                            v = (k0 * h[a + ia, b + ib, e] + k1 * h[a + ia, b + ib, e + 1]
+                                 + k2 * h[a + ia, b + ib, e + 2])
+                        else:
+                            v = 0.0
+                            for n in range(m):
+                                v += scale * coef[f, j, n0 + n] * h[a + ia, b + ib, e + n]
+                        table[f, j, a, b, c] = v
 
 
 @njit(cache=True, inline="always")
 def Workspace(n_orders):
     """Scratch arrays of :func:`_pair_stress_gradient` for triples of up to ``n_orders``:
-    ``sf, sl`` (6, 6), the series (4, 6), the gauge table (6, 6, n_orders + 5) of
-    :func:`gauge_table`, the potential tables (3, 3, 6, 6, 6) and the recurrence's
-    zero-padded scratch (:func:`inverse_distance_scratch`)."""
-    return (np.empty((6, 6)), np.empty((6, 6)), np.empty((4, 6)), np.empty((6, 6, n_orders + 5)),
+    ``sf, sl`` (6, 6), the series (4, 6), the gauge table (6, 6, n_orders + 7) of
+    :func:`gauge_table` (zeroed, and two more entries than it writes, read with a zero
+    coefficient by :func:`_potential_table`), the potential tables (3, 3, 6, 6, 6) and
+    the recurrence's zero-padded scratch (:func:`inverse_distance_scratch`)."""
+    return (np.empty((6, 6)), np.empty((6, 6)), np.empty((4, 6)), np.zeros((6, 6, n_orders + 7)),
             np.zeros((3, 3, 6, 6, 6)), np.zeros((3, 3, 6, 6, 6)), inverse_distance_scratch(n_orders + 4))
 
 
@@ -294,21 +274,20 @@ def _pair_tables(r1, r2, r3, sigma, coef, dcoef, order, work):
     # more halves the recurrence
     top = max(n_c - 2, 4)
     gauge_table(r1, r2, r3, sigma, n_c, top, sf, sl, ser, h, pad)
-    lower = order - 1  # a run-time int: one compiled _potential_table for both orders
-    _potential_table(coef, h, sigma, lower + 1, used, table)
-    _potential_table(dcoef, h, sigma, lower, used, dtable)
+    for d in range(2):  # one inlined _potential_table for both
+        _potential_table(dcoef if d else coef, h, sigma, order - d, used, dtable if d else table)
 
 
 @njit(cache=True)
 def _stress(table, f, da, db, dc, scale, s, delta, shear_modulus, lame, out):
     """``out[i, k] += scale *`` the stress of force ``f`` from the potential derivatives
     ``table`` shifted by ``(da, db, dc)`` (:func:`_stress_at`, ``out`` (3, 3))."""
-    _stress_at(table, f, da, db, dc, scale, s, delta, shear_modulus, lame, out.reshape((1, 3, 3)), 0)
+    _stress_at(table, f, da, db, dc, scale, s, delta, shear_modulus, lame, out.reshape((1, 1, 3, 3)), 0, 0)
 
 
 @njit(cache=True, fastmath=FAST, error_model="numpy", inline="always")
-def _stress_at(table, f, da, db, dc, scale, s, delta, shear_modulus, lame, out, q):
-    """``out[q, i, k] += scale *`` the stress of force ``f`` from the potential derivatives
+def _stress_at(table, f, da, db, dc, scale, s, delta, shear_modulus, lame, out, p, q):
+    """``out[p, q, i, k] += scale *`` the stress of force ``f`` from the potential derivatives
     ``table`` shifted by ``(da, db, dc)``: ref. Eq. 3.22's displacement, with harmonic
     potentials (so ``div u = 2 (1 - delta) phi2,33``),
     ``sigma_ik = G (2 phi1,ik - 2 phi2,ik - 4 delta s phi2,ik3 + 2 (1 - delta)
@@ -344,9 +323,9 @@ def _stress_at(table, f, da, db, dc, scale, s, delta, shear_modulus, lame, out, 
             v *= g
             if i == k:
                 v += lame * d33
-            out[q, i, k] += scale * v
+            out[p, q, i, k] += scale * v
             if i != k:
-                out[q, k, i] += scale * v
+                out[p, q, k, i] += scale * v
 
 
 @njit(cache=True, fastmath=FAST, error_model="numpy")
@@ -360,13 +339,10 @@ def _pair_stress_gradient(r1, r2, r3, eps, sigma, coef, dcoef, delta, shear_modu
     table = work[4]
     dtable = work[5]
     for f in range(3):
-        # literal shifts: numba compiles four _stress_at (LLVM inlines them with the shifts folded);
-        # one compiled _stress with run-time shifts measured ~30% more CPU per pair
-        of = out[f]
-        _stress_at(table, f, 1, 0, 0, -1.0, r3, delta, shear_modulus, lame, of, 0)
-        _stress_at(table, f, 0, 1, 0, -1.0, r3, delta, shear_modulus, lame, of, 1)
-        _stress_at(dtable, f, 0, 0, 0, 1.0, r3, delta, shear_modulus, lame, of, 2)
-        _stress_at(table, f, 0, 0, 1, -eps, r3, delta, shear_modulus, lame, of, 2)
+        for v in range(4):  # d/dx, d/dy, the coefficients' and the point's d/dz
+            _stress_at(dtable if v == 2 else table, f, 1 if v == 0 else 0, 1 if v == 1 else 0, 1 if v == 3 else 0,
+                       -eps if v == 3 else (1.0 if v == 2 else -1.0), r3, delta, shear_modulus, lame, out, f,
+                       min(v, 2))
         for i in range(3):
             for k in range(3):
                 a = (1 if i == 0 else 0) + (1 if k == 0 else 0)
