@@ -77,11 +77,12 @@ def largest_trace_capacity(shear_modulus, n_images):
     return cap, n_orders
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def orders_used(coef, dcoef):
     """One more than the highest power of ``D`` with a non-zero coefficient in ``coef`` or
     ``dcoef`` ``[f, j, n]`` (at least 1): most traced pairs and triples stop well below the
-    buffer's order."""
+    buffer's order. Inlined: a call would make its caller take and drop a reference count
+    on each of its array arguments (:func:`.potentials3d._pair_stress_gradient`)."""
     used = 1
     for f in range(coef.shape[0]):
         for j in range(coef.shape[1]):

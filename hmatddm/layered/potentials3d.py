@@ -34,13 +34,25 @@ part is a derivative of ``1/r``, whose Taylor coefficients follow a three-term r
 (any order). Horizontal derivatives (up to order 5) of ``F`` and ``L`` come from
 one-variable Taylor series along x of the closed forms of ``d1 F``, ``d2 F``, ``d1 L``,
 ``d2 L`` and from Laplace's equation (both are harmonic) for the higher ``d2`` powers.
+
+Cost (issue 32). The field of one triple at one point is the inner loop of the near-image
+quadrature and of the remainder table's sampling. Its functions compile with
+:data:`hmatddm.compiled.FAST` and numpy's error model (their divisions are by ``r > 0``,
+``r + sigma r3 > 0`` and integer orders: nothing to check), and everything
+:func:`_pair_stress_gradient` calls is inlined (numba's ``inline="always"``) and indexes
+its arrays whole: a call, or a view such as ``table[f, j]``, makes numba take and drop a
+reference count on each array (atomic operations: 36 a triple, a third of its cost
+before). One table of ``F`` serves both base functions (:func:`gauge_table`).
 """
 import math
 
 import numpy as np
 from numba import njit
 
+from ..compiled import FAST
 from .image_tracer import orders_used
+from .inverse_distance3d import (inverse_distance_derivatives, inverse_distance_recurrence,  # noqa: F401 (re-exported)
+                                 inverse_distance_scratch, inverse_distance_step, scaled_inverse_distance)
 
 _INV_8PI = 1.0 / (8.0 * math.pi)
 
@@ -59,32 +71,33 @@ def _original(coef, delta, shear_modulus, sigma, scale):
     coef[2, 1, 0] += scale * sigma * k
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath=FAST, error_model="numpy", inline="always")
 def _axis_series(r1, r3, r, m, ser):
     """Taylor coefficients (``k < m``) in ``t`` at ``(r1 + t, r2, r3)``, gauge +1, ``U = R + r3``:
-    ``ser[0] = R``, ``ser[1] = 1/R``, ``ser[2] = V = 1/U``, ``ser[3] = W = V/R``."""
-    rs, ir, v, w = ser[0], ser[1], ser[2], ser[3]
+    ``ser[0] = R``, ``ser[1] = 1/R``, ``ser[2] = V = 1/U``, ``ser[3] = W = V/R``. Its callers
+    keep ``r > 0`` and ``U > 0`` (numpy's error model: no check of the divisions); ``ser``
+    indexed whole, not by row views (each view a reference count taken and dropped)."""
     u0 = r + r3
-    rs[0] = r
-    ir[0] = 1.0 / r
-    v[0] = 1.0 / u0
+    ser[0, 0] = r
+    ser[1, 0] = 1.0 / r
+    ser[2, 0] = 1.0 / u0
     for k in range(1, m):
         s = 2.0 * r1 if k == 1 else (1.0 if k == 2 else 0.0)  # R^2 = r^2 + 2 r1 t + t^2
         for i in range(1, k):
-            s -= rs[i] * rs[k - i]
-        rs[k] = s / (2.0 * r)
+            s -= ser[0, i] * ser[0, k - i]
+        ser[0, k] = s / (2.0 * r)
         s_ir = 0.0
         s_v = 0.0
         for i in range(1, k + 1):
-            s_ir += rs[i] * ir[k - i]
-            s_v += rs[i] * v[k - i]  # U_i = R_i for i >= 1
-        ir[k] = -s_ir / r
-        v[k] = -s_v / u0
+            s_ir += ser[0, i] * ser[1, k - i]
+            s_v += ser[0, i] * ser[2, k - i]  # U_i = R_i for i >= 1
+        ser[1, k] = -s_ir / r
+        ser[2, k] = -s_v / u0
     for k in range(m):
         s = 0.0
         for i in range(k + 1):
-            s += v[i] * ir[k - i]
-        w[k] = s
+            s += ser[2, i] * ser[1, k - i]
+        ser[3, k] = s
 
 
 @njit(cache=True)
@@ -92,112 +105,66 @@ def base_derivatives(r1, r2, r3, sf, sl, q, ser, pad, top):
     """Derivatives of the gauge +1 base functions at ``(r1, r2, r3)``, ``r3 >= 0`` (away
     from the singular half-line): ``q[a, b, c] = d1^a d2^b d3^c (1/r)`` (``q``'s shape up
     to the total order ``top``, at least 4, :func:`inverse_distance_derivatives`),
-    ``sf[a, b] = d1^a d2^b F`` and
-    ``sl[a, b] = d1^a d2^b L`` for ``a + b <= 5``. Along x from one-variable Taylor series
-    of the closed forms ``d1 F = r1 / U``, ``d1 L = r1 / (R U)``, ``d2 F = r2 / U``,
-    ``d2 L = r2 / (R U)`` (``U = r + r3``, no cancelling terms); the other horizontal
-    derivatives from Laplace's equation, ``d2^2 F = -d1^2 F + 1/r``,
-    ``d2^2 L = -d1^2 L - d3 (1/r)`` (``F`` and ``L`` are harmonic; ``ser``: (4, 6) scratch;
-    ``pad``: the scratch of :func:`inverse_distance_derivatives`)."""
+    ``sf[a, b] = d1^a d2^b F`` and ``sl[a, b] = d1^a d2^b L`` for ``a + b <= 5``
+    (:func:`_axis_derivatives`), the higher ``d2`` powers from Laplace's equation,
+    ``d2^2 F = -d1^2 F + 1/r``, ``d2^2 L = -d1^2 L - d3 (1/r)`` (``F`` and ``L`` are
+    harmonic; ``ser``: (4, 6) scratch; ``pad``: the scratch of
+    :func:`inverse_distance_derivatives`)."""
     inverse_distance_derivatives(r1, r2, r3, q, pad, top)
-    r = math.sqrt(r1 * r1 + r2 * r2 + r3 * r3)
-    _axis_series(r1, r3, r, 5, ser)
-    v = ser[2]
-    w = ser[3]
-    sf[0, 0] = r - r3 * math.log(r + r3)
-    sl[0, 0] = math.log(r + r3)
-    fact = 1.0  # (a - 1)!
-    for a in range(1, 6):
-        if a > 1:
-            fact *= a - 1
-        sf[a, 0] = fact * (r1 * v[a - 1] + (v[a - 2] if a >= 2 else 0.0))
-        sl[a, 0] = fact * (r1 * w[a - 1] + (w[a - 2] if a >= 2 else 0.0))
-    fact = 1.0  # a!
-    for a in range(5):
-        if a > 0:
-            fact *= a
-        sf[a, 1] = fact * r2 * v[a]
-        sl[a, 1] = fact * r2 * w[a]
+    _axis_derivatives(r1, r2, r3, sf, sl, ser)
     for b in range(2, 6):
         for a in range(6 - b):
             sf[a, b] = -sf[a + 2, b - 2] + q[a, b - 2, 0]
             sl[a, b] = -sl[a + 2, b - 2] - q[a, b - 2, 1]
 
 
-@njit(cache=True, inline="always")
-def inverse_distance_step(q, a, b, c, n, x0, x1, x2):
-    """One entry (orders ``a, b, c``, ``n = a + b + c``) of the recurrence of the unscaled
-    derivatives of ``1/r`` from the lower orders already in ``q`` (``x_k = r_k / r``)."""
-    s = 0.0
-    if a >= 1:
-        s += x0 * q[a - 1, b, c]
-    if b >= 1:
-        s += x1 * q[a, b - 1, c]
-    if c >= 1:
-        s += x2 * q[a, b, c - 1]
-    s *= 2 * n - 1
-    t = 0.0
-    if a >= 2:
-        t += q[a - 2, b, c]
-    if b >= 2:
-        t += q[a, b - 2, c]
-    if c >= 2:
-        t += q[a, b, c - 2]
-    return -(s + (n - 1) * t) / n
-
-
-@njit(cache=True, inline="always")
-def inverse_distance_scratch(n_c):
-    """The zeroed scratch of :func:`inverse_distance_derivatives` for ``q`` of up to
-    ``(6, 6, n_c)``."""
-    return np.zeros((8, 8, n_c + 2))
-
-
-@njit(cache=True)
-def inverse_distance_derivatives(r1, r2, r3, q, pad, top):
-    """``q[a, b, c] = d1^a d2^b d3^c (1/r)`` for ``a + b < q.shape[0]``, ``c < q.shape[2]``
-    and a total order ``a + b + c <= top`` (the entries above it are not written) by the
-    recurrence of the Taylor coefficients ``t_k = d^k (1/r) / k!``:
-    ``n r^2 t_k + (2n - 1) sum_i r_i t_(k - e_i) + (n - 1) sum_i t_(k - 2 e_i) = 0``
-    (here on the unit vector, then scaled). The recurrence runs in ``pad`` (at least
-    ``(q.shape[0] + 2, q.shape[0] + 2, q.shape[2] + 2)``, :func:`inverse_distance_scratch`)
-    shifted by two in every index, whose entries below index 2 stay zero: the terms of
-    orders below zero read zeros instead of branching (1.8x faster than the branches of
-    :func:`inverse_distance_step`, the same arithmetic, so the same bits)."""
+@njit(cache=True, fastmath=FAST, error_model="numpy", inline="always")
+def _axis_derivatives(r1, r2, r3, sf, sl, ser):
+    """``sf[a, b] = d1^a d2^b F``, ``sl[a, b] = d1^a d2^b L`` of gauge +1 for ``b <= 1``,
+    ``a + b <= 5`` (:func:`base_derivatives`), along x from one-variable Taylor series of
+    the closed forms ``d1 F = r1 / U``, ``d1 L = r1 / (R U)``, ``d2 F = r2 / U``,
+    ``d2 L = r2 / (R U)`` (``U = r + r3``, no cancelling terms). Numpy's error model: the
+    divisions are by ``r > 0`` and ``r + r3 > 0`` (``r3 >= 0``)."""
     r = math.sqrt(r1 * r1 + r2 * r2 + r3 * r3)
-    inv = 1.0 / r
-    x0 = r1 * inv
-    x1 = r2 * inv
-    x2 = r3 * inv
-    ha = q.shape[0]
-    nc = q.shape[2]
-    pad[2, 2, 2] = 1.0
-    for c in range(min(nc, top + 1)):
-        for a in range(min(ha, top - c + 1)):
-            for b in range(min(ha - a, top - c - a + 1)):
-                n = a + b + c
-                if n == 0:
-                    continue
-                i = a + 2
-                j = b + 2
-                k = c + 2
-                s = (x0 * pad[i - 1, j, k] + x1 * pad[i, j - 1, k] + x2 * pad[i, j, k - 1]) * (2 * n - 1)
-                t = pad[i - 2, j, k] + pad[i, j - 2, k] + pad[i, j, k - 2]
-                pad[i, j, k] = -(s + (n - 1) * t) / n
-    # t_k / r^(n+1) * a! b! c!
-    fc = inv
-    for c in range(min(nc, top + 1)):
-        if c > 0:
-            fc *= c * inv
-        fa = fc
-        for a in range(min(ha, top - c + 1)):
-            if a > 0:
-                fa *= a * inv
-            fb = fa
-            for b in range(min(ha - a, top - c - a + 1)):
-                if b > 0:
-                    fb *= b * inv
-                q[a, b, c] = pad[a + 2, b + 2, c + 2] * fb
+    _axis_series(r1, r3, r, 5, ser)
+    sf[0, 0] = r - r3 * math.log(r + r3)
+    sl[0, 0] = math.log(r + r3)
+    fact = 1.0  # (a - 1)!
+    for a in range(1, 6):
+        if a > 1:
+            fact *= a - 1
+        sf[a, 0] = fact * (r1 * ser[2, a - 1] + (ser[2, a - 2] if a >= 2 else 0.0))
+        sl[a, 0] = fact * (r1 * ser[3, a - 1] + (ser[3, a - 2] if a >= 2 else 0.0))
+    fact = 1.0  # a!
+    for a in range(5):
+        if a > 0:
+            fact *= a
+        sf[a, 1] = fact * r2 * ser[2, a]
+        sl[a, 1] = fact * r2 * ser[3, a]
+
+
+@njit(cache=True, fastmath=FAST, error_model="numpy", inline="always")
+def gauge_table(r1, r2, r3, sigma, n_c, top, sf, sl, ser, h, pad):
+    """``h[a, b, c] = d1^a d2^b d3^c F`` of gauge ``sigma`` at ``(r1, r2, r3)`` (``sigma r3
+    >= 0``) for ``a + b <= 5``, ``c <= n_c`` and a total order up to ``top + 2`` (the
+    other entries not written): every table a triple reads, ``L`` included, since ``D F
+    = -sigma L`` (the ``L`` table is ``-sigma h`` shifted by one in ``c``). ``c <= 1`` from
+    :func:`_axis_derivatives` at the flipped point (``d3 F = -sigma L``), ``c >= 2`` from
+    ``d3^2 F = -1/r`` (:func:`inverse_distance_recurrence` at the receiver: ``1/r``'s
+    vertical derivatives at the flipped point are ``sigma^c`` times those, which the
+    tables of :func:`_base_table` multiply back) written straight into ``h`` -- no
+    copy, no ``L`` table. The same entries as :func:`_base_table`'s, to the signs (exact)."""
+    inv = inverse_distance_recurrence(r1, r2, r3, pad, 6, n_c - 1, top)
+    scaled_inverse_distance(pad, inv, h, 2, -1.0, 6, n_c - 1, top)
+    _axis_derivatives(r1, r2, sigma * r3, sf, sl, ser)
+    for b in range(2, 6):  # Laplace (base_derivatives): 1/r at the flipped point is -h[..., 2], sigma h[..., 3]
+        for a in range(6 - b):
+            sf[a, b] = -sf[a + 2, b - 2] - h[a, b - 2, 2]
+            sl[a, b] = -sl[a + 2, b - 2] + sigma * h[a, b - 2, 3]
+    for a in range(6):
+        for b in range(6 - a):
+            h[a, b, 0] = sf[a, b]
+            h[a, b, 1] = -sigma * sl[a, b]
 
 
 @njit(cache=True)
@@ -239,137 +206,129 @@ def potential_base(f, j):
     return 0, 0, 1
 
 
-@njit(cache=True, inline="always")
-def _potential_order(cf, n0, m, bk, ia, ib, tf, o):
-    """``tf[a, b, c] = sum_n cf[n0 + n] bk[a + ia, b + ib, c + n0 + n]`` (``n < m``) for
-    ``a + b + c = o``: one order of :func:`_potential_table`, the sum written out for the
-    ``m`` of 1 to 3 terms that most triples have (the same additions, in the same order)."""
-    for a in range(o + 1):
-        for b in range(o + 1 - a):
-            c = o - a - b + n0
-            row = bk[a + ia, b + ib]
-            if m == 1:
-                s = cf[n0] * row[c]
-            elif m == 2:
-                s = cf[n0] * row[c] + cf[n0 + 1] * row[c + 1]
-            elif m == 3:
-                s = cf[n0] * row[c] + cf[n0 + 1] * row[c + 1] + cf[n0 + 2] * row[c + 2]
-            else:
-                s = 0.0
-                for n in range(m):
-                    s += cf[n0 + n] * row[c + n]
-            tf[a, b, o - a - b] = s
-
-
-@njit(cache=True)
-def _potential_table(coef, base, order, table):
+@njit(cache=True, fastmath=FAST, error_model="numpy", inline="always")
+def _potential_table(coef, h, sigma, order, used, table):
     """``table[f, j, a, b, c] = d1^a d2^b d3^c phi_j`` of force ``f`` for the triple
     ``coef`` (``phi_j = sum_n coef[f, j, n] D^n`` of its base function ``d1 F``, ``d2 F``
-    or ``L``): the orders the stress needs, ``a + b + c = order`` (and ``order + 1`` for
-    ``phi_2``, the only one with the ``s`` term of ref. Eq. 3.22). The number of terms is
-    dispatched to literal 1, 2 or 3 (:func:`_potential_order`): LLVM then unrolls the
-    sums, 1.4x faster than one loop of run-time length."""
-    n_orders = coef.shape[2]
+    or ``L = -sigma D F``, from the gauge table ``h`` of :func:`gauge_table`; ``used``:
+    :func:`.image_tracer.orders_used`): the orders the stress needs, ``a + b + c =
+    order``, and ``order + 1`` for ``phi_2``, the only one with the ``s`` term of ref. Eq.
+    3.22. The up to three terms of most triples (near ones: 1 to 3) are written out, the
+    missing ones with a zero coefficient: ``h``'s entries past those computed are zero or
+    left by an earlier triple, finite (:func:`Workspace`), so the sum is the same; LLVM
+    unrolls it (a loop of run-time length was 1.4x slower)."""
     for f in range(3):
         for j in range(3):
             if f == 2 and j == 2:
                 continue
             kind, ia, ib = potential_base(f, j)
-            cf = coef[f, j]
             n0 = 0
-            while n0 < n_orders and cf[n0] == 0.0:
+            while n0 < used and coef[f, j, n0] == 0.0:
                 n0 += 1
-            n1 = n_orders
-            while n1 > n0 and cf[n1 - 1] == 0.0:
+            n1 = used
+            while n1 > n0 and coef[f, j, n1 - 1] == 0.0:
                 n1 -= 1
             m = n1 - n0
-            bk = base[kind]
-            tf = table[f, j]
+            ic = kind + n0  # L = -sigma D F
+            scale = -sigma if kind == 1 else 1.0
+            k0 = scale * coef[f, j, n0] if m >= 1 else 0.0
+            k1 = scale * coef[f, j, n0 + 1] if m >= 2 else 0.0
+            k2 = scale * coef[f, j, n0 + 2] if m >= 3 else 0.0
             top = order + 1 if j == 1 else order
             for o in range(order, top + 1):
-                if m == 1:
-                    _potential_order(cf, n0, 1, bk, ia, ib, tf, o)
-                elif m == 2:
-                    _potential_order(cf, n0, 2, bk, ia, ib, tf, o)
-                elif m == 3:
-                    _potential_order(cf, n0, 3, bk, ia, ib, tf, o)
-                else:  # more terms, or none (a zero potential)
-                    _potential_order(cf, n0, m, bk, ia, ib, tf, o)
+                for a in range(o + 1):
+                    for b in range(o + 1 - a):
+                        c = o - a - b
+                        e = c + ic
+                        if m <= 3:
+                            v = (k0 * h[a + ia, b + ib, e] + k1 * h[a + ia, b + ib, e + 1]
+                                 + k2 * h[a + ia, b + ib, e + 2])
+                        else:
+                            v = 0.0
+                            for n in range(m):
+                                v += scale * coef[f, j, n0 + n] * h[a + ia, b + ib, e + n]
+                        table[f, j, a, b, c] = v
 
 
 @njit(cache=True, inline="always")
 def Workspace(n_orders):
     """Scratch arrays of :func:`_pair_stress_gradient` for triples of up to ``n_orders``:
-    ``sf, sl`` (6, 6), the series (4, 6), ``q`` (6, 6, n_orders + 4), the base table
-    (2, 6, 6, n_orders + 5), the potential tables (3, 3, 6, 6, 6) and the recurrence's
-    zero-padded scratch (:func:`inverse_distance_scratch`)."""
-    return (np.empty((6, 6)), np.empty((6, 6)), np.empty((4, 6)), np.empty((6, 6, n_orders + 4)),
-            np.empty((2, 6, 6, n_orders + 5)), np.zeros((3, 3, 6, 6, 6)), np.zeros((3, 3, 6, 6, 6)),
-            inverse_distance_scratch(n_orders + 4))
+    ``sf, sl`` (6, 6), the series (4, 6), the gauge table (6, 6, n_orders + 7) of
+    :func:`gauge_table` (zeroed, and two more entries than it writes, read with a zero
+    coefficient by :func:`_potential_table`), the potential tables (3, 3, 6, 6, 6) and
+    the recurrence's zero-padded scratch (:func:`inverse_distance_scratch`)."""
+    return (np.empty((6, 6)), np.empty((6, 6)), np.empty((4, 6)), np.zeros((6, 6, n_orders + 7)),
+            np.zeros((3, 3, 6, 6, 6)), np.zeros((3, 3, 6, 6, 6)), inverse_distance_scratch(n_orders + 4))
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath=FAST, error_model="numpy", inline="always")
 def _pair_tables(r1, r2, r3, sigma, coef, dcoef, order, work):
     """Fill ``work``'s potential tables of the triple at the receiver ``r`` (relative to
     the triple's point): ``coef`` at ``order`` (3 for the stress, 2 for the displacement),
     ``dcoef`` one lower."""
-    sf, sl, ser, q, base, table, dtable, pad = work
+    sf, sl, ser, h, table, dtable, pad = work
     used = orders_used(coef, dcoef)
     n_c = order + used + 1
-    # the tables read F's derivatives up to the total order n_c and L's up to n_c - 1,
-    # that is 1/r's up to n_c - 2 (d3^2 F = -1/r, d3 L = 1/r), and base_derivatives'
-    # Laplace relations 1/r's up to 4: computing no more halves the recurrence
+    # the tables read F's derivatives up to the total order n_c, that is 1/r's up to
+    # n_c - 2 (d3^2 F = -1/r), and the Laplace relations 1/r's up to 4: computing no
+    # more halves the recurrence
     top = max(n_c - 2, 4)
-    base_derivatives(r1, r2, sigma * r3, sf, sl, q[:, :, :n_c - 1], ser, pad, top)
-    _base_table(sigma, n_c, sf, sl, q, base, top)
-    lower = order - 1  # a run-time int: one compiled _potential_table for both orders
-    _potential_table(coef, base, lower + 1, table)
-    _potential_table(dcoef, base, lower, dtable)
+    gauge_table(r1, r2, r3, sigma, n_c, top, sf, sl, ser, h, pad)
+    for d in range(2):  # one inlined _potential_table for both
+        _potential_table(dcoef if d else coef, h, sigma, order - d, used, dtable if d else table)
 
 
 @njit(cache=True)
 def _stress(table, f, da, db, dc, scale, s, delta, shear_modulus, lame, out):
     """``out[i, k] += scale *`` the stress of force ``f`` from the potential derivatives
+    ``table`` shifted by ``(da, db, dc)`` (:func:`_stress_at`, ``out`` (3, 3))."""
+    _stress_at(table, f, da, db, dc, scale, s, delta, shear_modulus, lame, out.reshape((1, 1, 3, 3)), 0, 0)
+
+
+@njit(cache=True, fastmath=FAST, error_model="numpy", inline="always")
+def _stress_at(table, f, da, db, dc, scale, s, delta, shear_modulus, lame, out, p, q):
+    """``out[p, q, i, k] += scale *`` the stress of force ``f`` from the potential derivatives
     ``table`` shifted by ``(da, db, dc)``: ref. Eq. 3.22's displacement, with harmonic
     potentials (so ``div u = 2 (1 - delta) phi2,33``),
     ``sigma_ik = G (2 phi1,ik - 2 phi2,ik - 4 delta s phi2,ik3 + 2 (1 - delta)
     (delta_k3 phi2,i3 + delta_i3 phi2,k3) + eps_ij3 phi3,jk + eps_kj3 phi3,ji)
-    + 2 lambda (1 - delta) delta_ik phi2,33`` (``s`` the height above the triple's point)."""
-    t0 = table[f, 0]
-    t1 = table[f, 1]
-    t2 = table[f, 2]
+    + 2 lambda (1 - delta) delta_ik phi2,33`` (``s`` the height above the triple's point).
+    The arrays are indexed whole, not through views (``table[f, j]``, ``out[f, q]``): each
+    view took and dropped a reference count, atomic operations that cost as much as the
+    arithmetic. No division: numpy's error model changes nothing."""
     g = shear_modulus
     w = 2.0 * (1.0 - delta)
-    d33 = w * t1[da, db, dc + 2]
+    d33 = w * table[f, 1, da, db, dc + 2]
     for i in range(3):
         for k in range(i, 3):
             a = da + (1 if i == 0 else 0) + (1 if k == 0 else 0)
             b = db + (1 if i == 1 else 0) + (1 if k == 1 else 0)
             c = dc + (1 if i == 2 else 0) + (1 if k == 2 else 0)
-            v = 2.0 * (t0[a, b, c] - t1[a, b, c]) - 4.0 * delta * s * t1[a, b, c + 1]
+            v = 2.0 * (table[f, 0, a, b, c] - table[f, 1, a, b, c]) - 4.0 * delta * s * table[f, 1, a, b, c + 1]
             if k == 2:
-                v += w * t1[da + (1 if i == 0 else 0), db + (1 if i == 1 else 0), dc + (1 if i == 2 else 0) + 1]
+                v += w * table[f, 1, da + (1 if i == 0 else 0), db + (1 if i == 1 else 0),
+                               dc + (1 if i == 2 else 0) + 1]
                 if i == 2:
-                    v += w * t1[da, db, dc + 2]
+                    v += w * table[f, 1, da, db, dc + 2]
             if i == 0 and k == 0:
-                v += 2.0 * t2[da + 1, db + 1, dc]
+                v += 2.0 * table[f, 2, da + 1, db + 1, dc]
             elif i == 1 and k == 1:
-                v -= 2.0 * t2[da + 1, db + 1, dc]
+                v -= 2.0 * table[f, 2, da + 1, db + 1, dc]
             elif i == 0 and k == 1:
-                v += t2[da, db + 2, dc] - t2[da + 2, db, dc]
+                v += table[f, 2, da, db + 2, dc] - table[f, 2, da + 2, db, dc]
             elif i == 0 and k == 2:
-                v += t2[da, db + 1, dc + 1]
+                v += table[f, 2, da, db + 1, dc + 1]
             elif i == 1 and k == 2:
-                v -= t2[da + 1, db, dc + 1]
+                v -= table[f, 2, da + 1, db, dc + 1]
             v *= g
             if i == k:
                 v += lame * d33
-            out[i, k] += scale * v
+            out[p, q, i, k] += scale * v
             if i != k:
-                out[k, i] += scale * v
+                out[p, q, k, i] += scale * v
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath=FAST, error_model="numpy")
 def _pair_stress_gradient(r1, r2, r3, eps, sigma, coef, dcoef, delta, shear_modulus, lame, out, work):
     """``out[f, q, i, k] +=`` derivative along the source coordinate ``q`` of the stress
     ``(i, k)`` at the receiver ``r`` (relative to the triple's point) of a unit force
@@ -377,25 +336,24 @@ def _pair_stress_gradient(r1, r2, r3, eps, sigma, coef, dcoef, delta, shear_modu
     source derivatives are minus receiver derivatives; the vertical one differentiates
     the coefficients (``dcoef``), the triple's height ``z`` and ``s = y3 - z``."""
     _pair_tables(r1, r2, r3, sigma, coef, dcoef, 3, work)
-    table = work[5]
-    dtable = work[6]
+    table = work[4]
+    dtable = work[5]
     for f in range(3):
-        # literal shifts: numba compiles four _stress (LLVM inlines them with the shifts folded);
-        # one compiled _stress with run-time shifts measured ~30% more CPU per pair
-        _stress(table, f, 1, 0, 0, -1.0, r3, delta, shear_modulus, lame, out[f, 0])
-        _stress(table, f, 0, 1, 0, -1.0, r3, delta, shear_modulus, lame, out[f, 1])
-        _stress(dtable, f, 0, 0, 0, 1.0, r3, delta, shear_modulus, lame, out[f, 2])
-        _stress(table, f, 0, 0, 1, -eps, r3, delta, shear_modulus, lame, out[f, 2])
-        t1 = table[f, 1]
+        # literal shifts, four inlined copies (LLVM folds the shifts): 10% of a triple's CPU
+        # against one copy in a loop over the four, for 3 s more compile
+        _stress_at(table, f, 1, 0, 0, -1.0, r3, delta, shear_modulus, lame, out, f, 0)
+        _stress_at(table, f, 0, 1, 0, -1.0, r3, delta, shear_modulus, lame, out, f, 1)
+        _stress_at(dtable, f, 0, 0, 0, 1.0, r3, delta, shear_modulus, lame, out, f, 2)
+        _stress_at(table, f, 0, 0, 1, -eps, r3, delta, shear_modulus, lame, out, f, 2)
         for i in range(3):
             for k in range(3):
                 a = (1 if i == 0 else 0) + (1 if k == 0 else 0)
                 b = (1 if i == 1 else 0) + (1 if k == 1 else 0)
                 c = (1 if i == 2 else 0) + (1 if k == 2 else 0)
-                out[f, 2, i, k] += 4.0 * shear_modulus * delta * eps * t1[a, b, c + 1]
+                out[f, 2, i, k] += 4.0 * shear_modulus * delta * eps * table[f, 1, a, b, c + 1]
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath=FAST, error_model="numpy")
 def _displacement(table, f, da, db, dc, scale, s, delta, out):
     """``out[i] += scale * u_i`` of force ``f`` (ref. Eq. 3.22) from ``table`` shifted by
     ``(da, db, dc)``."""
@@ -413,13 +371,13 @@ def _displacement(table, f, da, db, dc, scale, s, delta, out):
         out[i] += scale * v
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath=FAST, error_model="numpy")
 def _pair_displacement_gradient(r1, r2, r3, eps, sigma, coef, dcoef, delta, out, work):
     """``out[f, q, i] +=`` derivative along the source coordinate ``q`` of the
     displacement ``u_i`` at the receiver ``r`` of a unit force along ``f``."""
     _pair_tables(r1, r2, r3, sigma, coef, dcoef, 2, work)
-    table = work[5]
-    dtable = work[6]
+    table = work[4]
+    dtable = work[5]
     for f in range(3):
         for v in range(4):  # as in _pair_stress_gradient
             _displacement(dtable if v == 2 else table, f, 1 if v == 0 else 0, 1 if v == 1 else 0, 1 if v == 3 else 0,

@@ -11,7 +11,7 @@ import numpy as np
 from .image_tracer import trace_capacity
 from .image_tracer3d import trace
 from .remainder_table3d import (COMPONENTS, ERROR_SAMPLES, MAX_TABLE_VALUES, PAD, STENCIL, RemainderTable,
-                                empty_table, interpolate, is_far, keep_near, layer_bounds, layer_gap,
+                                empty_table, interpolate, interpolation_scratch, is_far, keep_near, layer_bounds, layer_gap,
                                 sample_remainder, triple_gap)
 
 
@@ -178,7 +178,7 @@ def build_table(mesh, layers, interfaces, shear_modulus, poisson_ratio, n_images
     pair_index = -np.ones((n_layers, n_layers), dtype=np.int64)
     grids, blocks, worst = [], [], 0.0
     response = np.empty(len(COMPONENTS))
-    w = np.empty((3, STENCIL))
+    w = interpolation_scratch()
     direct = np.empty((1, 1, 1, len(COMPONENTS)))
     total = 0
     for k, (ls, lr) in enumerate(pairs):

@@ -244,9 +244,9 @@ PAD = STENCIL // 2 - 1
 
 
 @njit(cache=True, inline="always")
-def _lagrange(x, x0, h, n, w):
-    """First node and the :data:`STENCIL`-point Lagrange weights ``w`` at ``x`` on the grid
-    ``x0 + i h``, ``i < n`` (centred; one-sided at the ends)."""
+def _lagrange(x, x0, h, n, w, row):
+    """First node and the :data:`STENCIL`-point Lagrange weights ``w[row]`` at ``x`` on the
+    grid ``x0 + i h``, ``i < n`` (centred; one-sided at the ends)."""
     u = (x - x0) / h
     i0 = int(math.floor(u)) - (STENCIL // 2 - 1)
     if i0 > n - STENCIL:
@@ -259,7 +259,7 @@ def _lagrange(x, x0, h, n, w):
         for b in range(STENCIL):
             if b != a:
                 v *= (s - b) / (a - b)
-        w[a] = v
+        w[row, a] = v
     return i0
 
 
@@ -281,43 +281,55 @@ def covers(table, source_layer, layer, t, y3, rho):
             and y_lo - tol <= y3 <= y_hi + tol)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
+def interpolation_scratch():
+    """The scratch ``w`` of :func:`interpolate`: the Lagrange weights of the three variables."""
+    return np.empty((3, STENCIL))
+
+
+@njit(cache=True, inline="always")
 def interpolate(table, source_layer, layer, rho, t, y3, out, w):
-    """``out[c]``: the tabulated response at ``(rho, t, y3)`` (``w``: (3, 4) scratch)."""
+    """``out[c]``: the tabulated response at ``(rho, t, y3)`` (``w``: :func:`interpolation_scratch`).
+    The :data:`STENCIL` nodes along ``y3`` are one contiguous run of values: contracted
+    there first, into a register, then added once to ``out`` (3x faster than adding every
+    node's values to ``out``, whose stores LLVM could not keep in registers). Indexed
+    through a slice of the run: ``values[at + ...]`` measured 2.3x slower (the index's
+    sign is checked at every load, and the loop is no longer vectorised). Inlined: a call
+    makes its callers take and drop a reference count on each array, atomic operations."""
     k = table.pair_index[source_layer, layer]
-    grid = table.grid[k]
-    n_t = int(grid[5])
-    n_y = int(grid[8])
-    i0 = _lagrange(math.asinh(rho / grid[0]), -PAD * grid[1], grid[1], int(grid[2]), w[0])
-    j0 = _lagrange(t, grid[3], grid[4], n_t, w[1])
-    k0 = _lagrange(y3, grid[6], grid[7], n_y, w[2])
-    n_c = out.shape[0]
+    grid = table.grid
     values = table.values
+    n_t = int(grid[k, 5])
+    n_y = int(grid[k, 8])
+    i0 = _lagrange(math.asinh(rho / grid[k, 0]), -PAD * grid[k, 1], grid[k, 1], int(grid[k, 2]), w, 0)
+    j0 = _lagrange(t, grid[k, 3], grid[k, 4], n_t, w, 1)
+    k0 = _lagrange(y3, grid[k, 6], grid[k, 7], n_y, w, 2)
     base = table.offset[k]
+    n_c = out.shape[0]
     for c in range(n_c):
         out[c] = 0.0
-    # the STENCIL nodes along y3 are one contiguous run of values: contracted there first,
-    # into a register, then added once to ``out`` (3x faster than adding every node's
-    # values to ``out``, whose stores LLVM could not keep in registers)
     for a in range(STENCIL):
         for b in range(STENCIL):
             wab = w[0, a] * w[1, b]
             at = base + (((i0 + a) * n_t + j0 + b) * n_y + k0) * n_c
             run = values[at:at + STENCIL * n_c]
             for c in range(n_c):
-                s = 0.0
+                v = 0.0
                 for d in range(STENCIL):
-                    s += w[2, d] * run[d * n_c + c]
-                out[c] += wab * s
+                    v += w[2, d] * run[d * n_c + c]
+                out[c] += wab * v
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def remainder_point_stress(table, y, layer, x, source_layer, normal, shear_modulus, lame, weight, out, response, w,
                            scratch):
     """``out[b, i, k] += weight *`` the remainder's stress at ``y`` (in ``layer``) of a unit
     DD density along global ``b`` at ``x`` (in ``source_layer``) on a plane of ``normal``,
-    the source layer's moduli (``response``, ``w``, ``scratch`` (2, 6): scratch): the table in the frame rotated about z towards the receiver,
-    contracted with the rotated moment tensor and rotated back."""
+    the source layer's moduli (``response``, ``w`` (:func:`interpolation_scratch`),
+    ``scratch`` (2, 6): scratch): the table in the frame rotated about z towards the
+    receiver, contracted with the rotated moment tensor (``scratch[0]``) and rotated back.
+    No call and no array view: numba takes no reference counts (atomic operations) in the
+    loop over the points of a rule."""
     r1 = y[0] - x[0]
     r2 = y[1] - x[1]
     rho = math.sqrt(r1 * r1 + r2 * r2)
@@ -327,13 +339,18 @@ def remainder_point_stress(table, y, layer, x, source_layer, normal, shear_modul
         c = r1 / rho
         s = r2 / rho
     interpolate(table, source_layer, layer, rho, x[2], y[2], response, w)
+    _rotated_stress(c, s, normal, shear_modulus, lame, weight, response, out, scratch)
+
+
+@njit(cache=True, inline="always")
+def _rotated_stress(c, s, normal, shear_modulus, lame, weight, response, out, scratch):
+    """``out[b, i, k] += weight *`` the stress of the tabulated ``response`` in the frame
+    turned about z by ``(cos, sin) = (c, s)`` (:func:`remainder_point_stress`)."""
     # rotated components of the normal: v' = (c v1 + s v2, -s v1 + c v2, v3)
     n0 = c * normal[0] + s * normal[1]
     n1 = -s * normal[0] + c * normal[1]
     n2 = normal[2]
     nr = (n0, n1, n2)
-    moment = scratch[0]
-    local = scratch[1]
     for b in range(3):
         # the rotated unit DD along global b
         b0 = c if b == 0 else (s if b == 1 else 0.0)
@@ -346,13 +363,14 @@ def remainder_point_stress(table, y, layer, x, source_layer, normal, shear_modul
             v = shear_modulus * (br[p] * nr[q] + br[q] * nr[p])
             if p == q:
                 v += bn
-            moment[m] = v
+            scratch[0, m] = v
         for m in range(6):
-            local[m] = 0.0
+            scratch[1, m] = 0.0
         for comp in range(COMPONENTS.shape[0]):
-            local[COMPONENTS[comp, 1]] += moment[COMPONENTS[comp, 0]] * response[comp]
+            scratch[1, COMPONENTS[comp, 1]] += scratch[0, COMPONENTS[comp, 0]] * response[comp]
         # back to the global frame: sigma = R^T sigma' R, R rows (c, s, 0), (-s, c, 0), (0, 0, 1)
-        sxx, syy, szz, sxy, sxz, syz = local[0], local[1], local[2], local[3], local[4], local[5]
+        sxx, syy, szz = scratch[1, 0], scratch[1, 1], scratch[1, 2]
+        sxy, sxz, syz = scratch[1, 3], scratch[1, 4], scratch[1, 5]
         gxx = c * c * sxx - 2.0 * c * s * sxy + s * s * syy
         gyy = s * s * sxx + 2.0 * c * s * sxy + c * c * syy
         gxy = c * s * (sxx - syy) + (c * c - s * s) * sxy
@@ -386,15 +404,72 @@ def rectangle_covered(table, y, layer, center, frame, a, b, source_layer):
 def remainder_rectangle_stress(table, y, layer, center, frame, a, b, source_layer, shear_modulus, lame, xi, eta, wt,
                                out):
     """``out[b, i, k] +=`` the remainder's stress at ``y`` of a unit global DD ``b`` on the
-    rectangle, by the rule ``(xi, eta, wt)`` on [-1, 1]^2."""
+    rectangle, by the rule ``(xi, eta, wt)`` on [-1, 1]^2. The receiver's height, so its
+    nodes and weights along ``y3``, is the same at every point of the rule, and the points'
+    stencils along ``(u, t)`` overlap: the values are contracted along ``y3`` once per node
+    of the box that the stencils cover, then each point takes its ``STENCIL^2`` nodes from
+    there (the same sums, in the same order, as :func:`interpolate`'s), unless the box has
+    as many nodes as the points' stencils together (:func:`remainder_point_stress` then)."""
+    n = xi.shape[0]
     x = np.empty(3)
     response = np.empty(COMPONENTS.shape[0])
-    w = np.empty((3, STENCIL))
+    w = interpolation_scratch()
     scratch = np.empty((2, 6))
     normal = frame[2]
     jac = a * b
-    for g in range(xi.shape[0]):
+    k = table.pair_index[source_layer, layer]
+    grid = table.grid
+    n_t = int(grid[k, 5])
+    n_y = int(grid[k, 8])
+    n_c = COMPONENTS.shape[0]
+    nodes = np.empty((n, 2), dtype=np.int64)
+    weights = np.empty((2 * n, STENCIL))
+    i_lo, i_hi, j_lo, j_hi = 1 << 62, 0, 1 << 62, 0
+    for g in range(n):
         for c in range(3):
             x[c] = center[c] + xi[g] * a * frame[0, c] + eta[g] * b * frame[1, c]
-        remainder_point_stress(table, y, layer, x, source_layer, normal, shear_modulus, lame, wt[g] * jac, out,
-                               response, w, scratch)
+        r1 = y[0] - x[0]
+        r2 = y[1] - x[1]
+        rho = math.sqrt(r1 * r1 + r2 * r2)
+        nodes[g, 0] = _lagrange(math.asinh(rho / grid[k, 0]), -PAD * grid[k, 1], grid[k, 1], int(grid[k, 2]),
+                                weights, 2 * g)
+        nodes[g, 1] = _lagrange(x[2], grid[k, 3], grid[k, 4], n_t, weights, 2 * g + 1)
+        i_lo, i_hi = min(i_lo, nodes[g, 0]), max(i_hi, nodes[g, 0])
+        j_lo, j_hi = min(j_lo, nodes[g, 1]), max(j_hi, nodes[g, 1])
+    n_i = i_hi - i_lo + STENCIL
+    n_j = j_hi - j_lo + STENCIL
+    if n_i * n_j >= n * STENCIL * STENCIL:
+        for g in range(n):
+            for c in range(3):
+                x[c] = center[c] + xi[g] * a * frame[0, c] + eta[g] * b * frame[1, c]
+            remainder_point_stress(table, y, layer, x, source_layer, normal, shear_modulus, lame, wt[g] * jac, out,
+                                   response, w, scratch)
+        return
+    k0 = _lagrange(y[2], grid[k, 6], grid[k, 7], n_y, w, 2)
+    contracted = np.empty((n_i * n_j, n_c))
+    values = table.values
+    for i in range(n_i):
+        for j in range(n_j):
+            at = table.offset[k] + (((i_lo + i) * n_t + j_lo + j) * n_y + k0) * n_c
+            run = values[at:at + STENCIL * n_c]
+            for c in range(n_c):
+                v = 0.0
+                for d in range(STENCIL):
+                    v += w[2, d] * run[d * n_c + c]
+                contracted[i * n_j + j, c] = v
+    for g in range(n):
+        for c in range(n_c):
+            response[c] = 0.0
+        for p in range(STENCIL):
+            for q in range(STENCIL):
+                wpq = weights[2 * g, p] * weights[2 * g + 1, q]
+                row = (nodes[g, 0] - i_lo + p) * n_j + nodes[g, 1] - j_lo + q
+                for c in range(n_c):
+                    response[c] += wpq * contracted[row, c]
+        for c in range(3):
+            x[c] = center[c] + xi[g] * a * frame[0, c] + eta[g] * b * frame[1, c]
+        r1 = y[0] - x[0]
+        r2 = y[1] - x[1]
+        rho = math.sqrt(r1 * r1 + r2 * r2)
+        cos, sin = (r1 / rho, r2 / rho) if rho > 0.0 else (1.0, 0.0)
+        _rotated_stress(cos, sin, normal, shear_modulus, lame, wt[g] * jac, response, out, scratch)

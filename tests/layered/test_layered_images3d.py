@@ -167,3 +167,36 @@ def test_three_layers_interface_conditions_converge_with_images():
     assert mismatch[0] > 1e-3
     assert mismatch[1] < 0.1 * mismatch[0]
     assert mismatch[2] < 1e-3 * mismatch[0]
+
+
+@pytest.mark.parametrize("sigma", [1.0, -1.0])
+def test_the_gauge_table_holds_the_base_tables_of_f_and_l(sigma):
+    """:func:`potentials3d.gauge_table` (one table of F of the gauge, at the receiver; what
+    the triples read) against the tables of F and L of :func:`potentials3d._base_table`
+    (at the flipped point, as the closed-form vertical rectangles read them): ``F`` as it
+    is, ``L = -sigma D F`` one order up in ``d3``, every entry both write."""
+    from hmatddm.layered import potentials3d as p3
+    rng = np.random.default_rng(5)
+    for n_c in (5, 7, 9):
+        top = max(n_c - 2, 4)  # as _pair_tables: the Laplace relations read 1/r's to order 4
+        for _ in range(10):
+            r1, r2 = rng.uniform(-2.0, 2.0, size=2)
+            r3 = sigma * rng.uniform(0.05, 2.0)
+            sf, sl, q = np.zeros((6, 6)), np.zeros((6, 6)), np.zeros((6, 6, n_c + 3))
+            base = np.full((2, 6, 6, n_c + 4), np.nan)
+            p3.base_derivatives(r1, r2, sigma * r3, sf, sl, q[:, :, :n_c - 1], np.zeros((4, 6)),
+                                p3.inverse_distance_scratch(n_c + 3), top)
+            p3._base_table(sigma, n_c, sf, sl, q, base, top)
+            h = np.full((6, 6, n_c + 4), np.nan)
+            p3.gauge_table(r1, r2, r3, sigma, n_c, top, np.zeros((6, 6)), np.zeros((6, 6)), np.zeros((4, 6)), h,
+                           p3.inverse_distance_scratch(n_c + 3))
+            compared = 0
+            for a in range(6):
+                for b in range(6 - a):
+                    for c in range(n_c):
+                        for kind, value in ((0, h[a, b, c]), (1, -sigma * h[a, b, c + 1])):
+                            expected = base[kind, a, b, c]
+                            if np.isfinite(expected):
+                                assert value == pytest.approx(expected, rel=1e-13, abs=1e-13 * abs(q).max())
+                                compared += 1
+            assert compared > 2 * 21 * 3

@@ -275,3 +275,40 @@ def test_near_images_keep_every_reflection_where_a_deeper_image_merges(monkeypat
 
     monkeypatch.setattr(build, "trace", merged)
     assert build.near_images(interfaces, g, nu, 3, ranges, bottoms, tops, [1, 2, 3]) == 3
+
+
+def test_a_rule_contracted_once_along_the_receiver_height_equals_its_points_one_by_one():
+    """:func:`remainder_table3d.remainder_rectangle_stress` contracts the values along
+    ``y3`` once for the nodes that the stencils of the rule's points share: the same as
+    :func:`remainder_table3d.remainder_point_stress` at each point (one-point rules take
+    that path; 2 x 2 and 3 x 3 rules the shared one), tilted rectangles, in and across
+    layers."""
+    from hmatddm.layered.rectangle_quadrature import square_rule
+    medium = _medium()
+    mesh = _random_mesh(2, CENTERS, 0.15)
+    interfaces, g, nu = medium.arrays()
+    table, _ = build.build_table(mesh, element_layers(mesh, medium), interfaces, g, nu, 3, 1e-6, 10.0)
+    ranges = {1: (-1.3, -0.2), 2: (-2.8, -1.7), 3: (-4.2, -3.2)}
+    rng = np.random.default_rng(3)
+    compared = 0
+    for _ in range(30):
+        ls, lr = rng.integers(1, 4, size=2)
+        center = np.array([rng.uniform(0.0, 1.0), rng.uniform(0.0, 0.5), rng.uniform(*ranges[ls])])
+        y = np.array([rng.uniform(-0.5, 1.5), rng.uniform(-0.5, 1.0), rng.uniform(*ranges[lr])])
+        frame = np.linalg.qr(rng.normal(size=(3, 3)))[0].T.copy()
+        a, b = 0.1, 0.07
+        if not rt.rectangle_covered(table, y, lr, center, frame, a, b, ls):
+            continue
+        lame = _lame(g[ls], nu[ls])
+        for n_gauss in (1, 2, 3):
+            xi, eta, wt = square_rule(n_gauss, 1)
+            rule = np.zeros((3, 3, 3))
+            rt.remainder_rectangle_stress(table, y, lr, center, frame, a, b, ls, g[ls], lame, xi, eta, wt, rule)
+            points = np.zeros((3, 3, 3))
+            for k in range(len(xi)):
+                x = center + xi[k] * a * frame[0] + eta[k] * b * frame[1]
+                rt.remainder_point_stress(table, y, lr, x, ls, frame[2], g[ls], lame, wt[k] * a * b, points,
+                                          np.empty(len(rt.COMPONENTS)), rt.interpolation_scratch(), np.empty((2, 6)))
+            assert np.abs(rule - points).max() <= 1e-14 * np.abs(points).max()
+            compared += 1
+    assert compared >= 30
