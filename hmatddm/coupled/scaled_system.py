@@ -180,7 +180,7 @@ class SchurFactor:
     :data:`MAX_SWEEPS` sweeps, and factorises ``S`` anew as soon as the sweeps' contraction
     says they will not get there. A factorisation costs ``~N / 5`` sweeps: on the
     dfn-3cluster network at 4x its area (~470 cells) the new complement of every iterate
-    took 17% of the run (benchmarks/RESULTS.md, issue 33)."""
+    took 17% of the run, profiled (benchmarks/RESULTS.md, issue 33)."""
 
     #: Relative residual of a refined solve that needs no better (round-off of a fresh LU's)
     REFINED = 1e-13
