@@ -5,6 +5,7 @@
     python benchmarks/bench_scaling.py --steps fixed,auto        # both step rules, side by side
     python benchmarks/bench_scaling.py --compare ../previous     # and another source tree, run by run
     python benchmarks/bench_scaling.py --sizes "" --steps fixed --dfn-areas 1,4   # the network at 1x, 4x area
+    python benchmarks/bench_scaling.py --sizes "" --steps fixed --dfn-areas 1,4 --schur-accuracy 1e-3  # both families
 
 Each row is one ``hmatddm run SCENE --set initial_fracture[0].element_size=h`` in a child
 process (its own CPU time and peak memory), with fixed 1 s steps or front-following steps
@@ -28,13 +29,17 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 
 _RUN = """
+import os
 import sys
+if os.environ.get("BENCH_SCHUR_ACCURACY"):  # --schur-accuracy: the kept Schur LU's refinement target
+    from hmatddm.coupled.scaled_system import SchurFactor
+    SchurFactor.ACCURACY = float(os.environ["BENCH_SCHUR_ACCURACY"])
 from hmatddm.app.cli import main
 sys.exit(main(sys.argv[1:]))
 """
 
 
-def run(scene, h, steps, folder, source=ROOT, label="this", extra=()):
+def run(scene, h, steps, folder, source=ROOT, label="this", extra=(), schur_accuracy=None):
     """One run in a child process (the package of the source tree ``source``): its
     summary totals, wall and CPU time, peak memory."""
     out = os.path.join(folder, f"{label}-{os.path.basename(scene)}-{h}-{steps}-{len(os.listdir(folder))}")
@@ -45,7 +50,8 @@ def run(scene, h, steps, folder, source=ROOT, label="this", extra=()):
         arguments += ["--set", "numerics.time_step=auto"]
     for setting in extra:
         arguments += ["--set", setting]
-    environment = dict(os.environ, PYTHONPATH=os.pathsep.join([source, os.environ.get("PYTHONPATH", "")]))
+    environment = dict(os.environ, PYTHONPATH=os.pathsep.join([source, os.environ.get("PYTHONPATH", "")]),
+                       BENCH_SCHUR_ACCURACY=schur_accuracy or "")
     start = time.perf_counter()
     # -P: not the working directory first on sys.path, so that PYTHONPATH picks the source tree
     child = subprocess.Popen([sys.executable, "-P", "-c", _RUN] + arguments, env=environment)
@@ -80,6 +86,10 @@ def main():
                         help="also run dfn-3cluster with its network region scaled to these multiples of its area "
                              "and its injection lengthened so that the fractures span the same share of it "
                              "(end time x area^0.75: plane-strain length ~ t^(2/3))")
+    parser.add_argument("--schur-accuracy", default="", metavar="A,B,...",
+                        help="also run the network with the kept Schur LU refined to these fractions of the solve's "
+                             "tolerance (SchurFactor.ACCURACY, default 1e-2): a round-off-level change that moves the "
+                             "4x run between its two families of answers (benchmarks/RESULTS.md, issue 33)")
     parser.add_argument("--compare", default=None, metavar="DIR",
                         help="also run the package of another source tree (e.g. a git worktree of the previous "
                              "version) in the same session, row by row")
@@ -104,9 +114,12 @@ def main():
             extra = [f"network.region=[{-50 * side}, {50 * side}, {-100 * side}, {100 * side}]",
                      f"numerics.end_time={70.0 * area ** 0.75:.6g}"]
             for steps in args.steps.split(","):
-                for label, source in sources:
-                    rows.append(dict(run("dfn-3cluster", None, steps, folder, source, label, extra), area=area))
-                    print(rows[-1], flush=True)
+                for accuracy in [None] + [a for a in args.schur_accuracy.split(",") if a]:
+                    for label, source in sources:
+                        version = label if accuracy is None else f"{label} (Schur {accuracy})"
+                        rows.append(dict(run("dfn-3cluster", None, steps, folder, source, version, extra, accuracy),
+                                         area=area))
+                        print(rows[-1], flush=True)
     header = ["version", "scene", "h (m)", "steps rule", "elements", "steps", "growth passes", "nonlinear its", "GMRES its",
               "matvecs", "matvecs/step", "builds", "wall (s)", "CPU (s)", "peak RSS (MB)", "R error", "w0 error", "p error",
               "CPU exponent vs previous h"]

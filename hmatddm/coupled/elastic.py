@@ -29,9 +29,11 @@ from .contact_factor import ContactFactor
 
 
 class ElasticSolver:
-    """Solver for ``A x = b`` (or ``(S A + D) x = b`` with contact rows) of one operator."""
+    """Solver for ``A x = b`` (or ``(S A + D) x = b`` with contact rows) of one operator;
+    ``contact_bases``: a :class:`~hmatddm.coupled.contact_factor.ContactBases` shared by the
+    solves of one step, whose growth passes then border the last solve's contact base."""
 
-    def __init__(self, operator, rtol=1e-9, restart=100, maxiter=20):
+    def __init__(self, operator, rtol=1e-9, restart=100, maxiter=20, contact_bases=None):
         self.operator = operator
         self.rtol = rtol
         self.restart, self.maxiter = restart, maxiter
@@ -43,6 +45,7 @@ class ElasticSolver:
         self._modified_factors = None  # (key, dense LU of S A + D) of exact operators, for solve
         self._update = None  # (key, UpdatedFactor) of exact operators (contact_update)
         self.contact_factor = None  # their ContactFactor (made on first use)
+        self.contact_bases = contact_bases  # the step's ContactBases: the previous solve's factor, bordered
 
     @property
     def shape(self):
@@ -101,7 +104,11 @@ class ElasticSolver:
         key = None if rows is None else rows.key
         if self._update is None or self._update[0] != key:
             if self.contact_factor is None:
-                self.contact_factor = ContactFactor(self.operator.to_dense(), self.operator.dof)
+                bases = self.contact_bases
+                self.contact_factor = ContactFactor(self.operator.to_dense(), self.operator.dof,
+                                                    previous=None if bases is None else bases.last)
+                if bases is not None:
+                    bases.last = self.contact_factor
             self._update = (key, self.contact_factor.update(rows))
         return self._update[1]
 

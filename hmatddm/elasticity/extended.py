@@ -25,7 +25,7 @@ Growth passes share work (a pass adds a few elements to the last pass's mesh): t
 is kept as one chunk of ``A_on`` columns and ``A_no`` rows per batch of added elements,
 so the chunks of the elements a pass shares with the previous one are reused as they are
 (no copy of the whole border per pass); the LU of ``A_nn`` grows by one level per batch
-(:class:`GrowingBlockLU`: the Schur complement of the added block, not a new
+(:class:`~hmatddm.elasticity.growing_lu.GrowingBlockLU`: the Schur complement of the added block, not a new
 factorisation of the whole block); and the product of the base with the old unknowns is
 kept for the last vector (a pass's first residual multiplies the previous pass's last
 iterate, whose old part it already multiplied).
@@ -40,6 +40,7 @@ from scipy.sparse.linalg import LinearOperator
 from ..errors import InputError
 from ..hmatrix.preconditioners import DEFAULT_ILU
 from ..kernels.drivers import traction_block
+from .growing_lu import GrowingBlockLU
 from .inverse import solve_with_inverse
 from .operator import ElasticityOperator, ProductCounter, influence_data, refuse_singular
 
@@ -448,45 +449,3 @@ class _LastProduct:
         product = self.matvec(x)
         self.x, self.product = x.copy(), product
         return product
-
-
-class GrowingBlockLU:
-    """Solves with a matrix ``M`` (the ``A_nn`` of a grown mesh) factored level by level:
-    when ``M`` gains rows and columns ``s:e`` (a growth pass's elements), the factors of
-    ``M[:s, :s]`` are kept and the level adds ``R = M[s:e, :s]``, ``H = M[:s, :s]^-1
-    M[:s, s:e]`` and the inverse of the Schur complement ``S = M[s:e, s:e] - R H`` (a
-    growth pass's few elements: a small dense block; an explicit inverse makes a level
-    three matrix-vector products, without the per-call cost of an LU solve). A solve runs
-    the levels in order: ``y[s:e] = S^-1 (r[s:e] - R y[:s])``, ``y[:s] -= H y[s:e]`` keeps
-    ``y[:e] = M[:e, :e]^-1 r[:e]`` (block elimination without pivoting between levels,
-    which suits the diagonally dominant DDM blocks). Adding ``b`` unknowns to ``s`` costs
-    O(s^2 b) instead of the O((s + b)^3) of a new LU.
-
-    ``kept``: the levels of an earlier ``GrowingBlockLU`` whose matrix is ``M[:s, :s]``
-    (from :meth:`prefix`), or None."""
-
-    def __init__(self, matrix, kept=None):
-        self.levels = list(kept or [])
-        start = self.levels[-1][1] if self.levels else 0
-        size = matrix.shape[0]
-        if start < size:
-            coupling = matrix[:start, start:]
-            solved = self.solve(coupling) if start else None
-            rows = matrix[start:, :start] if start else None
-            schur = matrix[start:, start:] - rows @ solved if start else matrix
-            self.levels.append((start, size, rows, solved, np.linalg.inv(schur)))
-
-    def prefix(self, size):
-        """The levels that factor ``M[:size, :size]`` whole (a shared run of unknowns)."""
-        return [level for level in self.levels if level[1] <= size]
-
-    def solve(self, r):
-        """``M^-1 r`` (``r``: a vector or a matrix of columns)."""
-        y = np.array(r, dtype=np.float64)
-        for start, stop, rows, solved, schur_inverse in self.levels:
-            if start:
-                y[start:stop] -= rows @ y[:start]
-            y[start:stop] = schur_inverse @ y[start:stop]
-            if start:
-                y[:start] -= solved @ y[start:stop]
-        return y

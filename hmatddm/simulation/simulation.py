@@ -28,6 +28,7 @@ import numpy as np
 
 from .._validation import finite_array, positive_scalar
 from ..coupled import SchemeSettings
+from ..coupled.contact_factor import ContactBases
 from ..errors import ConvergenceError, InputError, NoInjectionWarning, SizeLimitError
 from ..flow import Cluster, Fluid, LeakOff, LubricationModel
 from ..fracture import Propagation
@@ -233,6 +234,9 @@ class Simulation:
         self.proppant, self.pump_schedule = _checked_proppant(proppant, pump_schedule)
         self.records = []
         self._encoded_records = {}  # the records' checkpoint text, encoded once (checkpoint.metadata_text)
+        # the contact factor of the step's last solve, which a growth pass's solve borders
+        # (hmatddm.coupled.contact_factor); made anew at each step, so resumes stay bit for bit
+        self.contact_bases = ContactBases()
         self.front = None  # propagation.front == "asymptotic": its AsymptoticFront (raises for unsupported setups)
         if propagation is not None and propagation.front == "asymptotic":
             from .asymptotic import AsymptoticFront
@@ -436,6 +440,7 @@ class Simulation:
         tally = StepTally()
         builds = self.operator_builds
         relaxation = begin.relaxation
+        self.contact_bases = ContactBases()
         max_passes = 50 if self.propagation is None else self.propagation.max_growth_passes
         # growth decided on a solve's first iterate, converged only on the mesh the step keeps
         provisional = (self.propagation is not None and self.network is None

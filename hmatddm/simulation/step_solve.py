@@ -93,7 +93,7 @@ def solve(simulation, trial, start, t_old, t_new, relaxation, provisional=False)
     faces = with_links(faces, trial.extra_faces)
     flow = sim.flow_model(mesh, faces, proppant_step.viscosity_factor(sim, trial, start.width),
                           well=sim.well_link(start, t_old, t_new))
-    elastic = ElasticSolver(sim.operator(mesh), rtol=sim.settings.linear_rtol)
+    elastic = ElasticSolver(sim.operator(mesh), rtol=sim.settings.linear_rtol, contact_bases=sim.contact_bases)
     contact, fixed_pressure, pressure_guess = None, None, trial.pressure
     law = contact_law(sim, trial.origin)
     if np.any(law.enabled):

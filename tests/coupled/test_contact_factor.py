@@ -81,6 +81,66 @@ def test_an_ill_conditioned_update_makes_a_new_base(monkeypatch):
     assert updated.rank == 0 and elastic.contact_factor.bases_made == 2
 
 
+def _check_against_dense(operator, mesh, updated, rows, rng):
+    dense = _dense_modified(operator, rows)
+    r = rng.normal(size=dense.shape[0])
+    exact = np.linalg.solve(dense, r)
+    np.testing.assert_allclose(updated.solve(r), exact, rtol=0, atol=1e-10 * np.abs(exact).max())
+    x0, w, f = updated.inverse_times_b(mesh.normals)
+    columns = x0 if w is None else x0 + w @ f
+    expected = np.linalg.solve(dense, _schur_columns(mesh, rows))
+    np.testing.assert_allclose(columns, expected, rtol=0, atol=1e-10 * np.abs(expected).max())
+
+
+def test_a_growth_pass_borders_the_previous_solves_base():
+    """A mesh grown by appended elements (a growth pass of the same step): its first base is
+    the previous solve's, bordered by the new rows (no new factorisation), and its solves,
+    its ``(S A + D)^-1 S B`` and the columns solved for the updates (bordered too) agree
+    with the LU of the same rows; statuses changed meanwhile are the update's rows."""
+    line = hd.mesh.line([-5.0, 0.0], [5.0, 0.0], 40)
+    grown = hd.mesh.concatenate([line, hd.mesh.line([5.0, 0.0], [6.0, 0.0], 4)])
+    rng = np.random.default_rng(11)
+    bases = cf.ContactBases()
+    operator = hd.ElasticityOperator(line, MATERIAL, backend="dense")
+    elastic = ElasticSolver(operator, contact_bases=bases)
+    status = rng.choice([OPEN, STICK, SLIP], size=line.n_elements)
+    rows = _model(line, elastic, status, 0).rows()
+    _check_against_dense(operator, line, elastic.contact_update(rows), rows, rng)
+    flip = np.flatnonzero(status != SLIP)[:2]  # (the slip directions' draws stay the same)
+    status[flip] = np.where(status[flip] == OPEN, STICK, OPEN)  # an update: columns of M_0^-1 solved for them
+    rows = _model(line, elastic, status, 0).rows()
+    assert elastic.contact_update(rows).rank > 0
+    _check_against_dense(operator, line, elastic.contact_update(rows), rows, rng)
+    assert bases.last is elastic.contact_factor and elastic.contact_factor.bases_made == 1
+
+    operator_grown = hd.ElasticityOperator(grown, MATERIAL, backend="dense")
+    np.testing.assert_array_equal(operator_grown.to_dense()[:80, :80], operator.to_dense())  # the leading block
+    elastic_grown = ElasticSolver(operator_grown, contact_bases=bases)
+    status_grown = np.concatenate([status, [OPEN, OPEN, STICK, STICK]])
+    changed = np.flatnonzero(status != SLIP)[5]
+    status_grown[changed] = np.where(status_grown[changed] == OPEN, STICK, OPEN)
+    rows = _model(grown, elastic_grown, status_grown, 0).rows()
+    updated = elastic_grown.contact_update(rows)
+    factor = elastic_grown.contact_factor
+    assert factor.bases_made == 0 and factor.bases_bordered == 1
+    assert len(factor.base.levels.levels) == 2  # the previous LU and one border level
+    assert set(updated.changed) >= {flip[0], flip[1], changed}
+    _check_against_dense(operator_grown, grown, updated, rows, rng)
+
+    # the same mesh again (a pass that only linked elements): the same factors, no new level
+    again = ElasticSolver(operator_grown, contact_bases=bases)
+    updated = again.contact_update(rows)
+    assert again.contact_factor.bases_bordered == 1 and len(again.contact_factor.base.levels.levels) == 2
+    _check_against_dense(operator_grown, grown, updated, rows, rng)
+
+    # a matrix whose leading block is not the previous one's: a new factorisation
+    other = ElasticSolver(hd.ElasticityOperator(grown, hd.Elastic(shear_modulus=11e9, poisson_ratio=0.25),
+                                                backend="dense"), contact_bases=bases)
+    rows = _model(grown, other, status_grown, 0).rows()
+    other.contact_update(rows)
+    assert other.contact_factor.bases_made == 1 and other.contact_factor.bases_bordered == 0
+
+
 def _pressurised_step(pressure_peak):
     """One "krylov" step of an inclined crack, closed and stuck at the start, drained at a
     pressure that peaks at its centre: its middle opens, its flanks slip or stick, and the

@@ -93,32 +93,6 @@ def test_a_later_growth_pass_reuses_the_border_of_the_previous_one(grown, materi
     assert ExtendedElasticityOperator(other_base, mesh, previous=first).n_reused == 0
 
 
-def test_growing_block_lu_solves_like_a_dense_solve():
-    """Levels added one block at a time (Schur complements) solve with the whole matrix,
-    vectors and matrices of right-hand sides, as numpy's dense solve does."""
-    from hmatddm.elasticity.extended import GrowingBlockLU
-
-    rng = np.random.default_rng(3)
-    n = 40
-    matrix = rng.normal(size=(n, n)) + 2 * n * np.eye(n) * rng.choice([-1.0, 1.0], size=n)
-    levels = None
-    for size in (7, 8, 20, 33, 40):
-        factors = GrowingBlockLU(matrix[:size, :size], levels)
-        levels = factors.prefix(size)
-        assert len(levels) == len(factors.levels)
-        r = rng.normal(size=(size, 3))
-        np.testing.assert_allclose(factors.solve(r), np.linalg.solve(matrix[:size, :size], r), rtol=0, atol=1e-12)
-        np.testing.assert_allclose(factors.solve(r[:, 0]), np.linalg.solve(matrix[:size, :size], r[:, 0]), rtol=0,
-                                   atol=1e-12)
-    assert [(start, stop) for start, stop, *_ in factors.levels] == [(0, 7), (7, 8), (8, 20), (20, 33), (33, 40)]
-    # a shared run that ends inside a level keeps the levels before it only
-    assert [level[1] for level in factors.prefix(30)] == [7, 8, 20]
-    partly = GrowingBlockLU(matrix, factors.prefix(30))
-    assert [(start, stop) for start, stop, *_ in partly.levels] == [(0, 7), (7, 8), (8, 20), (20, 40)]
-    r = rng.normal(size=n)
-    np.testing.assert_allclose(partly.solve(r), np.linalg.solve(matrix, r), rtol=0, atol=1e-12)
-
-
 def _near_border(fresh, base):
     """``A_no`` without the element blocks below the preconditioner's threshold, written
     out block by block."""
