@@ -262,8 +262,11 @@ class ContactFactor:
         shared, k = ends[-1], ends[-1] // self.d
         select, direct = np.array(select), np.array(direct)
         select[:k], direct[:k] = base.select[:k], base.direct[:k]
-        with single_threaded_blas():
-            bordered = _Base(self.matrix, select, direct, self.d, previous=base, shared=shared)
+        try:
+            with single_threaded_blas():
+                bordered = _Base(self.matrix, select, direct, self.d, previous=base, shared=shared)
+        except np.linalg.LinAlgError:  # a singular border: the new rows' own factorisation decides
+            return None
         self.bases_bordered += 1
         return bordered
 

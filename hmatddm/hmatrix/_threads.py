@@ -21,6 +21,7 @@ import numba
 from threadpoolctl import ThreadpoolController
 
 _CONTROLLER = []
+_BLAS = []
 
 # Measured by benchmarks/bench_threads.py (benchmarks/RESULTS.md, "Threads that never
 # lose"): an H matvec with fewer stored entries x right-hand sides than this runs on one
@@ -33,11 +34,41 @@ ADAPT_TO_LOAD = True
 _LOAD = {"time": None, "busy": None, "cpu": None, "others": 0.0}
 
 
-def single_threaded_blas():
-    """Context manager limiting BLAS/LAPACK to one thread."""
+def _blas_libraries():
+    """threadpoolctl's controllers of the loaded BLAS libraries (found once)."""
     if not _CONTROLLER:
         _CONTROLLER.append(ThreadpoolController())
-    return _CONTROLLER[0].limit(limits=1, user_api="blas")
+        _BLAS.extend(_CONTROLLER[0].select(user_api="blas").lib_controllers)
+    return _BLAS
+
+
+class _OneBlasThread:
+    """BLAS/LAPACK on one thread inside the ``with`` block, their thread counts restored
+    after. Only the libraries' own get/set calls: threadpoolctl's ``limit`` reads every
+    library's state again at each use, ~12 us against ~1-4 us (the contact solves of a
+    network take it tens of thousands of times a run). Nested blocks find one thread and
+    change nothing."""
+
+    __slots__ = ("saved",)
+
+    def __enter__(self):
+        self.saved = []
+        for library in _blas_libraries():
+            threads = library.get_num_threads()
+            if threads is not None and threads != 1:
+                library.set_num_threads(1)
+                self.saved.append((library, threads))
+        return self
+
+    def __exit__(self, *exception):
+        for library, threads in self.saved:
+            library.set_num_threads(threads)
+        return False
+
+
+def single_threaded_blas():
+    """Context manager limiting BLAS/LAPACK to one thread."""
+    return _OneBlasThread()
 
 
 def machine_busy_seconds():

@@ -1,6 +1,7 @@
 """The low-rank (Woodbury) update of the contact-modified dense matrix ``S A + D``
 (hmatddm.coupled.contact_factor) against a fresh dense factorisation of the same rows."""
 import numpy as np
+import pytest
 
 import hmatddm as hd
 from hmatddm.coupled import ElasticSolver, SchemeSettings, solve_step
@@ -187,6 +188,30 @@ def test_a_step_with_updated_factors_matches_one_with_fresh_factorisations(monke
     np.testing.assert_allclose(dd, dd_fresh, rtol=0, atol=1e-8 * np.abs(dd_fresh).max())
 
 
+def test_a_3d_growth_pass_borders_the_previous_solves_base():
+    """The same in 3D (three unknowns an element): a vertical fracture of 6 x 4 squares grown
+    by a column of 4, open and stuck elements."""
+    plane = hd.mesh.rectangle([0.0, 0.0, 0.0], [1, 0, 0], [0, 0, 1], 6.0, 4.0, 6, 4)
+    grown = hd.mesh.concatenate([plane, hd.mesh.rectangle([3.5, 0.0, 0.0], [1, 0, 0], [0, 0, 1], 1.0, 4.0, 1, 4)])
+    rng = np.random.default_rng(12)
+    bases = cf.ContactBases()
+    operator = hd.ElasticityOperator(plane, MATERIAL, backend="dense")
+    elastic = ElasticSolver(operator, contact_bases=bases)
+    status = rng.choice([OPEN, STICK], size=plane.n_elements)
+    rows = _model(plane, elastic, status, 0).rows()
+    _check_against_dense(operator, plane, elastic.contact_update(rows), rows, rng)
+    operator_grown = hd.ElasticityOperator(grown, MATERIAL, backend="dense")
+    elastic_grown = ElasticSolver(operator_grown, contact_bases=bases)
+    status_grown = np.concatenate([status, [OPEN, STICK, OPEN, STICK]])
+    status_grown[7] = OPEN if status_grown[7] == STICK else STICK
+    rows = _model(grown, elastic_grown, status_grown, 0).rows()
+    updated = elastic_grown.contact_update(rows)
+    assert elastic_grown.contact_factor.bases_bordered == 1 and elastic_grown.contact_factor.bases_made == 0
+    assert list(updated.changed) == [7]
+    _check_against_dense(operator_grown, grown, updated, rows, rng)
+
+
+@pytest.mark.filterwarnings("ignore::hmatddm.errors.MeshQualityWarning")  # (the scene's near pair, expected)
 def test_a_network_run_with_bordered_bases_matches_one_that_factorises_every_base(monkeypatch):
     """The dfn-3cluster scene's first 12 s (23 growth passes through the network, contact
     on every element): with the growth passes' bases bordered (the default) and with a new

@@ -47,3 +47,26 @@ def test_serial_and_parallel_matvec_are_bit_identical(monkeypatch):
     monkeypatch.setattr(_threads, "SERIAL_MATVEC_ENTRIES", 10**12)
     serial = h @ x
     assert np.array_equal(parallel, serial)
+
+
+def test_single_threaded_blas_holds_every_blas_library_at_one_thread_and_restores_it():
+    """Inside the block every loaded BLAS runs one thread (as threadpoolctl reads it), nested
+    blocks change nothing, and the counts before come back after, also after an exception."""
+    from threadpoolctl import threadpool_info, threadpool_limits
+
+    def blas_threads():
+        return sorted(info["num_threads"] for info in threadpool_info() if info["user_api"] == "blas")
+
+    with threadpool_limits(limits=2, user_api="blas"):
+        before = blas_threads()
+        assert before and max(before) == 2
+        with _threads.single_threaded_blas():
+            assert set(blas_threads()) == {1}
+            with _threads.single_threaded_blas():
+                assert set(blas_threads()) == {1}
+            assert set(blas_threads()) == {1}
+        assert blas_threads() == before
+        with pytest.raises(RuntimeError):
+            with _threads.single_threaded_blas():
+                raise RuntimeError("inside")
+        assert blas_threads() == before
