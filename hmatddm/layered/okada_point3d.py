@@ -274,42 +274,91 @@ def point_frame(normal):
     return rows[0] if has_strike[0] else None
 
 
+#: Length of a point-form source's setup (:func:`point_setup`)
+POINT_SETUP = 14
+
+
 @njit(cache=True, inline="always")
-def _point_gradient(point, center, frame, a, b, okada, surface, shear_modulus, poisson_ratio, xi, eta, wt, work):
-    """The Gauss sum of :func:`_point_image` into ``work[3]`` (Okada's frame); returns the
-    strike's ``(s_x, s_y)`` and Lame's lambda, as :func:`.okada_stress3d.global_stress` takes them.
-    Its callers compile with :data:`FAST` and numpy's error model: the sum over the points is
-    then a vectorised loop (a 2 x 2 sum 2.3x cheaper, benchmarks/RESULTS.md, issue 32)."""
+def point_setup(center, frame, a, b, okada, surface, shear_modulus, poisson_ratio, setup):
+    """``setup[:14]``: what the receivers of a point-form source share: the strike ``(s0,
+    s1)``, ``(sin dip, cos dip, lambda, alpha)`` (:func:`.okada_stress3d.dip_and_medium`),
+    the Jacobian ``a b / (2 pi)``, the rectangle's sides ``e1``, ``e2`` turned into Okada's
+    frame ``(ax, ay, az, bx, by, bz)`` and the depth of its centre under the surface. Made
+    once per source (:func:`.images3d.source_state`): per pair, with its square root and
+    three divisions, it cost ~7% of a half-space entry (benchmarks/RESULTS.md, issue 32)."""
     s0 = okada[0, 0]
     s1 = okada[0, 1]
     sd, cd, lam, alpha = dip_and_medium(s0, s1, okada, shear_modulus, poisson_ratio)
+    setup[0] = s0
+    setup[1] = s1
+    setup[2] = sd
+    setup[3] = cd
+    setup[4] = lam
+    setup[5] = alpha
+    setup[6] = a * b * _INV_2PI
+    setup[7] = s0 * frame[0, 0] + s1 * frame[0, 1]
+    setup[8] = -s1 * frame[0, 0] + s0 * frame[0, 1]
+    setup[9] = frame[0, 2]
+    setup[10] = s0 * frame[1, 0] + s1 * frame[1, 1]
+    setup[11] = -s1 * frame[1, 0] + s0 * frame[1, 1]
+    setup[12] = frame[1, 2]
+    setup[13] = surface - center[2]
+
+
+@njit(cache=True, inline="always")
+def _point_gradient(point, center, a, b, setup, surface, xi, eta, wt, work):
+    """The Gauss sum of :func:`_point_image` into ``work[3]`` (Okada's frame) of the source
+    whose :func:`point_setup` is ``setup``. Its callers compile with :data:`FAST` and numpy's
+    error model: the sum over the points is then a vectorised loop (a 2 x 2 sum 2.3x
+    cheaper, benchmarks/RESULTS.md, issue 32)."""
+    s0 = setup[0]
+    s1 = setup[1]
+    sd = setup[2]
+    cd = setup[3]
+    alpha = setup[5]
+    jac = setup[6]
+    ax = setup[7]
+    ay = setup[8]
+    az = setup[9]
+    bx = setup[10]
+    by = setup[11]
+    bz = setup[12]
+    depth0 = setup[13]
     z = point[2] - surface
-    jac = a * b * _INV_2PI
     # the receiver from the rectangle's centre, in Okada's frame; each point moves it
     rx = point[0] - center[0]
     ry = point[1] - center[1]
     x0 = s0 * rx + s1 * ry
     y0 = -s1 * rx + s0 * ry
-    depth0 = surface - center[2]
-    ax = s0 * frame[0, 0] + s1 * frame[0, 1]
-    ay = -s1 * frame[0, 0] + s0 * frame[0, 1]
-    bx = s0 * frame[1, 0] + s1 * frame[1, 1]
-    by = -s1 * frame[1, 0] + s0 * frame[1, 1]
     acc = (0.0,) * 27
     for g in range(xi.shape[0]):
         ua = xi[g] * a
         ub = eta[g] * b
         acc = accumulate(acc, wt[g] * jac, _point_image(x0 - ua * ax - ub * bx, y0 - ua * ay - ub * by, z,
-                                                         depth0 - ua * frame[0, 2] - ub * frame[1, 2], sd, cd, alpha))
+                                                         depth0 - ua * az - ub * bz, sd, cd, alpha))
     for k in range(3):
         for i in range(3):
             for j in range(3):
                 work[3, k, i, j] = 0.0
     add_gradient(acc, work[3])
-    return s0, s1, lam
 
 
 @njit(cache=True, fastmath=FAST, error_model="numpy")
+def setup_image_stress(point, center, a, b, setup, okada, surface, shear_modulus, xi, eta, wt, work, out):
+    """:func:`point_image_stress` of the source whose :func:`point_setup` is ``setup``."""
+    _point_gradient(point, center, a, b, setup, surface, xi, eta, wt, work)
+    global_stress(work, setup[0], setup[1], setup[4], shear_modulus, okada, out)
+
+
+@njit(cache=True, fastmath=FAST, error_model="numpy")
+def setup_image_traction(point, normal, center, a, b, setup, okada, surface, shear_modulus, xi, eta, wt, work,
+                         block):
+    """:func:`point_image_traction` of the source whose :func:`point_setup` is ``setup``."""
+    _point_gradient(point, center, a, b, setup, surface, xi, eta, wt, work)
+    global_traction(work, setup[0], setup[1], setup[4], shear_modulus, okada, normal, block)
+
+
+@njit(cache=True)
 def point_image_stress(point, center, frame, a, b, okada, surface, shear_modulus, poisson_ratio, xi, eta, wt,
                        work, out):
     """``out[q, i, j]``: the image and surface terms of the global stress at ``point`` (below
@@ -317,30 +366,31 @@ def point_image_stress(point, center, frame, a, b, okada, surface, shear_modulus
     rows ``frame``, half sides ``a``, ``b``), by the Gauss rule ``(xi, eta, wt)`` on [-1,
     1]^2 of Okada's point source (:func:`_point_image`) at each point; ``okada``: the rows of
     :func:`point_frame`. ``work``: (5, 3, 3, 3) scratch (:func:`.okada_stress3d.global_stress`)."""
-    s0, s1, lam = _point_gradient(point, center, frame, a, b, okada, surface, shear_modulus, poisson_ratio, xi, eta,
-                                  wt, work)
-    global_stress(work, s0, s1, lam, shear_modulus, okada, out)
+    setup = np.empty(POINT_SETUP)
+    point_setup(center, frame, a, b, okada, surface, shear_modulus, poisson_ratio, setup)
+    setup_image_stress(point, center, a, b, setup, okada, surface, shear_modulus, xi, eta, wt, work, out)
 
 
-@njit(cache=True, fastmath=FAST, error_model="numpy")
+@njit(cache=True)
 def point_image_traction(point, normal, center, frame, a, b, okada, surface, shear_modulus, poisson_ratio, xi, eta,
                          wt, work, block):
     """``block[p, q] +=`` the traction ``sigma . normal`` (global component ``p``) of the terms
     of :func:`point_image_stress` (no stress tensor turned back:
     :func:`.okada_stress3d.global_traction`)."""
-    s0, s1, lam = _point_gradient(point, center, frame, a, b, okada, surface, shear_modulus, poisson_ratio, xi, eta,
-                                  wt, work)
-    global_traction(work, s0, s1, lam, shear_modulus, okada, normal, block)
+    setup = np.empty(POINT_SETUP)
+    point_setup(center, frame, a, b, okada, surface, shear_modulus, poisson_ratio, setup)
+    setup_image_traction(point, normal, center, a, b, setup, okada, surface, shear_modulus, xi, eta, wt, work, block)
 
 
 @njit(cache=True, inline="always")
-def point_form_terms(data, point, lr, j, work, entry_tol, normal, out, traction):
+def point_form_terms(data, point, lr, j, setup, work, entry_tol, normal, out, traction):
     """A ``point_form`` source ``j`` of the kernel record ``data``
     (:class:`.images3d.LayeredRectangles`; a half-space, no horizontal side): its image and
     surface terms at ``point`` (in layer ``lr``) by Okada's point source at the points of
     :func:`point_rule`; ``traction``: ``out[p, q] +=`` the traction on ``normal``
     (:func:`point_image_traction`), else ``out[q, i, k] =`` the stress
-    (:func:`point_image_stress`); ``work``: :func:`.images3d.workspace`. Inlined into the callers (no
+    (:func:`point_image_stress`); ``setup``: the source's :func:`point_setup` (in its
+    :func:`.images3d.source_state`); ``work``: :func:`.images3d.workspace`. Inlined into the callers (no
     record passed across a call, not held). On issue 32's lattice (2 x 2 points for 95% of
     the pairs) a whole entry, real source included, costs 0.44-0.47 us, ~4x a uniform-rock
     entry (AMD EPYC, dgemm 50 GFLOP/s, one thread; benchmarks/RESULTS.md, issue 32)."""
@@ -358,9 +408,8 @@ def point_form_terms(data, point, lr, j, work, entry_tol, normal, out, traction)
     else:
         xs, es, ws = square_rule(n_gauss, n_sub)
     g = data.shear_modulus[ls]
-    nu = data.poisson_ratio[ls]
     if traction:
-        point_image_traction(point, normal, center, frame, a, b, data.okada[j], data.surface, g, nu, xs, es, ws,
-                             work[8], out)
+        setup_image_traction(point, normal, center, a, b, setup, data.okada[j], data.surface, g, xs, es, ws, work[8],
+                             out)
     else:
-        point_image_stress(point, center, frame, a, b, data.okada[j], data.surface, g, nu, xs, es, ws, work[8], out)
+        setup_image_stress(point, center, a, b, setup, data.okada[j], data.surface, g, xs, es, ws, work[8], out)
