@@ -31,7 +31,8 @@ import numpy as np
 from numba import njit
 
 from ..compiled import FAST
-from .okada_stress3d import accumulate, add_gradient, dip_and_medium, global_stress, global_traction
+from .okada_stress3d import (accumulate_strain, accumulate_traction, add_traction, dip_and_medium, global_stress,
+                             set_strain)
 from .rectangle_quadrature import IMAGE_BOUND, nearest_singularity, square_rule
 
 _INV_2PI = 1.0 / (2.0 * math.pi)
@@ -52,8 +53,8 @@ def _point_image(x, y, z, depth, sd, cd, alpha):
     potency ``k`` (strike, dip, tensile) at depth ``depth``, times ``2 pi``: ``9 k + m``,
     ``m = 3 j + i`` in Okada's order (:func:`_combined`, :func:`.okada_stress3d.accumulate`).
     ``d > 0`` (the source below the surface) keeps ``R + d > 0``. Returned, not stored, so
-    that the Gauss sum of :func:`_point_gradient` stays in registers and is vectorised over
-    its points."""
+    that the Gauss sums of :func:`setup_image_stress` and :func:`setup_image_traction` stay
+    in registers and are vectorised over their points."""
     alp1 = 0.5 * (1.0 - alpha)
     alp2 = 0.5 * alpha
     alp3 = (1.0 - alpha) / alpha
@@ -315,56 +316,59 @@ def point_setup(center, frame, a, b, okada, surface, shear_modulus, poisson_rati
 
 
 @njit(cache=True, inline="always")
-def _point_gradient(point, center, a, b, setup, surface, xi, eta, wt, work):
-    """The Gauss sum of :func:`_point_image` into ``work[3]`` (Okada's frame) of the source
-    whose :func:`point_setup` is ``setup``. Its callers compile with :data:`FAST` and numpy's
-    error model: the sum over the points is then a vectorised loop (a 2 x 2 sum 2.3x
-    cheaper, benchmarks/RESULTS.md, issue 32)."""
-    s0 = setup[0]
-    s1 = setup[1]
-    sd = setup[2]
-    cd = setup[3]
-    alpha = setup[5]
-    jac = setup[6]
-    ax = setup[7]
-    ay = setup[8]
-    az = setup[9]
-    bx = setup[10]
-    by = setup[11]
-    bz = setup[12]
-    depth0 = setup[13]
-    z = point[2] - surface
-    # the receiver from the rectangle's centre, in Okada's frame; each point moves it
+def _receiver(point, center, setup, surface):
+    """The receiver from the rectangle's centre in Okada's frame, ``(x, y)`` horizontal, and
+    its height ``z`` over the surface (each Gauss point moves the source: :func:`_image_at`)."""
     rx = point[0] - center[0]
     ry = point[1] - center[1]
-    x0 = s0 * rx + s1 * ry
-    y0 = -s1 * rx + s0 * ry
-    acc = (0.0,) * 27
-    for g in range(xi.shape[0]):
-        ua = xi[g] * a
-        ub = eta[g] * b
-        acc = accumulate(acc, wt[g] * jac, _point_image(x0 - ua * ax - ub * bx, y0 - ua * ay - ub * by, z,
-                                                         depth0 - ua * az - ub * bz, sd, cd, alpha))
-    for k in range(3):
-        for i in range(3):
-            for j in range(3):
-                work[3, k, i, j] = 0.0
-    add_gradient(acc, work[3])
+    return setup[0] * rx + setup[1] * ry, -setup[1] * rx + setup[0] * ry, point[2] - surface
+
+
+@njit(cache=True, inline="always")
+def _image_at(g, x0, y0, z, a, b, setup, xi, eta):
+    """:func:`_point_image` of the Gauss point ``(xi[g] a, eta[g] b)`` of the source whose
+    :func:`point_setup` is ``setup``, at the receiver ``(x0, y0, z)`` of :func:`_receiver`."""
+    ua = xi[g] * a
+    ub = eta[g] * b
+    return _point_image(x0 - ua * setup[7] - ub * setup[10], y0 - ua * setup[8] - ub * setup[11], z,
+                        setup[13] - ua * setup[9] - ub * setup[12], setup[2], setup[3], setup[5])
 
 
 @njit(cache=True, fastmath=FAST, error_model="numpy")
 def setup_image_stress(point, center, a, b, setup, okada, surface, shear_modulus, xi, eta, wt, work, out):
-    """:func:`point_image_stress` of the source whose :func:`point_setup` is ``setup``."""
-    _point_gradient(point, center, a, b, setup, surface, xi, eta, wt, work)
+    """:func:`point_image_stress` of the source whose :func:`point_setup` is ``setup``: the
+    Gauss sum of the strains (:func:`.okada_stress3d.accumulate_strain`), then Hooke's law.
+    Compiled with :data:`FAST` and numpy's error model, the sum over the points is a
+    vectorised loop (its terms carried in a tuple, benchmarks/RESULTS.md, issue 32)."""
+    x0, y0, z = _receiver(point, center, setup, surface)
+    jac = setup[6]
+    acc = (0.0,) * 18
+    for g in range(xi.shape[0]):
+        acc = accumulate_strain(acc, wt[g] * jac, _image_at(g, x0, y0, z, a, b, setup, xi, eta))
+    set_strain(acc, work[3])
     global_stress(work, setup[0], setup[1], setup[4], shear_modulus, okada, out)
 
 
 @njit(cache=True, fastmath=FAST, error_model="numpy")
 def setup_image_traction(point, normal, center, a, b, setup, okada, surface, shear_modulus, xi, eta, wt, work,
                          block):
-    """:func:`point_image_traction` of the source whose :func:`point_setup` is ``setup``."""
-    _point_gradient(point, center, a, b, setup, surface, xi, eta, wt, work)
-    global_traction(work, setup[0], setup[1], setup[4], shear_modulus, okada, normal, block)
+    """:func:`point_image_traction` of the source whose :func:`point_setup` is ``setup``: the
+    Gauss sum of the traction on the normal turned into Okada's frame
+    (:func:`.okada_stress3d.accumulate_traction`: 9 sums, not 27 derivatives). ``work``
+    unused (the signature of :func:`setup_image_stress`)."""
+    s0 = setup[0]
+    s1 = setup[1]
+    x0, y0, z = _receiver(point, center, setup, surface)
+    n0 = s0 * normal[0] + s1 * normal[1]
+    n1 = -s1 * normal[0] + s0 * normal[1]
+    n2 = normal[2]
+    lam = setup[4]
+    jac = setup[6]
+    acc = (0.0,) * 9
+    for g in range(xi.shape[0]):
+        acc = accumulate_traction(acc, wt[g] * jac, _image_at(g, x0, y0, z, a, b, setup, xi, eta), n0, n1, n2,
+                                  shear_modulus, lam)
+    add_traction(acc, s0, s1, okada, block)
 
 
 @njit(cache=True)
@@ -384,8 +388,8 @@ def point_image_stress(point, center, frame, a, b, okada, surface, shear_modulus
 def point_image_traction(point, normal, center, frame, a, b, okada, surface, shear_modulus, poisson_ratio, xi, eta,
                          wt, work, block):
     """``block[p, q] +=`` the traction ``sigma . normal`` (global component ``p``) of the terms
-    of :func:`point_image_stress` (no stress tensor turned back:
-    :func:`.okada_stress3d.global_traction`)."""
+    of :func:`point_image_stress` (no stress tensor: the traction summed over the points,
+    :func:`.okada_stress3d.accumulate_traction`)."""
     setup = np.empty(POINT_SETUP)
     point_setup(center, frame, a, b, okada, surface, shear_modulus, poisson_ratio, setup)
     setup_image_traction(point, normal, center, a, b, setup, okada, surface, shear_modulus, xi, eta, wt, work, block)
