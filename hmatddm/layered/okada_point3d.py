@@ -421,8 +421,9 @@ def point_form_terms(data, point, lr, j, setup, work, entry_tol, normal, out, tr
     (:func:`point_image_stress`); ``setup``: the source's :func:`point_setup` (in its
     :func:`.images3d.source_state`); ``work``: :func:`.images3d.workspace`. Inlined into the callers (no
     record passed across a call, not held). On issue 32's lattice (2 x 2 points for 95% of
-    the pairs) a whole entry, real source included, costs 0.44-0.47 us, ~4x a uniform-rock
-    entry (AMD EPYC, dgemm 50 GFLOP/s, one thread; benchmarks/RESULTS.md, issue 32)."""
+    the pairs) a whole entry, real source included, costs 0.31-0.32 us, 2.8-2.9x a
+    uniform-rock entry (Intel Xeon, dgemm 73-80 GFLOP/s, one thread; benchmarks/RESULTS.md,
+    issue 32)."""
     xi, eta, wt, start = work[7]
     ls = data.layer[j]
     center = data.centers[j]
