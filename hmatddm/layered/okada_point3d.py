@@ -31,6 +31,7 @@ import numpy as np
 from numba import njit
 
 from ..compiled import FAST
+from ..kernels.rectangle3d import distance_to_rectangle
 from .okada_stress3d import (accumulate_strain, accumulate_traction, add_traction, dip_and_medium, global_stress,
                              set_strain)
 from .rectangle_quadrature import IMAGE_BOUND, nearest_singularity, square_rule
@@ -231,7 +232,7 @@ def _combined(z, ab0, ab1, ab2, ab3, ab4, ab5, ab6, ab7, ab8, c0, c1, c2, c3, c4
             ab6 + z * c6 + u0, ab7 + z * c7 + u1, ab8 + z * c8 + u2)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def point_rule(dmin, a, b, max_sub, far_tol, entry_tol):
     """``(n_gauss, n_sub)``: Gauss points per side and equal sub-squares per side of the point
     form's rule for a rectangle of half sides ``a``, ``b`` whose mirror is ``dmin`` from the
@@ -244,7 +245,8 @@ def point_rule(dmin, a, b, max_sub, far_tol, entry_tol):
     largest entry next to the free surface (issue 32 asks 1e-8); this one, 1e-11. The two
     rules' bounds ``40 n ratio^(-2n)`` (times the entry's size for the second) in one pass
     over the same powers: the smallest ``n`` either allows, as the smaller of the two
-    orders, with two divisions fewer and no call (inlined; a tenth of a half-space entry)."""
+    orders, with two divisions and two calls fewer (not inlined: inlined into the pair loop
+    it cost 15 s of its cold compile for ~1% of a pair, benchmarks/RESULTS.md, issue 32)."""
     half = max(a, b)
     if dmin >= POINT_NEAR_RATIO * half:
         ratio = dmin / half
@@ -396,22 +398,6 @@ def point_image_traction(point, normal, center, frame, a, b, okada, surface, she
 
 
 @njit(cache=True, inline="always")
-def _mirror_distance(point, twice_surface, center, frame, a, b):
-    """Distance from the receiver's mirror in the plane ``z = twice_surface / 2`` to the
-    rectangle (:func:`hmatddm.kernels.rectangle3d.distance_to_rectangle`, written out to be
-    inlined)."""
-    d0 = point[0] - center[0]
-    d1 = point[1] - center[1]
-    d2 = (twice_surface - point[2]) - center[2]
-    x1 = frame[0, 0] * d0 + frame[0, 1] * d1 + frame[0, 2] * d2
-    x2 = frame[1, 0] * d0 + frame[1, 1] * d1 + frame[1, 2] * d2
-    x3 = frame[2, 0] * d0 + frame[2, 1] * d1 + frame[2, 2] * d2
-    o1 = max(abs(x1) - a, 0.0)
-    o2 = max(abs(x2) - b, 0.0)
-    return math.sqrt(o1 * o1 + o2 * o2 + x3 * x3)
-
-
-@njit(cache=True, inline="always")
 def point_form_terms(data, point, lr, j, setup, work, entry_tol, normal, out, traction):
     """A ``point_form`` source ``j`` of the kernel record ``data``
     (:class:`.images3d.LayeredRectangles`; a half-space, no horizontal side): its image and
@@ -432,8 +418,8 @@ def point_form_terms(data, point, lr, j, setup, work, entry_tol, normal, out, tr
     b = data.half_b[j]
     if lr == ls and data.interfaces.shape[0] == 1:
         # the mirror in the free surface, the one singular point: what nearest_singularity
-        # gives there, without its call
-        dmin = _mirror_distance(point, 2.0 * data.interfaces[0], center, frame, a, b)
+        # gives there
+        dmin = distance_to_rectangle(point[0], point[1], 2.0 * data.interfaces[0] - point[2], center, frame, a, b)
     else:
         dmin = nearest_singularity(point, lr, center, frame, a, b, ls, data.interfaces, -1)
     n_gauss, n_sub = point_rule(dmin, a, b, data.max_subdivisions, data.far_tol, entry_tol)
