@@ -261,6 +261,10 @@ def _overload_shares_source_state(data):
     return lambda data: shares
 
 
+#: Sources whose blocks :func:`traction_block` stages (source by source): 3 cache lines a row.
+STAGED_SOURCES = 8
+
+
 @njit(cache=True, nogil=True)
 def traction_block(data, rows, cols, out):
     """Block generator kernel (see :class:`hmatddm.hmatrix.BlockGenerator`): ``out`` of
@@ -273,13 +277,18 @@ def traction_block(data, rows, cols, out):
     Receiver by receiver, or source by source for kinds with a ``source_state`` (made
     once per source); the choice is a constant of the record type, so LLVM keeps one of
     the two loop orders. One loop nest with the per-pair function inlined once: the
-    kernel is compiled (and optimised) here only, not again in helper levels."""
+    kernel is compiled (and optimised) here only, not again in helper levels. Source by
+    source, :data:`STAGED_SOURCES` sources' columns are staged, then copied row by row: each
+    pair's ``dof`` rows lie a row of ``out`` apart (0.05 us of a 0.45 us pair in a dense
+    half-space matrix, benchmarks/RESULTS.md, issue 32)."""
     dof = element_unknowns(data)
     by_source = _shares_source_state(data)
-    scratch = (_workspace(data), np.empty((dof, dof)))
+    n_staged = min(STAGED_SOURCES, cols.shape[0]) if by_source else 1
+    scratch = (_workspace(data), np.empty((dof, dof)), np.empty((dof * rows.shape[0] * by_source, dof * n_staged)))
     # every array borrowed (:func:`borrowed`): the caller holds the arguments, ``scratch``
     # lives until :func:`_hold` below
-    data_, rows_, cols_, out_, work, block = borrowed((data, rows, cols, out, scratch[0], scratch[1]))
+    data_, rows_, cols_, out_, work, block, stage = borrowed((data, rows, cols, out, scratch[0], scratch[1],
+                                                               scratch[2]))
     alpha = data_.alpha
     n_outer = cols_.shape[0] if by_source else rows_.shape[0]
     n_inner = rows_.shape[0] if by_source else cols_.shape[0]
@@ -299,11 +308,18 @@ def traction_block(data, rows, cols, out):
             _element_traction(data_, i, j, state, work, block)
             if alpha > 0.0 and i != j:
                 scale_to_self(block, alpha * data_.self_max[j])
+            target, column = (stage, dof * (outer % n_staged)) if by_source else (out_, dof * jb)
             for p in range(dof):
                 for q in range(dof):
-                    out_[dof * ia + p, dof * jb + q] = block[p, q]
+                    target[dof * ia + p, column + q] = block[p, q]
         if by_source:
             _hold(owner)
+            if outer % n_staged == n_staged - 1 or outer == n_outer - 1:
+                first = dof * (outer - outer % n_staged)
+                width = dof * (outer % n_staged + 1)
+                for r in range(dof * n_inner):
+                    for c in range(width):
+                        out_[r, first + c] = stage[r, c]
     _hold(scratch)
 
 

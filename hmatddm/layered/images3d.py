@@ -102,7 +102,7 @@ from ..kernels import rectangle3d
 from ..kernels.drivers import KernelKind, register_kind
 from ..kernels.held_function import HeldFunction, address_of, dereference, without_functions
 from . import okada3d
-from .okada_point3d import point_form_terms
+from .okada_point3d import POINT_SETUP, point_form_terms, point_setup
 from .image_points3d import image_point_displacement, image_point_stress, kelvin_point_displacement, kelvin_point_stress
 from .image_tracer import trace_capacity
 from .images2d import _lame, zero_in_void
@@ -228,10 +228,12 @@ def workspace(data):
 @njit(cache=True)
 def _untraced_state(gauss_points):
     """The arrays of :func:`source_state` for a source that traces nothing (closed form or
-    point source): one empty point, no rule traced, three empty heights."""
+    point source): one empty point, no rule traced, three empty heights (a point-form
+    source's :func:`.okada_point3d.point_setup` in their room: one source's state at a time
+    per workspace)."""
     one = np.int64(1)
     return (_traced_buffer(one, one, one), np.zeros(gauss_points + 1, dtype=np.bool_),
-            _traced_buffer(np.int64(3), one, one), np.zeros(3))
+            _traced_buffer(np.int64(3), one, one), np.zeros(max(3, POINT_SETUP)))
 
 
 @njit(cache=True)
@@ -260,6 +262,9 @@ def _source_state(data_at, j, work_at):
         # the workspace's arrays: nothing allocated a source (16 arrays a source made the
         # half-space's H-matrix rows cost as much again as their entries)
         traced, is_traced, three, heights = work[13]
+        if data.point_form[j]:
+            point_setup(data.centers[j], data.frames[j], data.half_a[j], data.half_b[j], data.okada[j], data.surface,
+                        data.shear_modulus[ls], data.poisson_ratio[ls], heights)
         return traced, is_traced, near_only, three, heights
     cap, n_orders = max(room[ls, 0], 1), max(room[ls, 1], 1)
     three, heights = three_heights(data, j, near_only, cap, n_orders)
@@ -298,7 +303,8 @@ def element_traction(data, i, j, state, work, block):
         okada3d.okada_traction(point, normal, center, data.okada[j], data.okada_half[j, 0], data.okada_half[j, 1],
                                data.surface, g[ls], nu[ls], False, True, okada_work, corners, block)
     elif data.point_form[j]:
-        point_form_terms(data, point, data.layer[i], j, work, data.entry_tol * data.entry_scale, normal, block, True)
+        point_form_terms(data, point, data.layer[i], j, state[4], work, data.entry_tol * data.entry_scale, normal,
+                         block, True)
     elif data.interfaces.shape[0] > 0:
         lr = data.layer[i]
         if data.surface_form[j] and lr == ls:
@@ -316,7 +322,7 @@ def _image_terms(data, point, lr, j, state, work, entry_tol, image):
     the arguments in the held signature's types: the point copied to the workspace (any
     layout), the layer and the source as int64, ``entry_tol`` as float64."""
     if data.point_form[j]:
-        point_form_terms(data, point, lr, j, work, entry_tol, point, image, False)
+        point_form_terms(data, point, lr, j, state[4], work, entry_tol, point, image, False)
         return
     here = work[12]
     for k in range(3):

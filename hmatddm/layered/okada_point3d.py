@@ -31,8 +31,10 @@ import numpy as np
 from numba import njit
 
 from ..compiled import FAST
-from .okada_stress3d import accumulate, add_gradient, dip_and_medium, global_stress, global_traction
-from .rectangle_quadrature import entry_order, far_order, nearest_singularity, square_rule
+from ..kernels.rectangle3d import distance_to_rectangle
+from .okada_stress3d import (accumulate_strain, accumulate_traction, add_traction, dip_and_medium, global_stress,
+                             set_strain)
+from .rectangle_quadrature import IMAGE_BOUND, nearest_singularity, square_rule
 
 _INV_2PI = 1.0 / (2.0 * math.pi)
 
@@ -52,8 +54,8 @@ def _point_image(x, y, z, depth, sd, cd, alpha):
     potency ``k`` (strike, dip, tensile) at depth ``depth``, times ``2 pi``: ``9 k + m``,
     ``m = 3 j + i`` in Okada's order (:func:`_combined`, :func:`.okada_stress3d.accumulate`).
     ``d > 0`` (the source below the surface) keeps ``R + d > 0``. Returned, not stored, so
-    that the Gauss sum of :func:`_point_gradient` stays in registers and is vectorised over
-    its points."""
+    that the Gauss sums of :func:`setup_image_stress` and :func:`setup_image_traction` stay
+    in registers and are vectorised over their points."""
     alp1 = 0.5 * (1.0 - alpha)
     alp2 = 0.5 * alpha
     alp3 = (1.0 - alpha) / alpha
@@ -240,13 +242,23 @@ def point_rule(dmin, a, b, max_sub, far_tol, entry_tol):
     :data:`POINT_GAUSS_POINTS`; nearer, :data:`POINT_GAUSS_POINTS` on the fewest sub-squares
     (a power of two, at most ``max_sub``) each that far from the mirror. The image method's
     rule (4 points on sub-squares at most half as large as ``dmin``) leaves up to 4e-8 of the
-    largest entry next to the free surface (issue 32 asks 1e-8); this one, 1e-11."""
+    largest entry next to the free surface (issue 32 asks 1e-8); this one, 1e-11. The two
+    rules' bounds ``40 n ratio^(-2n)`` (times the entry's size for the second) in one pass
+    over the same powers: the smallest ``n`` either allows, as the smaller of the two
+    orders, with two divisions and two calls fewer (not inlined: inlined into the pair loop
+    it cost 15 s of its cold compile for ~1% of a pair, benchmarks/RESULTS.md, issue 32)."""
     half = max(a, b)
     if dmin >= POINT_NEAR_RATIO * half:
-        n = far_order(dmin / half, POINT_GAUSS_POINTS, far_tol)
-        if entry_tol > 0.0:
-            n = min(n, entry_order(dmin, a, b, POINT_GAUSS_POINTS, entry_tol))
-        return n, 1
+        ratio = dmin / half
+        step = 1.0 / (ratio * ratio)
+        size = IMAGE_BOUND * 4.0 * a * b / (dmin * dmin * dmin)
+        power = step
+        for n in range(1, POINT_GAUSS_POINTS):
+            bound = 40.0 * n * power
+            if bound <= far_tol or (entry_tol > 0.0 and bound * size <= entry_tol):
+                return n, 1
+            power *= step
+        return POINT_GAUSS_POINTS, 1
     n_sub = 2
     while n_sub < max_sub and dmin * n_sub < POINT_NEAR_RATIO * half:
         n_sub *= 2
@@ -274,42 +286,94 @@ def point_frame(normal):
     return rows[0] if has_strike[0] else None
 
 
+#: Length of a point-form source's setup (:func:`point_setup`)
+POINT_SETUP = 14
+
+
 @njit(cache=True, inline="always")
-def _point_gradient(point, center, frame, a, b, okada, surface, shear_modulus, poisson_ratio, xi, eta, wt, work):
-    """The Gauss sum of :func:`_point_image` into ``work[3]`` (Okada's frame); returns the
-    strike's ``(s_x, s_y)`` and Lame's lambda, as :func:`.okada_stress3d.global_stress` takes them.
-    Its callers compile with :data:`FAST` and numpy's error model: the sum over the points is
-    then a vectorised loop (a 2 x 2 sum 2.3x cheaper, benchmarks/RESULTS.md, issue 32)."""
+def point_setup(center, frame, a, b, okada, surface, shear_modulus, poisson_ratio, setup):
+    """``setup[:14]``: what the receivers of a point-form source share: the strike ``(s0,
+    s1)``, ``(sin dip, cos dip, lambda, alpha)`` (:func:`.okada_stress3d.dip_and_medium`),
+    the Jacobian ``a b / (2 pi)``, the rectangle's sides ``e1``, ``e2`` turned into Okada's
+    frame ``(ax, ay, az, bx, by, bz)`` and the depth of its centre under the surface. Made
+    once per source (:func:`.images3d.source_state`): per pair, with its square root and
+    three divisions, it cost ~7% of a half-space entry (benchmarks/RESULTS.md, issue 32)."""
     s0 = okada[0, 0]
     s1 = okada[0, 1]
     sd, cd, lam, alpha = dip_and_medium(s0, s1, okada, shear_modulus, poisson_ratio)
-    z = point[2] - surface
-    jac = a * b * _INV_2PI
-    # the receiver from the rectangle's centre, in Okada's frame; each point moves it
+    setup[0] = s0
+    setup[1] = s1
+    setup[2] = sd
+    setup[3] = cd
+    setup[4] = lam
+    setup[5] = alpha
+    setup[6] = a * b * _INV_2PI
+    setup[7] = s0 * frame[0, 0] + s1 * frame[0, 1]
+    setup[8] = -s1 * frame[0, 0] + s0 * frame[0, 1]
+    setup[9] = frame[0, 2]
+    setup[10] = s0 * frame[1, 0] + s1 * frame[1, 1]
+    setup[11] = -s1 * frame[1, 0] + s0 * frame[1, 1]
+    setup[12] = frame[1, 2]
+    setup[13] = surface - center[2]
+
+
+@njit(cache=True, inline="always")
+def _receiver(point, center, setup, surface):
+    """The receiver from the rectangle's centre in Okada's frame, ``(x, y)`` horizontal, and
+    its height ``z`` over the surface (each Gauss point moves the source: :func:`_image_at`)."""
     rx = point[0] - center[0]
     ry = point[1] - center[1]
-    x0 = s0 * rx + s1 * ry
-    y0 = -s1 * rx + s0 * ry
-    depth0 = surface - center[2]
-    ax = s0 * frame[0, 0] + s1 * frame[0, 1]
-    ay = -s1 * frame[0, 0] + s0 * frame[0, 1]
-    bx = s0 * frame[1, 0] + s1 * frame[1, 1]
-    by = -s1 * frame[1, 0] + s0 * frame[1, 1]
-    acc = (0.0,) * 27
-    for g in range(xi.shape[0]):
-        ua = xi[g] * a
-        ub = eta[g] * b
-        acc = accumulate(acc, wt[g] * jac, _point_image(x0 - ua * ax - ub * bx, y0 - ua * ay - ub * by, z,
-                                                         depth0 - ua * frame[0, 2] - ub * frame[1, 2], sd, cd, alpha))
-    for k in range(3):
-        for i in range(3):
-            for j in range(3):
-                work[3, k, i, j] = 0.0
-    add_gradient(acc, work[3])
-    return s0, s1, lam
+    return setup[0] * rx + setup[1] * ry, -setup[1] * rx + setup[0] * ry, point[2] - surface
+
+
+@njit(cache=True, inline="always")
+def _image_at(g, x0, y0, z, a, b, setup, xi, eta):
+    """:func:`_point_image` of the Gauss point ``(xi[g] a, eta[g] b)`` of the source whose
+    :func:`point_setup` is ``setup``, at the receiver ``(x0, y0, z)`` of :func:`_receiver`."""
+    ua = xi[g] * a
+    ub = eta[g] * b
+    return _point_image(x0 - ua * setup[7] - ub * setup[10], y0 - ua * setup[8] - ub * setup[11], z,
+                        setup[13] - ua * setup[9] - ub * setup[12], setup[2], setup[3], setup[5])
 
 
 @njit(cache=True, fastmath=FAST, error_model="numpy")
+def setup_image_stress(point, center, a, b, setup, okada, surface, shear_modulus, xi, eta, wt, work, out):
+    """:func:`point_image_stress` of the source whose :func:`point_setup` is ``setup``: the
+    Gauss sum of the strains (:func:`.okada_stress3d.accumulate_strain`), then Hooke's law.
+    Compiled with :data:`FAST` and numpy's error model, the sum over the points is a
+    vectorised loop (its terms carried in a tuple, benchmarks/RESULTS.md, issue 32)."""
+    x0, y0, z = _receiver(point, center, setup, surface)
+    jac = setup[6]
+    acc = (0.0,) * 18
+    for g in range(xi.shape[0]):
+        acc = accumulate_strain(acc, wt[g] * jac, _image_at(g, x0, y0, z, a, b, setup, xi, eta))
+    set_strain(acc, work[3])
+    global_stress(work, setup[0], setup[1], setup[4], shear_modulus, okada, out)
+
+
+@njit(cache=True, fastmath=FAST, error_model="numpy")
+def setup_image_traction(point, normal, center, a, b, setup, okada, surface, shear_modulus, xi, eta, wt, work,
+                         block):
+    """:func:`point_image_traction` of the source whose :func:`point_setup` is ``setup``: the
+    Gauss sum of the traction on the normal turned into Okada's frame
+    (:func:`.okada_stress3d.accumulate_traction`: 9 sums, not 27 derivatives). ``work``
+    unused (the signature of :func:`setup_image_stress`)."""
+    s0 = setup[0]
+    s1 = setup[1]
+    x0, y0, z = _receiver(point, center, setup, surface)
+    n0 = s0 * normal[0] + s1 * normal[1]
+    n1 = -s1 * normal[0] + s0 * normal[1]
+    n2 = normal[2]
+    lam = setup[4]
+    jac = setup[6]
+    acc = (0.0,) * 9
+    for g in range(xi.shape[0]):
+        acc = accumulate_traction(acc, wt[g] * jac, _image_at(g, x0, y0, z, a, b, setup, xi, eta), n0, n1, n2,
+                                  shear_modulus, lam)
+    add_traction(acc, s0, s1, okada, block)
+
+
+@njit(cache=True)
 def point_image_stress(point, center, frame, a, b, okada, surface, shear_modulus, poisson_ratio, xi, eta, wt,
                        work, out):
     """``out[q, i, j]``: the image and surface terms of the global stress at ``point`` (below
@@ -317,40 +381,47 @@ def point_image_stress(point, center, frame, a, b, okada, surface, shear_modulus
     rows ``frame``, half sides ``a``, ``b``), by the Gauss rule ``(xi, eta, wt)`` on [-1,
     1]^2 of Okada's point source (:func:`_point_image`) at each point; ``okada``: the rows of
     :func:`point_frame`. ``work``: (5, 3, 3, 3) scratch (:func:`.okada_stress3d.global_stress`)."""
-    s0, s1, lam = _point_gradient(point, center, frame, a, b, okada, surface, shear_modulus, poisson_ratio, xi, eta,
-                                  wt, work)
-    global_stress(work, s0, s1, lam, shear_modulus, okada, out)
+    setup = np.empty(POINT_SETUP)
+    point_setup(center, frame, a, b, okada, surface, shear_modulus, poisson_ratio, setup)
+    setup_image_stress(point, center, a, b, setup, okada, surface, shear_modulus, xi, eta, wt, work, out)
 
 
-@njit(cache=True, fastmath=FAST, error_model="numpy")
+@njit(cache=True)
 def point_image_traction(point, normal, center, frame, a, b, okada, surface, shear_modulus, poisson_ratio, xi, eta,
                          wt, work, block):
     """``block[p, q] +=`` the traction ``sigma . normal`` (global component ``p``) of the terms
-    of :func:`point_image_stress` (no stress tensor turned back:
-    :func:`.okada_stress3d.global_traction`)."""
-    s0, s1, lam = _point_gradient(point, center, frame, a, b, okada, surface, shear_modulus, poisson_ratio, xi, eta,
-                                  wt, work)
-    global_traction(work, s0, s1, lam, shear_modulus, okada, normal, block)
+    of :func:`point_image_stress` (no stress tensor: the traction summed over the points,
+    :func:`.okada_stress3d.accumulate_traction`)."""
+    setup = np.empty(POINT_SETUP)
+    point_setup(center, frame, a, b, okada, surface, shear_modulus, poisson_ratio, setup)
+    setup_image_traction(point, normal, center, a, b, setup, okada, surface, shear_modulus, xi, eta, wt, work, block)
 
 
 @njit(cache=True, inline="always")
-def point_form_terms(data, point, lr, j, work, entry_tol, normal, out, traction):
+def point_form_terms(data, point, lr, j, setup, work, entry_tol, normal, out, traction):
     """A ``point_form`` source ``j`` of the kernel record ``data``
     (:class:`.images3d.LayeredRectangles`; a half-space, no horizontal side): its image and
     surface terms at ``point`` (in layer ``lr``) by Okada's point source at the points of
     :func:`point_rule`; ``traction``: ``out[p, q] +=`` the traction on ``normal``
     (:func:`point_image_traction`), else ``out[q, i, k] =`` the stress
-    (:func:`point_image_stress`); ``work``: :func:`.images3d.workspace`. Inlined into the callers (no
+    (:func:`point_image_stress`); ``setup``: the source's :func:`point_setup` (in its
+    :func:`.images3d.source_state`); ``work``: :func:`.images3d.workspace`. Inlined into the callers (no
     record passed across a call, not held). On issue 32's lattice (2 x 2 points for 95% of
-    the pairs) a whole entry, real source included, costs 0.44-0.47 us, ~4x a uniform-rock
-    entry (AMD EPYC, dgemm 50 GFLOP/s, one thread; benchmarks/RESULTS.md, issue 32)."""
+    the pairs) a whole entry, real source included, costs 0.31-0.32 us, 2.8-2.9x a
+    uniform-rock entry (Intel Xeon, dgemm 73-80 GFLOP/s, one thread; benchmarks/RESULTS.md,
+    issue 32)."""
     xi, eta, wt, start = work[7]
     ls = data.layer[j]
     center = data.centers[j]
     frame = data.frames[j]
     a = data.half_a[j]
     b = data.half_b[j]
-    dmin = nearest_singularity(point, lr, center, frame, a, b, ls, data.interfaces, -1)
+    if lr == ls and data.interfaces.shape[0] == 1:
+        # the mirror in the free surface, the one singular point: what nearest_singularity
+        # gives there
+        dmin = distance_to_rectangle(point[0], point[1], 2.0 * data.interfaces[0] - point[2], center, frame, a, b)
+    else:
+        dmin = nearest_singularity(point, lr, center, frame, a, b, ls, data.interfaces, -1)
     n_gauss, n_sub = point_rule(dmin, a, b, data.max_subdivisions, data.far_tol, entry_tol)
     if n_sub == 1 and n_gauss <= data.gauss_points:
         lo, hi = start[n_gauss - 1], start[n_gauss]
@@ -358,9 +429,8 @@ def point_form_terms(data, point, lr, j, work, entry_tol, normal, out, traction)
     else:
         xs, es, ws = square_rule(n_gauss, n_sub)
     g = data.shear_modulus[ls]
-    nu = data.poisson_ratio[ls]
     if traction:
-        point_image_traction(point, normal, center, frame, a, b, data.okada[j], data.surface, g, nu, xs, es, ws,
-                             work[8], out)
+        setup_image_traction(point, normal, center, a, b, setup, data.okada[j], data.surface, g, xs, es, ws, work[8],
+                             out)
     else:
-        point_image_stress(point, center, frame, a, b, data.okada[j], data.surface, g, nu, xs, es, ws, work[8], out)
+        setup_image_stress(point, center, a, b, setup, data.okada[j], data.surface, g, xs, es, ws, work[8], out)

@@ -138,3 +138,68 @@ def global_traction(work, s0, s1, lam, shear_modulus, okada, normal, block):
         f2 = okada[2, q]
         for p in range(3):
             block[p, q] += f0 * work[4, 0, 0, p] + f1 * work[4, 1, 0, p] + f2 * work[4, 2, 0, p]
+
+
+@njit(cache=True, inline="always")
+def accumulate_strain(acc, w, v):
+    """``acc + w e`` of 18-tuples: ``e`` the strains of the 27 derivatives ``v``
+    (:func:`accumulate`'s order) per dislocation ``k``: ``6 k +`` (0, 1, 2) the normal strains
+    ``xx, yy, zz``, (3, 4, 5) the engineering shears ``xy, xz, yz``. The stress needs no
+    more (Hooke's law), and 18 sums in registers are cheaper than 27 (the point source's Gauss
+    sum ~20%, benchmarks/RESULTS.md, issue 32)."""
+    return (acc[0] + w * v[0], acc[1] + w * v[4], acc[2] + w * v[8], acc[3] + w * (v[1] + v[3]),
+            acc[4] + w * (v[2] + v[6]), acc[5] + w * (v[5] + v[7]),
+            acc[6] + w * v[9], acc[7] + w * v[13], acc[8] + w * v[17], acc[9] + w * (v[10] + v[12]),
+            acc[10] + w * (v[11] + v[15]), acc[11] + w * (v[14] + v[16]),
+            acc[12] + w * v[18], acc[13] + w * v[22], acc[14] + w * v[26], acc[15] + w * (v[19] + v[21]),
+            acc[16] + w * (v[20] + v[24]), acc[17] + w * (v[23] + v[25]))
+
+
+@njit(cache=True, inline="always")
+def set_strain(acc, gradient):
+    """``gradient[k, i, j]`` (3, 3, 3): the symmetric gradient of :func:`accumulate_strain`'s
+    sums (what :func:`global_stress` turns into the same stress as the whole gradient)."""
+    for k in range(3):
+        gradient[k, 0, 0] = acc[6 * k]
+        gradient[k, 1, 1] = acc[6 * k + 1]
+        gradient[k, 2, 2] = acc[6 * k + 2]
+        for i, j, m in ((0, 1, 3), (0, 2, 4), (1, 2, 5)):
+            gradient[k, i, j] = 0.5 * acc[6 * k + m]
+            gradient[k, j, i] = 0.5 * acc[6 * k + m]
+
+
+@njit(cache=True, inline="always")
+def accumulate_traction(acc, w, v, n0, n1, n2, shear_modulus, lam):
+    """``acc + w t`` of 9-tuples: ``t[3 k + p]`` the traction (Okada's frame) on the normal
+    ``(n0, n1, n2)`` (Okada's frame) of the 27 derivatives ``v`` (:func:`accumulate`'s order)
+    through Hooke's law, as :func:`global_traction` makes it after the sum. Nine sums in
+    registers instead of 27 (the point source's Gauss sum, benchmarks/RESULTS.md, issue 32)."""
+    g = shear_modulus
+    tr0 = lam * (v[0] + v[4] + v[8])
+    tr1 = lam * (v[9] + v[13] + v[17])
+    tr2 = lam * (v[18] + v[22] + v[26])
+    return (acc[0] + w * (g * (2.0 * v[0] * n0 + (v[1] + v[3]) * n1 + (v[2] + v[6]) * n2) + tr0 * n0),
+            acc[1] + w * (g * ((v[1] + v[3]) * n0 + 2.0 * v[4] * n1 + (v[5] + v[7]) * n2) + tr0 * n1),
+            acc[2] + w * (g * ((v[2] + v[6]) * n0 + (v[5] + v[7]) * n1 + 2.0 * v[8] * n2) + tr0 * n2),
+            acc[3] + w * (g * (2.0 * v[9] * n0 + (v[10] + v[12]) * n1 + (v[11] + v[15]) * n2) + tr1 * n0),
+            acc[4] + w * (g * ((v[10] + v[12]) * n0 + 2.0 * v[13] * n1 + (v[14] + v[16]) * n2) + tr1 * n1),
+            acc[5] + w * (g * ((v[11] + v[15]) * n0 + (v[14] + v[16]) * n1 + 2.0 * v[17] * n2) + tr1 * n2),
+            acc[6] + w * (g * (2.0 * v[18] * n0 + (v[19] + v[21]) * n1 + (v[20] + v[24]) * n2) + tr2 * n0),
+            acc[7] + w * (g * ((v[19] + v[21]) * n0 + 2.0 * v[22] * n1 + (v[23] + v[25]) * n2) + tr2 * n1),
+            acc[8] + w * (g * ((v[20] + v[24]) * n0 + (v[23] + v[25]) * n1 + 2.0 * v[26] * n2) + tr2 * n2))
+
+
+@njit(cache=True, inline="always")
+def add_traction(acc, s0, s1, okada, block):
+    """``block[p, q] +=`` the global traction (component ``p``) of a unit global DD ``q``
+    from :func:`accumulate_traction`'s sums: turned about ``z`` by the strike ``(s0, s1)``
+    and mapped by the rows ``okada`` (as the end of :func:`global_traction`)."""
+    for q in range(3):
+        f0 = okada[0, q]
+        f1 = okada[1, q]
+        f2 = okada[2, q]
+        t0 = f0 * acc[0] + f1 * acc[3] + f2 * acc[6]
+        t1 = f0 * acc[1] + f1 * acc[4] + f2 * acc[7]
+        block[0, q] += t0 * s0 - t1 * s1
+        block[1, q] += t0 * s1 + t1 * s0
+        block[2, q] += f0 * acc[2] + f1 * acc[5] + f2 * acc[8]
