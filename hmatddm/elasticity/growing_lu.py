@@ -42,10 +42,6 @@ class GrowingBlockLU:
                 factor = np.linalg.inv(schur)
             self.levels.append((start, size, rows, solved, factor))
 
-    @property
-    def size(self):
-        return self.levels[-1][1] if self.levels else 0
-
     def prefix(self, size):
         """The levels that factor ``M[:size, :size]`` whole (a shared run of unknowns)."""
         return [level for level in self.levels if level[1] <= size]
