@@ -170,7 +170,7 @@ class PlanarElasticityOperator(ElasticityOperator):
     :attr:`shear_hmatrix` the shear one (2N x 2N, None until needed)."""
 
     def __init__(self, mesh, material, backend="hmatrix", eps=None, eta=None, leaf_size=None,
-                 singular_correction="none", alpha=None):
+                 singular_correction="none", alpha=None, check_spacing=True):
         if backend != "hmatrix":
             raise InputError(f"backend must be 'hmatrix' for a PlanarElasticityOperator, got {backend!r}")
         if not isinstance(material, Elastic):
@@ -185,7 +185,7 @@ class PlanarElasticityOperator(ElasticityOperator):
         self._diagonal_blocks = None
         self._parts = {}
         super().__init__(mesh, material, backend="hmatrix", singular_correction=singular_correction, alpha=alpha,
-                         **options)
+                         check_spacing=check_spacing, **options)
 
     def _build_compressed(self, eps, eta, leaf_size):
         self._compression = dict(eps=eps, eta=eta, leaf_size=leaf_size)

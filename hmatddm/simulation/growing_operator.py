@@ -126,10 +126,11 @@ class GrowingOperator:
         the choice of images to start from (default: the base's)."""
         if self._on_lattice(mesh):
             return self._lattice_operator(mesh)
-        # the mesh-quality check runs at every build of a growing mesh: warn once per run
+        # the mesh-quality check runs at every build of a growing mesh until it has warned:
+        # once per run
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", MeshQualityWarning)
-            settings = asdict(self.operator_settings)
+            settings = dict(asdict(self.operator_settings), check_spacing=not self._mesh_quality_warned)
             split = (SPLIT_PLANAR_MODES and settings["backend"] == "hmatrix" and isinstance(self.material, Elastic)
                      and is_planar(mesh))
             if split:
