@@ -13,6 +13,7 @@ with net pressure ``p`` satisfies ``op @ dd = -p n``. A 2D mesh of linear or qua
 elements (``mesh.element_order`` 1 or 2) has ``2 (order + 1)`` unknowns per element,
 node-major inside the element (docs/conventions.md §2), collocated at its nodes.
 """
+import dataclasses
 import time
 
 import numpy as np
@@ -90,6 +91,13 @@ class ElasticityOperator(ProductCounter, LinearOperator):
         instead of the choice made on ``mesh`` (a growing run's rebuilds keep their choice
         while the mesh stays within twice its extent:
         :class:`hmatddm.simulation.growing_operator.GrowingOperator`); >= 0.
+    leading : ElasticityOperator or None
+        ``backend="dense"`` in a homogeneous medium: a dense operator of a mesh whose
+        elements are this mesh's first ones (:func:`leads`), same material and options.
+        Its matrix is this one's leading block, copied; only the new elements' rows and
+        columns are computed (a growing run's growth pass:
+        :class:`~hmatddm.simulation.growing_operator.GrowingOperator`). Every entry is
+        one pair's, so the matrix is the one a full build gives, bit for bit.
     check_spacing : bool
         False skips the check below (a growing run that has warned once already:
         :class:`~hmatddm.simulation.growing_operator.GrowingOperator`, whose check at
@@ -105,7 +113,7 @@ class ElasticityOperator(ProductCounter, LinearOperator):
 
     def __init__(self, mesh, material, backend="dense", eps=DEFAULT_EPS, eta=DEFAULT_ETA,
                  leaf_size=DEFAULT_LEAF_SIZE, singular_correction="none", alpha=None, n_images=None,
-                 check_spacing=True):
+                 leading=None, check_spacing=True):
         if not isinstance(mesh, (Mesh2D, Mesh3D)):
             raise InputError(f"mesh must be a Mesh2D or Mesh3D, got {type(mesh).__name__}")
         if not isinstance(material, (Elastic, LayeredMedium)):
@@ -140,7 +148,10 @@ class ElasticityOperator(ProductCounter, LinearOperator):
         t0 = time.perf_counter()
         if backend == "dense":
             self._matrix = np.empty(self.shape)
-            drivers.traction_matrix(self.data, self._matrix)
+            if leading is None:
+                drivers.traction_matrix(self.data, self._matrix)
+            else:
+                _bordered_matrix(self, leading)
             self._hmatrix = None
             if not np.all(np.isfinite(self._matrix)):
                 self._refuse_singular()
@@ -324,6 +335,38 @@ def _refuse_coincident(mesh):
             f"overlap (the centre of element {j} lies inside element {i}, in its plane)"
         raise InputError(f"elements {min(i, j)} and {max(i, j)} {kind}, which makes the DDM system singular; "
                          "remove or re-mesh one of them")
+
+
+def leads(leading_mesh, mesh):
+    """Whether the elements of ``leading_mesh`` are the first ones of ``mesh`` (same kind,
+    element order and arrays)."""
+    if type(leading_mesh) is not type(mesh) or leading_mesh.element_order != mesh.element_order:
+        return False
+    n = leading_mesh.n_elements
+    return n <= mesh.n_elements and all(
+        np.array_equal(getattr(leading_mesh, field.name), getattr(mesh, field.name)[:n])
+        for field in dataclasses.fields(mesh) if isinstance(getattr(mesh, field.name), np.ndarray))
+
+
+def _bordered_matrix(operator, leading):
+    """``operator``'s dense matrix from ``leading``'s (its leading block) and the new
+    elements' rows and columns from the kernels (the ``leading`` parameter)."""
+    if not (isinstance(leading, ElasticityOperator) and leading._matrix is not None
+            and isinstance(operator.material, Elastic) and leading.material == operator.material
+            and leading.singular_correction == operator.singular_correction and leading.alpha == operator.alpha
+            and leads(leading.mesh, operator.mesh)):
+        raise InputError("leading must be a dense ElasticityOperator in the same homogeneous material, with the "
+                         "same singular_correction and alpha, of a mesh whose elements are this mesh's first ones")
+    n, dof, start = operator.mesh.n_elements, operator.dof, leading.mesh.n_elements
+    s, out = start * dof, operator._matrix
+    out[:s, :s] = leading._matrix
+    everything = np.arange(n, dtype=np.int64)
+    if start < n:
+        if start:
+            band = np.empty((s, out.shape[1] - s))
+            drivers.traction_block(operator.data, everything[:start], everything[start:], band)
+            out[:s, s:] = band
+        drivers.traction_block(operator.data, everything[start:], everything, out[s:])
 
 
 def influence_data(mesh, material, singular_correction="none", alpha=None, n_images=None):

@@ -2,7 +2,10 @@
 blocks while the mesh grows a little, rebuilt when it grew too much.
 
 The operator is rebuilt only when the mesh has grown, never inside the nonlinear
-iterations of a step. A planar 3D mesh in a homogeneous medium gets the ``hmatrix``
+iterations of a step. A dense operator in a homogeneous medium is not rebuilt when the mesh
+grows: its matrix leads the grown mesh's, and only the new elements' rows and columns are
+computed (``ElasticityOperator(leading=)``; on dfn-3cluster at 4x its area the 313 full
+assemblies took 1.55 s of the run's 30 s, benchmarks/RESULTS.md, issue 33). A planar 3D mesh in a homogeneous medium gets the ``hmatrix``
 backend's opening and shear operators apart, and their border blocks apart while it grows
 in its plane (:mod:`hmatddm.elasticity.planar`; the same matrix, ~7x faster products for a
 crack loaded in opening) unless :data:`SPLIT_PLANAR_MODES` is False; and a planar lattice
@@ -83,6 +86,8 @@ class GrowingOperator:
             grown = (PlanarExtendedOperator if isinstance(base, PlanarElasticityOperator) and is_planar(mesh)
                      else ExtendedElasticityOperator)
             operator = grown(base, mesh, previous=self._operator)
+        elif extends and self._borders_dense(base):
+            operator = self.build(mesh, leading=base)
         else:
             operator = self.build(mesh)
         self._operator, self._mesh = operator, mesh
@@ -121,9 +126,17 @@ class GrowingOperator:
         layers)`` of the mesh it was made on, or None (module docstring)."""
         return getattr(self.base, "image_choice", None)
 
-    def build(self, mesh, image_choice=None):
-        """A full build of the operator of ``mesh``, which becomes the base; ``image_choice``:
-        the choice of images to start from (default: the base's)."""
+    def _borders_dense(self, base):
+        """Whether a grown mesh's dense operator takes ``base``'s matrix as its leading
+        block (module docstring): the dense backend in a homogeneous medium."""
+        return (self.operator_settings.backend == "dense" and isinstance(self.material, Elastic)
+                and type(base) is ElasticityOperator and base.backend == "dense")
+
+    def build(self, mesh, image_choice=None, leading=None):
+        """A build of the operator of ``mesh``, which becomes the base; ``image_choice``:
+        the choice of images to start from (default: the base's); ``leading``: a dense base
+        whose matrix leads this one's (only the new rows and columns are computed; not
+        counted in :attr:`builds`)."""
         if self._on_lattice(mesh):
             return self._lattice_operator(mesh)
         # the mesh-quality check runs at every build of a growing mesh until it has warned:
@@ -138,7 +151,7 @@ class GrowingOperator:
             else:
                 previous = self.image_choice if image_choice is None else image_choice
                 self.base = ElasticityOperator(mesh, self.material, n_images=self._kept_images(mesh, previous),
-                                               **settings)
+                                               leading=leading, **settings)
                 self.base.image_choice = self._remembered_images(mesh, previous)
         for warning in caught:
             if issubclass(warning.category, MeshQualityWarning):
@@ -148,7 +161,8 @@ class GrowingOperator:
                                   stacklevel=2)
             else:
                 warnings.warn_explicit(warning.message, warning.category, warning.filename, warning.lineno)
-        self.builds += 1
+        if leading is None:
+            self.builds += 1
         return self.base
 
     def _chooses_images(self, mesh):
