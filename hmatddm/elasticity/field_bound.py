@@ -146,7 +146,7 @@ def stress_bound(mesh, material, dd, points, near_fraction=0.0, limit=None, poin
     near = np.maximum(near_fraction * smaller, 1e-9 * (half_a + half_b))
     from ..hmatrix.cluster_tree import cluster_tree
 
-    tree = cluster_tree(mesh.centers, mesh.radii, _LEAF_SIZE)
+    tree = cluster_tree(mesh.centers, mesh.radii, _LEAF_SIZE, oriented=False)  # its axis-aligned boxes only
     cumulative = np.concatenate(([0.0], np.cumsum(weight[tree.permutation])))
     limit = np.full(m, np.inf) if limit is None else np.ascontiguousarray(limit, dtype=np.float64)
     elements = tuple(np.ascontiguousarray(a, dtype=np.float64) for a in

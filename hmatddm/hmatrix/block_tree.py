@@ -99,6 +99,9 @@ def block_tree(tree, eta=3.0, col_tree=None, boxes="axis"):
         raise InputError(f"eta must be > 0, got {eta!r}")
     if boxes not in ("axis", "oriented"):
         raise InputError(f"boxes must be 'axis' or 'oriented', got {boxes!r}")
+    if boxes == "oriented" and (tree.box_axes is None or (col_tree is not None and col_tree.box_axes is None)):
+        raise InputError("boxes='oriented' needs cluster trees with their oriented boxes (cluster_tree(..., "
+                         "oriented=True), the default)")
     split = _split_both if col_tree is None or col_tree is tree else _split_larger
     col_tree = tree if col_tree is None else col_tree
     rows = np.zeros(1, dtype=np.int64)

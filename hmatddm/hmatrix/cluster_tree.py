@@ -122,7 +122,7 @@ def _group_split(points, groups):
     return first, second
 
 
-def cluster_tree(points, radii, leaf_size=64, groups=None):
+def cluster_tree(points, radii, leaf_size=64, groups=None, oriented=True):
     """Build the cluster tree of element centres ``points`` (N, dim).
 
     Each cluster with more than ``leaf_size`` elements is bisected at the median of
@@ -134,6 +134,11 @@ def cluster_tree(points, radii, leaf_size=64, groups=None):
     holds several groups is split between whole groups (:func:`_group_split`), so
     that every cluster below the group level lies on one fracture, whose blocks have
     the low ranks of a planar crack; the tree is then only roughly balanced.
+
+    ``oriented=False`` leaves out the oriented boxes (``box_center``, ``box_axes``,
+    ``box_half`` None: an eigenproblem per cluster, over half the tree's cost), for a
+    tree whose axis-aligned boxes are all its user reads (the stress bound of
+    :mod:`hmatddm.elasticity.field_bound`, built at every remote-failure check).
     """
     points = np.ascontiguousarray(points, dtype=np.float64)
     if points.ndim != 2 or points.shape[0] < 1:
@@ -188,7 +193,9 @@ def cluster_tree(points, radii, leaf_size=64, groups=None):
         else:
             bbox_min[c] = np.minimum(bbox_min[left[c]], bbox_min[right[c]])
             bbox_max[c] = np.maximum(bbox_max[left[c]], bbox_max[right[c]])
-    box_center, box_axes, box_half = _oriented_boxes(points[permutation], radii[permutation], start, stop)
+    box_center = box_axes = box_half = None
+    if oriented:
+        box_center, box_axes, box_half = _oriented_boxes(points[permutation], radii[permutation], start, stop)
     return ClusterTree(
         permutation=permutation,
         start=start,

@@ -230,3 +230,17 @@ def test_oriented_block_tree_covers_once_and_its_hmatrix_matches_dense():
     assert np.linalg.norm(h @ x - dense @ x) <= 1e-5 * np.linalg.norm(dense @ x)
     with pytest.raises(InputError, match="boxes"):
         block_tree(tree, 3.0, boxes="spheres")
+
+
+def test_a_tree_without_oriented_boxes_is_the_same_tree_and_refused_where_they_are_needed():
+    rng = np.random.default_rng(3)
+    points = rng.uniform(-1.0, 1.0, (300, 3))
+    full = cluster_tree(points, 0.01, 16)
+    bare = cluster_tree(points, 0.01, 16, oriented=False)
+    for name in ("permutation", "start", "stop", "left", "right", "parent", "level", "bbox_min", "bbox_max"):
+        assert np.array_equal(getattr(bare, name), getattr(full, name))
+    assert bare.box_center is None and bare.box_axes is None and bare.box_half is None
+    a, b = block_tree(bare, 2.0), block_tree(full, 2.0)  # axis-aligned boxes: the same partition
+    assert np.array_equal(a.admissible_rows, b.admissible_rows) and np.array_equal(a.admissible_cols, b.admissible_cols)
+    with pytest.raises(InputError, match="oriented=True"):
+        block_tree(bare, 2.0, boxes="oriented")
