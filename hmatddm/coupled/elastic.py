@@ -105,7 +105,8 @@ class ElasticSolver:
         if self._update is None or self._update[0] != key:
             if self.contact_factor is None:
                 bases = self.contact_bases
-                self.contact_factor = ContactFactor(self.operator.to_dense(), self.operator.dof,
+                read = getattr(self.operator, "dense_view", self.operator.to_dense)  # read only: no copy
+                self.contact_factor = ContactFactor(read(), self.operator.dof,
                                                     previous=None if bases is None else bases.last)
                 if bases is not None:
                     bases.last = self.contact_factor

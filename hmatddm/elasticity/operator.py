@@ -220,6 +220,16 @@ class ElasticityOperator(ProductCounter, LinearOperator):
             return self._matrix.copy()
         return self._hmatrix.to_dense()
 
+    def dense_view(self):
+        """The full matrix for reading: ``dense``'s own, read-only (no copy: the contact
+        factor of every solve reads it, 518 copies of up to 16 MB on dfn-3cluster at 4x its
+        area), else :meth:`to_dense`."""
+        if self._matrix is None:
+            return self.to_dense()
+        view = self._matrix.view()
+        view.flags.writeable = False
+        return view
+
     def exact_block(self, rows, cols):
         """Exact entries for element index arrays ``rows`` x ``cols`` from the kernels."""
         rows = np.ascontiguousarray(rows, dtype=np.int64)

@@ -1,7 +1,7 @@
 """A dense operator whose matrix leads a grown mesh's (``ElasticityOperator(leading=)``):
 the new elements' rows and columns from the kernels, the rest copied; the same matrix as a
 full build, bit for bit (every entry is one pair's), and a growing run's grown meshes
-bordered instead of assembled again."""
+bordered instead of assembled again; and ``dense_view``, the matrix read without a copy."""
 import numpy as np
 import pytest
 
@@ -79,3 +79,14 @@ def test_a_growing_dense_run_borders_its_operator(monkeypatch):
     assert operators.builds == 1 and assembled == [3 * old.n_elements]  # the grown one bordered
     assert operators.base is grown and grown is not first
     assert np.array_equal(grown.to_dense(), hd.ElasticityOperator(new, ROCK).to_dense())
+
+
+def test_dense_view_is_the_matrix_read_only():
+    old, _ = _network_3d()
+    dense = hd.ElasticityOperator(old, ROCK)
+    view = dense.dense_view()
+    assert np.array_equal(view, dense.to_dense()) and not view.flags.writeable
+    with pytest.raises(ValueError):
+        view[0, 0] = 1.0
+    compressed = hd.ElasticityOperator(old, ROCK, backend="hmatrix")
+    assert np.array_equal(compressed.dense_view(), compressed.to_dense())
