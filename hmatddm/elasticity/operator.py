@@ -124,6 +124,8 @@ class ElasticityOperator(ProductCounter, LinearOperator):
             (("backend", backend), ("singular_correction", singular_correction), ("eps", eps), ("eta", eta),
              ("leaf_size", leaf_size), ("alpha", alpha)))
 
+        if leading is not None and backend != "dense":
+            raise InputError(f"leading is for backend='dense' only, got backend={backend!r}")
         check_mesh(mesh)
         _refuse_coincident(mesh)
         if check_spacing:

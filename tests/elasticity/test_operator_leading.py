@@ -43,6 +43,12 @@ def test_bordered_matrix_is_the_full_build_bit_for_bit(network, options):
     assert np.array_equal(hd.ElasticityOperator(new, ROCK, leading=full, **options).to_dense(), full.to_dense())
 
 
+def test_leading_is_refused_for_the_hmatrix_backend():
+    old, new = _network_3d()
+    with pytest.raises(hd.InputError, match="leading is for backend='dense' only"):
+        hd.ElasticityOperator(new, ROCK, backend="hmatrix", leading=hd.ElasticityOperator(old, ROCK))
+
+
 @pytest.mark.parametrize("change", ["material", "alpha", "mesh", "backend"])
 def test_a_leading_operator_that_does_not_lead_is_refused(change):
     old, new = _network_2d()
