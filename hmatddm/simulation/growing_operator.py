@@ -6,9 +6,10 @@ iterations of a step. A dense operator in a homogeneous medium is not rebuilt wh
 grows: its matrix leads the grown mesh's, and only the new elements' rows and columns are
 computed (``ElasticityOperator(leading=)``; on dfn-3cluster at 4x its area the 313 full
 assemblies took 1.55 s of the run's 30 s, benchmarks/RESULTS.md, issue 33). A planar 3D
-mesh in a homogeneous medium gets the ``hmatrix`` backend's opening and shear operators apart, and their border blocks apart while it grows
-in its plane (:mod:`hmatddm.elasticity.planar`; the same matrix, ~7x faster products for a
-crack loaded in opening) unless :data:`SPLIT_PLANAR_MODES` is False; and a planar lattice
+mesh in a homogeneous medium gets the ``hmatrix`` backend's opening and shear operators
+apart, and their border blocks apart while it grows in its plane
+(:mod:`hmatddm.elasticity.planar`; the same matrix, ~7x faster products for a crack loaded
+in opening) unless :data:`SPLIT_PLANAR_MODES` is False; and a planar lattice
 mesh gets the FFT operator of :mod:`hmatddm.elasticity.lattice` unless
 :data:`LATTICE_PLANAR` is False.
 
