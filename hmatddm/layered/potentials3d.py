@@ -301,13 +301,14 @@ def _stress_at(table, f, da, db, dc, scale, s, delta, shear_modulus, lame, out, 
     d33 = w * table[f, 1, da, db, dc + 2]
     for i in range(3):
         for k in range(i, 3):
-            a = da + (1 if i == 0 else 0) + (1 if k == 0 else 0)
-            b = db + (1 if i == 1 else 0) + (1 if k == 1 else 0)
-            c = dc + (1 if i == 2 else 0) + (1 if k == 2 else 0)
+            # the shifts as sums of comparisons, not conditional expressions (three blocks
+            # each, which numba's inlining copies with the whole scope, benchmarks/RESULTS.md)
+            a = da + (i == 0) + (k == 0)
+            b = db + (i == 1) + (k == 1)
+            c = dc + (i == 2) + (k == 2)
             v = 2.0 * (table[f, 0, a, b, c] - table[f, 1, a, b, c]) - 4.0 * delta * s * table[f, 1, a, b, c + 1]
             if k == 2:
-                v += w * table[f, 1, da + (1 if i == 0 else 0), db + (1 if i == 1 else 0),
-                               dc + (1 if i == 2 else 0) + 1]
+                v += w * table[f, 1, da + (i == 0), db + (i == 1), dc + (i == 2) + 1]
                 if i == 2:
                     v += w * table[f, 1, da, db, dc + 2]
             if i == 0 and k == 0:
@@ -334,10 +335,19 @@ def _pair_stress_gradient(r1, r2, r3, eps, sigma, coef, dcoef, delta, shear_modu
     ``(i, k)`` at the receiver ``r`` (relative to the triple's point) of a unit force
     along ``f``; ``delta``, moduli: the receiver layer's; ``eps = dz/dt``. Horizontal
     source derivatives are minus receiver derivatives; the vertical one differentiates
-    the coefficients (``dcoef``), the triple's height ``z`` and ``s = y3 - z``."""
-    _pair_tables(r1, r2, r3, sigma, coef, dcoef, 3, work)
-    table = work[4]
-    dtable = work[5]
+    the coefficients (``dcoef``), the triple's height ``z`` and ``s = y3 - z``. The body of
+    :func:`_pair_tables` written here, not inlined: numba's inlining copies each block of
+    the inlined function with its whole scope, and ``_pair_tables`` holds everything it
+    inlines (about 4 s of this function's cold compile, more in a process that has compiled
+    much already: the copies' garbage collection, benchmarks/RESULTS.md, issue 32)."""
+    sf, sl, ser, h, table, dtable, pad = work
+    order = 3
+    used = orders_used(coef, dcoef)
+    n_c = order + used + 1
+    top = max(n_c - 2, 4)  # as in _pair_tables
+    gauge_table(r1, r2, r3, sigma, n_c, top, sf, sl, ser, h, pad)
+    for d in range(2):
+        _potential_table(dcoef if d else coef, h, sigma, order - d, used, dtable if d else table)
     for f in range(3):
         # literal shifts, four inlined copies (LLVM folds the shifts): 10% of a triple's CPU
         # against one copy in a loop over the four, for 3 s more compile
@@ -347,9 +357,9 @@ def _pair_stress_gradient(r1, r2, r3, eps, sigma, coef, dcoef, delta, shear_modu
         _stress_at(table, f, 0, 0, 1, -eps, r3, delta, shear_modulus, lame, out, f, 2)
         for i in range(3):
             for k in range(3):
-                a = (1 if i == 0 else 0) + (1 if k == 0 else 0)
-                b = (1 if i == 1 else 0) + (1 if k == 1 else 0)
-                c = (1 if i == 2 else 0) + (1 if k == 2 else 0)
+                a = (i == 0) + (k == 0)
+                b = (i == 1) + (k == 1)
+                c = (i == 2) + (k == 2)
                 out[f, 2, i, k] += 4.0 * shear_modulus * delta * eps * table[f, 1, a, b, c + 1]
 
 
