@@ -421,7 +421,7 @@ def point_form_terms(data, point, lr, j, setup, work, entry_tol, normal, out, tr
         # gives there
         dmin = distance_to_rectangle(point[0], point[1], 2.0 * data.interfaces[0] - point[2], center, frame, a, b)
     else:
-        dmin = nearest_singularity(point, lr, center, frame, a, b, ls, data.interfaces, -1)
+        dmin = nearest_singularity(point, lr, center, frame, a, b, ls, data.interfaces, np.int64(-1))
     n_gauss, n_sub = point_rule(dmin, a, b, data.max_subdivisions, data.far_tol, entry_tol)
     if n_sub == 1 and n_gauss <= data.gauss_points:
         lo, hi = start[n_gauss - 1], start[n_gauss]
