@@ -16,7 +16,8 @@ import numpy as np
 from numba import njit
 
 from ..kernels.drivers import _hold, _in_parts, borrowed
-from .images3d import element_stress_traced, source_state, workspace
+from ..kernels.held_function import address_of, without_functions
+from .images3d import source_state, workspace
 
 __all__ = ["stress_points", "stress_sum", "stress_columns_points", "stress_columns"]
 
@@ -32,11 +33,16 @@ def stress_points(data, points, point_layer, dd, out):
         for i in range(3):
             for k in range(3):
                 out[m, i, k] = 0.0
+    # the record and the workspace on the stack once, for every call of the held per-pair
+    # stress (.stress_terms3d): live while ``data`` and ``work`` are
+    data_at, work_at = address_of(without_functions(data)), address_of(work)
     for j in range(data.centers.shape[0]):
         owner = source_state(data, j, work)
         state = borrowed(owner)  # no reference counts per point (kernels.drivers.traction_block)
+        state_at = address_of(state)
         for m in range(points.shape[0]):
-            element_stress_traced(data, points[m], point_layer[m], j, state, work, pair)
+            data.point_stress(data_at, points[m], point_layer[m], np.int64(j), state_at, work_at, data.image_terms,
+                              data.vertical_terms, pair)
             for i in range(3):
                 for k in range(3):
                     acc = 0.0
@@ -70,11 +76,14 @@ def stress_columns_points(data, points, point_layer, out):
     additions)."""
     work = workspace(data)
     pair = np.empty((3, 3, 3))
+    data_at, work_at = address_of(without_functions(data)), address_of(work)  # as in stress_points
     for j in range(data.centers.shape[0]):
         owner = source_state(data, j, work)
         state = borrowed(owner)
+        state_at = address_of(state)
         for m in range(points.shape[0]):
-            element_stress_traced(data, points[m], point_layer[m], j, state, work, pair)
+            data.point_stress(data_at, points[m], point_layer[m], np.int64(j), state_at, work_at, data.image_terms,
+                              data.vertical_terms, pair)
             out[m, j] = pair
         _hold(owner)
 

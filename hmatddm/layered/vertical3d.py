@@ -290,6 +290,16 @@ def vertical_image_stress(y, receiver_layer, center, strike, hs, hd, heights, tr
     :func:`entry_order` when ``triple_tol > 0`` (the error allowed per unit largest shear
     modulus). Returns False, adding nothing, where the triples differ between the heights
     or a table does not reach."""
+    return _vertical_stress(y, receiver_layer, center, strike, hs, hd, heights, traced, shear_modulus, poisson_ratio,
+                            source_layer, far_tol, triple_tol, work, out)
+
+
+@njit(cache=True, inline="always")
+def _vertical_stress(y, receiver_layer, center, strike, hs, hd, heights, traced, shear_modulus, poisson_ratio,
+                     source_layer, far_tol, triple_tol, work, out):
+    """:func:`vertical_image_stress`, inlined into it and into the record's held
+    :func:`.images3d._vertical_terms` (the closed forms compiled once for every caller of
+    the image terms, not again in each: benchmarks/RESULTS.md, issue 32)."""
     edge, tables, gradient, with_s, without, local, yr, far_work, coef_t, dcoef_t = work
     sj_bot, sj_top, integrated = tables
     n_pairs, layer, z, eps, sigma, coef, dcoef = traced
