@@ -100,7 +100,7 @@ from numba import njit, typeof, types
 
 from ..kernels import rectangle3d
 from ..kernels.drivers import KernelKind, register_kind
-from ..kernels.held_function import HeldFunction, address_of, dereference, without_functions
+from ..kernels.held_function import HeldFunction, address_of, dereference, held_record
 from . import okada3d
 from .okada_point3d import POINT_SETUP, point_form_terms, point_setup
 from .image_points3d import image_point_displacement, image_point_stress, kelvin_point_displacement, kelvin_point_stress
@@ -278,7 +278,7 @@ def source_state(data, j, work):
     (``closed_form``) or by Okada's point source (``point_form``) traces nothing: its state
     is the workspace's (:func:`_untraced_state`). :func:`_source_state` through
     ``data.source_tracer`` (:func:`with_image_terms`)."""
-    return data.source_tracer(address_of(without_functions(data)), np.int64(j), address_of(work))
+    return data.source_tracer(held_record(data), np.int64(j), address_of(work))
 
 
 @njit(cache=True, no_cpython_wrapper=True)  # held: called through its C wrapper only
@@ -335,31 +335,25 @@ def element_traction(data, i, j, state, work, block):
         okada3d.okada_traction(point, normal, center, data.okada[j], data.okada_half[j, 0], data.okada_half[j, 1],
                                data.surface, g[ls], nu[ls], False, True, okada_work, corners, block)
     elif data.point_form[j]:
-        point_form_terms(data, point, data.layer[i], j, state[4], work, data.entry_tol * data.entry_scale, normal,
-                         block, True)
+        point_form_terms(data, point, data.layer[i], j, state[4], work[7], okada_work,
+                         data.entry_tol * data.entry_scale, normal, block, True)
     elif data.interfaces.shape[0] > 0:
         lr = data.layer[i]
         if data.surface_form[j] and lr == ls:
             okada3d.okada_traction(point, normal, center, data.okada[j], data.okada_half[j, 0], data.okada_half[j, 1],
                                    data.surface, g[ls], nu[ls], False, True, okada_work, corners, block)
-        _image_terms(data, point, lr, j, state, work, data.entry_tol * data.entry_scale, image)
+        # the held image terms (with_image_terms), the point copied to the workspace (any
+        # layout): called here, not through an inlined helper taking the record, the state
+        # and the workspace (numba takes and drops a reference to each of their arrays per
+        # inlined function they are passed to: code that LLVM optimises in every caller)
+        here = work[12]
+        for k in range(3):
+            here[k] = point[k]
+        data.image_terms(held_record(data), here, np.int64(lr), np.int64(j), address_of(state), address_of(work),
+                         np.float64(data.entry_tol * data.entry_scale), image, data.vertical_terms)
         for p in range(3):
             for q in range(3):
                 block[p, q] += image[q, p, 0] * normal[0] + image[q, p, 1] * normal[1] + image[q, p, 2] * normal[2]
-
-
-@njit(cache=True, inline="always")
-def _image_terms(data, point, lr, j, state, work, entry_tol, image):
-    """:func:`_complementary_stress` through ``data.image_terms`` (:func:`with_image_terms`),
-    the arguments in the held signature's types: the point copied to the workspace (any
-    layout), the layer and the source as int64, ``entry_tol`` as float64. Not for a
-    ``point_form`` source (:func:`element_traction` takes its terms: the stress's Gauss sum
-    of Okada's point source is not linked into the traction's callers)."""
-    here = work[12]
-    for k in range(3):
-        here[k] = point[k]
-    data.image_terms(address_of(without_functions(data)), here, np.int64(lr), np.int64(j), address_of(state),
-                     address_of(work), np.float64(entry_tol), image, data.vertical_terms)
 
 
 @njit(cache=True, no_cpython_wrapper=True)  # held: called through its C wrapper only
@@ -478,5 +472,13 @@ def element_stress(data, point, point_layer, j, work, out):
     element_stress_traced(data, point, point_layer, j, source_state(data, j, work), work, out)
 
 
-register_kind(LayeredRectangles, KernelKind(workspace, source_state, element_traction, element_stress,
+@njit(cache=True)
+def _kind_workspace(data):
+    """:func:`workspace` called, not inlined: the registered workspace of the drivers, which
+    inline it into each driver (and compile it on their own first); once a block, the call
+    costs nothing, and the workspace's code is compiled once for every driver."""
+    return workspace(data)
+
+
+register_kind(LayeredRectangles, KernelKind(_kind_workspace, source_state, element_traction, element_stress,
                                             rectangle3d.edge_distance))

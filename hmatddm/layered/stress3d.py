@@ -16,7 +16,7 @@ import numpy as np
 from numba import njit
 
 from ..kernels.drivers import _hold, _in_parts, borrowed
-from ..kernels.held_function import address_of, without_functions
+from ..kernels.held_function import address_of, held_record
 from .images3d import source_state, workspace
 
 __all__ = ["stress_points", "stress_sum", "stress_columns_points", "stress_columns"]
@@ -35,7 +35,7 @@ def stress_points(data, points, point_layer, dd, out):
                 out[m, i, k] = 0.0
     # the record and the workspace on the stack once, for every call of the held per-pair
     # stress (.stress_terms3d): live while ``data`` and ``work`` are
-    data_at, work_at = address_of(without_functions(data)), address_of(work)
+    data_at, work_at = held_record(data), address_of(work)
     for j in range(data.centers.shape[0]):
         owner = source_state(data, j, work)
         state = borrowed(owner)  # no reference counts per point (kernels.drivers.traction_block)
@@ -76,7 +76,7 @@ def stress_columns_points(data, points, point_layer, out):
     additions)."""
     work = workspace(data)
     pair = np.empty((3, 3, 3))
-    data_at, work_at = address_of(without_functions(data)), address_of(work)  # as in stress_points
+    data_at, work_at = held_record(data), address_of(work)  # as in stress_points
     for j in range(data.centers.shape[0]):
         owner = source_state(data, j, work)
         state = borrowed(owner)

@@ -20,7 +20,7 @@ import numpy as np
 from numba import njit
 
 from ..kernels import rectangle3d
-from ..kernels.held_function import address_of, dereference, without_functions
+from ..kernels.held_function import address_of, dereference, held_record
 from . import okada3d
 from .images2d import zero_in_void
 from .okada_point3d import point_form_terms
@@ -55,7 +55,7 @@ def _stress_traced(data_at, point, point_layer, j, state_at, work_at, image_term
                     out[q, i, k] += image[q, i, k]
     elif data.interfaces.shape[0] > 0:
         if data.point_form[j]:
-            point_form_terms(data, point, point_layer, j, state[4], work, 0.0, point, image, False)
+            point_form_terms(data, point, point_layer, j, state[4], work[7], work[8], 0.0, point, image, False)
         else:
             here = work[12]
             for k in range(3):
@@ -94,5 +94,5 @@ def element_stress_traced(data, point, point_layer, j, state, work, out):
     here = work[12]
     for k in range(3):
         here[k] = point[k]
-    data.point_stress(address_of(without_functions(data)), here, np.int64(point_layer), np.int64(j),
+    data.point_stress(held_record(data), here, np.int64(point_layer), np.int64(j),
                       address_of(state), address_of(work), data.image_terms, data.vertical_terms, out)
