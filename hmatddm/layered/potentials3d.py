@@ -335,17 +335,28 @@ def _pair_stress_gradient(r1, r2, r3, eps, sigma, coef, dcoef, delta, shear_modu
     ``(i, k)`` at the receiver ``r`` (relative to the triple's point) of a unit force
     along ``f``; ``delta``, moduli: the receiver layer's; ``eps = dz/dt``. Horizontal
     source derivatives are minus receiver derivatives; the vertical one differentiates
-    the coefficients (``dcoef``), the triple's height ``z`` and ``s = y3 - z``. The body of
-    :func:`_pair_tables` written here, not inlined: numba's inlining copies each block of
-    the inlined function with its whole scope, and ``_pair_tables`` holds everything it
-    inlines (about 4 s of this function's cold compile, more in a process that has compiled
-    much already: the copies' garbage collection, benchmarks/RESULTS.md, issue 32)."""
+    the coefficients (``dcoef``), the triple's height ``z`` and ``s = y3 - z``. The bodies of
+    :func:`_pair_tables` and :func:`gauge_table` written here, not inlined: numba's inlining
+    copies each block of the inlined function with its whole scope, and those hold everything
+    they inline (about 5 s of this function's cold compile, more in a process that has
+    compiled much already: the copies' garbage collection, benchmarks/RESULTS.md, issue 32)."""
     sf, sl, ser, h, table, dtable, pad = work
     order = 3
     used = orders_used(coef, dcoef)
     n_c = order + used + 1
     top = max(n_c - 2, 4)  # as in _pair_tables
-    gauge_table(r1, r2, r3, sigma, n_c, top, sf, sl, ser, h, pad)
+    # gauge_table's body (the same reason)
+    inv = inverse_distance_recurrence(r1, r2, r3, pad, 6, n_c - 1, top)
+    scaled_inverse_distance(pad, inv, h, 2, -1.0, 6, n_c - 1, top)
+    _axis_derivatives(r1, r2, sigma * r3, sf, sl, ser)
+    for b in range(2, 6):
+        for a in range(6 - b):
+            sf[a, b] = -sf[a + 2, b - 2] - h[a, b - 2, 2]
+            sl[a, b] = -sl[a + 2, b - 2] + sigma * h[a, b - 2, 3]
+    for a in range(6):
+        for b in range(6 - a):
+            h[a, b, 0] = sf[a, b]
+            h[a, b, 1] = -sigma * sl[a, b]
     for d in range(2):
         _potential_table(dcoef if d else coef, h, sigma, order - d, used, dtable if d else table)
     for f in range(3):
