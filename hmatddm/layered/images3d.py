@@ -88,6 +88,14 @@ caller: the operator's ``traction_block``, the stress at points (:mod:`.stress3d
 :func:`element_stress_traced`), the drivers' generic ``stress_block`` and numba's own
 compiles of the per-kind functions that the drivers inline (they were six copies of the
 image terms; the cold compile of the layered 3D entry points 126 -> 96 s of CPU, RESULTS.md).
+Then the stress at a point (:mod:`.stress_terms3d`, ``point_stress``) and the vertical
+closed forms (:func:`_vertical_terms`, ``vertical_terms``) are held the same way, the
+functions only compiled code calls have no CPython or C wrapper, and the record (29
+arrays), the workspace (69) and a source's state (16) are passed to inlined functions as
+seldom as possible: numba takes and drops a reference on every array of such an aggregate
+each time it is copied or passed to an inlined function, code that LLVM optimises in every
+caller (``traction_block`` was 77k lines of IR for 3900 reference counts; the cold compile
+~129 -> ~97 s of CPU, RESULTS.md, issue 32 continued).
 A record built otherwise than by :func:`.influence3d.influence_data` needs
 :func:`with_image_terms` before a compiled function takes it.
 ``benchmarks/bench_layered3d_compile.py`` measures it.
@@ -99,7 +107,7 @@ import numpy as np
 from numba import njit, typeof, types
 
 from ..kernels import rectangle3d
-from ..kernels.drivers import KernelKind, register_kind
+from ..kernels.drivers import KernelKind, _hold, register_kind
 from ..kernels.held_function import HeldFunction, address_of, dereference, held_record
 from . import okada3d
 from .okada_point3d import POINT_SETUP, point_form_terms, point_setup
@@ -468,8 +476,12 @@ def _vertical_terms(data_at, point, lr, j, state_at, work_at, entry_tol, image):
 def element_stress(data, point, point_layer, j, work, out):
     """:func:`element_stress_traced` for one point (the registered per-pair function of
     :func:`hmatddm.kernels.drivers.stress_block`, which has no source state: the source's
-    triples are traced for this point alone; :mod:`.stress3d` traces them once per source)."""
-    element_stress_traced(data, point, point_layer, j, source_state(data, j, work), work, out)
+    triples are traced for this point alone; :mod:`.stress3d` traces them once per source).
+    The state is held to the end: the inlined :func:`element_stress_traced` passes it by
+    pointer, and numba would release a temporary after its last use, before the call."""
+    owner = data.source_tracer(held_record(data), np.int64(j), address_of(work))
+    element_stress_traced(data, point, point_layer, j, owner, work, out)
+    _hold(owner)
 
 
 @njit(cache=True)

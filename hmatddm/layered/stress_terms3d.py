@@ -90,7 +90,9 @@ def element_stress_traced(data, point, point_layer, j, state, work, out):
     reflection in the free surface in closed form, for points of its layer. Through the
     record's ``point_stress`` (:func:`_stress_traced`), the point copied to the workspace
     (any layout), the record, state and workspace copied to the stack for the call (a loop
-    over pairs makes those pointers once: :mod:`.stress3d`)."""
+    over pairs makes those pointers once: :mod:`.stress3d`): their arrays must outlive the
+    call, held by the caller's variables (numba releases a temporary after its last use,
+    here the copy, not the call)."""
     here = work[12]
     for k in range(3):
         here[k] = point[k]
