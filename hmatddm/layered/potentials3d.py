@@ -301,14 +301,15 @@ def _stress_at(table, f, da, db, dc, scale, s, delta, shear_modulus, lame, out, 
     d33 = w * table[f, 1, da, db, dc + 2]
     for i in range(3):
         for k in range(i, 3):
-            # the shifts as sums of comparisons, not conditional expressions (three blocks
-            # each, which numba's inlining copies with the whole scope, benchmarks/RESULTS.md)
-            a = da + (i == 0) + (k == 0)
-            b = db + (i == 1) + (k == 1)
-            c = dc + (i == 2) + (k == 2)
+            # conditional expressions (sums of comparisons compile faster, but LLVM then
+            # associates the FAST sums differently: not the same round-off, RESULTS.md)
+            a = da + (1 if i == 0 else 0) + (1 if k == 0 else 0)
+            b = db + (1 if i == 1 else 0) + (1 if k == 1 else 0)
+            c = dc + (1 if i == 2 else 0) + (1 if k == 2 else 0)
             v = 2.0 * (table[f, 0, a, b, c] - table[f, 1, a, b, c]) - 4.0 * delta * s * table[f, 1, a, b, c + 1]
             if k == 2:
-                v += w * table[f, 1, da + (i == 0), db + (i == 1), dc + (i == 2) + 1]
+                v += w * table[f, 1, da + (1 if i == 0 else 0), db + (1 if i == 1 else 0),
+                               dc + (1 if i == 2 else 0) + 1]
                 if i == 2:
                     v += w * table[f, 1, da, db, dc + 2]
             if i == 0 and k == 0:
@@ -368,9 +369,9 @@ def _pair_stress_gradient(r1, r2, r3, eps, sigma, coef, dcoef, delta, shear_modu
         _stress_at(table, f, 0, 0, 1, -eps, r3, delta, shear_modulus, lame, out, f, 2)
         for i in range(3):
             for k in range(3):
-                a = (i == 0) + (k == 0)
-                b = (i == 1) + (k == 1)
-                c = (i == 2) + (k == 2)
+                a = (1 if i == 0 else 0) + (1 if k == 0 else 0)
+                b = (1 if i == 1 else 0) + (1 if k == 1 else 0)
+                c = (1 if i == 2 else 0) + (1 if k == 2 else 0)
                 out[f, 2, i, k] += 4.0 * shear_modulus * delta * eps * table[f, 1, a, b, c + 1]
 
 
