@@ -95,7 +95,7 @@ arrays), the workspace (69) and a source's state (16) are passed to inlined func
 seldom as possible: numba takes and drops a reference on every array of such an aggregate
 each time it is copied or passed to an inlined function, code that LLVM optimises in every
 caller (``traction_block`` was 77k lines of IR for 3900 reference counts; the cold compile
-~129 -> ~97 s of CPU, RESULTS.md, issue 32 continued).
+0.73-0.85x of the CPU before, RESULTS.md, issue 32 continued).
 A record built otherwise than by :func:`.influence3d.influence_data` needs
 :func:`with_image_terms` before a compiled function takes it.
 ``benchmarks/bench_layered3d_compile.py`` measures it.
