@@ -176,10 +176,14 @@ def _per_kind(stub):
 
     function.__signature__ = resolve.__signature__ = inspect.signature(stub)
     function.__name__, function.__qualname__, function.__doc__ = stub.__name__, stub.__qualname__, stub.__doc__
-    # numba compiles the implementation on its own too before inlining it (never called
-    # from Python: no CPython or C wrapper, each of which unboxes or passes every field of
-    # the record, a large part of a small function's compile)
-    overload(function, inline="always", jit_options=dict(no_cpython_wrapper=True, no_cfunc_wrapper=True))(resolve)
+    # numba compiles the implementation on its own too before inlining it, only to type it:
+    # never called, from Python or compiled code (no CPython or C wrapper, each of which
+    # unboxes or passes every field of the record, a large part of a small function's
+    # compile), so left unoptimised by LLVM (``optnone``; its callees are compiled as usual):
+    # numba's reference counts of a large record made a layered kernel's per-pair function
+    # 20-30k lines that LLVM optimised for nothing (benchmarks/RESULTS.md, issue 32)
+    overload(function, inline="always",
+             jit_options=dict(no_cpython_wrapper=True, no_cfunc_wrapper=True, _dbg_optnone=True))(resolve)
     return function
 
 
@@ -286,9 +290,13 @@ def traction_block(data, rows, cols, out):
     n_staged = min(STAGED_SOURCES, cols.shape[0]) if by_source else 1
     scratch = (_workspace(data), np.empty((dof, dof)), np.empty((dof * rows.shape[0] * by_source, dof * n_staged)))
     # every array borrowed (:func:`borrowed`): the caller holds the arguments, ``scratch``
-    # lives until :func:`_hold` below
-    data_, rows_, cols_, out_, work, block, stage = borrowed((data, rows, cols, out, scratch[0], scratch[1],
-                                                               scratch[2]))
+    # lives until :func:`_hold` below; one by one, each copied once (numba takes and drops a
+    # reference on every array of an aggregate it copies: a layered workspace's dozens)
+    data_ = borrowed(data)
+    rows_ = borrowed(rows)
+    cols_ = borrowed(cols)
+    out_ = borrowed(out)
+    work, block, stage = borrowed(scratch)
     alpha = data_.alpha
     n_outer = cols_.shape[0] if by_source else rows_.shape[0]
     n_inner = rows_.shape[0] if by_source else cols_.shape[0]
@@ -333,9 +341,13 @@ def stress_block(data, points, point_layer, dd, out):
     dof = element_unknowns(data)
     scratch = (_workspace(data), np.empty((dof, dim, dim)))
     # every array borrowed (:func:`borrowed`): the caller holds the arguments, ``scratch``
-    # lives until :func:`_hold` below
-    data_, points_, point_layer_, dd_, out_, work, pair = borrowed((data, points, point_layer, dd, out, scratch[0],
-                                                                    scratch[1]))
+    # lives until :func:`_hold` below (one by one: as in traction_block)
+    data_ = borrowed(data)
+    points_ = borrowed(points)
+    point_layer_ = borrowed(point_layer)
+    dd_ = borrowed(dd)
+    out_ = borrowed(out)
+    work, pair = borrowed(scratch)
     for m in range(points_.shape[0]):
         acc = np.zeros((dim, dim))
         for j in range(n):

@@ -12,8 +12,9 @@ it as ``FunctionType(signature)`` and fetches the function's address when the re
 passed in from Python (the function compiled for that signature, or loaded from numba's
 disk cache, once per process). A record type cannot contain a function of itself, so the
 held function takes the record with its function fields set to None
-(:func:`without_functions`), through a pointer (:func:`address_of`, :func:`dereference`)
-as its first argument; large tuples (a workspace) are best passed the same way.
+(:func:`without_functions`), through a pointer (:func:`address_of`, :func:`dereference`;
+both at once: :func:`held_record`) as its first argument; large tuples (a workspace) are
+best passed the same way.
 
 A call whose argument types differ from the held signature does not compile (numba's
 check of first-class function calls): no call can reach the function with other types.
@@ -105,6 +106,27 @@ def address_of(typingctx, value):
 
 
 @intrinsic
+def held_record(typingctx, record):
+    """``address_of(without_functions(record))`` in one step: no stripped record between
+    them, whose arrays numba would release one by one (code that LLVM optimises in every
+    caller of a held function)."""
+    stripped = _strip_functions(record)
+
+    def codegen(context, builder, signature, args):
+        value = cgutils.get_null_value(context.get_value_type(stripped))
+        for k, kind in enumerate(record.types):
+            if not isinstance(kind, types.FunctionType):
+                item = _without_reference_count(context, builder, kind, builder.extract_value(args[0], k))
+                value = builder.insert_value(value, item, k)
+        model = context.data_model_manager[stripped]
+        slot = cgutils.alloca_once(builder, model.get_data_type())
+        builder.store(model.as_data(builder, value), slot)
+        return slot
+
+    return types.CPointer(stripped)(record), codegen
+
+
+@intrinsic
 def dereference(typingctx, pointer):
     """The value :func:`address_of` points to (borrowed, as it was stored)."""
     def codegen(context, builder, signature, args):
@@ -113,4 +135,4 @@ def dereference(typingctx, pointer):
     return pointer.dtype(pointer), codegen
 
 
-__all__ = ["HeldFunction", "without_functions", "address_of", "dereference"]
+__all__ = ["HeldFunction", "without_functions", "address_of", "held_record", "dereference"]

@@ -70,7 +70,7 @@ def merge_coincident(n, pair_layer, pair_z, pair_eps, pair_sigma, pair_coef, pai
     ``eps`` (:func:`.potentials3d._pair_stress_gradient`, the vertical source derivative
     included), so the merged triple's coefficients are the sums: exact, and a third to a
     half fewer triples to evaluate with two or more interfaces. Returns the new count."""
-    kept = 0
+    kept = np.int64(0)  # not a literal: one specialization of copy_triple
     for k in range(n):
         into = -1
         tol = 1e-12 * (1.0 + abs(pair_z[k]))

@@ -88,6 +88,14 @@ caller: the operator's ``traction_block``, the stress at points (:mod:`.stress3d
 :func:`element_stress_traced`), the drivers' generic ``stress_block`` and numba's own
 compiles of the per-kind functions that the drivers inline (they were six copies of the
 image terms; the cold compile of the layered 3D entry points 126 -> 96 s of CPU, RESULTS.md).
+Then the stress at a point (:mod:`.stress_terms3d`, ``point_stress``) and the vertical
+closed forms (:func:`_vertical_terms`, ``vertical_terms``) are held the same way, the
+functions only compiled code calls have no CPython or C wrapper, and the record (29
+arrays), the workspace (69) and a source's state (16) are passed to inlined functions as
+seldom as possible: numba takes and drops a reference on every array of such an aggregate
+each time it is copied or passed to an inlined function, code that LLVM optimises in every
+caller (``traction_block`` was 77k lines of IR for 3900 reference counts; the cold compile
+0.73-0.85x of the CPU before, RESULTS.md, issue 32 continued).
 A record built otherwise than by :func:`.influence3d.influence_data` needs
 :func:`with_image_terms` before a compiled function takes it.
 ``benchmarks/bench_layered3d_compile.py`` measures it.
@@ -99,18 +107,19 @@ import numpy as np
 from numba import njit, typeof, types
 
 from ..kernels import rectangle3d
-from ..kernels.drivers import KernelKind, register_kind
-from ..kernels.held_function import HeldFunction, address_of, dereference, without_functions
+from ..kernels.drivers import KernelKind, _hold, register_kind
+from ..kernels.held_function import HeldFunction, address_of, dereference, held_record
 from . import okada3d
 from .okada_point3d import POINT_SETUP, point_form_terms, point_setup
 from .image_points3d import image_point_displacement, image_point_stress, kelvin_point_displacement, kelvin_point_stress
 from .image_tracer import trace_capacity
-from .images2d import _lame, zero_in_void
+from .images2d import _lame
 from .image_tracer3d import _traced_buffer, trace, trace_points
 from .source_traces3d import three_heights, traced_slot
+from .stress_terms3d import _stress_traced, element_stress_traced
 from .remainder_table3d import rectangle_covered, remainder_rectangle_stress
 from .potentials3d import Workspace, base_derivatives, inverse_distance_derivatives, inverse_distance_scratch
-from .vertical3d import vertical_image_stress, vertical_workspace
+from .vertical3d import _vertical_stress, vertical_workspace
 from .rectangle_quadrature import (FAR_TOL, _cached_rules, _image_order, _integrate, far_order, image_rectangle_stress,
                                    image_rectangle_stress_without, mirror_distance, one_square_order,
                                    nearest_singularity, square_rule, subdivisions)
@@ -170,16 +179,25 @@ class LayeredRectangles(NamedTuple):
     image_terms: object = None
     #: :func:`_source_state` held the same way (the tracer it calls compiled once)
     source_tracer: object = None
+    #: :func:`.stress_terms3d._stress_traced`, the stress at a point, held the same way
+    #: (:func:`element_stress_traced`)
+    point_stress: object = None
+    #: :func:`_vertical_terms`, the closed forms of a vertical source, held the same way
+    #: (an argument of ``image_terms``)
+    vertical_terms: object = None
 
 
 def with_image_terms(data):
-    """``data`` with its ``image_terms`` and ``source_tracer``: :func:`_complementary_stress`
-    and :func:`_source_state` held as first-class functions
-    (:class:`hmatddm.kernels.held_function.HeldFunction`), so that each is compiled once, not
-    again in every compiled caller (module docstring, compile cost)."""
-    core = data._replace(image_terms=None, source_tracer=None)
+    """``data`` with its ``image_terms``, ``source_tracer``, ``point_stress`` and
+    ``vertical_terms``: :func:`_complementary_stress`, :func:`_source_state`,
+    :func:`.stress_terms3d._stress_traced` and :func:`_vertical_terms` held as first-class
+    functions (:class:`hmatddm.kernels.held_function.HeldFunction`), so that each is compiled
+    once, not again in every compiled caller (module docstring, compile cost)."""
+    core = data._replace(image_terms=None, source_tracer=None, point_stress=None, vertical_terms=None)
     return data._replace(image_terms=HeldFunction(_complementary_stress, core, _image_term_types),
-                         source_tracer=HeldFunction(_source_state, core, _source_state_types))
+                         source_tracer=HeldFunction(_source_state, core, _source_state_types),
+                         point_stress=HeldFunction(_stress_traced, core, _point_stress_types),
+                         vertical_terms=HeldFunction(_vertical_terms, core, _vertical_term_types))
 
 
 def _state_type():
@@ -194,16 +212,38 @@ def _source_state_types(data):
     return _state_type(), (types.int64, types.CPointer(typeof(workspace.py_func(data))))
 
 
+def _vertical_term_types(data):
+    """The numba types of :func:`_vertical_terms`'s result and arguments after the record:
+    the point, its layer, the source, :func:`source_state`'s tuple, :func:`workspace`'s
+    tuple, the entry tolerance and the stress."""
+    return types.boolean, (types.Array(types.float64, 1, "C"), types.int64, types.int64,
+                           types.CPointer(_state_type()), types.CPointer(typeof(workspace.py_func(data))),
+                           types.float64, types.Array(types.float64, 3, "C"))
+
+
+def _held_type(data, types_of):
+    """The numba type of a record's held function whose :class:`HeldFunction` takes
+    ``types_of`` (``data``: the record without its function fields)."""
+    result, arguments = types_of(data)
+    return types.FunctionType(result(types.CPointer(typeof(data)), *arguments))
+
+
 def _image_term_types(data):
     """The numba types of :func:`_complementary_stress`'s result and arguments after the
-    record: the point, its layer, the source, :func:`source_state`'s tuple,
-    :func:`workspace`'s tuple, the entry tolerance and the stress."""
+    record: those of :func:`_vertical_terms` and the held :func:`_vertical_terms`."""
+    return types.none, _vertical_term_types(data)[1] + (_held_type(data, _vertical_term_types),)
+
+
+def _point_stress_types(data):
+    """The numba types of :func:`.stress_terms3d._stress_traced`'s result and arguments
+    after the record: the point, its layer, the source, :func:`source_state`'s tuple,
+    :func:`workspace`'s tuple, the held image terms (``image_terms``) and the stress."""
     return types.none, (types.Array(types.float64, 1, "C"), types.int64, types.int64, types.CPointer(_state_type()),
-                        types.CPointer(typeof(workspace.py_func(data))), types.float64,
-                        types.Array(types.float64, 3, "C"))
+                        types.CPointer(typeof(workspace.py_func(data))), _held_type(data, _image_term_types),
+                        _held_type(data, _vertical_term_types), types.Array(types.float64, 3, "C"))
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)  # compiled callers only
 def workspace(data):
     """Scratch: local stress (3, 3, 3), image stress (3, 3, 3), gradient (3, 3, 3, 3), the
     Kelvin scratch (2, 3, 3, 1), the :func:`Workspace` of order 1 and of the largest order
@@ -214,7 +254,7 @@ def workspace(data):
     nothing (:func:`_untraced_state`: made once a block, not once a source)."""
     n_layers = data.shear_modulus.shape[0]
     room = np.zeros((n_layers, 2), dtype=np.int64)
-    n_orders = 1
+    n_orders = np.int64(1)  # not a literal: one specialization of vertical_workspace
     if data.interfaces.shape[0] > 0:
         for layer in range(n_layers):
             if data.shear_modulus[layer] > 0.0:
@@ -236,7 +276,7 @@ def _untraced_state(gauss_points):
             _traced_buffer(np.int64(3), one, one), np.zeros(max(3, POINT_SETUP)))
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)  # compiled callers only
 def source_state(data, j, work):
     """What the receivers of source ``j`` share: room for the image triples at the points
     of the cached rules, traced when a receiver first needs a rule, and whether they are
@@ -246,7 +286,7 @@ def source_state(data, j, work):
     (``closed_form``) or by Okada's point source (``point_form``) traces nothing: its state
     is the workspace's (:func:`_untraced_state`). :func:`_source_state` through
     ``data.source_tracer`` (:func:`with_image_terms`)."""
-    return data.source_tracer(address_of(without_functions(data)), np.int64(j), address_of(work))
+    return data.source_tracer(held_record(data), np.int64(j), address_of(work))
 
 
 @njit(cache=True, no_cpython_wrapper=True)  # held: called through its C wrapper only
@@ -303,36 +343,29 @@ def element_traction(data, i, j, state, work, block):
         okada3d.okada_traction(point, normal, center, data.okada[j], data.okada_half[j, 0], data.okada_half[j, 1],
                                data.surface, g[ls], nu[ls], False, True, okada_work, corners, block)
     elif data.point_form[j]:
-        point_form_terms(data, point, data.layer[i], j, state[4], work, data.entry_tol * data.entry_scale, normal,
-                         block, True)
+        point_form_terms(data, point, data.layer[i], j, state[4], work[7], okada_work,
+                         data.entry_tol * data.entry_scale, normal, block, True)
     elif data.interfaces.shape[0] > 0:
         lr = data.layer[i]
         if data.surface_form[j] and lr == ls:
             okada3d.okada_traction(point, normal, center, data.okada[j], data.okada_half[j, 0], data.okada_half[j, 1],
                                    data.surface, g[ls], nu[ls], False, True, okada_work, corners, block)
-        _image_terms(data, point, lr, j, state, work, data.entry_tol * data.entry_scale, image)
+        # the held image terms (with_image_terms), the point copied to the workspace (any
+        # layout): called here, not through an inlined helper taking the record, the state
+        # and the workspace (numba takes and drops a reference to each of their arrays per
+        # inlined function they are passed to: code that LLVM optimises in every caller)
+        here = work[12]
+        for k in range(3):
+            here[k] = point[k]
+        data.image_terms(held_record(data), here, np.int64(lr), np.int64(j), address_of(state), address_of(work),
+                         np.float64(data.entry_tol * data.entry_scale), image, data.vertical_terms)
         for p in range(3):
             for q in range(3):
                 block[p, q] += image[q, p, 0] * normal[0] + image[q, p, 1] * normal[1] + image[q, p, 2] * normal[2]
 
 
-@njit(cache=True, inline="always")
-def _image_terms(data, point, lr, j, state, work, entry_tol, image):
-    """:func:`_complementary_stress` through ``data.image_terms`` (:func:`with_image_terms`),
-    the arguments in the held signature's types: the point copied to the workspace (any
-    layout), the layer and the source as int64, ``entry_tol`` as float64."""
-    if data.point_form[j]:
-        point_form_terms(data, point, lr, j, state[4], work, entry_tol, point, image, False)
-        return
-    here = work[12]
-    for k in range(3):
-        here[k] = point[k]
-    data.image_terms(address_of(without_functions(data)), here, np.int64(lr), np.int64(j), address_of(state),
-                     address_of(work), np.float64(entry_tol), image)
-
-
 @njit(cache=True, no_cpython_wrapper=True)  # held: called through its C wrapper only
-def _complementary_stress(data_at, point, lr, j, state_at, work_at, entry_tol, image):
+def _complementary_stress(data_at, point, lr, j, state_at, work_at, entry_tol, image, vertical_terms):
     """``image[q, i, k]``: the complementary (image) stress at ``point`` (in layer ``lr``)
     of a unit global DD ``q`` of rectangle ``j`` (interfaces present, not ``closed_form``),
     what :func:`element_traction` and :func:`element_stress_traced` share: the quadrature
@@ -346,12 +379,12 @@ def _complementary_stress(data_at, point, lr, j, state_at, work_at, entry_tol, i
     it. A ``vertical_form`` source (a vertical rectangle, interfaces between solids) takes
     its triples in closed form (:func:`.vertical3d.vertical_image_stress`) where the
     quadrature would need sub-squares or :data:`VERTICAL_FROM` points per side, the
-    quadrature elsewhere. The record, the state and the workspace come as pointers
+    quadrature elsewhere (``vertical_terms``: the record's held :func:`_vertical_terms`). The
+    record, the state and the workspace come as pointers
     (:func:`hmatddm.kernels.held_function.address_of`)."""
     data, state, work = dereference(data_at), dereference(state_at), dereference(work_at)
     traced, is_traced, near_only, three, heights = state
-    local, gradient, kelvin, ws1, ws, rules, vwork, uniform = work[0], work[2], work[3], work[4], work[5], work[7], \
-        work[10], work[11]
+    local, gradient, kelvin, ws1, ws, rules, uniform = work[0], work[2], work[3], work[4], work[5], work[7], work[11]
     xi, eta, wt, start = rules
     g = data.shear_modulus
     nu = data.poisson_ratio
@@ -380,11 +413,9 @@ def _complementary_stress(data_at, point, lr, j, state_at, work_at, entry_tol, i
         closed = False
         if data.vertical_form[j] and (n_sub > 1 or n_gauss >= VERTICAL_FROM):
             # next to the images: every triple traced at three heights, in closed form
-            closed = vertical_image_stress(point, lr, center, data.okada[j, 0], data.okada_half[j, 0],
-                                           data.okada_half[j, 1], heights, three, g, nu, ls, data.far_tol,
-                                           entry_tol, vwork, image)
+            closed = vertical_terms(data_at, point, lr, j, state_at, work_at, entry_tol, image)
             if closed and lr != ls:  # minus the whole space of the source's material
-                rectangle3d.stress_pair(point, center, frame, a, b, g[ls], nu[ls], 0.0, uniform, local)
+                rectangle3d.stress_pair(point, center, frame, a, b, g[ls], nu[ls], 0.0, uniform, local, 0.0)
                 for q in range(3):
                     for p in range(3):
                         for kk in range(3):
@@ -428,59 +459,38 @@ def _complementary_stress(data_at, point, lr, j, state_at, work_at, entry_tol, i
                                    xi[lo:hi], eta[lo:hi], wt[lo:hi], image)
 
 
-@njit(cache=True)
-def element_stress_traced(data, point, point_layer, j, state, work, out):
-    """``out[q, i, k]``: stress at ``point`` (in ``point_layer``; zero in a void layer)
-    for a unit global DD ``q`` of rectangle ``j``, closed form plus images, with the
-    source's ``state`` (:func:`source_state`: its triples traced once for every point;
-    the sum over points of :mod:`.stress3d`). A point within ``near_fraction`` smaller half
-    sides of an edge counts as on it. The images as :func:`element_traction`'s
-    (:func:`_complementary_stress`) with the relative Gauss rule (no ``entry_tol``: a point's
-    stress has no largest entry to be small against) and no table unless ``data`` has one;
-    a ``closed_form`` source: the image and surface terms of :func:`.okada3d.okada_stress`;
-    a ``surface_form`` source: its reflection in the free surface in closed form, for points
-    of its layer."""
-    local, image = work[0], work[1]
-    if zero_in_void(data.shear_modulus, point_layer, out):
-        return
-    g = data.shear_modulus
-    nu = data.poisson_ratio
-    ls = data.layer[j]
-    center = data.centers[j]
-    frame = data.frames[j]
-    a = data.half_a[j]
-    b = data.half_b[j]
-    rectangle3d.stress_pair(point, center, frame, a, b, g[ls], nu[ls], data.singular_shift, out, local,
-                            data.near_fraction * min(a, b))
-    if data.closed_form[j]:
-        okada3d.okada_stress(point, center, data.okada[j], data.okada_half[j, 0], data.okada_half[j, 1], data.surface,
-                             g[ls], nu[ls], False, True, work[8], work[9], image)
-        for q in range(3):
-            for i in range(3):
-                for k in range(3):
-                    out[q, i, k] += image[q, i, k]
-    elif data.interfaces.shape[0] > 0:
-        _image_terms(data, point, point_layer, j, state, work, 0.0, image)
-        for q in range(3):
-            for i in range(3):
-                for k in range(3):
-                    out[q, i, k] += image[q, i, k]
-        if data.surface_form[j] and point_layer == ls:
-            okada3d.okada_stress(point, center, data.okada[j], data.okada_half[j, 0], data.okada_half[j, 1],
-                                 data.surface, g[ls], nu[ls], False, True, work[8], work[9], image)
-            for q in range(3):
-                for i in range(3):
-                    for k in range(3):
-                        out[q, i, k] += image[q, i, k]
+@njit(cache=True, no_cpython_wrapper=True)  # held: called through its C wrapper only
+def _vertical_terms(data_at, point, lr, j, state_at, work_at, entry_tol, image):
+    """:func:`.vertical3d.vertical_image_stress` of the ``vertical_form`` source ``j`` at
+    ``point`` (layer ``lr``), its triples traced at three heights in the source's state
+    (held by the record, ``vertical_terms``, and called by :func:`_complementary_stress`:
+    the closed forms compiled once, not again in the image terms' library). The record, the
+    state and the workspace as pointers."""
+    data, state, work = dereference(data_at), dereference(state_at), dereference(work_at)
+    return _vertical_stress(point, lr, data.centers[j], data.okada[j, 0], data.okada_half[j, 0], data.okada_half[j, 1],
+                            state[4], state[3], data.shear_modulus, data.poisson_ratio, data.layer[j], data.far_tol,
+                            entry_tol, work[10], image)
 
 
 @njit(cache=True)
 def element_stress(data, point, point_layer, j, work, out):
     """:func:`element_stress_traced` for one point (the registered per-pair function of
     :func:`hmatddm.kernels.drivers.stress_block`, which has no source state: the source's
-    triples are traced for this point alone; :mod:`.stress3d` traces them once per source)."""
-    element_stress_traced(data, point, point_layer, j, source_state(data, j, work), work, out)
+    triples are traced for this point alone; :mod:`.stress3d` traces them once per source).
+    The state is held to the end: the inlined :func:`element_stress_traced` passes it by
+    pointer, and numba would release a temporary after its last use, before the call."""
+    owner = data.source_tracer(held_record(data), np.int64(j), address_of(work))
+    element_stress_traced(data, point, point_layer, j, owner, work, out)
+    _hold(owner)
 
 
-register_kind(LayeredRectangles, KernelKind(workspace, source_state, element_traction, element_stress,
+@njit(cache=True)
+def _kind_workspace(data):
+    """:func:`workspace` called, not inlined: the registered workspace of the drivers, which
+    inline it into each driver (and compile it on their own first); once a block, the call
+    costs nothing, and the workspace's code is compiled once for every driver."""
+    return workspace(data)
+
+
+register_kind(LayeredRectangles, KernelKind(_kind_workspace, source_state, element_traction, element_stress,
                                             rectangle3d.edge_distance))

@@ -398,19 +398,22 @@ def point_image_traction(point, normal, center, frame, a, b, okada, surface, she
 
 
 @njit(cache=True, inline="always")
-def point_form_terms(data, point, lr, j, setup, work, entry_tol, normal, out, traction):
+def point_form_terms(data, point, lr, j, setup, rules, okada_work, entry_tol, normal, out, traction):
     """A ``point_form`` source ``j`` of the kernel record ``data``
     (:class:`.images3d.LayeredRectangles`; a half-space, no horizontal side): its image and
     surface terms at ``point`` (in layer ``lr``) by Okada's point source at the points of
     :func:`point_rule`; ``traction``: ``out[p, q] +=`` the traction on ``normal``
     (:func:`point_image_traction`), else ``out[q, i, k] =`` the stress
     (:func:`point_image_stress`); ``setup``: the source's :func:`point_setup` (in its
-    :func:`.images3d.source_state`); ``work``: :func:`.images3d.workspace`. Inlined into the callers (no
-    record passed across a call, not held). On issue 32's lattice (2 x 2 points for 95% of
+    :func:`.images3d.source_state`); ``rules``, ``okada_work``: the cached rules and Okada's
+    scratch of :func:`.images3d.workspace` (not the whole workspace: numba takes and drops a
+    reference to each of its arrays for each inlined function it is passed to, code that
+    LLVM optimises in every caller, benchmarks/RESULTS.md, issue 32). Inlined into the
+    callers (no record passed across a call, not held). On issue 32's lattice (2 x 2 points for 95% of
     the pairs) a whole entry, real source included, costs 0.31-0.32 us, 2.8-2.9x a
     uniform-rock entry (Intel Xeon, dgemm 73-80 GFLOP/s, one thread; benchmarks/RESULTS.md,
     issue 32)."""
-    xi, eta, wt, start = work[7]
+    xi, eta, wt, start = rules
     ls = data.layer[j]
     center = data.centers[j]
     frame = data.frames[j]
@@ -421,7 +424,7 @@ def point_form_terms(data, point, lr, j, setup, work, entry_tol, normal, out, tr
         # gives there
         dmin = distance_to_rectangle(point[0], point[1], 2.0 * data.interfaces[0] - point[2], center, frame, a, b)
     else:
-        dmin = nearest_singularity(point, lr, center, frame, a, b, ls, data.interfaces, -1)
+        dmin = nearest_singularity(point, lr, center, frame, a, b, ls, data.interfaces, np.int64(-1))
     n_gauss, n_sub = point_rule(dmin, a, b, data.max_subdivisions, data.far_tol, entry_tol)
     if n_sub == 1 and n_gauss <= data.gauss_points:
         lo, hi = start[n_gauss - 1], start[n_gauss]
@@ -430,7 +433,7 @@ def point_form_terms(data, point, lr, j, setup, work, entry_tol, normal, out, tr
         xs, es, ws = square_rule(n_gauss, n_sub)
     g = data.shear_modulus[ls]
     if traction:
-        setup_image_traction(point, normal, center, a, b, setup, data.okada[j], data.surface, g, xs, es, ws, work[8],
-                             out)
+        setup_image_traction(point, normal, center, a, b, setup, data.okada[j], data.surface, g, xs, es, ws,
+                             okada_work, out)
     else:
-        setup_image_stress(point, center, a, b, setup, data.okada[j], data.surface, g, xs, es, ws, work[8], out)
+        setup_image_stress(point, center, a, b, setup, data.okada[j], data.surface, g, xs, es, ws, okada_work, out)

@@ -301,6 +301,8 @@ def _stress_at(table, f, da, db, dc, scale, s, delta, shear_modulus, lame, out, 
     d33 = w * table[f, 1, da, db, dc + 2]
     for i in range(3):
         for k in range(i, 3):
+            # conditional expressions (sums of comparisons compile faster, but LLVM then
+            # associates the FAST sums differently: not the same round-off, RESULTS.md)
             a = da + (1 if i == 0 else 0) + (1 if k == 0 else 0)
             b = db + (1 if i == 1 else 0) + (1 if k == 1 else 0)
             c = dc + (1 if i == 2 else 0) + (1 if k == 2 else 0)
@@ -334,10 +336,30 @@ def _pair_stress_gradient(r1, r2, r3, eps, sigma, coef, dcoef, delta, shear_modu
     ``(i, k)`` at the receiver ``r`` (relative to the triple's point) of a unit force
     along ``f``; ``delta``, moduli: the receiver layer's; ``eps = dz/dt``. Horizontal
     source derivatives are minus receiver derivatives; the vertical one differentiates
-    the coefficients (``dcoef``), the triple's height ``z`` and ``s = y3 - z``."""
-    _pair_tables(r1, r2, r3, sigma, coef, dcoef, 3, work)
-    table = work[4]
-    dtable = work[5]
+    the coefficients (``dcoef``), the triple's height ``z`` and ``s = y3 - z``. The bodies of
+    :func:`_pair_tables` and :func:`gauge_table` written here, not inlined: numba's inlining
+    copies each block of the inlined function with its whole scope, and those hold everything
+    they inline (about 5 s of this function's cold compile, more in a process that has
+    compiled much already: the copies' garbage collection, benchmarks/RESULTS.md, issue 32)."""
+    sf, sl, ser, h, table, dtable, pad = work
+    order = 3
+    used = orders_used(coef, dcoef)
+    n_c = order + used + 1
+    top = max(n_c - 2, 4)  # as in _pair_tables
+    # gauge_table's body (the same reason)
+    inv = inverse_distance_recurrence(r1, r2, r3, pad, 6, n_c - 1, top)
+    scaled_inverse_distance(pad, inv, h, 2, -1.0, 6, n_c - 1, top)
+    _axis_derivatives(r1, r2, sigma * r3, sf, sl, ser)
+    for b in range(2, 6):
+        for a in range(6 - b):
+            sf[a, b] = -sf[a + 2, b - 2] - h[a, b - 2, 2]
+            sl[a, b] = -sl[a + 2, b - 2] + sigma * h[a, b - 2, 3]
+    for a in range(6):
+        for b in range(6 - a):
+            h[a, b, 0] = sf[a, b]
+            h[a, b, 1] = -sigma * sl[a, b]
+    for d in range(2):
+        _potential_table(dcoef if d else coef, h, sigma, order - d, used, dtable if d else table)
     for f in range(3):
         # literal shifts, four inlined copies (LLVM folds the shifts): 10% of a triple's CPU
         # against one copy in a loop over the four, for 3 s more compile

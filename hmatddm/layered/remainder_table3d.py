@@ -148,7 +148,7 @@ def is_far(z, eps, t, source_layer, layer, bottoms, tops):
 def keep_near(n, pair_layer, pair_z, pair_eps, pair_sigma, pair_coef, pair_dcoef, t, source_layer, bottoms, tops):
     """Drop the far triples (:func:`is_far`) of a traced source point at height ``t``, in
     place; returns the number kept."""
-    kept = 0
+    kept = np.int64(0)  # not a literal: one specialization of copy_triple
     for k in range(n):
         if is_far(pair_z[k], pair_eps[k], t, source_layer, pair_layer[k], bottoms, tops):
             continue

@@ -5,8 +5,11 @@ natural fractures, the microseismic forward model and the monitors in layered ro
 Sources outside, points inside (:func:`stress_points`): each source's image triples are
 traced once for all the points (:func:`.images3d.source_state`: the points of its Gauss
 rules, and for a vertical rectangle its three heights), and each point-source pair takes
-the per-pair image terms of the operator (:func:`.images3d.element_stress_traced`: the
-closed forms of :mod:`.okada3d` and :mod:`.vertical3d`, the quadrature elsewhere). The
+the per-pair image terms of the operator (:func:`.stress_terms3d.element_stress_traced`:
+the closed forms of :mod:`.okada3d` and :mod:`.vertical3d`, the quadrature elsewhere),
+called through the record's held functions (``source_tracer``, ``point_stress``) with the
+record, the workspace and the source's state as pointers made once (issue 32: compiled
+once, not again here; no per-pair copies of them). The
 generic driver :func:`hmatddm.kernels.drivers.stress_block` loops over points outside and
 has no source state, so it traces every source's triples again at every point (issue 32,
 a free surface over two interfaces, ``images=4``: 857 us a pair against 643 us with sources
@@ -16,7 +19,8 @@ import numpy as np
 from numba import njit
 
 from ..kernels.drivers import _hold, _in_parts, borrowed
-from .images3d import element_stress_traced, source_state, workspace
+from ..kernels.held_function import address_of, held_record
+from .images3d import workspace
 
 __all__ = ["stress_points", "stress_sum", "stress_columns_points", "stress_columns"]
 
@@ -32,11 +36,16 @@ def stress_points(data, points, point_layer, dd, out):
         for i in range(3):
             for k in range(3):
                 out[m, i, k] = 0.0
+    # the record and the workspace on the stack once, for every call of the held per-pair
+    # stress (.stress_terms3d): live while ``data`` and ``work`` are (``_hold`` below)
+    data_at, work_at = held_record(data), address_of(work)
     for j in range(data.centers.shape[0]):
-        owner = source_state(data, j, work)
+        owner = data.source_tracer(data_at, np.int64(j), work_at)  # source_state through the pointers
         state = borrowed(owner)  # no reference counts per point (kernels.drivers.traction_block)
+        state_at = address_of(state)
         for m in range(points.shape[0]):
-            element_stress_traced(data, points[m], point_layer[m], j, state, work, pair)
+            data.point_stress(data_at, points[m], point_layer[m], np.int64(j), state_at, work_at, data.image_terms,
+                              data.vertical_terms, pair)
             for i in range(3):
                 for k in range(3):
                     acc = 0.0
@@ -44,6 +53,7 @@ def stress_points(data, points, point_layer, dd, out):
                         acc += pair[q, i, k] * dd[j, q]
                     out[m, i, k] += acc
         _hold(owner)
+    _hold(work)
 
 
 def stress_sum(data, points, dd, point_layer):
@@ -70,13 +80,17 @@ def stress_columns_points(data, points, point_layer, out):
     additions)."""
     work = workspace(data)
     pair = np.empty((3, 3, 3))
+    data_at, work_at = held_record(data), address_of(work)  # as in stress_points
     for j in range(data.centers.shape[0]):
-        owner = source_state(data, j, work)
+        owner = data.source_tracer(data_at, np.int64(j), work_at)  # as in stress_points
         state = borrowed(owner)
+        state_at = address_of(state)
         for m in range(points.shape[0]):
-            element_stress_traced(data, points[m], point_layer[m], j, state, work, pair)
+            data.point_stress(data_at, points[m], point_layer[m], np.int64(j), state_at, work_at, data.image_terms,
+                              data.vertical_terms, pair)
             out[m, j] = pair
         _hold(owner)
+    _hold(work)
 
 
 def stress_columns(data, points, point_layer):

@@ -290,6 +290,16 @@ def vertical_image_stress(y, receiver_layer, center, strike, hs, hd, heights, tr
     :func:`entry_order` when ``triple_tol > 0`` (the error allowed per unit largest shear
     modulus). Returns False, adding nothing, where the triples differ between the heights
     or a table does not reach."""
+    return _vertical_stress(y, receiver_layer, center, strike, hs, hd, heights, traced, shear_modulus, poisson_ratio,
+                            source_layer, far_tol, triple_tol, work, out)
+
+
+@njit(cache=True, inline="always")
+def _vertical_stress(y, receiver_layer, center, strike, hs, hd, heights, traced, shear_modulus, poisson_ratio,
+                     source_layer, far_tol, triple_tol, work, out):
+    """:func:`vertical_image_stress`, inlined into it and into the record's held
+    :func:`.images3d._vertical_terms` (the closed forms compiled once for every caller of
+    the image terms, not again in each: benchmarks/RESULTS.md, issue 32)."""
     edge, tables, gradient, with_s, without, local, yr, far_work, coef_t, dcoef_t = work
     sj_bot, sj_top, integrated = tables
     n_pairs, layer, z, eps, sigma, coef, dcoef = traced
@@ -348,9 +358,9 @@ def vertical_image_stress(y, receiver_layer, center, strike, hs, hd, heights, tr
             along = max(abs(yr[0]) - hs, 0.0)
             up = max(z_lo - yr[2], yr[2] - z_hi, 0.0)
             distance = math.sqrt(along * along + yr[1] * yr[1] + up * up)
-            n_gauss = far_order(distance / max(hs, hd), CLOSED_FROM, far_tol)
+            n_gauss = far_order(distance / max(hs, hd), np.int64(CLOSED_FROM), far_tol)
             if triple_tol > 0.0:
-                n_gauss = min(n_gauss, entry_order(distance, hs, hd, CLOSED_FROM, triple_tol))
+                n_gauss = min(n_gauss, entry_order(distance, hs, hd, np.int64(CLOSED_FROM), triple_tol))
             if n_gauss < CLOSED_FROM:
                 _far_triple(yr, hs, hd, t_mid, z0, e, sg, polys, dpolys, n_gauss, delta_r, g_r, lame_r, coef_t,
                             dcoef_t, far_work, gradient)
