@@ -70,6 +70,17 @@ def _strip_functions(record):
     return types.NamedTuple(fields, record.instance_class)
 
 
+def _stripped_value(context, builder, record, stripped, value):
+    """The code of ``value`` (a ``record``) as its ``stripped`` type: the function fields
+    None, the arrays borrowed."""
+    out = cgutils.get_null_value(context.get_value_type(stripped))
+    for k, kind in enumerate(record.types):
+        if not isinstance(kind, types.FunctionType):
+            item = _without_reference_count(context, builder, kind, builder.extract_value(value, k))
+            out = builder.insert_value(out, item, k)
+    return out
+
+
 @intrinsic
 def without_functions(typingctx, record):
     """``record`` (a kernel record) with its first-class function fields (:class:`HeldFunction`)
@@ -79,12 +90,7 @@ def without_functions(typingctx, record):
     stripped = _strip_functions(record)
 
     def codegen(context, builder, signature, args):
-        value = cgutils.get_null_value(context.get_value_type(stripped))
-        for k, kind in enumerate(record.types):
-            if not isinstance(kind, types.FunctionType):
-                item = _without_reference_count(context, builder, kind, builder.extract_value(args[0], k))
-                value = builder.insert_value(value, item, k)
-        return value
+        return _stripped_value(context, builder, record, stripped, args[0])
 
     return stripped(record), codegen
 
@@ -113,11 +119,7 @@ def held_record(typingctx, record):
     stripped = _strip_functions(record)
 
     def codegen(context, builder, signature, args):
-        value = cgutils.get_null_value(context.get_value_type(stripped))
-        for k, kind in enumerate(record.types):
-            if not isinstance(kind, types.FunctionType):
-                item = _without_reference_count(context, builder, kind, builder.extract_value(args[0], k))
-                value = builder.insert_value(value, item, k)
+        value = _stripped_value(context, builder, record, stripped, args[0])
         model = context.data_model_manager[stripped]
         slot = cgutils.alloca_once(builder, model.get_data_type())
         builder.store(model.as_data(builder, value), slot)
