@@ -12,7 +12,7 @@ from . import images3d, okada3d, okada_point3d, remainder_build3d, remainder_tab
 from .image_tracer3d import trace_points
 from .influence2d import choose_images as _choose_images
 from .influence2d import layers_of_extents, with_images
-from .rectangle_quadrature import ENTRY_TOL, entry_scale
+from .rectangle_quadrature import ENTRY_TOL, NEAR_GAUSS_POINTS, entry_scale
 
 #: Largest number of sub-squares per side of a rectangle for the image quadrature.
 MAX_SUBDIVISIONS = 16
@@ -54,7 +54,10 @@ def influence_data(mesh, medium, singular_shift, alpha, near_fraction, n_images,
     closed form (``surface_form``) and their other triples by quadrature. Vertical
     rectangles in a medium with interfaces (not a half-space, not ``"quadrature"``, at least
     one image) take their near triples in closed form next to them (``vertical_form``,
-    :mod:`.vertical3d`). ``with_table=False``: never a table (the stress at points,
+    :mod:`.vertical3d`). The quadrature takes at least :data:`.rectangle_quadrature.NEAR_GAUSS_POINTS`
+    per side next to the images (the medium's ``gauss_points`` when larger), and on one square
+    the points :func:`.rectangle_quadrature.entry_order` needs for :data:`ENTRY_TOL` of the
+    largest entry. ``with_table=False``: never a table (the stress at points,
     :func:`stress_at`, takes every triple itself)."""
     layers = element_layers(mesh, medium)
     interfaces, g, nu = medium.arrays()
@@ -77,7 +80,7 @@ def influence_data(mesh, medium, singular_shift, alpha, near_fraction, n_images,
         okada[point] = rows[point]
     return with_self_max(images3d.with_image_terms(images3d.LayeredRectangles(
         mesh.centers, mesh.frames, mesh.half_a, mesh.half_b, layers, interfaces, g, nu, n_images=int(n_images),
-        gauss_points=int(medium.gauss_points), max_subdivisions=int(MAX_SUBDIVISIONS),
+        gauss_points=max(int(medium.gauss_points), NEAR_GAUSS_POINTS), max_subdivisions=int(MAX_SUBDIVISIONS),
         singular_shift=float(singular_shift), near_fraction=float(near_fraction), alpha=float(alpha),
         self_max=np.zeros(mesh.n_elements), entry_tol=float(ENTRY_TOL), entry_scale=float(scale), table=table,
         closed_form=closed, okada=okada, okada_half=half,

@@ -51,7 +51,10 @@ class LayeredMedium:
     image_tol : float in (0, 1)
     gauss_points : int in [1, 32]
         Gauss points per sub-segment for the regular image terms (ref. Eqs 3.12-3.13);
-        sub-segments are added where an image lies close to the receiver.
+        sub-segments are added where an image lies close to the receiver. 3D rectangles
+        take at least :data:`~hmatddm.layered.rectangle_quadrature.NEAR_GAUSS_POINTS` (5)
+        per side next to the images, what their entries' 1e-8 needs, and fewer where the
+        entry's error bound allows (:func:`~hmatddm.layered.rectangle_quadrature.entry_order`).
     method : "table" or "quadrature"
         3D constant rectangles: ``"table"`` (default) integrates the near image triples by
         quadrature and takes the far ones (the layered remainder, which exists with two or

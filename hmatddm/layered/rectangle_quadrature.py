@@ -125,25 +125,46 @@ ENTRY_TOL = 1e-9
 #: point is ``d`` away, in units of ``G_max 4 a b / d^3`` (``G_max``: the stiffest
 #: layer): measured up to 1.9 (half-space), 0.5 (three layers, 2G middle layer), 1.3 (5G
 #: middle layer), 0.9 (a 5:1 bi-material) on randomly oriented squares at 2 to 100 half
-#: sides; five times the largest.
+#: sides; five times the largest. The point form's rule (:mod:`.okada_point3d`) uses it.
 IMAGE_BOUND = 10.0
+#: ``K_n`` of :func:`entry_order`'s bound ``K_n ratio^(-2n) G_max 4 a b / d^3`` of the error
+#: of ``n x n`` Gauss points on one square (``n`` = 1, 2, ...; the last for every larger
+#: ``n``): four times the largest error measured (7.4, 5.4, 3.5, 2.3, 1.3 for ``n`` = 1-5)
+#: on 2,700 randomly oriented rectangles (aspect 1 to 2) at 4 to 100 half sides from their
+#: singular point, in a half-space, 2:1, 1:5 and 5:1 bi-materials (reflected and
+#: transmitted fields) and three layers (G, 2G, G and G, 5G, G; four images), against 14
+#: points on 2 x 2 sub-squares (benchmarks/RESULTS.md, issue 32, twelfth session).
+ENTRY_BOUND = (30.0, 22.0, 14.0, 10.0, 6.0, 5.0)
+#: Gauss points per side on a (sub-)square next to the images when an entry tolerance is
+#: set (``entry_tol > 0``; the medium's ``gauss_points`` when larger): 4 left up to 8e-8 of
+#: the largest entry next to an interface (a 5:1 bi-material), 5 leaves at most 2e-9 and 6
+#: 2e-11 at 1.5-2x the CPU of 5 next to the interfaces (benchmarks/RESULTS.md, issue 32,
+#: twelfth session): 5 keeps the 1e-8 that issue 32 asks for.
+NEAR_GAUSS_POINTS = 5
 
 
 @njit(cache=True)
 def entry_order(dmin, a, b, n_max, tol):
-    """Gauss points per side (at most ``n_max``) so that the error of the image stress,
-    bounded by :func:`far_order`'s ``40 n ratio^(-2n)`` times its size
-    (:data:`IMAGE_BOUND` ``4 a b / dmin^3``, per unit ``G_max``), is at most ``tol``:
-    the error allowed relative to the largest entry times that entry over ``G_max``
-    (what :func:`_image_order` passes). An entry far from the images is small against
-    the largest one, so it needs fewer points than :func:`far_order`'s relative
-    criterion gives: one point from ~34 half sides at the default
-    :data:`ENTRY_TOL`, where the relative rule asks for four up to 10.6 and three up
-    to 22 half sides."""
+    """Gauss points per side (at most ``n_max``) of one square so that the error of its image
+    stress, bounded by ``K_n ratio^(-2n)`` (:data:`ENTRY_BOUND`) times its size ``4 a b /
+    dmin^3`` (per unit ``G_max``; ``ratio = dmin / max(a, b)``), is at most ``tol``: the
+    error allowed relative to the largest entry times that entry over ``G_max`` (what
+    :func:`_image_order` passes). The bound is the measured error's, with a margin of four:
+    an entry far from the images is small against the largest one: for 0.5 m squares in one
+    material at the default :data:`ENTRY_TOL`, 5 points from 6.5 half sides, 4 from 9.6, 3
+    from 16.5, 2 from 41 and one from ~180."""
     if tol <= 0.0 or dmin <= 0.0:
         return n_max
     ratio = dmin / max(a, b)
-    return _bounded_order(ratio, IMAGE_BOUND * 4.0 * a * b / (dmin * dmin * dmin), n_max, tol)
+    size = 4.0 * a * b / (dmin * dmin * dmin)
+    step = 1.0 / (ratio * ratio)
+    power = step
+    last = len(ENTRY_BOUND) - 1
+    for n in range(1, n_max):
+        if ENTRY_BOUND[min(n - 1, last)] * power * size <= tol:
+            return n
+        power *= step
+    return n_max
 
 
 @njit(cache=True)
@@ -225,9 +246,9 @@ def image_rectangle_stress_without(y, receiver_layer, center, frame, a, b, sourc
 def _image_order(y, receiver_layer, center, frame, a, b, source_layer, interfaces, gauss_points, max_sub, far_tol,
                  entry_tol, skip):
     """``(n_gauss, n_sub)`` of the image quadrature of a rectangle at ``y``: sub-squares
-    by :func:`subdivisions` rounded up to a power of two, and, on one square,
-    :func:`far_order` points per side, or fewer by :func:`entry_order` when
-    ``entry_tol > 0`` (the error allowed relative to the largest entry, over ``G_max``);
+    by :func:`subdivisions` rounded up to a power of two, ``gauss_points`` on each, and, on
+    one square, :func:`one_square_order`: :func:`entry_order` when ``entry_tol > 0`` (the
+    error allowed relative to the largest entry, over ``G_max``), else :func:`far_order`;
     ``skip``: an interface whose mirror is no singular point of the triples integrated
     (:func:`nearest_singularity`; -1: none)."""
     dmin = nearest_singularity(y, receiver_layer, center, frame, a, b, source_layer, interfaces, skip)
@@ -240,12 +261,14 @@ def _image_order(y, receiver_layer, center, frame, a, b, source_layer, interface
 @njit(cache=True)
 def one_square_order(dmin, a, b, gauss_points, far_tol, entry_tol):
     """Gauss points per side on one square (no sub-squares) whose nearest singular point is
-    ``dmin`` away: :func:`far_order`, or fewer by :func:`entry_order` when ``entry_tol > 0``
-    (a receiver's rule, a group of its triples', the tabulated remainder's)."""
-    n = far_order(dmin / max(a, b), gauss_points, far_tol)
+    ``dmin`` away (a receiver's rule, a group of its triples', the tabulated remainder's):
+    :func:`entry_order` when ``entry_tol > 0`` (issue 32's criterion, the error against the
+    largest entry), else :func:`far_order` (the relative rule, the cross-check's). Up to
+    issue 32's eleventh session the smaller of the two: the relative rule then took fewer
+    points than the entries needed next to the images (up to 8e-8 of the largest entry)."""
     if entry_tol > 0.0:
-        n = min(n, entry_order(dmin, a, b, gauss_points, entry_tol))
-    return n
+        return entry_order(dmin, a, b, gauss_points, entry_tol)
+    return far_order(dmin / max(a, b), gauss_points, far_tol)
 
 
 @njit(cache=True)
