@@ -25,7 +25,7 @@ from numba import types
 from numba.core import cgutils
 from numba.core.types import WrapperAddressProtocol
 from numba.experimental.function_type import _get_wrapper_address
-from numba.extending import intrinsic
+from numba.extending import intrinsic, typeof_impl
 from numba.np.arrayobj import make_array, populate_array
 
 from .drivers import _without_reference_count
@@ -47,6 +47,8 @@ class HeldFunction(WrapperAddressProtocol):
         self.record = record
         self.types_of = types_of
         self._signature = None
+        self._type = None
+        self._address = None
 
     def signature(self):
         if self._signature is None:
@@ -54,15 +56,32 @@ class HeldFunction(WrapperAddressProtocol):
             self._signature = result(types.CPointer(numba.typeof(self.record)), *arguments)
         return self._signature
 
+    def numba_type(self):
+        """``FunctionType(signature())``, made once: numba types the record's fields at
+        every call from Python, and making the type again hashes the whole record type
+        it holds (~150 us a held function a call, benchmarks/RESULTS.md, twelfth session)."""
+        if self._type is None:
+            self._type = types.FunctionType(self.signature())
+        return self._type
+
     def __wrapper_address__(self):
-        key = (self.function, self.signature())
-        address = _ADDRESSES.get(key)
-        if address is None:
-            address = _ADDRESSES[key] = _get_wrapper_address(self.function, key[1])
-        return address
+        if self._address is None:  # per instance too: the key's hash is the signature's, deep
+            key = (self.function, self.signature())
+            address = _ADDRESSES.get(key)
+            if address is None:
+                address = _ADDRESSES[key] = _get_wrapper_address(self.function, key[1])
+            self._address = address
+        return self._address
 
     def __reduce__(self):
         return HeldFunction, (self.function, self.record, self.types_of)
+
+
+@typeof_impl.register(HeldFunction)
+def _typeof_held(value, context):
+    """The held function's :meth:`HeldFunction.numba_type` (numba's own typeof of a
+    wrapper-address object makes it anew at every call)."""
+    return value.numba_type()
 
 
 def _strip_functions(record):
