@@ -85,7 +85,10 @@ from numba.core import cgutils
 from numba.extending import intrinsic, overload
 from numba.np.arrayobj import make_array
 
+from . import compile_collector
 from .correction import scale_to_self
+
+compile_collector.install()  # the collector off the old heap while numba compiles (issue 32)
 
 #: The fields every kernel record has, after its geometry and material: (name, type,
 #: description) as :func:`kernel_record` takes them.

@@ -20,11 +20,13 @@ A call whose argument types differ from the held signature does not compile (num
 check of first-class function calls): no call can reach the function with other types.
 """
 import numba
+from llvmlite import ir
 from numba import types
 from numba.core import cgutils
 from numba.core.types import WrapperAddressProtocol
 from numba.experimental.function_type import _get_wrapper_address
-from numba.extending import intrinsic
+from numba.extending import intrinsic, typeof_impl
+from numba.np.arrayobj import make_array, populate_array
 
 from .drivers import _without_reference_count
 
@@ -45,6 +47,8 @@ class HeldFunction(WrapperAddressProtocol):
         self.record = record
         self.types_of = types_of
         self._signature = None
+        self._type = None
+        self._address = None
 
     def signature(self):
         if self._signature is None:
@@ -52,15 +56,32 @@ class HeldFunction(WrapperAddressProtocol):
             self._signature = result(types.CPointer(numba.typeof(self.record)), *arguments)
         return self._signature
 
+    def numba_type(self):
+        """``FunctionType(signature())``, made once: numba types the record's fields at
+        every call from Python, and making the type again hashes the whole record type
+        it holds (~150 us a held function a call, benchmarks/RESULTS.md, twelfth session)."""
+        if self._type is None:
+            self._type = types.FunctionType(self.signature())
+        return self._type
+
     def __wrapper_address__(self):
-        key = (self.function, self.signature())
-        address = _ADDRESSES.get(key)
-        if address is None:
-            address = _ADDRESSES[key] = _get_wrapper_address(self.function, key[1])
-        return address
+        if self._address is None:  # per instance too: the key's hash is the signature's, deep
+            key = (self.function, self.signature())
+            address = _ADDRESSES.get(key)
+            if address is None:
+                address = _ADDRESSES[key] = _get_wrapper_address(self.function, key[1])
+            self._address = address
+        return self._address
 
     def __reduce__(self):
         return HeldFunction, (self.function, self.record, self.types_of)
+
+
+@typeof_impl.register(HeldFunction)
+def _typeof_held(value, context):
+    """The held function's :meth:`HeldFunction.numba_type` (numba's own typeof of a
+    wrapper-address object makes it anew at every call)."""
+    return value.numba_type()
 
 
 def _strip_functions(record):
@@ -137,4 +158,103 @@ def dereference(typingctx, pointer):
     return pointer.dtype(pointer), codegen
 
 
-__all__ = ["HeldFunction", "without_functions", "address_of", "held_record", "dereference"]
+def _array_leaves(kind, path=()):
+    """``(path, array type)`` of every array in ``kind`` (an array, or tuples of them)."""
+    if isinstance(kind, types.Array):
+        return [(path, kind)]
+    if isinstance(kind, types.BaseTuple):
+        return [leaf for k, item in enumerate(kind.types) for leaf in _array_leaves(item, path + (k,))]
+    return []
+
+
+def _stash_dtor(module):
+    """The destructor of a :func:`stash`'s buffer: releases the ``n`` meminfos stored after
+    ``n`` at its start."""
+    void_p = cgutils.voidptr_t
+    fn = cgutils.get_or_insert_function(module, ir.FunctionType(ir.VoidType(), [void_p, cgutils.intp_t, void_p]),
+                                        "_hmatddm_stash_dtor")
+    if fn.is_declaration:
+        fn.linkage = "linkonce_odr"
+        builder = ir.IRBuilder(fn.append_basic_block())
+        words = builder.bitcast(fn.args[0], cgutils.intp_t.as_pointer())
+        decref = cgutils.get_or_insert_function(module, ir.FunctionType(ir.VoidType(), [void_p]), "NRT_decref")
+        owners = builder.bitcast(builder.gep(words, [cgutils.intp_t(1)]), void_p.as_pointer())
+        with cgutils.for_range(builder, builder.load(words)) as loop:
+            builder.call(decref, [builder.load(builder.gep(owners, [loop.index]))])
+        builder.ret_void()
+    return fn
+
+
+@intrinsic
+def stash(typingctx, value):
+    """``(buffer, pointer)``: ``value`` (a tuple of arrays, nested tuples of them) stored
+    in a new uint8 array ``buffer`` with every array borrowed (no reference counts),
+    ``pointer`` (``CPointer``) to it (:func:`dereference`, :func:`item`); the buffer holds a
+    reference to each array and releases them when it is freed. A copy of ``(buffer,
+    pointer)`` takes one reference, not one per array: numba takes and drops a reference
+    on every array of an aggregate each time it copies it or passes it to an inlined
+    function, and LLVM optimised those counts of a 69-array workspace in every caller
+    (benchmarks/RESULTS.md, issue 32, twelfth session). The arrays are the same arrays,
+    not copies."""
+    leaves = _array_leaves(value)
+    buffer_type = types.Array(types.uint8, 1, "C")
+    result = types.Tuple((buffer_type, types.CPointer(value)))
+
+    def codegen(context, builder, signature, args):
+        model = context.data_model_manager[value]
+        data_type = model.get_data_type()
+        word = context.get_abi_sizeof(cgutils.intp_t)
+        header = -(-(word * (1 + len(leaves))) // 16) * 16  # n, then the n owners
+        size = header + context.get_abi_sizeof(data_type)
+        meminfo = context.nrt.meminfo_alloc_dtor(builder, cgutils.intp_t(size), _stash_dtor(builder.module))
+        data = context.nrt.meminfo_data(builder, meminfo)
+        words = builder.bitcast(data, cgutils.intp_t.as_pointer())
+        builder.store(cgutils.intp_t(len(leaves)), words)
+        owners = builder.bitcast(builder.gep(words, [cgutils.intp_t(1)]), cgutils.voidptr_t.as_pointer())
+        out = args[0]
+        for n, (path, kind) in enumerate(leaves):
+            leaf = args[0]
+            for k in path:
+                leaf = builder.extract_value(leaf, k)
+            context.nrt.incref(builder, kind, leaf)  # the buffer's reference
+            array = make_array(kind)(context, builder, value=leaf)
+            builder.store(builder.bitcast(array.meminfo, cgutils.voidptr_t), builder.gep(owners, [cgutils.intp_t(n)]))
+            array.meminfo = cgutils.get_null_value(array.meminfo.type)
+            out = _insert_at(builder, out, path, array._getvalue())
+        slot = builder.bitcast(builder.gep(data, [cgutils.intp_t(header)]), data_type.as_pointer())
+        builder.store(model.as_data(builder, out), slot)
+        buffer = make_array(buffer_type)(context, builder)
+        populate_array(buffer, data=data, shape=cgutils.pack_array(builder, [cgutils.intp_t(size)]),
+                       strides=cgutils.pack_array(builder, [cgutils.intp_t(1)]), itemsize=cgutils.intp_t(1),
+                       meminfo=meminfo)
+        return context.make_tuple(builder, result, [buffer._getvalue(), slot])
+
+    return result(value), codegen
+
+
+def _insert_at(builder, value, path, item):
+    """``value`` with ``item`` at ``path`` (nested tuple indices)."""
+    if len(path) == 1:
+        return builder.insert_value(value, item, path[0])
+    inner = _insert_at(builder, builder.extract_value(value, path[0]), path[1:], item)
+    return builder.insert_value(value, inner, path[0])
+
+
+@intrinsic
+def item(typingctx, pointer, index):
+    """``dereference(pointer)[index]`` (``index`` a constant) without loading the rest of
+    the tuple (numba would release each of its arrays at the end of the loaded value's
+    life: code for LLVM, though :func:`stash`'s arrays count no references)."""
+    if not isinstance(index, types.IntegerLiteral):
+        return None
+    k = index.literal_value
+    kind = pointer.dtype.types[k]
+
+    def codegen(context, builder, signature, args):
+        slot = builder.gep(args[0], [ir.Constant(ir.IntType(32), 0), ir.Constant(ir.IntType(32), k)])
+        return context.data_model_manager[kind].load_from_data_pointer(builder, slot)
+
+    return kind(pointer, index), codegen
+
+
+__all__ = ["HeldFunction", "without_functions", "address_of", "held_record", "dereference", "stash", "item"]

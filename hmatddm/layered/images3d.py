@@ -95,7 +95,8 @@ arrays), the workspace (69) and a source's state (16) are passed to inlined func
 seldom as possible: numba takes and drops a reference on every array of such an aggregate
 each time it is copied or passed to an inlined function, code that LLVM optimises in every
 caller (``traction_block`` was 77k lines of IR for 3900 reference counts; the cold compile
-0.73-0.85x of the CPU before, RESULTS.md, issue 32 continued).
+0.73-0.85x of the CPU before, RESULTS.md, issue 32 continued). The workspace is stashed
+in one buffer (:mod:`.workspace3d`: one reference a copy, not 69; RESULTS.md, twelfth session).
 A record built otherwise than by :func:`.influence3d.influence_data` needs
 :func:`with_image_terms` before a compiled function takes it.
 ``benchmarks/bench_layered3d_compile.py`` measures it.
@@ -108,19 +109,19 @@ from numba import njit, typeof, types
 
 from ..kernels import rectangle3d
 from ..kernels.drivers import KernelKind, _hold, register_kind
-from ..kernels.held_function import HeldFunction, address_of, dereference, held_record
+from ..kernels.held_function import HeldFunction, address_of, dereference, held_record, item
 from . import okada3d
-from .okada_point3d import POINT_SETUP, point_form_terms, point_setup
+from .okada_point3d import point_form_terms, point_setup
 from .image_points3d import image_point_displacement, image_point_stress, kelvin_point_displacement, kelvin_point_stress
-from .image_tracer import trace_capacity
 from .images2d import _lame
 from .image_tracer3d import _traced_buffer, trace, trace_points
 from .source_traces3d import three_heights, traced_slot
+from .workspace3d import _make_workspace, workspace, workspace_arrays
 from .stress_terms3d import _stress_traced, element_stress_traced
 from .remainder_table3d import rectangle_covered, remainder_rectangle_stress
 from .potentials3d import Workspace, base_derivatives, inverse_distance_derivatives, inverse_distance_scratch
-from .vertical3d import _vertical_stress, vertical_workspace
-from .rectangle_quadrature import (FAR_TOL, _cached_rules, _image_order, _integrate, far_order, image_rectangle_stress,
+from .vertical3d import _vertical_stress
+from .rectangle_quadrature import (FAR_TOL, _image_order, _integrate, far_order, image_rectangle_stress,
                                    image_rectangle_stress_without, mirror_distance, one_square_order,
                                    nearest_singularity, square_rule, subdivisions)
 
@@ -185,19 +186,24 @@ class LayeredRectangles(NamedTuple):
     #: :func:`_vertical_terms`, the closed forms of a vertical source, held the same way
     #: (an argument of ``image_terms``)
     vertical_terms: object = None
+    #: :func:`.workspace3d._make_workspace` (:func:`workspace`) held the same way
+    workspace_maker: object = None
 
 
 def with_image_terms(data):
-    """``data`` with its ``image_terms``, ``source_tracer``, ``point_stress`` and
-    ``vertical_terms``: :func:`_complementary_stress`, :func:`_source_state`,
-    :func:`.stress_terms3d._stress_traced` and :func:`_vertical_terms` held as first-class
+    """``data`` with its ``image_terms``, ``source_tracer``, ``point_stress``,
+    ``vertical_terms`` and ``workspace_maker``: :func:`_complementary_stress`,
+    :func:`_source_state`, :func:`.stress_terms3d._stress_traced`, :func:`_vertical_terms`
+    and :func:`.workspace3d._make_workspace` held as first-class
     functions (:class:`hmatddm.kernels.held_function.HeldFunction`), so that each is compiled
     once, not again in every compiled caller (module docstring, compile cost)."""
-    core = data._replace(image_terms=None, source_tracer=None, point_stress=None, vertical_terms=None)
+    core = data._replace(image_terms=None, source_tracer=None, point_stress=None, vertical_terms=None,
+                         workspace_maker=None)
     return data._replace(image_terms=HeldFunction(_complementary_stress, core, _image_term_types),
                          source_tracer=HeldFunction(_source_state, core, _source_state_types),
                          point_stress=HeldFunction(_stress_traced, core, _point_stress_types),
-                         vertical_terms=HeldFunction(_vertical_terms, core, _vertical_term_types))
+                         vertical_terms=HeldFunction(_vertical_terms, core, _vertical_term_types),
+                         workspace_maker=HeldFunction(_make_workspace, core, _workspace_types))
 
 
 def _state_type():
@@ -209,7 +215,7 @@ def _state_type():
 
 def _source_state_types(data):
     """The numba types of :func:`_source_state`'s result and arguments after the record."""
-    return _state_type(), (types.int64, types.CPointer(typeof(workspace.py_func(data))))
+    return _state_type(), (types.int64, types.CPointer(typeof(workspace_arrays.py_func(data))))
 
 
 def _vertical_term_types(data):
@@ -217,8 +223,14 @@ def _vertical_term_types(data):
     the point, its layer, the source, :func:`source_state`'s tuple, :func:`workspace`'s
     tuple, the entry tolerance and the stress."""
     return types.boolean, (types.Array(types.float64, 1, "C"), types.int64, types.int64,
-                           types.CPointer(_state_type()), types.CPointer(typeof(workspace.py_func(data))),
+                           types.CPointer(_state_type()), types.CPointer(typeof(workspace_arrays.py_func(data))),
                            types.float64, types.Array(types.float64, 3, "C"))
+
+
+def _workspace_types(data):
+    """The numba types of :func:`.workspace3d._make_workspace`'s result (the stashed
+    :func:`workspace`) and arguments after the record (none)."""
+    return types.Tuple((types.Array(types.uint8, 1, "C"), types.CPointer(typeof(workspace_arrays.py_func(data))))), ()
 
 
 def _held_type(data, types_of):
@@ -239,41 +251,8 @@ def _point_stress_types(data):
     after the record: the point, its layer, the source, :func:`source_state`'s tuple,
     :func:`workspace`'s tuple, the held image terms (``image_terms``) and the stress."""
     return types.none, (types.Array(types.float64, 1, "C"), types.int64, types.int64, types.CPointer(_state_type()),
-                        types.CPointer(typeof(workspace.py_func(data))), _held_type(data, _image_term_types),
+                        types.CPointer(typeof(workspace_arrays.py_func(data))), _held_type(data, _image_term_types),
                         _held_type(data, _vertical_term_types), types.Array(types.float64, 3, "C"))
-
-
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)  # compiled callers only
-def workspace(data):
-    """Scratch: local stress (3, 3, 3), image stress (3, 3, 3), gradient (3, 3, 3, 3), the
-    Kelvin scratch (2, 3, 3, 1), the :func:`Workspace` of order 1 and of the largest order
-    of any source layer's triples, the tracer's room per layer ``(cap, n_orders)``, the
-    :func:`_cached_rules`, the scratch of :func:`.okada3d.okada_stress` and of
-    :func:`.vertical3d.vertical_image_stress`, the whole-space stress and the receiver point
-    of :func:`_complementary_stress`, and the arrays of the state of a source that traces
-    nothing (:func:`_untraced_state`: made once a block, not once a source)."""
-    n_layers = data.shear_modulus.shape[0]
-    room = np.zeros((n_layers, 2), dtype=np.int64)
-    n_orders = np.int64(1)  # not a literal: one specialization of vertical_workspace
-    if data.interfaces.shape[0] > 0:
-        for layer in range(n_layers):
-            if data.shear_modulus[layer] > 0.0:
-                room[layer, 0], room[layer, 1] = trace_capacity(layer, data.shear_modulus, data.n_images)
-                n_orders = max(n_orders, room[layer, 1])
-    return (np.empty((3, 3, 3)), np.zeros((3, 3, 3)), np.empty((3, 3, 3, 3)), np.zeros((2, 3, 3, 1)), Workspace(1),
-            Workspace(n_orders), room, _cached_rules(data.gauss_points), np.empty((5, 3, 3, 3)), np.empty((30, 4)),
-            vertical_workspace(n_orders), np.empty((3, 3, 3)), np.empty(3), _untraced_state(data.gauss_points))
-
-
-@njit(cache=True)
-def _untraced_state(gauss_points):
-    """The arrays of :func:`source_state` for a source that traces nothing (closed form or
-    point source): one empty point, no rule traced, three empty heights (a point-form
-    source's :func:`.okada_point3d.point_setup` in their room: one source's state at a time
-    per workspace)."""
-    one = np.int64(1)
-    return (_traced_buffer(one, one, one), np.zeros(gauss_points + 1, dtype=np.bool_),
-            _traced_buffer(np.int64(3), one, one), np.zeros(max(3, POINT_SETUP)))
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)  # compiled callers only
@@ -286,22 +265,22 @@ def source_state(data, j, work):
     (``closed_form``) or by Okada's point source (``point_form``) traces nothing: its state
     is the workspace's (:func:`_untraced_state`). :func:`_source_state` through
     ``data.source_tracer`` (:func:`with_image_terms`)."""
-    return data.source_tracer(held_record(data), np.int64(j), address_of(work))
+    return data.source_tracer(held_record(data), np.int64(j), work[1])
 
 
 @njit(cache=True, no_cpython_wrapper=True)  # held: called through its C wrapper only
 def _source_state(data_at, j, work_at):
     """:func:`source_state` (held by the record: the tracer compiled once), the record and
     the workspace as pointers."""
-    data, work = dereference(data_at), dereference(work_at)
-    room = work[6]
-    start = work[7][3]
+    data = dereference(data_at)
+    room = item(work_at, 6)
+    start = item(work_at, 7)[3]
     ls = data.layer[j]
     near_only = data.table.pair_index[ls].max() >= 0
     if data.closed_form[j] or data.point_form[j]:
         # the workspace's arrays: nothing allocated a source (16 arrays a source made the
         # half-space's H-matrix rows cost as much again as their entries)
-        traced, is_traced, three, heights = work[13]
+        traced, is_traced, three, heights = item(work_at, 13)
         if data.point_form[j]:
             point_setup(data.centers[j], data.frames[j], data.half_a[j], data.half_b[j], data.okada[j], data.surface,
                         data.shear_modulus[ls], data.poisson_ratio[ls], heights)
@@ -324,7 +303,8 @@ def element_traction(data, i, j, state, work, block):
     of images (the closed form is the exact half-space). With two or more solid layers, a
     ``surface_form`` source adds its reflection in the free surface the same way for
     receivers of its layer (and the quadrature leaves it out)."""
-    local, image, okada_work, corners = work[0], work[1], work[8], work[9]
+    work_at = work[1]  # the stashed arrays (workspace), one by one
+    local, image, okada_work, corners = item(work_at, 0), item(work_at, 1), item(work_at, 8), item(work_at, 9)
     g = data.shear_modulus
     nu = data.poisson_ratio
     ls = data.layer[j]
@@ -343,7 +323,7 @@ def element_traction(data, i, j, state, work, block):
         okada3d.okada_traction(point, normal, center, data.okada[j], data.okada_half[j, 0], data.okada_half[j, 1],
                                data.surface, g[ls], nu[ls], False, True, okada_work, corners, block)
     elif data.point_form[j]:
-        point_form_terms(data, point, data.layer[i], j, state[4], work[7], okada_work,
+        point_form_terms(data, point, data.layer[i], j, state[4], item(work_at, 7), okada_work,
                          data.entry_tol * data.entry_scale, normal, block, True)
     elif data.interfaces.shape[0] > 0:
         lr = data.layer[i]
@@ -354,10 +334,10 @@ def element_traction(data, i, j, state, work, block):
         # layout): called here, not through an inlined helper taking the record, the state
         # and the workspace (numba takes and drops a reference to each of their arrays per
         # inlined function they are passed to: code that LLVM optimises in every caller)
-        here = work[12]
+        here = item(work_at, 12)
         for k in range(3):
             here[k] = point[k]
-        data.image_terms(held_record(data), here, np.int64(lr), np.int64(j), address_of(state), address_of(work),
+        data.image_terms(held_record(data), here, np.int64(lr), np.int64(j), address_of(state), work_at,
                          np.float64(data.entry_tol * data.entry_scale), image, data.vertical_terms)
         for p in range(3):
             for q in range(3):
@@ -382,9 +362,11 @@ def _complementary_stress(data_at, point, lr, j, state_at, work_at, entry_tol, i
     quadrature elsewhere (``vertical_terms``: the record's held :func:`_vertical_terms`). The
     record, the state and the workspace come as pointers
     (:func:`hmatddm.kernels.held_function.address_of`)."""
-    data, state, work = dereference(data_at), dereference(state_at), dereference(work_at)
+    data, state = dereference(data_at), dereference(state_at)
     traced, is_traced, near_only, three, heights = state
-    local, gradient, kelvin, ws1, ws, rules, uniform = work[0], work[2], work[3], work[4], work[5], work[7], work[11]
+    # the workspace's arrays one by one (held_function.item: not all 69 loaded and released)
+    local, gradient, kelvin = item(work_at, 0), item(work_at, 2), item(work_at, 3)
+    ws1, ws, rules, uniform = item(work_at, 4), item(work_at, 5), item(work_at, 7), item(work_at, 11)
     xi, eta, wt, start = rules
     g = data.shear_modulus
     nu = data.poisson_ratio
@@ -466,10 +448,10 @@ def _vertical_terms(data_at, point, lr, j, state_at, work_at, entry_tol, image):
     (held by the record, ``vertical_terms``, and called by :func:`_complementary_stress`:
     the closed forms compiled once, not again in the image terms' library). The record, the
     state and the workspace as pointers."""
-    data, state, work = dereference(data_at), dereference(state_at), dereference(work_at)
+    data, state = dereference(data_at), dereference(state_at)
     return _vertical_stress(point, lr, data.centers[j], data.okada[j, 0], data.okada_half[j, 0], data.okada_half[j, 1],
                             state[4], state[3], data.shear_modulus, data.poisson_ratio, data.layer[j], data.far_tol,
-                            entry_tol, work[10], image)
+                            entry_tol, item(work_at, 10), image)
 
 
 @njit(cache=True)
@@ -479,18 +461,10 @@ def element_stress(data, point, point_layer, j, work, out):
     triples are traced for this point alone; :mod:`.stress3d` traces them once per source).
     The state is held to the end: the inlined :func:`element_stress_traced` passes it by
     pointer, and numba would release a temporary after its last use, before the call."""
-    owner = data.source_tracer(held_record(data), np.int64(j), address_of(work))
+    owner = data.source_tracer(held_record(data), np.int64(j), work[1])
     element_stress_traced(data, point, point_layer, j, owner, work, out)
     _hold(owner)
 
 
-@njit(cache=True)
-def _kind_workspace(data):
-    """:func:`workspace` called, not inlined: the registered workspace of the drivers, which
-    inline it into each driver (and compile it on their own first); once a block, the call
-    costs nothing, and the workspace's code is compiled once for every driver."""
-    return workspace(data)
-
-
-register_kind(LayeredRectangles, KernelKind(_kind_workspace, source_state, element_traction, element_stress,
+register_kind(LayeredRectangles, KernelKind(workspace, source_state, element_traction, element_stress,
                                             rectangle3d.edge_distance))

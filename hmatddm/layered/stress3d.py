@@ -38,7 +38,7 @@ def stress_points(data, points, point_layer, dd, out):
                 out[m, i, k] = 0.0
     # the record and the workspace on the stack once, for every call of the held per-pair
     # stress (.stress_terms3d): live while ``data`` and ``work`` are (``_hold`` below)
-    data_at, work_at = held_record(data), address_of(work)
+    data_at, work_at = held_record(data), work[1]
     for j in range(data.centers.shape[0]):
         owner = data.source_tracer(data_at, np.int64(j), work_at)  # source_state through the pointers
         state = borrowed(owner)  # no reference counts per point (kernels.drivers.traction_block)
@@ -80,7 +80,7 @@ def stress_columns_points(data, points, point_layer, out):
     additions)."""
     work = workspace(data)
     pair = np.empty((3, 3, 3))
-    data_at, work_at = held_record(data), address_of(work)  # as in stress_points
+    data_at, work_at = held_record(data), work[1]  # as in stress_points
     for j in range(data.centers.shape[0]):
         owner = data.source_tracer(data_at, np.int64(j), work_at)  # as in stress_points
         state = borrowed(owner)

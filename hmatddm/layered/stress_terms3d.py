@@ -20,7 +20,7 @@ import numpy as np
 from numba import njit
 
 from ..kernels import rectangle3d
-from ..kernels.held_function import address_of, dereference, held_record
+from ..kernels.held_function import address_of, dereference, held_record, item
 from . import okada3d
 from .images2d import zero_in_void
 from .okada_point3d import point_form_terms
@@ -33,8 +33,8 @@ def _stress_traced(data_at, point, point_layer, j, state_at, work_at, image_term
     """:func:`element_stress_traced` (held by the record), the record, the source's state
     and the workspace as pointers, ``image_terms`` and ``vertical_terms`` the record's held
     :func:`.images3d._complementary_stress` and :func:`.images3d._vertical_terms`."""
-    data, state, work = dereference(data_at), dereference(state_at), dereference(work_at)
-    local, image = work[0], work[1]
+    data, state = dereference(data_at), dereference(state_at)
+    local, image = item(work_at, 0), item(work_at, 1)  # the workspace's arrays one by one
     if zero_in_void(data.shear_modulus, point_layer, out):
         return
     g = data.shear_modulus
@@ -48,16 +48,16 @@ def _stress_traced(data_at, point, point_layer, j, state_at, work_at, image_term
                             data.near_fraction * min(a, b))
     if data.closed_form[j]:
         okada3d.okada_stress(point, center, data.okada[j], data.okada_half[j, 0], data.okada_half[j, 1], data.surface,
-                             g[ls], nu[ls], False, True, work[8], work[9], image)
+                             g[ls], nu[ls], False, True, item(work_at, 8), item(work_at, 9), image)
         for q in range(3):
             for i in range(3):
                 for k in range(3):
                     out[q, i, k] += image[q, i, k]
     elif data.interfaces.shape[0] > 0:
         if data.point_form[j]:
-            point_form_terms(data, point, point_layer, j, state[4], work[7], work[8], 0.0, point, image, False)
+            point_form_terms(data, point, point_layer, j, state[4], item(work_at, 7), item(work_at, 8), 0.0, point, image, False)
         else:
-            here = work[12]
+            here = item(work_at, 12)
             for k in range(3):
                 here[k] = point[k]
             image_terms(data_at, here, point_layer, j, state_at, work_at, np.float64(0.0), image, vertical_terms)
@@ -67,7 +67,7 @@ def _stress_traced(data_at, point, point_layer, j, state_at, work_at, image_term
                     out[q, i, k] += image[q, i, k]
         if data.surface_form[j] and point_layer == ls:
             okada3d.okada_stress(point, center, data.okada[j], data.okada_half[j, 0], data.okada_half[j, 1],
-                                 data.surface, g[ls], nu[ls], False, True, work[8], work[9], image)
+                                 data.surface, g[ls], nu[ls], False, True, item(work_at, 8), item(work_at, 9), image)
             for q in range(3):
                 for i in range(3):
                     for k in range(3):
@@ -93,8 +93,8 @@ def element_stress_traced(data, point, point_layer, j, state, work, out):
     over pairs makes those pointers once: :mod:`.stress3d`): their arrays must outlive the
     call, held by the caller's variables (numba releases a temporary after its last use,
     here the copy, not the call)."""
-    here = work[12]
+    here = item(work[1], 12)
     for k in range(3):
         here[k] = point[k]
     data.point_stress(held_record(data), here, np.int64(point_layer), np.int64(j),
-                      address_of(state), address_of(work), data.image_terms, data.vertical_terms, out)
+                      address_of(state), work[1], data.image_terms, data.vertical_terms, out)
