@@ -32,6 +32,24 @@ from .drivers import _without_reference_count
 
 #: Addresses of compiled functions, per (function, signature), in this process.
 _ADDRESSES = {}
+#: Signatures of held functions, per (``types_of``, the record's numba type), in this process.
+_SIGNATURES = {}
+
+
+def held_signature(types_of, record):
+    """The signature ``result(CPointer(typeof(record)), *arguments)`` of a held function whose
+    :class:`HeldFunction` takes ``types_of``, made once per record type: ``types_of`` types
+    the workspace and the state (the layered 3D kernel's make their arrays in Python to type
+    them), and a growing simulation makes a new record at every operator build (13 builds
+    of ``shallow-sill``: 0.11 s of its 0.39 s run, benchmarks/RESULTS.md, issue 32, twelfth
+    session)."""
+    record_type = numba.typeof(record)
+    key = (types_of, record_type)
+    found = _SIGNATURES.get(key)
+    if found is None:
+        result, arguments = types_of(record)
+        found = _SIGNATURES[key] = result(types.CPointer(record_type), *arguments)
+    return found
 
 
 class HeldFunction(WrapperAddressProtocol):
@@ -52,8 +70,7 @@ class HeldFunction(WrapperAddressProtocol):
 
     def signature(self):
         if self._signature is None:
-            result, arguments = self.types_of(self.record)
-            self._signature = result(types.CPointer(numba.typeof(self.record)), *arguments)
+            self._signature = held_signature(self.types_of, self.record)
         return self._signature
 
     def numba_type(self):

@@ -109,7 +109,7 @@ from numba import njit, typeof, types
 
 from ..kernels import rectangle3d
 from ..kernels.drivers import KernelKind, _hold, register_kind
-from ..kernels.held_function import HeldFunction, address_of, dereference, held_record, item
+from ..kernels.held_function import HeldFunction, address_of, dereference, held_record, held_signature, item
 from . import okada3d
 from .okada_point3d import point_form_terms, point_setup
 from .image_points3d import image_point_displacement, image_point_stress, kelvin_point_displacement, kelvin_point_stress
@@ -236,8 +236,7 @@ def _workspace_types(data):
 def _held_type(data, types_of):
     """The numba type of a record's held function whose :class:`HeldFunction` takes
     ``types_of`` (``data``: the record without its function fields)."""
-    result, arguments = types_of(data)
-    return types.FunctionType(result(types.CPointer(typeof(data)), *arguments))
+    return types.FunctionType(held_signature(types_of, data))
 
 
 def _image_term_types(data):

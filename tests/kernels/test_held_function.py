@@ -37,3 +37,30 @@ def test_stash_reads_back_and_frees():
     # every meminfo made in the call (4 arrays and the buffer at least) released
     made = after.mi_alloc - before.mi_alloc
     assert made >= 5 and after.mi_free - before.mi_free == made
+
+
+def test_records_of_one_type_share_their_held_signatures():
+    """A growing simulation makes a new layered record at every operator build: the held
+    functions' signatures are made once per record type (:func:`held_signature`), not per
+    record -- two meshes of different sizes in one medium give the same signature objects,
+    and the kernel still runs on both."""
+    import hmatddm as hd
+    from hmatddm.elasticity import operator as operators
+    from hmatddm.kernels import drivers
+    from hmatddm.layered import LayeredMedium
+
+    medium = LayeredMedium([0.0, -2.0], [0.0, 1.0, 2.0], [0.25, 0.25, 0.25], images=1)
+    records = []
+    for n in (2, 3):
+        centers = np.array([[0.7 * k, 0.0, -1.0] for k in range(n)])
+        mesh = hd.Mesh3D.from_rectangles(centers, np.tile([1.0, 0, 0], (n, 1)), np.tile([0, 0.6, 0.8], (n, 1)),
+                                         np.full(n, 0.2), np.full(n, 0.2))
+        records.append(operators.influence_data(mesh, medium))
+    first, second = records
+    for name in ("image_terms", "vertical_terms", "point_stress"):
+        assert getattr(first, name).signature() is getattr(second, name).signature()
+    for data in records:
+        every = np.arange(data.centers.shape[0], dtype=np.int64)
+        out = np.empty((3 * every.size, 3 * every.size))
+        drivers.traction_block(data, every, every, out)
+        assert np.all(np.isfinite(out))
