@@ -6,9 +6,9 @@ their scopes, typing and lowering make new IR), which trigger Python's collectio
 full collection walks every object of the process, and in a process that has imported
 numba, llvmlite and numpy and compiled much already that heap is large. In
 ``benchmarks/bench_layered3d_compile.py`` 46 full collections took 7.1 s of an 82 s cold
-compile (8.3 s with the young generations; benchmarks/RESULTS.md, issue 32, twelfth
-session). From the start of the outermost compile to its end, the objects that existed
-before it are frozen (:func:`gc.freeze`: the collector no longer examines them) and
+compile (8.3 s with the young generations; Intel Xeon at dgemm ~71-76 GFLOP/s, 1 thread;
+benchmarks/RESULTS.md, issue 32, twelfth session). From the start of the outermost compile
+to its end, the objects that existed before it are frozen (:func:`gc.freeze`: the collector no longer examines them) and
 unfrozen after (:func:`gc.unfreeze`), and again at the start of each compile it nests
 (the objects of the compiles finished within it): the garbage a compile makes is still
 collected (what was not yet when a nested compile began, after the outermost one), the

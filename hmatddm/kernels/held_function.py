@@ -41,8 +41,8 @@ def held_signature(types_of, record):
     :class:`HeldFunction` takes ``types_of``, made once per record type: ``types_of`` types
     the workspace and the state (the layered 3D kernel's make their arrays in Python to type
     them), and a growing simulation makes a new record at every operator build (13 builds
-    of ``shallow-sill``: 0.11 s of its 0.39 s run, benchmarks/RESULTS.md, issue 32, twelfth
-    session)."""
+    of ``shallow-sill``: 0.39 -> 0.26 s of CPU a run on an Intel Xeon at dgemm 73 GFLOP/s,
+    1 thread; benchmarks/RESULTS.md, issue 32, twelfth session)."""
     record_type = numba.typeof(record)
     key = (types_of, record_type)
     found = _SIGNATURES.get(key)
@@ -76,7 +76,8 @@ class HeldFunction(WrapperAddressProtocol):
     def numba_type(self):
         """``FunctionType(signature())``, made once: numba types the record's fields at
         every call from Python, and making the type again hashes the whole record type
-        it holds (~150 us a held function a call, benchmarks/RESULTS.md, twelfth session)."""
+        it holds (~150 us a held function a call on an Intel Xeon at dgemm ~73 GFLOP/s, 1
+        thread; benchmarks/RESULTS.md, twelfth session)."""
         if self._type is None:
             self._type = types.FunctionType(self.signature())
         return self._type
