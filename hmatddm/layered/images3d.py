@@ -118,6 +118,7 @@ from .image_tracer3d import _traced_buffer, trace, trace_points
 from .source_traces3d import three_heights, traced_slot
 from .workspace3d import _make_workspace, workspace, workspace_arrays
 from .stress_terms3d import _stress_traced, element_stress_traced
+from .near_table3d import near_rectangle_stress
 from .remainder_table3d import rectangle_covered, remainder_rectangle_stress
 from .potentials3d import Workspace, base_derivatives, inverse_distance_derivatives, inverse_distance_scratch
 from .vertical3d import _vertical_stress
@@ -401,7 +402,32 @@ def _complementary_stress(data_at, point, lr, j, state_at, work_at, entry_tol, i
                     for p in range(3):
                         for kk in range(3):
                             image[q, p, kk] -= uniform[q, p, kk]
-        if not closed and n_sub == 1 and tabulated and lr == ls:
+        near = table.near
+        if not closed and tabulated and near.ready[ls, lr]:
+            # the near triples tabulated in one angle (.near_table3d): the same rules, a
+            # lookup a point instead of a triple; the surface's group left out when skipped
+            g_s, lame_s = g[ls], _lame(g[ls], nu[ls])
+            first = 1 if 0 <= skip == ls - 1 else 0
+            if n_sub == 1 and lr == ls:
+                for side in range(first, 2):
+                    k = ls - 1 if side == 0 else ls
+                    if near.group[ls, lr, side] < 0:
+                        continue
+                    n = one_square_order(mirror_distance(point, interfaces[k], center, frame, a, b), a, b,
+                                         data.gauss_points, data.far_tol, entry_tol)
+                    lo, hi = start[n - 1], start[n]
+                    near_rectangle_stress(near, point, lr, center, frame, a, b, ls, g_s, lame_s, xi[lo:hi],
+                                          eta[lo:hi], wt[lo:hi], side, side + 1, image)
+            elif n_sub <= 2:
+                slot = n_gauss - 1 if n_sub == 1 else data.gauss_points
+                lo, hi = start[slot], start[slot + 1]
+                near_rectangle_stress(near, point, lr, center, frame, a, b, ls, g_s, lame_s, xi[lo:hi], eta[lo:hi],
+                                      wt[lo:hi], first, 2, image)
+            else:
+                sub_xi, sub_eta, sub_wt = square_rule(n_gauss, n_sub)
+                near_rectangle_stress(near, point, lr, center, frame, a, b, ls, g_s, lame_s, sub_xi, sub_eta, sub_wt,
+                                      first, 2, image)
+        elif not closed and n_sub == 1 and tabulated and lr == ls:
             # with the rest tabulated, the near triples of the receiver's own layer are its
             # first reflections in the layer's top (above it) and bottom (below it): each
             # takes the rule of its own mirror, not both the nearer one's

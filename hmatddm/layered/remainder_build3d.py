@@ -10,6 +10,7 @@ import numpy as np
 
 from .image_tracer import trace_capacity
 from .image_tracer3d import trace
+from .near_table3d import build_near_table, empty_near_table
 from .remainder_table3d import (COMPONENTS, ERROR_SAMPLES, MAX_TABLE_VALUES, PAD, STENCIL, RemainderTable,
                                 empty_table, interpolate, interpolation_scratch, is_far, keep_near, layer_bounds, layer_gap,
                                 sample_remainder, triple_gap)
@@ -194,7 +195,7 @@ def build_table(mesh, layers, interfaces, shear_modulus, poisson_ratio, n_images
                 return empty_table(n_layers), stats
             values = _sample_pair(ls, lr, grid, interfaces, g, nu, n_images, bottoms, tops)
             one = RemainderTable(pair_index, grid[None, :], np.zeros(1, dtype=np.int64), values.ravel(), clearance,
-                                 bottoms, tops)
+                                 bottoms, tops, 0, empty_near_table(n_layers))
             saved = pair_index[ls, lr]
             pair_index[ls, lr] = 0
             error = 0.0
@@ -215,9 +216,10 @@ def build_table(mesh, layers, interfaces, shear_modulus, poisson_ratio, n_images
         blocks.append(values.ravel())
         total += size
     offset = np.cumsum([0] + [b.size for b in blocks[:-1]]).astype(np.int64)
+    images = near_images(interfaces, g, nu, n_images, ranges, bottoms, tops, sorted({ls for ls, _ in pairs}))
+    near, near_stats = build_near_table(interfaces, g, nu) if images == 1 else (empty_near_table(n_layers), {})
     table = RemainderTable(pair_index, np.array(grids), offset, np.concatenate(blocks), clearance, bottoms, tops,
-                           near_images(interfaces, g, nu, n_images, ranges, bottoms, tops,
-                                       sorted({ls for ls, _ in pairs})))
+                           images, near)
     stats.update(table_pairs=len(pairs), table_values=int(total), table_error=worst / entry_scale,
-                 table_build_cpu=time.process_time() - cpu)
+                 table_build_cpu=time.process_time() - cpu, **near_stats)
     return table, stats

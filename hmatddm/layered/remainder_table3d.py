@@ -90,14 +90,19 @@ class RemainderTable(NamedTuple):
     #: reflections to trace for a source's near triples (:func:`.remainder_build3d.near_images`;
     #: 0: the medium's own ``images``)
     near_images: int = 0
+    #: the near triples tabulated in one angle (:class:`.near_table3d.NearTable`; every
+    #: constructor passes one, :func:`.near_table3d.empty_near_table` for none)
+    near: tuple = None
 
 
 def empty_table(n_layers):
     """A table that tabulates nothing (every pair by quadrature)."""
+    from .near_table3d import empty_near_table  # it builds on this module
+
     zeros = np.zeros(n_layers)
     return RemainderTable(-np.ones((n_layers, n_layers), dtype=np.int64), np.ones((1, 9)),
                           np.zeros(1, dtype=np.int64), np.zeros(1), np.zeros((n_layers, n_layers)), zeros - np.inf,
-                          zeros + np.inf)
+                          zeros + np.inf, 0, empty_near_table(n_layers))
 
 
 def layer_bounds(interfaces):
