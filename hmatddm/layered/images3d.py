@@ -22,7 +22,12 @@ their image error below :data:`.rectangle_quadrature.ENTRY_TOL` of the largest e
 triples (those that can reach the receiver's layer) are integrated by quadrature; the far
 ones, the smooth layered remainder, come from a table built once per medium and mesh
 extent (:mod:`.remainder_table3d`, ``LayeredMedium(method="table")``, the default;
-``method="quadrature"`` integrates every triple, the cross-check). In a half-space (one
+``method="quadrature"`` integrates every triple, the cross-check). With that table, the
+near triples' field at a quadrature point is itself a lookup: a first reflection or a
+transmission is homogeneous of degree -3 about its interface, so it is tabulated in one
+angle, exactly to 1e-11 (:mod:`.near_table3d`; three layers on the issue-32 lattice 23.8
+-> 5.9 us a pair, one thread of the 2-core Xeon at dgemm 87 GFLOP/s, benchmarks/RESULTS.md,
+thirteenth session). In a half-space (one
 solid layer under a void) the image and surface terms of a rectangle with a horizontal side
 are in closed form (:mod:`.okada3d`, Okada 1992; ``LayeredRectangles.closed_form``). With
 two or more solid layers under a void, a source of the top solid layer with a horizontal
@@ -407,7 +412,8 @@ def _complementary_stress(data_at, point, lr, j, state_at, work_at, entry_tol, i
             # the near triples tabulated in one angle (.near_table3d): the same rules, a
             # lookup a point instead of a triple; the surface's group left out when skipped
             g_s, lame_s = g[ls], _lame(g[ls], nu[ls])
-            first = 1 if 0 <= skip == ls - 1 else 0
+            first = np.int64(1 if 0 <= skip == ls - 1 else 0)  # no literal: one signature
+            every = np.int64(2)
             if n_sub == 1 and lr == ls:
                 for side in range(first, 2):
                     k = ls - 1 if side == 0 else ls
@@ -415,18 +421,16 @@ def _complementary_stress(data_at, point, lr, j, state_at, work_at, entry_tol, i
                         continue
                     n = one_square_order(mirror_distance(point, interfaces[k], center, frame, a, b), a, b,
                                          data.gauss_points, data.far_tol, entry_tol)
-                    lo, hi = start[n - 1], start[n]
-                    near_rectangle_stress(near, point, lr, center, frame, a, b, ls, g_s, lame_s, xi[lo:hi],
-                                          eta[lo:hi], wt[lo:hi], side, side + 1, image)
+                    near_rectangle_stress(near, point, lr, center, frame, a, b, ls, g_s, lame_s, xi, eta, wt,
+                                          start[n - 1], start[n], side, side + 1, image)
             elif n_sub <= 2:
                 slot = n_gauss - 1 if n_sub == 1 else data.gauss_points
-                lo, hi = start[slot], start[slot + 1]
-                near_rectangle_stress(near, point, lr, center, frame, a, b, ls, g_s, lame_s, xi[lo:hi], eta[lo:hi],
-                                      wt[lo:hi], first, 2, image)
+                near_rectangle_stress(near, point, lr, center, frame, a, b, ls, g_s, lame_s, xi, eta, wt, start[slot],
+                                      start[slot + 1], first, every, image)
             else:
                 sub_xi, sub_eta, sub_wt = square_rule(n_gauss, n_sub)
                 near_rectangle_stress(near, point, lr, center, frame, a, b, ls, g_s, lame_s, sub_xi, sub_eta, sub_wt,
-                                      first, 2, image)
+                                      np.int64(0), np.int64(sub_xi.shape[0]), first, every, image)
         elif not closed and n_sub == 1 and tabulated and lr == ls:
             # with the rest tabulated, the near triples of the receiver's own layer are its
             # first reflections in the layer's top (above it) and bottom (below it): each

@@ -15,8 +15,10 @@ triples for a source below a free surface and two interfaces at ``images=4``, ea
   from the receiver's layer for every source height in the source's layer
   (:func:`triple_gap`), so their sum -- the *layered remainder* -- is smooth there.
 
-The near triples keep the quadrature of :mod:`.rectangle_quadrature` (exact to its
-tolerance next to the interfaces). The remainder depends only on the horizontal offset
+The near triples keep the quadrature's rules of :mod:`.rectangle_quadrature` (exact to its
+tolerance next to the interfaces), their field at each point looked up in a table of one
+angle (:mod:`.near_table3d`, built with this one: a near triple has no length but its
+offset from its interface). The remainder depends only on the horizontal offset
 ``rho``, the source height ``t`` and the receiver height ``y3`` (the medium is
 axisymmetric about the vertical through the source), and is tabulated on uniform grids in
 the source frame rotated so that the receiver lies on its x axis (the approach of the

@@ -7,12 +7,13 @@ import math
 import numpy as np
 import pytest
 
-import hmatddm as hd
-from hmatddm.kernels import drivers
+from test_layered_fast3d import _matrix, _random_mesh  # tests/layered on the path (pytest's prepend mode)
+
 from hmatddm.layered import LayeredMedium
 from hmatddm.layered import near_table3d as nt
 from hmatddm.layered.influence3d import influence_data
 from hmatddm.layered.images3d import with_image_terms
+from hmatddm.layered.remainder_table3d import layer_bounds
 
 INTERFACES = np.array([0.0, -1.5, -3.0])
 SHEAR = np.array([0.0, 1.0, 2.0, 1.0])
@@ -36,7 +37,8 @@ def _groups():
 
 def _direct(ls, lr, geometry, theta, tau, radius):
     out = np.empty((1, 1, 20))
-    nt.sample_group(ls, lr, *geometry, np.array([theta]), np.array([tau]), radius, INTERFACES, SHEAR, POISSON, out)
+    nt.sample_group(ls, lr, *geometry, np.array([theta]), np.array([tau]), radius, INTERFACES, SHEAR, POISSON,
+                    *layer_bounds(INTERFACES), out)
     return out[0, 0]
 
 
@@ -95,20 +97,6 @@ def test_the_error_falls_as_the_grid_of_angles_is_refined(monkeypatch):
         monkeypatch.setattr(nt, "NEAR_TABLE_TOL", 1.0)  # no refinement: the first grid's error
         errors.append(nt.build_near_table(INTERFACES, SHEAR, POISSON)[1]["near_error"])
     assert errors[0] > 8.0 * errors[1] > 64.0 * errors[2] > 0.0
-
-
-def _random_mesh(seed, centers, half):
-    rng = np.random.default_rng(seed)
-    frames = np.linalg.qr(rng.normal(size=(len(centers), 3, 3)))[0]
-    half = np.full(len(centers), half)
-    return hd.Mesh3D.from_rectangles(np.asarray(centers, float), frames[:, :, 0], frames[:, :, 1], half, half)
-
-
-def _matrix(data):
-    every = np.arange(data.centers.shape[0], dtype=np.int64)
-    out = np.empty((3 * every.size, 3 * every.size))
-    drivers.traction_block(data, every, every, out)
-    return out
 
 
 def test_entries_equal_the_quadrature_of_the_near_triples_at_the_same_rules(monkeypatch):
