@@ -124,7 +124,8 @@ from .source_traces3d import three_heights, traced_slot
 from .workspace3d import _make_workspace, workspace, workspace_arrays
 from .stress_terms3d import _stress_traced, element_stress_traced
 from .near_table3d import near_rectangle_stress
-from .remainder_table3d import rectangle_covered, remainder_rectangle_stress
+from .remainder_rows3d import remainder_rule, remainder_terms
+from .remainder_table3d import rectangle_covered
 from .potentials3d import Workspace, base_derivatives, inverse_distance_derivatives, inverse_distance_scratch
 from .vertical3d import _vertical_stress
 from .rectangle_quadrature import (FAR_TOL, _image_order, _integrate, far_order, image_rectangle_stress,
@@ -378,12 +379,13 @@ def _complementary_stress(data_at, point, lr, j, state_at, work_at, entry_tol, i
     interfaces = data.interfaces
     table = data.table
     ls = data.layer[j]
-    center = data.centers[j]
-    frame = data.frames[j]
-    a = data.half_a[j]
-    b = data.half_b[j]
+    g_s, lame_s = g[ls], _lame(g[ls], nu[ls])
+    center, frame, a, b = data.centers[j], data.frames[j], data.half_a[j], data.half_b[j]
     image[:] = 0.0
     tabulated = near_only and rectangle_covered(table, point, lr, center, frame, a, b, ls)
+    rows, fused = item(work_at, 14), False  # the remainder's rule and rows (.remainder_rows3d)
+    lo_r, hi_r, entry = (remainder_rule(table, rows, j, point, lr, center, frame, a, b, ls, data.gauss_points,
+                                        data.far_tol, entry_tol, xi, eta, start) if tabulated else (0, 0, -1))
     # the reflection in the free surface in closed form: the quadrature neither takes it
     # nor refines for its singular point (the receiver's mirror in the surface)
     surface_form = data.surface_form[j]
@@ -409,11 +411,8 @@ def _complementary_stress(data_at, point, lr, j, state_at, work_at, entry_tol, i
                             image[q, p, kk] -= uniform[q, p, kk]
         near = table.near
         if not closed and tabulated and near.ready[ls, lr]:
-            # the near triples tabulated in one angle (.near_table3d): the same rules, a
-            # lookup a point instead of a triple; the surface's group left out when skipped
-            g_s, lame_s = g[ls], _lame(g[ls], nu[ls])
-            first = np.int64(1 if 0 <= skip == ls - 1 else 0)  # no literal: one signature
-            every = np.int64(2)
+            # the near triples tabulated in one angle (.near_table3d), the surface's group left out when skipped
+            first, every = np.int64(1 if 0 <= skip == ls - 1 else 0), np.int64(2)  # no literals: one signature
             if n_sub == 1 and lr == ls:
                 for side in range(first, 2):
                     k = ls - 1 if side == 0 else ls
@@ -421,16 +420,22 @@ def _complementary_stress(data_at, point, lr, j, state_at, work_at, entry_tol, i
                         continue
                     n = one_square_order(mirror_distance(point, interfaces[k], center, frame, a, b), a, b,
                                          data.gauss_points, data.far_tol, entry_tol)
+                    # the remainder added at the same points when its rule is this one (one turn a point)
+                    with_rows = entry if not fused and start[n - 1] == lo_r and start[n] == hi_r else -1
+                    fused = fused or with_rows >= 0
                     near_rectangle_stress(near, point, lr, center, frame, a, b, ls, g_s, lame_s, xi, eta, wt,
-                                          start[n - 1], start[n], side, side + 1, image)
+                                          start[n - 1], start[n], side, side + 1, table, rows, with_rows, image)
             elif n_sub <= 2:
                 slot = n_gauss - 1 if n_sub == 1 else data.gauss_points
+                with_rows = entry if start[slot] == lo_r and start[slot + 1] == hi_r else -1
+                fused = with_rows >= 0
                 near_rectangle_stress(near, point, lr, center, frame, a, b, ls, g_s, lame_s, xi, eta, wt, start[slot],
-                                      start[slot + 1], first, every, image)
+                                      start[slot + 1], first, every, table, rows, with_rows, image)
             else:
                 sub_xi, sub_eta, sub_wt = square_rule(n_gauss, n_sub)
                 near_rectangle_stress(near, point, lr, center, frame, a, b, ls, g_s, lame_s, sub_xi, sub_eta, sub_wt,
-                                      np.int64(0), np.int64(sub_xi.shape[0]), first, every, image)
+                                      np.int64(0), np.int64(sub_xi.shape[0]), first, every, table, rows,
+                                      np.int64(-1), image)
         elif not closed and n_sub == 1 and tabulated and lr == ls:
             # with the rest tabulated, the near triples of the receiver's own layer are its
             # first reflections in the layer's top (above it) and bottom (below it): each
@@ -456,18 +461,9 @@ def _complementary_stress(data_at, point, lr, j, state_at, work_at, entry_tol, i
             image_rectangle_stress_without(point, lr, center, frame, a, b, ls, interfaces, g, nu, data.n_images,
                                            n_gauss, n_sub, image, near_only, table.bottoms, table.tops, surface_form,
                                            data.surface)
-    if tabulated:
-        # the far triples' points lie below or above the source points, at least
-        # the clearance outside the receiver's layer
-        r1 = point[0] - center[0]
-        r2 = point[1] - center[1]
-        beside = max(0.0, math.sqrt(r1 * r1 + r2 * r2) - a - b)
-        clearance = table.clearance[ls, lr]
-        n = one_square_order(math.sqrt(clearance * clearance + beside * beside), a, b, data.gauss_points, data.far_tol,
-                            entry_tol)
-        lo, hi = start[n - 1], start[n]
-        remainder_rectangle_stress(table, point, lr, center, frame, a, b, ls, g[ls], _lame(g[ls], nu[ls]),
-                                   xi[lo:hi], eta[lo:hi], wt[lo:hi], image)
+    if tabulated and not fused:
+        remainder_terms(table, rows, entry, point, lr, center, frame, a, b, ls, g_s, lame_s, xi, eta, wt, lo_r, hi_r,
+                        image)
 
 
 @njit(cache=True, no_cpython_wrapper=True)  # held: called through its C wrapper only

@@ -8,7 +8,7 @@ import numpy as np
 from .._validation import finite_array
 from ..errors import InputError
 from ..kernels.drivers import with_self_max
-from . import images3d, okada3d, okada_point3d, remainder_build3d, remainder_table3d, stress3d, vertical3d
+from . import images3d, okada3d, okada_point3d, remainder_build3d, stress3d, vertical3d
 from .image_tracer3d import trace_points
 from .influence2d import choose_images as _choose_images
 from .influence2d import layers_of_extents, with_images
@@ -62,7 +62,7 @@ def influence_data(mesh, medium, singular_shift, alpha, near_fraction, n_images,
     layers = element_layers(mesh, medium)
     interfaces, g, nu = medium.arrays()
     scale = entry_scale(mesh.half_a, mesh.half_b, layers, g, nu) / g.max() if interfaces.shape[0] > 0 else 0.0
-    table = remainder_table3d.empty_table(g.shape[0])
+    table = remainder_build3d.empty_table(g.shape[0])
     if (with_table and medium.method == "table" and n_images > 0 and interfaces.shape[0] >= 2
             and mesh.n_elements >= TABLE_MIN_ELEMENTS):
         table = remainder_table(mesh, medium, layers, int(n_images), scale * g.max())[0]

@@ -26,7 +26,9 @@ a polynomial of degree < :data:`DEGREES` in ``tau`` (the ``D`` orders of a near 
 2) whose coefficients are functions of the angle alone, analytic on ``[0, pi / 2]`` (the
 singular half-line of the triple's gauge lies at ``theta = pi``). They are tabulated once per
 medium (:func:`build_near_table`) from the image sum itself (:func:`sample_group`: the
-polynomial fitted through three heights, a fourth checks it) on a uniform grid of ``theta``,
+polynomial fitted through three heights, a fourth checks it) on a uniform grid of
+``v = tan(theta / 2) = rho / (R + |r3|)`` over ``[0, 1]`` (analytic in ``v`` too: a division
+where ``theta`` took an ``atan2``, a fifth of a point's cost),
 interpolated by the remainder's :data:`.remainder_table3d.STENCIL`-point Lagrange rule, the
 grid halved until the interpolation's error, at random angles and heights against the image
 sum, is below :data:`NEAR_TABLE_TOL` of the group's largest value. The quadrature's rules stay
@@ -48,6 +50,7 @@ from .image_tracer import trace_capacity
 from .image_tracer3d import trace
 from .images2d import _lame, receiver_constants
 from .potentials3d import Workspace, _original, _pair_stress_gradient
+from .remainder_rows3d import rows_add
 from .remainder_table3d import (COMPONENTS, PAD, STENCIL, _lagrange, _response, _rotated_stress, keep_near,
                                 layer_bounds)
 
@@ -56,7 +59,8 @@ DEGREES = 3
 #: Error of the interpolation in the angle allowed relative to the group's largest value of
 #: ``R^3 T`` (the entries' image parts are at most the largest entry: a few 1e-11 of it).
 NEAR_TABLE_TOL = 1e-11
-#: Angles of the first grid over ``[0, pi / 2]``; halved until :data:`NEAR_TABLE_TOL` holds.
+#: Intervals of the first grid over ``v`` in ``[0, 1]`` (``theta`` in ``[0, pi / 2]``); halved until
+#: :data:`NEAR_TABLE_TOL` holds.
 FIRST_NODES = 64
 #: Most angles of a grid (the refinement stops there; the group then stays on the quadrature).
 MAX_NODES = 8192
@@ -78,14 +82,14 @@ class NearTable(NamedTuple):
     group of the pair tabulated (the quadrature takes the pair otherwise). Group ``q``:
     ``anchor[q]`` the interface's height, ``reflected[q]`` 1 when the triples' point is the
     source's mirror ``2 d - t`` (0: the source point); its values
-    ``values[((q n + i) DEGREES + k) 20 + c]`` at the angles ``theta_i = (i - PAD) step``."""
+    ``values[((q n + i) DEGREES + k) 20 + c]`` at ``v_i = tan(theta_i / 2) = (i - PAD) step``."""
 
     group: np.ndarray  #: (L, L, 2) int64
     ready: np.ndarray  #: (L, L) bool
     anchor: np.ndarray  #: (G,)
     reflected: np.ndarray  #: (G,)
     values: np.ndarray  #: (G n DEGREES 20,)
-    step: float  #: angle between nodes
+    step: float  #: spacing of the nodes in ``v = tan(theta / 2)``
     n_nodes: int  #: nodes of every group's grid (the pads included)
 
 
@@ -177,29 +181,37 @@ def _add_group(near, q, rho, t, y3, response, w):
     radius = math.sqrt(r2)
     inv3 = 1.0 / (r2 * radius)
     tau = abs(t - d) / radius
-    theta = math.atan2(rho, abs(r3))
     n = near.n_nodes
-    i0 = _lagrange(theta, -PAD * near.step, near.step, n, w, 0)
+    i0 = _lagrange(rho / (radius + abs(r3)), -PAD * near.step, near.step, n, w, 0)  # tan(theta / 2)
     values = near.values
-    for s in range(STENCIL):
-        w0 = w[0, s] * inv3
-        w1 = w0 * tau
-        w2 = w1 * tau
-        at = ((q * n + i0 + s) * DEGREES) * _N_C
-        for c in range(_N_C):
-            response[c] += w0 * values[at + c] + w1 * values[at + _N_C + c] + w2 * values[at + 2 * _N_C + c]
+    at = ((q * n + i0) * DEGREES) * _N_C
+    node = DEGREES * _N_C
+    # each power of tau (DEGREES = 3 of them) summed over the stencil in a register, then
+    # once into the response (its stores were a tenth of a group's cost)
+    for c in range(_N_C):
+        v0 = 0.0
+        v1 = 0.0
+        v2 = 0.0
+        for s in range(STENCIL):
+            ws = w[0, s]
+            v0 += ws * values[at + s * node + c]
+            v1 += ws * values[at + s * node + _N_C + c]
+            v2 += ws * values[at + s * node + 2 * _N_C + c]
+        response[c] += inv3 * (v0 + tau * (v1 + tau * v2))
 
 
 @njit(cache=True)
 def near_rectangle_stress(near, y, lr, center, frame, a, b, ls, shear_modulus, lame, xi, eta, wt, lo, hi, side_lo,
-                          side_hi, out):
+                          side_hi, table, rows, entry, out):
     """``out[b, i, k] +=`` the near triples' stress at ``y`` (in ``lr``) of a unit global DD
     ``b`` on the rectangle (in ``ls``, its moduli ``shear_modulus``, ``lame``) by the points
     ``lo .. hi - 1`` of the rule ``(xi, eta, wt)`` on [-1, 1]^2 (whole arrays and a range,
-    not slices: one compiled signature for the cached rules and the sub-squares'), the groups of sides ``side_lo <= side < side_hi`` (the
-    top interface's 0, the bottom's 1): at each point the groups' tabulated responses summed
+    not slices: one compiled signature for the cached rules and the sub-squares'), the
+    groups of sides ``side_lo <= side < side_hi`` (the top interface's 0, the bottom's 1): at each point the groups' tabulated responses summed
     in the frame turned towards the receiver, contracted with the moment and turned back
-    once (:func:`.remainder_table3d._rotated_stress`)."""
+    once (:func:`.remainder_table3d._rotated_stress`); with the remainder's table at the same
+    points too, through the rows' ``entry`` of ``rows`` (:func:`.remainder_rows3d.rows_add`;
+    -1: not here)."""
     normal = frame[2]
     jac = a * b
     response = np.empty(_N_C)
@@ -220,6 +232,8 @@ def near_rectangle_stress(near, y, lr, center, frame, a, b, ls, shear_modulus, l
             _add_group(near, q0, rho, x2, y[2], response, w)
         if q1 >= 0:
             _add_group(near, q1, rho, x2, y[2], response, w)
+        if entry >= 0:
+            rows_add(table, rows, entry, lr, ls, rho, g - lo, hi - lo, response)
         cos, sin = (r1 / rho, r2 / rho) if rho > 0.0 else (1.0, 0.0)
         _rotated_stress(cos, sin, normal, shear_modulus, lame, wt[g] * jac, response, out, scratch)
 
@@ -286,9 +300,9 @@ def build_near_table(interfaces, shear_modulus, poisson_ratio, seed=0):
         return empty_near_table(n_layers), stats
     nodes = FIRST_NODES
     while True:
-        step = 0.5 * math.pi / nodes
+        step = 1.0 / nodes
         n_nodes = nodes + 1 + 2 * PAD
-        thetas = (np.arange(n_nodes) - PAD) * step
+        thetas = 2.0 * np.arctan((np.arange(n_nodes) - PAD) * step)
         blocks, kept, worst = [], [], 0.0
         for ls, lr, side, geometry in specs:
             samples = np.empty((n_nodes, len(FIT_TAUS), _N_C))

@@ -12,8 +12,16 @@ from .image_tracer import trace_capacity
 from .image_tracer3d import trace
 from .near_table3d import build_near_table, empty_near_table
 from .remainder_table3d import (COMPONENTS, ERROR_SAMPLES, MAX_TABLE_VALUES, PAD, STENCIL, RemainderTable,
-                                empty_table, interpolate, interpolation_scratch, is_far, keep_near, layer_bounds, layer_gap,
+                                interpolate, interpolation_scratch, is_far, keep_near, layer_bounds, layer_gap,
                                 sample_remainder, triple_gap)
+
+
+def empty_table(n_layers):
+    """A table that tabulates nothing (every pair by quadrature, no near table)."""
+    zeros = np.zeros(n_layers)
+    return RemainderTable(-np.ones((n_layers, n_layers), dtype=np.int64), np.ones((1, 9)),
+                          np.zeros(1, dtype=np.int64), np.zeros(1), np.zeros((n_layers, n_layers)), zeros - np.inf,
+                          zeros + np.inf, 0, empty_near_table(n_layers))
 
 
 def _far_pairs(interfaces, shear_modulus, poisson_ratio, n_images, ranges, bottoms, tops):

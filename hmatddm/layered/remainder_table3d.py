@@ -93,18 +93,9 @@ class RemainderTable(NamedTuple):
     #: 0: the medium's own ``images``)
     near_images: int = 0
     #: the near triples tabulated in one angle (:class:`.near_table3d.NearTable`; every
-    #: constructor passes one, :func:`.near_table3d.empty_near_table` for none)
+    #: constructor passes one, :func:`.near_table3d.empty_near_table` for none;
+    #: :func:`.remainder_build3d.empty_table`: a table of neither)
     near: tuple = None
-
-
-def empty_table(n_layers):
-    """A table that tabulates nothing (every pair by quadrature)."""
-    from .near_table3d import empty_near_table  # it builds on this module
-
-    zeros = np.zeros(n_layers)
-    return RemainderTable(-np.ones((n_layers, n_layers), dtype=np.int64), np.ones((1, 9)),
-                          np.zeros(1, dtype=np.int64), np.zeros(1), np.zeros((n_layers, n_layers)), zeros - np.inf,
-                          zeros + np.inf, 0, empty_near_table(n_layers))
 
 
 def layer_bounds(interfaces):
@@ -248,6 +239,8 @@ STENCIL = 6
 #: the source and the receiver both padded, its singular points stay at least
 #: ``clearance - 2 PAD h >= clearance / 2`` away (``h <= clearance / 8``).
 PAD = STENCIL // 2 - 1
+#: ``1 / prod_{b != a} (a - b)`` of :func:`_lagrange`'s weights.
+_INVERSE_DENOMINATORS = tuple(1.0 / math.prod(a - b for b in range(STENCIL) if b != a) for a in range(STENCIL))
 
 
 @njit(cache=True, inline="always")
@@ -261,19 +254,26 @@ def _lagrange(x, x0, h, n, w, row):
     if i0 < 0:
         i0 = 0
     s = u - i0
+    # the products of (s - b) over b < a and over b > a, times 1 / prod (a - b): 10
+    # multiplications and no division (the 30 divisions of the textbook form were, with
+    # asinh, most of the remainder's cost a point: benchmarks/RESULTS.md, thirteenth session)
+    left = 1.0
     for a in range(STENCIL):
-        v = 1.0
-        for b in range(STENCIL):
-            if b != a:
-                v *= (s - b) / (a - b)
-        w[row, a] = v
+        w[row, a] = left
+        left *= s - a
+    right = 1.0
+    for a in range(STENCIL - 1, -1, -1):
+        w[row, a] *= right * _INVERSE_DENOMINATORS[a]
+        right *= s - a
     return i0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def covers(table, source_layer, layer, t, y3, rho):
     """True when the table holds the pair of layers and the point lies in its range (the
-    grids less their :data:`PAD` nodes at either end)."""
+    grids less their :data:`PAD` nodes at either end). Inlined: a call took and dropped a
+    reference on each of the table's arrays (0.4 us a pair of the issue-32 lattice with
+    :func:`rectangle_covered`'s two calls, one thread of the 2-core Xeon)."""
     k = table.pair_index[source_layer, layer]
     if k < 0:
         return False
@@ -352,32 +352,36 @@ def remainder_point_stress(table, y, layer, x, source_layer, normal, shear_modul
 @njit(cache=True, inline="always")
 def _rotated_stress(c, s, normal, shear_modulus, lame, weight, response, out, scratch):
     """``out[b, i, k] += weight *`` the stress of the tabulated ``response`` in the frame
-    turned about z by ``(cos, sin) = (c, s)`` (:func:`remainder_point_stress`)."""
+    turned about z by ``(cos, sin) = (c, s)`` (:func:`remainder_point_stress`): the moment of
+    a unit DD along global ``b`` turned into that frame, contracted with the 20 components
+    (:data:`COMPONENTS`, written out: the loop over them through the index arrays cost twice
+    as much) and the stress turned back. ``scratch``: unused (the callers' room)."""
     # rotated components of the normal: v' = (c v1 + s v2, -s v1 + c v2, v3)
     n0 = c * normal[0] + s * normal[1]
     n1 = -s * normal[0] + c * normal[1]
     n2 = normal[2]
-    nr = (n0, n1, n2)
+    # the response's components by (moment, stress): m in (xx, yy, zz, xz) with s in (xx,
+    # yy, zz, xz), m in (xy, yz) with s in (xy, yz) (the order of COMPONENTS)
+    g = shear_modulus
     for b in range(3):
         # the rotated unit DD along global b
         b0 = c if b == 0 else (s if b == 1 else 0.0)
         b1 = -s if b == 0 else (c if b == 1 else 0.0)
         b2 = 1.0 if b == 2 else 0.0
-        br = (b0, b1, b2)
         bn = normal[b] * lame
-        for m in range(6):
-            p, q = _PAIRS[m, 0], _PAIRS[m, 1]
-            v = shear_modulus * (br[p] * nr[q] + br[q] * nr[p])
-            if p == q:
-                v += bn
-            scratch[0, m] = v
-        for m in range(6):
-            scratch[1, m] = 0.0
-        for comp in range(COMPONENTS.shape[0]):
-            scratch[1, COMPONENTS[comp, 1]] += scratch[0, COMPONENTS[comp, 0]] * response[comp]
+        m_xx = g * (b0 * n0 + b0 * n0) + bn
+        m_yy = g * (b1 * n1 + b1 * n1) + bn
+        m_zz = g * (b2 * n2 + b2 * n2) + bn
+        m_xy = g * (b0 * n1 + b1 * n0)
+        m_xz = g * (b0 * n2 + b2 * n0)
+        m_yz = g * (b1 * n2 + b2 * n1)
+        sxx = m_xx * response[0] + m_yy * response[4] + m_zz * response[8] + m_xz * response[14]
+        syy = m_xx * response[1] + m_yy * response[5] + m_zz * response[9] + m_xz * response[15]
+        szz = m_xx * response[2] + m_yy * response[6] + m_zz * response[10] + m_xz * response[16]
+        sxz = m_xx * response[3] + m_yy * response[7] + m_zz * response[11] + m_xz * response[17]
+        sxy = m_xy * response[12] + m_yz * response[18]
+        syz = m_xy * response[13] + m_yz * response[19]
         # back to the global frame: sigma = R^T sigma' R, R rows (c, s, 0), (-s, c, 0), (0, 0, 1)
-        sxx, syy, szz = scratch[1, 0], scratch[1, 1], scratch[1, 2]
-        sxy, sxz, syz = scratch[1, 3], scratch[1, 4], scratch[1, 5]
         gxx = c * c * sxx - 2.0 * c * s * sxy + s * s * syy
         gyy = s * s * sxx + 2.0 * c * s * sxy + c * c * syy
         gxy = c * s * (sxx - syy) + (c * c - s * s) * sxy
@@ -394,7 +398,7 @@ def _rotated_stress(c, s, normal, shear_modulus, lame, weight, response, out, sc
         out[b, 2, 1] += weight * gyz
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def rectangle_covered(table, y, layer, center, frame, a, b, source_layer):
     """True when the table covers every point of the rectangle against the receiver ``y``."""
     if table.pair_index[source_layer, layer] < 0:

@@ -1,8 +1,8 @@
 """The scratch of the 3D layered kernel's per-pair functions (:mod:`.images3d`), made once
-a block: :func:`workspace` stashes its 69 arrays in one buffer
+a block: :func:`workspace` stashes its 79 arrays in one buffer
 (:func:`hmatddm.kernels.held_function.stash`), so that the drivers, which copy the
 workspace and pass it to inlined functions, take and drop one reference where they took
-69 -- code that LLVM optimised in every caller (the cold compile of the layered kernels,
+79 -- code that LLVM optimised in every caller (the cold compile of the layered kernels,
 issue 32: benchmarks/RESULTS.md, twelfth session). The held functions take ``work[1]``,
 the pointer to the tuple, and read its arrays one by one
 (:func:`hmatddm.kernels.held_function.item`). The record holds the function that makes it
@@ -18,6 +18,7 @@ from .image_tracer import trace_capacity
 from .image_tracer3d import _traced_buffer
 from .okada_point3d import POINT_SETUP
 from .potentials3d import Workspace
+from .remainder_rows3d import remainder_rows
 from .rectangle_quadrature import _cached_rules
 from .vertical3d import vertical_workspace
 
@@ -27,8 +28,8 @@ __all__ = ["workspace", "workspace_arrays"]
 @njit(cache=True, inline="always")
 def workspace(data):
     """:func:`workspace_arrays` stashed (:func:`hmatddm.kernels.held_function.stash`):
-    ``(buffer, pointer)``, the tuple of 69 arrays behind ``pointer`` (``work[1]``, what the
-    held functions take), so that a copy of the workspace takes one reference, not 69
+    ``(buffer, pointer)``, the tuple of 79 arrays behind ``pointer`` (``work[1]``, what the
+    held functions take), so that a copy of the workspace takes one reference, not 79
     (benchmarks/RESULTS.md, issue 32, twelfth session). Made by the record's held
     :func:`_make_workspace`."""
     return data.workspace_maker(held_record(data))
@@ -47,8 +48,9 @@ def workspace_arrays(data):
     of any source layer's triples, the tracer's room per layer ``(cap, n_orders)``, the
     :func:`.rectangle_quadrature._cached_rules`, the scratch of :func:`.okada3d.okada_stress` and of
     :func:`.vertical3d.vertical_image_stress`, the whole-space stress and the receiver point
-    of :func:`.images3d._complementary_stress`, and the arrays of the state of a source that traces
-    nothing (:func:`_untraced_state`: made once a block, not once a source)."""
+    of :func:`.images3d._complementary_stress`, the arrays of the state of a source that traces
+    nothing (:func:`_untraced_state`: made once a block, not once a source) and the rows of the
+    remainder's table a source keeps per receiver height (:func:`.remainder_rows3d.remainder_rows`)."""
     n_layers = data.shear_modulus.shape[0]
     room = np.zeros((n_layers, 2), dtype=np.int64)
     n_orders = np.int64(1)  # not a literal: one specialization of vertical_workspace
@@ -59,7 +61,8 @@ def workspace_arrays(data):
                 n_orders = max(n_orders, room[layer, 1])
     return (np.empty((3, 3, 3)), np.zeros((3, 3, 3)), np.empty((3, 3, 3, 3)), np.zeros((2, 3, 3, 1)), Workspace(1),
             Workspace(n_orders), room, _cached_rules(data.gauss_points), np.empty((5, 3, 3, 3)), np.empty((30, 4)),
-            vertical_workspace(n_orders), np.empty((3, 3, 3)), np.empty(3), _untraced_state(data.gauss_points))
+            vertical_workspace(n_orders), np.empty((3, 3, 3)), np.empty(3), _untraced_state(data.gauss_points),
+            remainder_rows(data.table))
 
 
 @njit(cache=True)
