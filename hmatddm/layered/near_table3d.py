@@ -207,9 +207,9 @@ def near_rectangle_stress(near, y, lr, center, frame, a, b, ls, shear_modulus, l
     ``b`` on the rectangle (in ``ls``, its moduli ``shear_modulus``, ``lame``) by the points
     ``lo .. hi - 1`` of the rule ``(xi, eta, wt)`` on [-1, 1]^2 (whole arrays and a range,
     not slices: one compiled signature for the cached rules and the sub-squares'), the
-    groups of sides ``side_lo <= side < side_hi`` (the top interface's 0, the bottom's 1): at each point the groups' tabulated responses summed
-    in the frame turned towards the receiver, contracted with the moment and turned back
-    once (:func:`.remainder_table3d._rotated_stress`); with the remainder's table at the same
+    groups of sides ``side_lo <= side < side_hi`` (the top interface's 0, the bottom's 1):
+    at each point the groups' tabulated responses summed in the frame turned towards the
+    receiver, contracted with the moment and turned back once (:func:`.remainder_table3d._rotated_stress`); with the remainder's table at the same
     points too, through the rows' ``entry`` of ``rows`` (:func:`.remainder_rows3d.rows_add`;
     -1: not here)."""
     normal = frame[2]
