@@ -118,6 +118,28 @@ def rows_entry(table, rows, j, y, layer, center, frame, a, b, source_layer, xi, 
     return e
 
 
+@njit(cache=True)
+def _fill_row(values, base, u, n_t, n_y, k0, j_lo, n_j, e, n_points, row, y_weights, t_nodes, t_weights, box,
+              values_rows):
+    """Row ``u`` of entry ``e``: the box's ``n_j`` nodes of ``t`` from ``j_lo`` contracted
+    along ``y3`` (the table's ``values`` from ``base``), then each point's ``t`` stencil, into
+    ``values_rows`` from ``row`` (compiled once, not inlined: its callers run it once a row)."""
+    for jj in range(n_j):
+        at = base + ((u * n_t + j_lo + jj) * n_y + k0) * _N_C
+        for c in range(_N_C):
+            v = 0.0
+            for d in range(STENCIL):
+                v += y_weights[e, 1 + d] * values[at + d * _N_C + c]
+            box[jj * _N_C + c] = v
+    for point in range(n_points):
+        first = (t_nodes[e, point] - j_lo) * _N_C
+        for c in range(_N_C):
+            v = 0.0
+            for q in range(STENCIL):
+                v += t_weights[e, point, q] * box[first + q * _N_C + c]
+            values_rows[row + point * _N_C + c] = v
+
+
 @njit(cache=True, inline="always")
 def rows_add(table, rows, e, layer, source_layer, rho, p, n_points, response):
     """``response[c] +=`` the remainder at the rule's point ``p`` (of ``n_points``), ``rho``
@@ -139,21 +161,8 @@ def rows_add(table, rows, e, layer, source_layer, rho, p, n_points, response):
         u = i0 + s
         row = (e * n_u_room + u) * MOST_POINTS * _N_C
         if not filled[e, u]:
-            for jj in range(n_j):
-                at = base + ((u * n_t + j_lo + jj) * n_y + k0) * _N_C
-                run = values[at:at + STENCIL * _N_C]
-                for c in range(_N_C):
-                    v = 0.0
-                    for d in range(STENCIL):
-                        v += y_weights[e, 1 + d] * run[d * _N_C + c]
-                    box[jj * _N_C + c] = v
-            for point in range(n_points):
-                first = (t_nodes[e, point] - j_lo) * _N_C
-                for c in range(_N_C):
-                    v = 0.0
-                    for q in range(STENCIL):
-                        v += t_weights[e, point, q] * box[first + q * _N_C + c]
-                    values_rows[row + point * _N_C + c] = v
+            _fill_row(values, base, u, n_t, n_y, k0, j_lo, n_j, e, n_points, row, y_weights, t_nodes, t_weights, box,
+                      values_rows)
             filled[e, u] = True
         w_u = u_weights[0, s]
         at = row + p * _N_C
@@ -161,7 +170,7 @@ def rows_add(table, rows, e, layer, source_layer, rho, p, n_points, response):
             response[c] += w_u * values_rows[at + c]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def remainder_rule(table, rows, j, y, layer, center, frame, a, b, source_layer, gauss_points, far_tol, entry_tol,
                    xi, eta, start):
     """``(lo, hi, entry)``: the cached rule's points of the remainder of rectangle ``j`` at

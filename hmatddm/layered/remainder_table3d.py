@@ -352,36 +352,32 @@ def remainder_point_stress(table, y, layer, x, source_layer, normal, shear_modul
 @njit(cache=True, inline="always")
 def _rotated_stress(c, s, normal, shear_modulus, lame, weight, response, out, scratch):
     """``out[b, i, k] += weight *`` the stress of the tabulated ``response`` in the frame
-    turned about z by ``(cos, sin) = (c, s)`` (:func:`remainder_point_stress`): the moment of
-    a unit DD along global ``b`` turned into that frame, contracted with the 20 components
-    (:data:`COMPONENTS`, written out: the loop over them through the index arrays cost twice
-    as much) and the stress turned back. ``scratch``: unused (the callers' room)."""
+    turned about z by ``(cos, sin) = (c, s)`` (:func:`remainder_point_stress`)."""
     # rotated components of the normal: v' = (c v1 + s v2, -s v1 + c v2, v3)
     n0 = c * normal[0] + s * normal[1]
     n1 = -s * normal[0] + c * normal[1]
     n2 = normal[2]
-    # the response's components by (moment, stress): m in (xx, yy, zz, xz) with s in (xx,
-    # yy, zz, xz), m in (xy, yz) with s in (xy, yz) (the order of COMPONENTS)
-    g = shear_modulus
+    nr = (n0, n1, n2)
     for b in range(3):
         # the rotated unit DD along global b
         b0 = c if b == 0 else (s if b == 1 else 0.0)
         b1 = -s if b == 0 else (c if b == 1 else 0.0)
         b2 = 1.0 if b == 2 else 0.0
+        br = (b0, b1, b2)
         bn = normal[b] * lame
-        m_xx = g * (b0 * n0 + b0 * n0) + bn
-        m_yy = g * (b1 * n1 + b1 * n1) + bn
-        m_zz = g * (b2 * n2 + b2 * n2) + bn
-        m_xy = g * (b0 * n1 + b1 * n0)
-        m_xz = g * (b0 * n2 + b2 * n0)
-        m_yz = g * (b1 * n2 + b2 * n1)
-        sxx = m_xx * response[0] + m_yy * response[4] + m_zz * response[8] + m_xz * response[14]
-        syy = m_xx * response[1] + m_yy * response[5] + m_zz * response[9] + m_xz * response[15]
-        szz = m_xx * response[2] + m_yy * response[6] + m_zz * response[10] + m_xz * response[16]
-        sxz = m_xx * response[3] + m_yy * response[7] + m_zz * response[11] + m_xz * response[17]
-        sxy = m_xy * response[12] + m_yz * response[18]
-        syz = m_xy * response[13] + m_yz * response[19]
+        for m in range(6):
+            p, q = _PAIRS[m, 0], _PAIRS[m, 1]
+            v = shear_modulus * (br[p] * nr[q] + br[q] * nr[p])
+            if p == q:
+                v += bn
+            scratch[0, m] = v
+        for m in range(6):
+            scratch[1, m] = 0.0
+        for comp in range(COMPONENTS.shape[0]):
+            scratch[1, COMPONENTS[comp, 1]] += scratch[0, COMPONENTS[comp, 0]] * response[comp]
         # back to the global frame: sigma = R^T sigma' R, R rows (c, s, 0), (-s, c, 0), (0, 0, 1)
+        sxx, syy, szz = scratch[1, 0], scratch[1, 1], scratch[1, 2]
+        sxy, sxz, syz = scratch[1, 3], scratch[1, 4], scratch[1, 5]
         gxx = c * c * sxx - 2.0 * c * s * sxy + s * s * syy
         gyy = s * s * sxx + 2.0 * c * s * sxy + c * c * syy
         gxy = c * s * (sxx - syy) + (c * c - s * s) * sxy
