@@ -124,8 +124,8 @@ from .source_traces3d import three_heights, traced_slot
 from .workspace3d import _make_workspace, workspace, workspace_arrays
 from .stress_terms3d import _stress_traced, element_stress_traced
 from .near_table3d import near_rectangle_stress
-from .remainder_rows3d import remainder_rule, remainder_terms
-from .remainder_table3d import rectangle_covered
+from .remainder_rows3d import remainder_rule
+from .remainder_table3d import rectangle_covered, remainder_rectangle_stress
 from .potentials3d import Workspace, base_derivatives, inverse_distance_derivatives, inverse_distance_scratch
 from .vertical3d import _vertical_stress
 from .rectangle_quadrature import (FAR_TOL, _image_order, _integrate, far_order, image_rectangle_stress,
@@ -461,9 +461,12 @@ def _complementary_stress(data_at, point, lr, j, state_at, work_at, entry_tol, i
             image_rectangle_stress_without(point, lr, center, frame, a, b, ls, interfaces, g, nu, data.n_images,
                                            n_gauss, n_sub, image, near_only, table.bottoms, table.tops, surface_form,
                                            data.surface)
-    if tabulated and not fused:
-        remainder_terms(table, rows, entry, point, lr, center, frame, a, b, ls, g_s, lame_s, xi, eta, wt, lo_r, hi_r,
-                        image)
+    if tabulated and not fused and entry >= 0:  # the remainder alone at its points, through the rows
+        near_rectangle_stress(table.near, point, lr, center, frame, a, b, ls, g_s, lame_s, xi, eta, wt, lo_r, hi_r,
+                              np.int64(0), np.int64(0), table, rows, entry, image)
+    elif tabulated and not fused:
+        remainder_rectangle_stress(table, point, lr, center, frame, a, b, ls, g_s, lame_s, xi[lo_r:hi_r],
+                                   eta[lo_r:hi_r], wt[lo_r:hi_r], image)
 
 
 @njit(cache=True, no_cpython_wrapper=True)  # held: called through its C wrapper only

@@ -48,11 +48,11 @@ from numba import njit
 
 from .image_tracer import trace_capacity
 from .image_tracer3d import trace
-from .images2d import _lame, receiver_constants
+from .images2d import receiver_constants
 from .potentials3d import Workspace, _original, _pair_stress_gradient
 from .remainder_rows3d import rows_add
 from .remainder_table3d import (COMPONENTS, PAD, STENCIL, _lagrange, _response, _rotated_stress, keep_near,
-                                layer_bounds)
+                                layer_bounds, trace_room)
 
 #: Powers of ``tau`` of a group's response (the ``D`` orders of a first reflection: 0 to 2).
 DEGREES = 3
@@ -128,16 +128,8 @@ def sample_group(ls, lr, anchor, reflected, source_side, receiver_sign, thetas, 
     layers' (:func:`.remainder_table3d.layer_bounds`)."""
     cap, n_orders = trace_capacity(ls, shear_modulus, 1)
     g_r, delta_r, lame_r = receiver_constants(shear_modulus, poisson_ratio, lr)
-    g_s = shear_modulus[ls]
-    nu_s = poisson_ratio[ls]
-    delta_s = 1.0 / (3.0 - 4.0 * nu_s)
-    lame_s = _lame(g_s, nu_s)
-    pair_layer = np.empty(cap, dtype=np.int64)
-    pair_z = np.empty(cap)
-    pair_eps = np.empty(cap)
-    pair_sigma = np.empty(cap)
-    coef = np.empty((cap, 3, 3, n_orders))
-    dcoef = np.empty((cap, 3, 3, n_orders))
+    g_s, delta_s, lame_s = receiver_constants(shear_modulus, poisson_ratio, ls)  # the source layer's
+    pair_layer, pair_z, pair_eps, pair_sigma, coef, dcoef = trace_room(cap, n_orders)
     work = Workspace(n_orders)
     work1 = Workspace(1)
     gradient = np.zeros((3, 3, 3, 3))

@@ -28,7 +28,7 @@ import numpy as np
 from numba import njit
 
 from .rectangle_quadrature import one_square_order
-from .remainder_table3d import COMPONENTS, PAD, STENCIL, _lagrange, _rotated_stress, remainder_rectangle_stress
+from .remainder_table3d import COMPONENTS, PAD, STENCIL, _lagrange
 
 #: Entries kept (source, receiver layer, receiver height, rule), reused round-robin.
 ENTRIES = 48
@@ -177,8 +177,9 @@ def remainder_rule(table, rows, j, y, layer, center, frame, a, b, source_layer, 
     ``y`` (:func:`.rectangle_quadrature.one_square_order` at the distance of the far
     triples' points: at least the table's clearance below or above, beside by the horizontal
     distance) and its entry of the rows (:func:`takes_rows`, :func:`rows_entry`; -1: the
-    table directly), for :func:`remainder_terms` or a caller that adds it at the same points
-    (:func:`.near_table3d.near_rectangle_stress`)."""
+    table directly, :func:`.remainder_table3d.remainder_rectangle_stress`), for
+    :func:`.near_table3d.near_rectangle_stress`, which adds it at a rule's points with the
+    near triples or alone."""
     r1 = y[0] - center[0]
     r2 = y[1] - center[1]
     beside = max(0.0, math.sqrt(r1 * r1 + r2 * r2) - a - b)
@@ -189,29 +190,3 @@ def remainder_rule(table, rows, j, y, layer, center, frame, a, b, source_layer, 
     if takes_rows(rows, j, hi - lo):
         entry = rows_entry(table, rows, j, y, layer, center, frame, a, b, source_layer, xi, eta, lo, hi)
     return lo, hi, entry
-
-
-@njit(cache=True)
-def remainder_terms(table, rows, entry, y, layer, center, frame, a, b, source_layer, shear_modulus, lame, xi, eta, wt,
-                    lo, hi, out):
-    """``out[b, i, k] +=`` the remainder's stress by the points ``lo .. hi - 1`` of the rule:
-    through the rows of ``entry`` (:func:`rows_add`), or the table directly
-    (:func:`.remainder_table3d.remainder_rectangle_stress`) where it is -1."""
-    if entry < 0:
-        remainder_rectangle_stress(table, y, layer, center, frame, a, b, source_layer, shear_modulus, lame, xi[lo:hi],
-                                   eta[lo:hi], wt[lo:hi], out)
-        return
-    response = rows[11]
-    normal = frame[2]
-    jac = a * b
-    for g in range(lo, hi):
-        x0 = center[0] + xi[g] * a * frame[0, 0] + eta[g] * b * frame[1, 0]
-        x1 = center[1] + xi[g] * a * frame[0, 1] + eta[g] * b * frame[1, 1]
-        r1 = y[0] - x0
-        r2 = y[1] - x1
-        rho = math.sqrt(r1 * r1 + r2 * r2)
-        for c in range(_N_C):
-            response[c] = 0.0
-        rows_add(table, rows, entry, layer, source_layer, rho, g - lo, hi - lo, response)
-        cos, sin = (r1 / rho, r2 / rho) if rho > 0.0 else (1.0, 0.0)
-        _rotated_stress(cos, sin, normal, shear_modulus, lame, wt[g] * jac, response, out, rows[12])

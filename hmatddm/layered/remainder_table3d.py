@@ -181,6 +181,14 @@ def _response(gradient, out):
         out[c] = v
 
 
+@njit(cache=True)
+def trace_room(cap, n_orders):
+    """Room for the triples of one traced source point (:func:`.image_tracer3d.trace`): their
+    layers, heights, ``eps``, gauges and coefficients (and their derivatives)."""
+    return (np.empty(cap, dtype=np.int64), np.empty(cap), np.empty(cap), np.empty(cap),
+            np.empty((cap, 3, 3, n_orders)), np.empty((cap, 3, 3, n_orders)))
+
+
 @njit(cache=True, parallel=True)
 def sample_remainder(source_layer, layer, rho, heights, receiver_heights, interfaces, shear_modulus, poisson_ratio,
                      n_images, bottoms, tops, out):
@@ -197,12 +205,7 @@ def sample_remainder(source_layer, layer, rho, heights, receiver_heights, interf
     whole_space = layer_gap(source_layer, layer, bottoms, tops) > 0.0
     for j in prange(heights.shape[0]):
         t = heights[j]
-        pair_layer = np.empty(cap, dtype=np.int64)
-        pair_z = np.empty(cap)
-        pair_eps = np.empty(cap)
-        pair_sigma = np.empty(cap)
-        coef = np.empty((cap, 3, 3, n_orders))
-        dcoef = np.empty((cap, 3, 3, n_orders))
+        pair_layer, pair_z, pair_eps, pair_sigma, coef, dcoef = trace_room(cap, n_orders)
         n = trace(t, source_layer, interfaces, shear_modulus, poisson_ratio, n_images, pair_layer, pair_z, pair_eps,
                   pair_sigma, coef, dcoef)
         work = Workspace(n_orders)
