@@ -25,8 +25,9 @@ extent (:mod:`.remainder_table3d`, ``LayeredMedium(method="table")``, the defaul
 ``method="quadrature"`` integrates every triple, the cross-check). With that table, the
 near triples' field at a quadrature point is itself a lookup: a first reflection or a
 transmission is homogeneous of degree -3 about its interface, so it is tabulated in one
-angle, exactly to 1e-11 (:mod:`.near_table3d`; three layers on the issue-32 lattice 23.8
--> 5.9 us a pair, one thread of the 2-core Xeon at dgemm 87 GFLOP/s, benchmarks/RESULTS.md,
+angle, exactly to 1e-11 (:mod:`.near_table3d`), and the remainder is contracted once per
+source and receiver height (:mod:`.remainder_rows3d`): three layers on the issue-32 lattice
+25 -> 5.2 us a pair, one thread of the 2-core Xeon at dgemm 73 GFLOP/s (benchmarks/RESULTS.md,
 thirteenth session). In a half-space (one
 solid layer under a void) the image and surface terms of a rectangle with a horizontal side
 are in closed form (:mod:`.okada3d`, Okada 1992; ``LayeredRectangles.closed_form``). With
