@@ -48,13 +48,12 @@ _N_C = COMPONENTS.shape[0]
 @njit(cache=True)
 def remainder_rows(table):
     """The workspace's room: ``(rows, filled, keys, heights, t_nodes, t_weights, y_weights,
-    state, u_nodes, u_weights, box, response, scratch)`` -- the rows of :data:`ENTRIES`
+    state, u_nodes, u_weights, box)`` -- the rows of :data:`ENTRIES`
     entries for the largest grid's nodes of ``u`` (empty without a table), which rows hold
     values, each entry's ``(source, layer, rule's first point, first t node of its box, t
     nodes)``, its receiver height, its points' ``t`` stencils (first nodes, weights) and its
     ``y3`` stencil (first node, weights), ``(next entry, source served, receivers served)``,
-    a pair's ``u`` stencils, the box's contraction along ``y3`` a fill, a response and the
-    rotation's scratch."""
+    a pair's ``u`` stencils and the box's contraction along ``y3`` a fill."""
     n_u = 0
     if table.pair_index.max() >= 0:
         for k in range(table.grid.shape[0]):
@@ -67,7 +66,7 @@ def remainder_rows(table):
     return (np.empty(n_entries * n_u * MOST_POINTS * _N_C), np.zeros((n_entries, n_u), dtype=np.bool_), keys,
             np.zeros(room), np.zeros((room, MOST_POINTS), dtype=np.int64), np.zeros((room, MOST_POINTS, STENCIL)),
             np.zeros((room, STENCIL + 1)), state, np.empty(MOST_POINTS, dtype=np.int64),
-            np.empty((MOST_POINTS, STENCIL)), np.empty(BOX_T * _N_C), np.empty(_N_C), np.empty((2, 6)))
+            np.empty((MOST_POINTS, STENCIL)), np.empty(BOX_T * _N_C))
 
 
 @njit(cache=True, inline="always")

@@ -1,8 +1,8 @@
 """The scratch of the 3D layered kernel's per-pair functions (:mod:`.images3d`), made once
-a block: :func:`workspace` stashes its 79 arrays in one buffer
+a block: :func:`workspace` stashes its 80 arrays in one buffer
 (:func:`hmatddm.kernels.held_function.stash`), so that the drivers, which copy the
 workspace and pass it to inlined functions, take and drop one reference where they took
-79 -- code that LLVM optimised in every caller (the cold compile of the layered kernels,
+80 -- code that LLVM optimised in every caller (the cold compile of the layered kernels,
 issue 32: benchmarks/RESULTS.md, twelfth session). The held functions take ``work[1]``,
 the pointer to the tuple, and read its arrays one by one
 (:func:`hmatddm.kernels.held_function.item`). The record holds the function that makes it
@@ -28,8 +28,8 @@ __all__ = ["workspace", "workspace_arrays"]
 @njit(cache=True, inline="always")
 def workspace(data):
     """:func:`workspace_arrays` stashed (:func:`hmatddm.kernels.held_function.stash`):
-    ``(buffer, pointer)``, the tuple of 79 arrays behind ``pointer`` (``work[1]``, what the
-    held functions take), so that a copy of the workspace takes one reference, not 79
+    ``(buffer, pointer)``, the tuple of 80 arrays behind ``pointer`` (``work[1]``, what the
+    held functions take), so that a copy of the workspace takes one reference, not 80
     (benchmarks/RESULTS.md, issue 32, twelfth session). Made by the record's held
     :func:`_make_workspace`."""
     return data.workspace_maker(held_record(data))
