@@ -51,8 +51,9 @@ from .image_tracer3d import trace
 from .images2d import receiver_constants
 from .potentials3d import Workspace, _original, _pair_stress_gradient
 from .remainder_rows3d import rows_add
-from .remainder_table3d import (COMPONENTS, PAD, STENCIL, _lagrange, _response, _rotated_stress, keep_near,
+from .remainder_table3d import (COMPONENTS, PAD, STENCIL, U_COMPONENTS, U_STENCIL, _lagrange, _response, keep_near,
                                 layer_bounds, trace_room)
+from .turned_response3d import rotated_stress
 
 #: Powers of ``tau`` of a group's response (the ``D`` orders of a first reflection: 0 to 2).
 DEGREES = 3
@@ -71,6 +72,7 @@ NEAR_ERROR_SAMPLES = 200
 FIT_TAUS = (0.25, 0.5, 0.75, 0.9)
 
 _N_C = COMPONENTS.shape[0]
+_U_NODE, _U_TWICE = np.uint64(DEGREES * _N_C), np.uint64(2 * _N_C)  # a node's values, unsigned
 
 
 class NearTable(NamedTuple):
@@ -176,19 +178,20 @@ def _add_group(near, q, rho, t, y3, response, w):
     n = near.n_nodes
     i0 = _lagrange(rho / (radius + abs(r3)), -PAD * near.step, near.step, n, w, 0)  # tan(theta / 2)
     values = near.values
-    at = ((q * n + i0) * DEGREES) * _N_C
-    node = DEGREES * _N_C
+    # unsigned offsets (turned_response3d.U_COMPONENTS: no negative-index checks)
+    at = np.uint64((q * n + i0) * DEGREES * _N_C)
     # each power of tau (DEGREES = 3 of them) summed over the stencil in a register, then
     # once into the response (its stores were a tenth of a group's cost)
-    for c in range(_N_C):
+    for c in range(U_COMPONENTS):
         v0 = 0.0
         v1 = 0.0
         v2 = 0.0
-        for s in range(STENCIL):
+        for s in range(U_STENCIL):
+            k = at + s * _U_NODE + c
             ws = w[0, s]
-            v0 += ws * values[at + s * node + c]
-            v1 += ws * values[at + s * node + _N_C + c]
-            v2 += ws * values[at + s * node + 2 * _N_C + c]
+            v0 += ws * values[k]
+            v1 += ws * values[k + U_COMPONENTS]
+            v2 += ws * values[k + _U_TWICE]
         response[c] += inv3 * (v0 + tau * (v1 + tau * v2))
 
 
@@ -201,14 +204,13 @@ def near_rectangle_stress(near, y, lr, center, frame, a, b, ls, shear_modulus, l
     not slices: one compiled signature for the cached rules and the sub-squares'), the
     groups of sides ``side_lo <= side < side_hi`` (the top interface's 0, the bottom's 1):
     at each point the groups' tabulated responses summed in the frame turned towards the
-    receiver, contracted with the moment and turned back once (:func:`.remainder_table3d._rotated_stress`); with the remainder's table at the same
+    receiver, contracted with the moment and turned back once
+    (:func:`.turned_response3d.rotated_stress`); with the remainder's table at the same
     points too, through the rows' ``entry`` of ``rows`` (:func:`.remainder_rows3d.rows_add`;
     -1: not here)."""
     normal = frame[2]
     jac = a * b
-    response = np.empty(_N_C)
-    w = np.empty((1, STENCIL))
-    scratch = np.empty((2, 6))
+    response, w = rows[11], rows[12]  # the workspace's scratch, not allocated a call
     q0 = near.group[ls, lr, 0] if side_lo <= 0 < side_hi else -1
     q1 = near.group[ls, lr, 1] if side_lo <= 1 < side_hi else -1
     for g in range(lo, hi):
@@ -227,7 +229,7 @@ def near_rectangle_stress(near, y, lr, center, frame, a, b, ls, shear_modulus, l
         if entry >= 0:
             rows_add(table, rows, entry, lr, ls, rho, g - lo, hi - lo, response)
         cos, sin = (r1 / rho, r2 / rho) if rho > 0.0 else (1.0, 0.0)
-        _rotated_stress(cos, sin, normal, shear_modulus, lame, wt[g] * jac, response, out, scratch)
+        rotated_stress(cos, sin, normal, shear_modulus, lame, wt[g] * jac, response, out)
 
 
 def _fit(samples):

@@ -28,7 +28,7 @@ import numpy as np
 from numba import njit
 
 from .rectangle_quadrature import one_square_order
-from .remainder_table3d import COMPONENTS, PAD, STENCIL, _lagrange
+from .remainder_table3d import COMPONENTS, PAD, STENCIL, U_COMPONENTS, _lagrange
 
 #: Entries kept (source, receiver layer, receiver height, rule), reused round-robin.
 ENTRIES = 48
@@ -48,12 +48,14 @@ _N_C = COMPONENTS.shape[0]
 @njit(cache=True)
 def remainder_rows(table):
     """The workspace's room: ``(rows, filled, keys, heights, t_nodes, t_weights, y_weights,
-    state, u_nodes, u_weights, box)`` -- the rows of :data:`ENTRIES`
+    state, u_nodes, u_weights, box, response, weights)`` -- the rows of :data:`ENTRIES`
     entries for the largest grid's nodes of ``u`` (empty without a table), which rows hold
     values, each entry's ``(source, layer, rule's first point, first t node of its box, t
     nodes)``, its receiver height, its points' ``t`` stencils (first nodes, weights) and its
     ``y3`` stencil (first node, weights), ``(next entry, source served, receivers served)``,
-    a pair's ``u`` stencils and the box's contraction along ``y3`` a fill."""
+    a pair's ``u`` stencils, the box's contraction along ``y3`` a fill, and a point's
+    response and stencil weights for :func:`.near_table3d.near_rectangle_stress` (arrays it
+    allocated a call)."""
     n_u = 0
     if table.pair_index.max() >= 0:
         for k in range(table.grid.shape[0]):
@@ -66,7 +68,7 @@ def remainder_rows(table):
     return (np.empty(n_entries * n_u * MOST_POINTS * _N_C), np.zeros((n_entries, n_u), dtype=np.bool_), keys,
             np.zeros(room), np.zeros((room, MOST_POINTS), dtype=np.int64), np.zeros((room, MOST_POINTS, STENCIL)),
             np.zeros((room, STENCIL + 1)), state, np.empty(MOST_POINTS, dtype=np.int64),
-            np.empty((MOST_POINTS, STENCIL)), np.empty(BOX_T * _N_C))
+            np.empty((MOST_POINTS, STENCIL)), np.empty(BOX_T * _N_C), np.empty(_N_C), np.empty((1, STENCIL)))
 
 
 @njit(cache=True, inline="always")
@@ -124,12 +126,14 @@ def _fill_row(values, base, u, n_t, n_y, k0, j_lo, n_j, e, n_points, row, y_weig
     along ``y3`` (the table's ``values`` from ``base``), then each point's ``t`` stencil, into
     ``values_rows`` from ``row`` (compiled once, not inlined: its callers run it once a row)."""
     for jj in range(n_j):
-        at = base + ((u * n_t + j_lo + jj) * n_y + k0) * _N_C
-        for c in range(_N_C):
+        # unsigned offsets (turned_response3d.U_COMPONENTS: no negative-index checks)
+        at = np.uint64(base + ((u * n_t + j_lo + jj) * n_y + k0) * _N_C)
+        to = np.uint64(jj * _N_C)
+        for c in range(U_COMPONENTS):
             v = 0.0
             for d in range(STENCIL):
-                v += y_weights[e, 1 + d] * values[at + d * _N_C + c]
-            box[jj * _N_C + c] = v
+                v += y_weights[e, 1 + d] * values[at + np.uint64(d) * U_COMPONENTS + c]
+            box[to + c] = v
     for point in range(n_points):
         first = (t_nodes[e, point] - j_lo) * _N_C
         for c in range(_N_C):
@@ -164,8 +168,8 @@ def rows_add(table, rows, e, layer, source_layer, rho, p, n_points, response):
                       values_rows)
             filled[e, u] = True
         w_u = u_weights[0, s]
-        at = row + p * _N_C
-        for c in range(_N_C):
+        at = np.uint64(row + p * _N_C)  # unsigned (turned_response3d.U_COMPONENTS)
+        for c in range(U_COMPONENTS):
             response[c] += w_u * values_rows[at + c]
 
 

@@ -48,6 +48,7 @@ from .image_tracer import trace_capacity
 from .image_tracer3d import copy_triple, trace
 from .images2d import _lame, receiver_constants
 from .potentials3d import Workspace, _original, _pair_stress_gradient
+from .turned_response3d import COMPONENTS, PAIRS as _PAIRS, U_COMPONENTS, rotated_stress
 
 #: Largest number of values a table may hold (8 bytes each) before refinement stops.
 MAX_TABLE_VALUES = 40_000_000
@@ -55,18 +56,6 @@ MAX_TABLE_VALUES = 40_000_000
 #: (half of them near the ends of the height ranges).
 ERROR_SAMPLES = 128
 
-# the 6 symmetric index pairs of a moment or a stress: xx, yy, zz, xy, xz, yz
-_PAIRS = np.array([[0, 0], [1, 1], [2, 2], [0, 1], [0, 2], [1, 2]], dtype=np.int64)
-
-
-def _nonzero_components():
-    """``(m, s)`` of the 20 response components that the mirror ``y -> -y`` leaves (the
-    number of ``y`` indices of the moment and the stress is even)."""
-    count = [int(p == 1) + int(q == 1) for p, q in _PAIRS]
-    return np.array([[m, s] for m in range(6) for s in range(6) if (count[m] + count[s]) % 2 == 0], dtype=np.int64)
-
-
-COMPONENTS = _nonzero_components()
 
 
 class RemainderTable(NamedTuple):
@@ -237,6 +226,8 @@ def sample_remainder(source_layer, layer, rho, heights, receiver_heights, interf
 #: Nodes per variable of the local Lagrange interpolation (degree ``STENCIL - 1``): the
 #: error falls like ``(h / clearance)^STENCIL``.
 STENCIL = 6
+#: :data:`STENCIL` unsigned (:data:`U_COMPONENTS`).
+U_STENCIL = np.uint64(STENCIL)
 #: Nodes each grid carries beyond either end of its range, so that every stencil in the
 #: range is centred. The remainder continues analytically past a layer's boundary; with
 #: the source and the receiver both padded, its singular points stay at least
@@ -331,13 +322,12 @@ def interpolate(table, source_layer, layer, rho, t, y3, out, w):
 
 
 @njit(cache=True, inline="always")
-def remainder_point_stress(table, y, layer, x, source_layer, normal, shear_modulus, lame, weight, out, response, w,
-                           scratch):
+def remainder_point_stress(table, y, layer, x, source_layer, normal, shear_modulus, lame, weight, out, response, w):
     """``out[b, i, k] += weight *`` the remainder's stress at ``y`` (in ``layer``) of a unit
     DD density along global ``b`` at ``x`` (in ``source_layer``) on a plane of ``normal``,
-    the source layer's moduli (``response``, ``w`` (:func:`interpolation_scratch`),
-    ``scratch`` (2, 6): scratch): the table in the frame rotated about z towards the
-    receiver, contracted with the rotated moment tensor (``scratch[0]``) and rotated back.
+    the source layer's moduli (``response``, ``w`` (:func:`interpolation_scratch`):
+    scratch): the table in the frame rotated about z towards the receiver, contracted with
+    the rotated moment tensor and rotated back (:func:`.turned_response3d.rotated_stress`).
     No call and no array view: numba takes no reference counts (atomic operations) in the
     loop over the points of a rule."""
     r1 = y[0] - x[0]
@@ -349,52 +339,7 @@ def remainder_point_stress(table, y, layer, x, source_layer, normal, shear_modul
         c = r1 / rho
         s = r2 / rho
     interpolate(table, source_layer, layer, rho, x[2], y[2], response, w)
-    _rotated_stress(c, s, normal, shear_modulus, lame, weight, response, out, scratch)
-
-
-@njit(cache=True, inline="always")
-def _rotated_stress(c, s, normal, shear_modulus, lame, weight, response, out, scratch):
-    """``out[b, i, k] += weight *`` the stress of the tabulated ``response`` in the frame
-    turned about z by ``(cos, sin) = (c, s)`` (:func:`remainder_point_stress`)."""
-    # rotated components of the normal: v' = (c v1 + s v2, -s v1 + c v2, v3)
-    n0 = c * normal[0] + s * normal[1]
-    n1 = -s * normal[0] + c * normal[1]
-    n2 = normal[2]
-    nr = (n0, n1, n2)
-    for b in range(3):
-        # the rotated unit DD along global b
-        b0 = c if b == 0 else (s if b == 1 else 0.0)
-        b1 = -s if b == 0 else (c if b == 1 else 0.0)
-        b2 = 1.0 if b == 2 else 0.0
-        br = (b0, b1, b2)
-        bn = normal[b] * lame
-        for m in range(6):
-            p, q = _PAIRS[m, 0], _PAIRS[m, 1]
-            v = shear_modulus * (br[p] * nr[q] + br[q] * nr[p])
-            if p == q:
-                v += bn
-            scratch[0, m] = v
-        for m in range(6):
-            scratch[1, m] = 0.0
-        for comp in range(COMPONENTS.shape[0]):
-            scratch[1, COMPONENTS[comp, 1]] += scratch[0, COMPONENTS[comp, 0]] * response[comp]
-        # back to the global frame: sigma = R^T sigma' R, R rows (c, s, 0), (-s, c, 0), (0, 0, 1)
-        sxx, syy, szz = scratch[1, 0], scratch[1, 1], scratch[1, 2]
-        sxy, sxz, syz = scratch[1, 3], scratch[1, 4], scratch[1, 5]
-        gxx = c * c * sxx - 2.0 * c * s * sxy + s * s * syy
-        gyy = s * s * sxx + 2.0 * c * s * sxy + c * c * syy
-        gxy = c * s * (sxx - syy) + (c * c - s * s) * sxy
-        gxz = c * sxz - s * syz
-        gyz = s * sxz + c * syz
-        out[b, 0, 0] += weight * gxx
-        out[b, 1, 1] += weight * gyy
-        out[b, 2, 2] += weight * szz
-        out[b, 0, 1] += weight * gxy
-        out[b, 1, 0] += weight * gxy
-        out[b, 0, 2] += weight * gxz
-        out[b, 2, 0] += weight * gxz
-        out[b, 1, 2] += weight * gyz
-        out[b, 2, 1] += weight * gyz
+    rotated_stress(c, s, normal, shear_modulus, lame, weight, response, out)
 
 
 @njit(cache=True, inline="always")
@@ -424,7 +369,6 @@ def remainder_rectangle_stress(table, y, layer, center, frame, a, b, source_laye
     x = np.empty(3)
     response = np.empty(COMPONENTS.shape[0])
     w = interpolation_scratch()
-    scratch = np.empty((2, 6))
     normal = frame[2]
     jac = a * b
     k = table.pair_index[source_layer, layer]
@@ -453,7 +397,7 @@ def remainder_rectangle_stress(table, y, layer, center, frame, a, b, source_laye
             for c in range(3):
                 x[c] = center[c] + xi[g] * a * frame[0, c] + eta[g] * b * frame[1, c]
             remainder_point_stress(table, y, layer, x, source_layer, normal, shear_modulus, lame, wt[g] * jac, out,
-                                   response, w, scratch)
+                                   response, w)
         return
     k0 = _lagrange(y[2], grid[k, 6], grid[k, 7], n_y, w, 2)
     contracted = np.empty((n_i * n_j, n_c))
@@ -482,4 +426,4 @@ def remainder_rectangle_stress(table, y, layer, center, frame, a, b, source_laye
         r2 = y[1] - x[1]
         rho = math.sqrt(r1 * r1 + r2 * r2)
         cos, sin = (r1 / rho, r2 / rho) if rho > 0.0 else (1.0, 0.0)
-        _rotated_stress(cos, sin, normal, shear_modulus, lame, wt[g] * jac, response, out, scratch)
+        rotated_stress(cos, sin, normal, shear_modulus, lame, wt[g] * jac, response, out)

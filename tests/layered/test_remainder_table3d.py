@@ -123,8 +123,7 @@ def test_near_triples_plus_the_table_give_the_image_sum_at_points():
         remainder = np.zeros((3, 3, 3))
         assert rt.covers(table, ls, lr, x[2], y[2], np.hypot(*(y - x)[:2]))
         rt.remainder_point_stress(table, y, lr, x, ls, normal, g[ls], _lame(g[ls], nu[ls]), 1.0, remainder,
-                                  np.empty(len(rt.COMPONENTS)), np.empty((3, rt.STENCIL)),
-                                  np.empty((2, 6)))
+                                  np.empty(len(rt.COMPONENTS)), np.empty((3, rt.STENCIL)))
         worst = max(worst, np.abs(full - near - remainder).max())
     assert worst <= 1e-6 * 10.0 / 0.09
 
@@ -308,7 +307,7 @@ def test_a_rule_contracted_once_along_the_receiver_height_equals_its_points_one_
             for k in range(len(xi)):
                 x = center + xi[k] * a * frame[0] + eta[k] * b * frame[1]
                 rt.remainder_point_stress(table, y, lr, x, ls, frame[2], g[ls], lame, wt[k] * a * b, points,
-                                          np.empty(len(rt.COMPONENTS)), rt.interpolation_scratch(), np.empty((2, 6)))
+                                          np.empty(len(rt.COMPONENTS)), rt.interpolation_scratch())
             assert np.abs(rule - points).max() <= 1e-14 * np.abs(points).max()
             compared += 1
     assert compared >= 30
