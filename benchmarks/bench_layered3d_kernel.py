@@ -127,10 +127,11 @@ def issue32(args):
 
 
 def whole(error_rows, repeats=5, media=None):
-    """``{medium: (CPU s, wall s, CPU us / pair, error)}`` of the whole issue-32 matrix, uniform
-    rock and the half-space the best of ``repeats`` after a whole untimed one (the first one or
-    two after another kernel's ran up to 1.5x slower), the three layers once; ``media``: the
-    names of the media to run (None: all)."""
+    """``{medium: (CPU s, wall s, CPU us / pair, error)}`` of the whole issue-32 matrix, each
+    medium the best of ``repeats`` after a whole untimed one (the first one or two after
+    another kernel's ran up to 1.5x slower; the three layers were timed once while a matrix
+    took minutes, up to the thirteenth session); ``media``: the names of the media to run
+    (None: all)."""
     grid = issue32_mesh()
     every = np.arange(grid.n_elements, dtype=np.int64)
     g = 1.0
@@ -143,9 +144,8 @@ def whole(error_rows, repeats=5, media=None):
         if media is not None and name.split(",")[0].split(" ")[0] not in media:
             continue
         data = operators.influence_data(grid, medium)  # the three layers' table is built here
-        if not name.startswith("surface"):
-            _timed(data, every, every)  # a whole warm-up: the first runs after another kernel's are slower
-        runs = [_timed(data, every, every) for _ in range(1 if name.startswith("surface") else repeats)]
+        _timed(data, every, every)  # a whole warm-up: the first runs after another kernel's are slower
+        runs = [_timed(data, every, every) for _ in range(repeats)]
         out, cpu, wall = min(runs, key=lambda run: run[1])
         error = "-"
         if name.startswith("surface"):

@@ -176,6 +176,26 @@ def dereference(typingctx, pointer):
     return pointer.dtype(pointer), codegen
 
 
+@intrinsic
+def data_pointer(typingctx, array):
+    """The address of a C-contiguous array's first element (``CPointer`` of its dtype),
+    indexed as the flat array: no reference counts (numba calls ``NRT_incref`` and
+    ``NRT_decref``, functions it never inlines, for each array an inlined function takes or a
+    record's field it reads, ~10 calls a near-table lookup of the layered 3D kernel) and no
+    check for a negative index. Valid while the array lives; for hot loops over arrays held
+    elsewhere (a record, a workspace). A boolean array's pointer is of ``uint8`` (numba loads
+    a boolean through a pointer as the byte it stores)."""
+    if not isinstance(array, types.Array) or array.layout != "C":
+        return None
+    dtype = types.uint8 if isinstance(array.dtype, types.Boolean) else array.dtype
+
+    def codegen(context, builder, signature, args):
+        data = make_array(array)(context, builder, args[0]).data
+        return builder.bitcast(data, context.get_value_type(signature.return_type))
+
+    return types.CPointer(dtype)(array), codegen
+
+
 def _array_leaves(kind, path=()):
     """``(path, array type)`` of every array in ``kind`` (an array, or tuples of them)."""
     if isinstance(kind, types.Array):
@@ -275,4 +295,5 @@ def item(typingctx, pointer, index):
     return kind(pointer, index), codegen
 
 
-__all__ = ["HeldFunction", "without_functions", "address_of", "held_record", "dereference", "stash", "item"]
+__all__ = ["HeldFunction", "without_functions", "address_of", "held_record", "dereference", "stash", "item",
+           "data_pointer"]

@@ -124,7 +124,7 @@ from .image_tracer3d import _traced_buffer, trace, trace_points
 from .source_traces3d import three_heights, traced_slot
 from .workspace3d import _make_workspace, workspace, workspace_arrays
 from .stress_terms3d import _stress_traced, element_stress_traced
-from .near_table3d import near_rectangle_stress
+from .near_table3d import near_rule_stress
 from .remainder_rows3d import remainder_rule
 from .remainder_table3d import rectangle_covered, remainder_rectangle_stress
 from .potentials3d import Workspace, base_derivatives, inverse_distance_derivatives, inverse_distance_scratch
@@ -424,19 +424,18 @@ def _complementary_stress(data_at, point, lr, j, state_at, work_at, entry_tol, i
                     # the remainder added at the same points when its rule is this one (one turn a point)
                     with_rows = entry if not fused and start[n - 1] == lo_r and start[n] == hi_r else -1
                     fused = fused or with_rows >= 0
-                    near_rectangle_stress(near, point, lr, center, frame, a, b, ls, g_s, lame_s, xi, eta, wt,
-                                          start[n - 1], start[n], side, side + 1, table, rows, with_rows, image)
+                    near_rule_stress(data_at, work_at, point, lr, center, frame, a, b, ls, g_s, lame_s, xi, eta, wt,
+                                     start[n - 1], start[n], side, side + 1, with_rows, image)
             elif n_sub <= 2:
                 slot = n_gauss - 1 if n_sub == 1 else data.gauss_points
                 with_rows = entry if start[slot] == lo_r and start[slot + 1] == hi_r else -1
                 fused = with_rows >= 0
-                near_rectangle_stress(near, point, lr, center, frame, a, b, ls, g_s, lame_s, xi, eta, wt, start[slot],
-                                      start[slot + 1], first, every, table, rows, with_rows, image)
+                near_rule_stress(data_at, work_at, point, lr, center, frame, a, b, ls, g_s, lame_s, xi, eta, wt,
+                                 start[slot], start[slot + 1], first, every, with_rows, image)
             else:
                 sub_xi, sub_eta, sub_wt = square_rule(n_gauss, n_sub)
-                near_rectangle_stress(near, point, lr, center, frame, a, b, ls, g_s, lame_s, sub_xi, sub_eta, sub_wt,
-                                      np.int64(0), np.int64(sub_xi.shape[0]), first, every, table, rows,
-                                      np.int64(-1), image)
+                near_rule_stress(data_at, work_at, point, lr, center, frame, a, b, ls, g_s, lame_s, sub_xi, sub_eta,
+                                 sub_wt, np.int64(0), np.int64(sub_xi.shape[0]), first, every, np.int64(-1), image)
         elif not closed and n_sub == 1 and tabulated and lr == ls:
             # with the rest tabulated, the near triples of the receiver's own layer are its
             # first reflections in the layer's top (above it) and bottom (below it): each
@@ -463,8 +462,8 @@ def _complementary_stress(data_at, point, lr, j, state_at, work_at, entry_tol, i
                                            n_gauss, n_sub, image, near_only, table.bottoms, table.tops, surface_form,
                                            data.surface)
     if tabulated and not fused and entry >= 0:  # the remainder alone at its points, through the rows
-        near_rectangle_stress(table.near, point, lr, center, frame, a, b, ls, g_s, lame_s, xi, eta, wt, lo_r, hi_r,
-                              np.int64(0), np.int64(0), table, rows, entry, image)
+        near_rule_stress(data_at, work_at, point, lr, center, frame, a, b, ls, g_s, lame_s, xi, eta, wt, lo_r, hi_r,
+                         np.int64(0), np.int64(0), entry, image)
     elif tabulated and not fused:
         remainder_rectangle_stress(table, point, lr, center, frame, a, b, ls, g_s, lame_s, xi[lo_r:hi_r],
                                    eta[lo_r:hi_r], wt[lo_r:hi_r], image)

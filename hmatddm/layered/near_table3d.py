@@ -50,8 +50,9 @@ from .image_tracer import trace_capacity
 from .image_tracer3d import trace
 from .images2d import receiver_constants
 from .potentials3d import Workspace, _original, _pair_stress_gradient
-from .remainder_rows3d import rows_add
-from .remainder_table3d import (COMPONENTS, PAD, STENCIL, U_COMPONENTS, U_STENCIL, _lagrange, _response, keep_near,
+from ..kernels.held_function import data_pointer, dereference, item
+from .remainder_rows3d import ROWS_ITEM, rows_add, rows_view
+from .remainder_table3d import (COMPONENTS, PAD, STENCIL, _response, keep_near, lagrange_at,
                                 layer_bounds, trace_room)
 from .turned_response3d import rotated_stress
 
@@ -72,7 +73,6 @@ NEAR_ERROR_SAMPLES = 200
 FIT_TAUS = (0.25, 0.5, 0.75, 0.9)
 
 _N_C = COMPONENTS.shape[0]
-_U_NODE, _U_TWICE = np.uint64(DEGREES * _N_C), np.uint64(2 * _N_C)  # a node's values, unsigned
 
 
 class NearTable(NamedTuple):
@@ -165,9 +165,20 @@ def sample_group(ls, lr, anchor, reflected, source_side, receiver_sign, thetas, 
 def _add_group(near, q, rho, t, y3, response, w):
     """``response[c] +=`` group ``q``'s tabulated response at the horizontal offset ``rho``
     from a source point at height ``t``, the receiver at height ``y3`` (``w``: (1, STENCIL)
-    scratch). Inlined, its arrays indexed whole (no reference counts in the loop of a rule)."""
-    d = near.anchor[q]
-    point = 2.0 * d - t if near.reflected[q] > 0.0 else t
+    scratch)."""
+    _add_group_at(data_pointer(near.anchor), data_pointer(near.reflected), data_pointer(near.values), near.step,
+                  near.n_nodes, q, rho, t, y3, data_pointer(response), data_pointer(w))
+
+
+@njit(cache=True, inline="always")
+def _add_group_at(anchor, reflected, values, step, n, q, rho, t, y3, response, w):
+    """:func:`_add_group` on pointers to the table's arrays, the response and the scratch
+    (:func:`hmatddm.kernels.held_function.data_pointer`, taken once a rule): indexed
+    without reference counts (~10 calls of numba's ``NRT_incref``/``NRT_decref`` a lookup
+    with arrays) or checks for a negative index (LLVM gathered a stencil's loads one by
+    one: half a lookup's cost)."""
+    d = anchor[q]
+    point = 2.0 * d - t if reflected[q] > 0.0 else t
     r3 = y3 - point
     r2 = rho * rho + r3 * r3
     if r2 <= 0.0:
@@ -175,23 +186,20 @@ def _add_group(near, q, rho, t, y3, response, w):
     radius = math.sqrt(r2)
     inv3 = 1.0 / (r2 * radius)
     tau = abs(t - d) / radius
-    n = near.n_nodes
-    i0 = _lagrange(rho / (radius + abs(r3)), -PAD * near.step, near.step, n, w, 0)  # tan(theta / 2)
-    values = near.values
-    # unsigned offsets (turned_response3d.U_COMPONENTS: no negative-index checks)
-    at = np.uint64((q * n + i0) * DEGREES * _N_C)
+    i0 = lagrange_at(rho / (radius + abs(r3)), -PAD * step, step, n, w, 0)  # tan(theta / 2)
+    at = (q * n + i0) * DEGREES * _N_C
     # each power of tau (DEGREES = 3 of them) summed over the stencil in a register, then
     # once into the response (its stores were a tenth of a group's cost)
-    for c in range(U_COMPONENTS):
+    for c in range(_N_C):
         v0 = 0.0
         v1 = 0.0
         v2 = 0.0
-        for s in range(U_STENCIL):
-            k = at + s * _U_NODE + c
-            ws = w[0, s]
+        for s in range(STENCIL):
+            k = at + s * DEGREES * _N_C + c
+            ws = w[s]
             v0 += ws * values[k]
-            v1 += ws * values[k + U_COMPONENTS]
-            v2 += ws * values[k + _U_TWICE]
+            v1 += ws * values[k + _N_C]
+            v2 += ws * values[k + 2 * _N_C]
         response[c] += inv3 * (v0 + tau * (v1 + tau * v2))
 
 
@@ -208,9 +216,34 @@ def near_rectangle_stress(near, y, lr, center, frame, a, b, ls, shear_modulus, l
     (:func:`.turned_response3d.rotated_stress`); with the remainder's table at the same
     points too, through the rows' ``entry`` of ``rows`` (:func:`.remainder_rows3d.rows_add`;
     -1: not here)."""
+    _rule_stress(near, y, lr, center, frame, a, b, ls, shear_modulus, lame, xi, eta, wt, lo, hi, side_lo, side_hi,
+                 table, rows, entry, out)
+
+
+@njit(cache=True, no_cpython_wrapper=True)  # compiled callers only
+def near_rule_stress(data_at, work_at, y, lr, center, frame, a, b, ls, shear_modulus, lame, xi, eta, wt, lo, hi,
+                     side_lo, side_hi, entry, out):
+    """:func:`near_rectangle_stress` of the record's table, the rows those of the workspace
+    (:mod:`.workspace3d`), both by pointer (:mod:`hmatddm.kernels.held_function`): what
+    :func:`.images3d._complementary_stress` calls. Passed by value, the near table, the
+    remainder's and the rows were 35 arrays, each split into its fields for the call: ~1 us
+    a call, ~2 calls a three-layer pair on the issue-32 lattice (RESULTS.md, fourteenth session)."""
+    table = dereference(data_at).table
+    _rule_stress(table.near, y, lr, center, frame, a, b, ls, shear_modulus, lame, xi, eta, wt, lo, hi, side_lo,
+                 side_hi, table, item(work_at, ROWS_ITEM), entry, out)
+
+
+@njit(cache=True, inline="always")
+def _rule_stress(near, y, lr, center, frame, a, b, ls, shear_modulus, lame, xi, eta, wt, lo, hi, side_lo, side_hi,
+                 table, rows, entry, out):
+    """:func:`near_rectangle_stress` (inlined into it and into :func:`near_rule_stress`)."""
     normal = frame[2]
     jac = a * b
     response, w = rows[11], rows[12]  # the workspace's scratch, not allocated a call
+    # the lookups' arrays as pointers, taken once (_add_group_at)
+    anchor, reflected, values = data_pointer(near.anchor), data_pointer(near.reflected), data_pointer(near.values)
+    response_at, w_at, step, n_nodes = data_pointer(response), data_pointer(w), near.step, near.n_nodes
+    view = rows_view(table, rows, max(entry, 0), lr, ls)  # the rows' pointers, taken once (entry >= 0)
     q0 = near.group[ls, lr, 0] if side_lo <= 0 < side_hi else -1
     q1 = near.group[ls, lr, 1] if side_lo <= 1 < side_hi else -1
     for g in range(lo, hi):
@@ -223,11 +256,11 @@ def near_rectangle_stress(near, y, lr, center, frame, a, b, ls, shear_modulus, l
         for c in range(_N_C):
             response[c] = 0.0
         if q0 >= 0:
-            _add_group(near, q0, rho, x2, y[2], response, w)
+            _add_group_at(anchor, reflected, values, step, n_nodes, q0, rho, x2, y[2], response_at, w_at)
         if q1 >= 0:
-            _add_group(near, q1, rho, x2, y[2], response, w)
+            _add_group_at(anchor, reflected, values, step, n_nodes, q1, rho, x2, y[2], response_at, w_at)
         if entry >= 0:
-            rows_add(table, rows, entry, lr, ls, rho, g - lo, hi - lo, response)
+            rows_add(view, entry, rho, g - lo, hi - lo, response_at)
         cos, sin = (r1 / rho, r2 / rho) if rho > 0.0 else (1.0, 0.0)
         rotated_stress(cos, sin, normal, shear_modulus, lame, wt[g] * jac, response, out)
 

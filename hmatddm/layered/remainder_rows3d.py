@@ -28,7 +28,8 @@ import numpy as np
 from numba import njit
 
 from .rectangle_quadrature import one_square_order
-from .remainder_table3d import COMPONENTS, PAD, STENCIL, U_COMPONENTS, _lagrange
+from ..kernels.held_function import data_pointer
+from .remainder_table3d import COMPONENTS, PAD, STENCIL, _lagrange, lagrange_at
 
 #: Entries kept (source, receiver layer, receiver height, rule), reused round-robin.
 ENTRIES = 48
@@ -41,6 +42,9 @@ ROWS_AFTER = 8
 #: Most points of a rule that takes the rows (3 x 3: the remainder's singular points are a
 #: layer away, its rules one square of 1 to 3 points per side).
 MOST_POINTS = 9
+
+#: The rows' place in the workspace's tuple (:func:`.workspace3d.workspace_arrays`).
+ROWS_ITEM = 14
 
 _N_C = COMPONENTS.shape[0]
 
@@ -119,57 +123,64 @@ def rows_entry(table, rows, j, y, layer, center, frame, a, b, source_layer, xi, 
     return e
 
 
+@njit(cache=True, inline="always")
+def rows_view(table, rows, e, layer, source_layer):
+    """Entry ``e``'s rows for :func:`rows_add`, taken once a rule: pointers to the rows, their
+    flags and stencils, the table's values
+    (:func:`hmatddm.kernels.held_function.data_pointer`: numba calls ``NRT_incref`` and
+    ``NRT_decref``, functions it never inlines, for each array an inlined function takes, a
+    dozen a point) and the constants of the entry and its layer pair."""
+    k = max(table.pair_index[source_layer, layer], 0)  # (a pair without a table takes no rows)
+    grid = table.grid
+    keys, y_weights = rows[2], rows[6]
+    return (data_pointer(rows[0]), data_pointer(rows[1]), data_pointer(rows[4]), data_pointer(rows[5]),
+            data_pointer(y_weights), data_pointer(rows[9]), data_pointer(rows[10]), data_pointer(table.values),
+            table.offset[k], int(grid[k, 5]), int(grid[k, 8]), rows[1].shape[1], int(y_weights[e, 0]), keys[e, 3],
+            keys[e, 4], grid[k, 0], grid[k, 1], int(grid[k, 2]))
+
+
 @njit(cache=True)
 def _fill_row(values, base, u, n_t, n_y, k0, j_lo, n_j, e, n_points, row, y_weights, t_nodes, t_weights, box,
               values_rows):
     """Row ``u`` of entry ``e``: the box's ``n_j`` nodes of ``t`` from ``j_lo`` contracted
     along ``y3`` (the table's ``values`` from ``base``), then each point's ``t`` stencil, into
-    ``values_rows`` from ``row`` (compiled once, not inlined: its callers run it once a row)."""
+    ``values_rows`` from ``row`` (compiled once, not inlined: its callers run it once a row;
+    the arrays as :func:`rows_view`'s pointers, indexed flat)."""
     for jj in range(n_j):
-        # unsigned offsets (turned_response3d.U_COMPONENTS: no negative-index checks)
-        at = np.uint64(base + ((u * n_t + j_lo + jj) * n_y + k0) * _N_C)
-        to = np.uint64(jj * _N_C)
-        for c in range(U_COMPONENTS):
+        at = base + ((u * n_t + j_lo + jj) * n_y + k0) * _N_C
+        for c in range(_N_C):
             v = 0.0
             for d in range(STENCIL):
-                v += y_weights[e, 1 + d] * values[at + np.uint64(d) * U_COMPONENTS + c]
-            box[to + c] = v
+                v += y_weights[e * (STENCIL + 1) + 1 + d] * values[at + d * _N_C + c]
+            box[jj * _N_C + c] = v
     for point in range(n_points):
-        first = (t_nodes[e, point] - j_lo) * _N_C
+        first = (t_nodes[e * MOST_POINTS + point] - j_lo) * _N_C
         for c in range(_N_C):
             v = 0.0
             for q in range(STENCIL):
-                v += t_weights[e, point, q] * box[first + q * _N_C + c]
+                v += t_weights[(e * MOST_POINTS + point) * STENCIL + q] * box[first + q * _N_C + c]
             values_rows[row + point * _N_C + c] = v
 
 
 @njit(cache=True, inline="always")
-def rows_add(table, rows, e, layer, source_layer, rho, p, n_points, response):
+def rows_add(view, e, rho, p, n_points, response):
     """``response[c] +=`` the remainder at the rule's point ``p`` (of ``n_points``), ``rho``
-    from the receiver, through the rows of entry ``e`` (each filled on first use: the box's
-    ``t`` nodes contracted along ``y3``, then each point's ``t`` stencil)."""
-    values_rows, filled, keys, t_nodes, t_weights, y_weights, u_weights, box = (rows[0], rows[1], rows[2], rows[4],
-                                                                               rows[5], rows[6], rows[9], rows[10])
-    k = table.pair_index[source_layer, layer]
-    grid = table.grid
-    n_t = int(grid[k, 5])
-    n_y = int(grid[k, 8])
-    n_u_room = filled.shape[1]
-    k0 = int(y_weights[e, 0])
-    j_lo, n_j = keys[e, 3], keys[e, 4]
-    values = table.values
-    base = table.offset[k]
-    i0 = _lagrange(math.asinh(rho / grid[k, 0]), -PAD * grid[k, 1], grid[k, 1], int(grid[k, 2]), u_weights, 0)
+    from the receiver, through the rows of entry ``e`` (``view``: :func:`rows_view`; each
+    row filled on first use: the box's ``t`` nodes contracted along ``y3``, then each
+    point's ``t`` stencil; ``response`` a pointer)."""
+    (values_rows, filled, t_nodes, t_weights, y_weights, u_weights, box, values, base, n_t, n_y, n_u_room, k0, j_lo,
+     n_j, scale, h_u, n_u) = view
+    i0 = lagrange_at(math.asinh(rho / scale), -PAD * h_u, h_u, n_u, u_weights, 0)
     for s in range(STENCIL):
         u = i0 + s
         row = (e * n_u_room + u) * MOST_POINTS * _N_C
-        if not filled[e, u]:
+        if filled[e * n_u_room + u] == 0:  # (a boolean array's pointer is of uint8)
             _fill_row(values, base, u, n_t, n_y, k0, j_lo, n_j, e, n_points, row, y_weights, t_nodes, t_weights, box,
                       values_rows)
-            filled[e, u] = True
-        w_u = u_weights[0, s]
-        at = np.uint64(row + p * _N_C)  # unsigned (turned_response3d.U_COMPONENTS)
-        for c in range(U_COMPONENTS):
+            filled[e * n_u_room + u] = 1
+        w_u = u_weights[s]
+        at = row + p * _N_C
+        for c in range(_N_C):
             response[c] += w_u * values_rows[at + c]
 
 

@@ -44,11 +44,12 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit, prange
 
+from ..kernels.held_function import data_pointer
 from .image_tracer import trace_capacity
 from .image_tracer3d import copy_triple, trace
 from .images2d import _lame, receiver_constants
 from .potentials3d import Workspace, _original, _pair_stress_gradient
-from .turned_response3d import COMPONENTS, PAIRS as _PAIRS, U_COMPONENTS, rotated_stress
+from .turned_response3d import COMPONENTS, PAIRS as _PAIRS, rotated_stress
 
 #: Largest number of values a table may hold (8 bytes each) before refinement stops.
 MAX_TABLE_VALUES = 40_000_000
@@ -226,8 +227,6 @@ def sample_remainder(source_layer, layer, rho, heights, receiver_heights, interf
 #: Nodes per variable of the local Lagrange interpolation (degree ``STENCIL - 1``): the
 #: error falls like ``(h / clearance)^STENCIL``.
 STENCIL = 6
-#: :data:`STENCIL` unsigned (:data:`U_COMPONENTS`).
-U_STENCIL = np.uint64(STENCIL)
 #: Nodes each grid carries beyond either end of its range, so that every stencil in the
 #: range is centred. The remainder continues analytically past a layer's boundary; with
 #: the source and the receiver both padded, its singular points stay at least
@@ -240,7 +239,15 @@ _INVERSE_DENOMINATORS = tuple(1.0 / math.prod(a - b for b in range(STENCIL) if b
 @njit(cache=True, inline="always")
 def _lagrange(x, x0, h, n, w, row):
     """First node and the :data:`STENCIL`-point Lagrange weights ``w[row]`` at ``x`` on the
-    grid ``x0 + i h``, ``i < n`` (centred; one-sided at the ends)."""
+    grid ``x0 + i h``, ``i < n`` (centred; one-sided at the ends; ``w`` C-contiguous, of
+    :data:`STENCIL` columns)."""
+    return lagrange_at(x, x0, h, n, data_pointer(w), row * STENCIL)
+
+
+@njit(cache=True, inline="always")
+def lagrange_at(x, x0, h, n, w, at):
+    """:func:`_lagrange` with its weights at ``w[at:at + STENCIL]``, ``w`` a pointer
+    (:func:`hmatddm.kernels.held_function.data_pointer`: no reference counts in a hot loop)."""
     u = (x - x0) / h
     i0 = int(math.floor(u)) - (STENCIL // 2 - 1)
     if i0 > n - STENCIL:
@@ -253,11 +260,11 @@ def _lagrange(x, x0, h, n, w, row):
     # asinh, most of the remainder's cost a point: benchmarks/RESULTS.md, thirteenth session)
     left = 1.0
     for a in range(STENCIL):
-        w[row, a] = left
+        w[at + a] = left
         left *= s - a
     right = 1.0
     for a in range(STENCIL - 1, -1, -1):
-        w[row, a] *= right * _INVERSE_DENOMINATORS[a]
+        w[at + a] *= right * _INVERSE_DENOMINATORS[a]
         right *= s - a
     return i0
 

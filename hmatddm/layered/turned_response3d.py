@@ -30,11 +30,6 @@ def _nonzero_components():
 
 #: ``(m, s)`` of each response component (the order of the tables' values).
 COMPONENTS = _nonzero_components()
-#: The response's length as an unsigned integer: a compiled loop over ``range(U_COMPONENTS)``
-#: indexes the tables with unsigned offsets, which need no check for a negative index (with
-#: signed offsets LLVM gathered a stencil's loads one by one, and a slice instead costs a
-#: reference count; half a near group's lookup, RESULTS.md, fourteenth session).
-U_COMPONENTS = np.uint64(COMPONENTS.shape[0])
 
 # the layout _turned_moment_stress is written for: m = xx, yy, zz, xz to s = xx, yy, zz, xz
 # (components 0-11, 14-17), m = xy, yz to s = xy, yz (12, 13, 18, 19)

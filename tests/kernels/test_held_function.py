@@ -64,3 +64,23 @@ def test_records_of_one_type_share_their_held_signatures():
         out = np.empty((3 * every.size, 3 * every.size))
         drivers.traction_block(data, every, every, out)
         assert np.all(np.isfinite(out))
+
+
+def test_data_pointer_reads_and_writes_the_flat_array():
+    """A pointer indexes a C-contiguous array flat, in place; a boolean array's as bytes."""
+    from numba import njit
+
+    from hmatddm.kernels.held_function import data_pointer
+
+    @njit
+    def touch(values, flags):
+        p, f = data_pointer(values), data_pointer(flags)
+        total = p[0] + p[5]
+        p[4] = -1.0
+        flag = f[1]
+        f[2] = 1
+        return total, flag
+
+    values, flags = np.arange(6.0).reshape(2, 3), np.array([False, True, False])
+    total, flag = touch(values, flags)
+    assert total == 5.0 and flag == 1 and values[1, 1] == -1.0 and flags.tolist() == [False, True, True]
