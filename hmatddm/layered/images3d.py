@@ -27,8 +27,8 @@ near triples' field at a quadrature point is itself a lookup: a first reflection
 transmission is homogeneous of degree -3 about its interface, so it is tabulated in one
 angle, exactly to 1e-11 (:mod:`.near_table3d`), and the remainder is contracted once per
 source and receiver height (:mod:`.remainder_rows3d`): three layers on the issue-32 lattice
-25 -> 5.2 us a pair, one thread of the 2-core Xeon at dgemm 73 GFLOP/s (benchmarks/RESULTS.md,
-thirteenth session). In a half-space (one
+25 -> 3.3 us a pair (27x uniform rock), one thread of the 2-core Xeon at dgemm 74 GFLOP/s
+(benchmarks/RESULTS.md, thirteenth and fourteenth sessions). In a half-space (one
 solid layer under a void) the image and surface terms of a rectangle with a horizontal side
 are in closed form (:mod:`.okada3d`, Okada 1992; ``LayeredRectangles.closed_form``). With
 two or more solid layers under a void, a source of the top solid layer with a horizontal

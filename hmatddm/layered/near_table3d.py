@@ -225,9 +225,10 @@ def near_rule_stress(data_at, work_at, y, lr, center, frame, a, b, ls, shear_mod
                      side_lo, side_hi, entry, out):
     """:func:`near_rectangle_stress` of the record's table, the rows those of the workspace
     (:mod:`.workspace3d`), both by pointer (:mod:`hmatddm.kernels.held_function`): what
-    :func:`.images3d._complementary_stress` calls. Passed by value, the near table, the
-    remainder's and the rows were 35 arrays, each split into its fields for the call: ~1 us
-    a call, ~2 calls a three-layer pair on the issue-32 lattice (RESULTS.md, fourteenth session)."""
+    :func:`.images3d._complementary_stress` calls, two pointers where the near table, the
+    remainder's and the rows are 35 arrays, each split into its fields for a call by value
+    (no measurable difference on the issue-32 lattice alone; the arrays the loop reads are
+    taken as pointers once a rule, :func:`_rule_stress`: RESULTS.md, fourteenth session)."""
     table = dereference(data_at).table
     _rule_stress(table.near, y, lr, center, frame, a, b, ls, shear_modulus, lame, xi, eta, wt, lo, hi, side_lo,
                  side_hi, table, item(work_at, ROWS_ITEM), entry, out)
