@@ -58,7 +58,6 @@ MAX_TABLE_VALUES = 40_000_000
 ERROR_SAMPLES = 128
 
 
-
 class RemainderTable(NamedTuple):
     """The tabulated layered remainder of a medium (empty: ``pair_index`` all -1).
 

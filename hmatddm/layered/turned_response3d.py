@@ -4,16 +4,18 @@ the receiver, and its stress in the global frame (issue 32).
 The tables of a layered medium (:mod:`.remainder_table3d`, :mod:`.near_table3d`) hold, at a
 horizontal offset ``rho`` along the turned frame's x axis, the stress components ``s`` of a
 unit moment component ``m`` of a point source (ref. Secs 3.2-3.3; the moment of a DD on a
-plane: ref. Eq. 2.52's ``lambda delta b.n + mu (b n + n b)``). The medium is unchanged by the
+plane: ref. Eq. 7.3 with isotropic moduli, ``lambda delta b.n + mu (b n + n b)``;
+docs/conventions.md §4). The medium is unchanged by the
 mirror ``y -> -y`` of that frame, so a component is zero unless ``m`` and ``s`` hold an even
 number of ``y`` indices together: 20 of the 36 (:data:`COMPONENTS`), a 4 x 4 block (``xx, yy,
 zz, xz``) and a 2 x 2 one (``xy, yz``).
 
 :func:`rotated_stress` turns a DD's moment into that frame, contracts it with the response
 and turns the stress back. Written out for this layout: the loop over :data:`COMPONENTS`
-through a scratch array (indices loaded from a table, each sum a store and a load) was 110 ns
-a point against 32 ns written out, one thread of the 2-core Xeon at dgemm 73 GFLOP/s
-(benchmarks/RESULTS.md, fourteenth session); the layout is checked where this module loads."""
+through a scratch array (indices loaded from a table, each sum a store and a load) was 107 ns
+a point against 32 ns written out (a micro-benchmark, one thread of the 2-core Xeon, dgemm
+74-86 GFLOP/s in the same hour; benchmarks/RESULTS.md, fourteenth session); the layout is
+checked where this module loads."""
 import numpy as np
 from numba import njit
 
